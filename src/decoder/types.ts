@@ -1,0 +1,121 @@
+import type { Resolution } from './spec.js';
+
+export type RemoteKind = 'internal' | 'external';
+
+/** What byte 0 of an internal remote's frame carries (§8.3, §8.3.1). */
+export type HeaderMode = 'fades' | 'rssi';
+
+/**
+ * Spektrum VTX control carried in the last two slots (bytes 12–15) instead of channels.
+ * Fields follow the layout PX4 and Betaflight read.
+ */
+export interface VtxControl {
+  /** The raw 32-bit value of bytes 12–15. */
+  raw: number;
+  /** Band index, 0–7 (Fatshark, Raceband, E, B, A as the transmitter numbers them). */
+  band: number;
+  /** Channel index within the band, 0–15. */
+  channel: number;
+  /** Power index, 0–7. */
+  power: number;
+  /** 0 = US, 1 = EU. */
+  region: number;
+  /** Pit mode on. */
+  pit: boolean;
+}
+
+/**
+ * One decoded frame. The decoder hands out the same object each time: it is a borrowed view,
+ * valid until the next call to `next()`, `push()` or `finish()`. Copy what you keep
+ * (`copyFrame()` does it for you).
+ */
+export interface DecodedFrame {
+  /** Sequence number of the frame since the decoder was created (0, 1, 2, …). */
+  index: number;
+  /** Byte offset of the frame's first byte in the stream pushed so far. */
+  offset: number;
+  /**
+   * Time of the frame's first byte in the caller's clock, in µs: exact with per-byte times,
+   * estimated (chunk time less the bytes after it at 115200 baud) with chunk times, NaN
+   * when no time was given.
+   */
+  timeUs: number;
+  remote: RemoteKind;
+  /** The system byte of an internal remote (§8.3), `null` for an external one. */
+  system: number | null;
+  resolution: Resolution;
+  /** Fade counter: UINT8 for an internal remote, UINT16 for an external one; `null` in RSSI mode. */
+  fades: number | null;
+  /** Fades since the previous frame, with the counter's wrap; 0 on the first frame. */
+  fadesDelta: number;
+  /** RSSI in dBm (SPM4649T, §8.3.1), -128 on loss; `null` when byte 0 carries fades. */
+  rssi: number | null;
+  /** How many channel values this frame carries (`ids[0..count)`, `positions[0..count)`). */
+  count: number;
+  /** Channel IDs 0–19 of the slots that carry a channel, in slot order. Borrowed, length 7. */
+  ids: Uint8Array;
+  /**
+   * Servo positions, same order as `ids`: 0–1023 or 0–2047; X-Plus values are scaled to the
+   * 2047 scale (§8.6). Borrowed, length 7.
+   */
+  positions: Uint16Array;
+  /** The seven raw slot words, in order, as sent. Borrowed, length 7. */
+  words: Uint16Array;
+  /** Spektrum VTX control in slots 6–7, or `null`. Borrowed. */
+  vtx: VtxControl | null;
+  /** The 16 raw bytes. Borrowed. */
+  bytes: Uint8Array;
+}
+
+/** Why the decoder believes the resolution it uses. */
+export type ResolutionReason =
+  /** The caller fixed it. */
+  | 'override'
+  /** The internal remote's system byte names it and the channel IDs agree (or cannot tell). */
+  | 'system-byte'
+  /** No valid system byte: inferred from which reading gives consistent channel IDs. */
+  | 'channel-ids'
+  /** The system byte names one resolution but the channel IDs only make sense in the other. */
+  | 'system-byte-contradicted'
+  /** Nothing decided yet. */
+  | 'unknown';
+
+/** What the decoder has decided about the stream's format, and why. */
+export interface FormatInfo {
+  /** True once the decoder has locked on to frames. */
+  locked: boolean;
+  resolution: Resolution | null;
+  resolutionReason: ResolutionReason;
+  /** A sentence a person can read: what was decided from what. */
+  explanation: string;
+  remote: RemoteKind | null;
+  /** The system byte the internal remote sends, if valid. */
+  system: number | null;
+  headerMode: HeaderMode;
+}
+
+/** Counters. Every byte pushed ends up in exactly one of `frameBytes`, `discardedBytes` or `pendingBytes`. */
+export interface DecoderStats {
+  bytes: number;
+  frames: number;
+  frameBytes: number;
+  /** Bytes dropped: noise, truncated frames, bytes before lock. */
+  discardedBytes: number;
+  /** Bytes held until more arrive. */
+  pendingBytes: number;
+  /** Times the decoder lost alignment and found it again. */
+  resyncs: number;
+  /** 16-byte candidates rejected after lock (truncated or corrupted frames). */
+  badFrames: number;
+  /** Slots that held 0xFFFF. */
+  emptySlots: number;
+  /** Frames that carried VTX control. */
+  vtxFrames: number;
+}
+
+/** Something the decoder did that an inspector or log may want to show. */
+export type DecoderEvent =
+  | { type: 'locked'; offset: number; format: FormatInfo }
+  | { type: 'discarded'; offset: number; length: number; reason: 'before-lock' | 'noise' | 'truncated-frame' | 'end-of-stream' }
+  | { type: 'resync'; offset: number }
+  | { type: 'format-changed'; offset: number; format: FormatInfo };
