@@ -1,0 +1,555 @@
+/**
+ * The push decoder: bytes in (`push`), frames out (`next`). It finds frames without a sync
+ * byte and without trusting timing, infers the stream's format, and never throws on bytes.
+ *
+ * How it finds frames. Frames are 16 bytes back to back in the byte stream; only a truncated
+ * or corrupted frame, or noise, shifts the alignment. Content alone decides where a frame
+ * starts, so the result is identical however the bytes are chunked and whatever times come
+ * with them:
+ *
+ * - Unlocked, it looks at the next four frames' worth of bytes (plus 15) and scores each of
+ *   the 16 alignments under both resolutions: every slot must hold a valid channel ID (or
+ *   0xFFFF, or VTX), no ID may repeat within a frame, the header bytes must behave like a header
+ *   (the same valid system byte in every frame, or a slowly rising UINT16 fade count), and
+ *   channel sets that are contiguous, layouts that recur every other frame and a system byte
+ *   that agrees with the resolution score higher.
+ * - Locked, a frame whose slot layout the transmitter has already used and whose header fits
+ *   is emitted as soon as its 16 bytes are in. A frame with a new layout or a surprising header
+ *   waits for the next frame to confirm the alignment (one frame of latency, rarely).
+ * - A frame that fails starts a search for the nearest offset where frames continue; what lies
+ *   between is discarded and counted (a truncated frame when it overlaps the next one).
+ */
+import {
+  BYTE_TIME_US, FRAME_SIZE, systemInfo, type Resolution,
+} from './spec.js';
+import { createFrame, createVtx, countZeroWords, INVALID, layoutChannels, readSlots, slotLayout } from './frame.js';
+import type {
+  DecodedFrame, DecoderEvent, DecoderStats, FormatInfo, HeaderMode, RemoteKind, ResolutionReason,
+} from './types.js';
+
+export interface DecoderOptions {
+  /** Fix the servo resolution instead of inferring it (e.g. from the internal remote). Default 'auto'. */
+  resolution?: 'auto' | Resolution;
+  /** Fix the remote kind instead of inferring it from the header bytes. Default 'auto'. */
+  remote?: 'auto' | RemoteKind;
+  /** What byte 0 of an internal remote carries. 'auto' (default) detects SPM4649T RSSI. */
+  headerMode?: 'auto' | HeaderMode;
+  /** Called synchronously for locks, discards, resyncs and format changes. */
+  onEvent?: (event: DecoderEvent) => void;
+}
+
+/** Frames looked at before the first lock. */
+const ACQUIRE_FRAMES = 4;
+/** A UINT16 fade count that rises by more than this between two frames is suspect (≈ 22 s of loss at 11 ms). */
+const MAX_FADE_STEP = 2048;
+/** How far a locked decoder searches for the next frame before it starts over. */
+const MAX_RESYNC_BYTES = 8 * FRAME_SIZE;
+/** Slot layouts remembered (a transmitter uses two to four). */
+const LAYOUT_MEMORY = 16;
+const INITIAL_CAPACITY = 4096;
+
+const NEED_MORE = -2;
+
+/**
+ * SPM4649T RSSI (§8.3.1): -42 dBm (strong) … -92 dBm (weak), -128 on loss. Values from -20 to
+ * -110 are accepted to allow for receivers beyond the documented range.
+ */
+function plausibleRssi(byte: number): boolean {
+  return byte === 0x80 || (byte >= 0x92 && byte <= 0xec);
+}
+
+export class SpektrumDecoder {
+  readonly #options: Required<Omit<DecoderOptions, 'onEvent'>>;
+  readonly #onEvent: ((event: DecoderEvent) => void) | undefined;
+
+  #buf = new Uint8Array(INITIAL_CAPACITY);
+  #view = new DataView(this.#buf.buffer);
+  #times = new Float64Array(INITIAL_CAPACITY);
+  /** Index in #buf of the first byte not yet decided. */
+  #head = 0;
+  /** Index in #buf after the last byte pushed. */
+  #tail = 0;
+  /** Stream offset of #buf[0]. */
+  #base = 0;
+  #ended = false;
+
+  #locked = false;
+  #everLocked = false;
+  #resolution: Resolution | null = null;
+  #reason: ResolutionReason = 'unknown';
+  #remote: RemoteKind | null = null;
+  #system: number | null = null;
+  #headerMode: HeaderMode = 'fades';
+  /** Fade count (or -1) of the last emitted frame, for deltas and header checks. */
+  #lastFades = -1;
+  #layouts = new Int32Array(LAYOUT_MEMORY);
+  #layoutCount = 0;
+  #layoutNext = 0;
+
+  readonly #frame = createFrame();
+  readonly #vtx = createVtx();
+  readonly #stats: DecoderStats = {
+    bytes: 0, frames: 0, frameBytes: 0, discardedBytes: 0, pendingBytes: 0,
+    resyncs: 0, badFrames: 0, emptySlots: 0, vtxFrames: 0,
+  };
+
+  /** Acquisition scratch: the best candidate's header reading. */
+  #candInternal = false;
+  #candRssi = false;
+
+  /**
+   * @throws {TypeError} when an option has a value outside its documented set.
+   */
+  constructor(options: DecoderOptions = {}) {
+    const resolution = options.resolution ?? 'auto';
+    const remote = options.remote ?? 'auto';
+    const headerMode = options.headerMode ?? 'auto';
+    if (resolution !== 'auto' && resolution !== 1024 && resolution !== 2048) {
+      throw new TypeError(`resolution must be 'auto', 1024 or 2048, not ${String(resolution)}`);
+    }
+    if (remote !== 'auto' && remote !== 'internal' && remote !== 'external') {
+      throw new TypeError(`remote must be 'auto', 'internal' or 'external', not ${String(remote)}`);
+    }
+    if (headerMode !== 'auto' && headerMode !== 'fades' && headerMode !== 'rssi') {
+      throw new TypeError(`headerMode must be 'auto', 'fades' or 'rssi', not ${String(headerMode)}`);
+    }
+    if (options.onEvent !== undefined && typeof options.onEvent !== 'function') {
+      throw new TypeError('onEvent must be a function');
+    }
+    this.#options = { resolution, remote, headerMode };
+    this.#onEvent = options.onEvent;
+  }
+
+  /**
+   * Adds bytes as they arrived. `time` is one of:
+   * - a number: the chunk's arrival time in µs (taken as the time of its last byte; earlier
+   *   bytes are placed one byte time, 86.8 µs, apart before it);
+   * - a Float64Array with one time in µs per byte (logic-analyser captures);
+   * - omitted: no timing (frame times are then NaN).
+   *
+   * The bytes are copied; the caller may reuse its buffer.
+   * @throws {TypeError} after `end()`, or when per-byte times do not match the bytes in length.
+   */
+  push(bytes: Uint8Array, time?: number | Float64Array): void {
+    if (this.#ended) throw new TypeError('push() after end(): call reset() to decode a new stream');
+    const n = bytes.length;
+    if (time instanceof Float64Array && time.length !== n) {
+      throw new TypeError(`per-byte times have length ${time.length}, bytes ${n}`);
+    }
+    if (n === 0) return;
+    this.#reserve(n);
+    const at = this.#tail;
+    this.#buf.set(bytes, at);
+    const times = this.#times;
+    if (time === undefined) {
+      times.fill(NaN, at, at + n);
+    } else if (typeof time === 'number') {
+      const first = time - (n - 1) * BYTE_TIME_US;
+      for (let i = 0; i < n; i++) times[at + i] = first + i * BYTE_TIME_US;
+    } else {
+      times.set(time, at);
+    }
+    this.#tail = at + n;
+    this.#stats.bytes += n;
+    this.#stats.pendingBytes += n;
+  }
+
+  /**
+   * Marks the end of the stream: bytes still held are decided with what is there (a last frame
+   * is emitted without a following frame to confirm it; a partial one is discarded).
+   */
+  end(): void {
+    this.#ended = true;
+  }
+
+  /** Forgets everything: buffered bytes, lock, format and counters. */
+  reset(): void {
+    this.#head = this.#tail = this.#base = 0;
+    this.#ended = false;
+    this.#locked = this.#everLocked = false;
+    this.#resolution = null;
+    this.#reason = 'unknown';
+    this.#remote = this.#system = null;
+    this.#headerMode = 'fades';
+    this.#lastFades = -1;
+    this.#layoutCount = this.#layoutNext = 0;
+    this.#frame.index = -1;
+    const s = this.#stats;
+    s.bytes = s.frames = s.frameBytes = s.discardedBytes = s.pendingBytes = 0;
+    s.resyncs = s.badFrames = s.emptySlots = s.vtxFrames = 0;
+  }
+
+  /** Live counters (the same object each time; read, don't write). */
+  get stats(): Readonly<DecoderStats> {
+    return this.#stats;
+  }
+
+  /** What the decoder has decided about the format, and why (a new object each call). */
+  get format(): FormatInfo {
+    return {
+      locked: this.#locked,
+      resolution: this.#resolution,
+      resolutionReason: this.#reason,
+      explanation: this.#explain(),
+      remote: this.#remote,
+      system: this.#system,
+      headerMode: this.#headerMode,
+    };
+  }
+
+  /**
+   * The next decoded frame, or `undefined` when more bytes are needed. The frame is borrowed:
+   * the same object is reused and is valid until the next call to `next()`, `push()`, `end()`
+   * or `reset()`.
+   */
+  next(): DecodedFrame | undefined {
+    for (;;) {
+      if (!this.#locked) {
+        if (!this.#acquire()) return undefined;
+        continue;
+      }
+      const o = this.#head;
+      const avail = this.#tail - o;
+      if (avail < FRAME_SIZE) {
+        if (this.#ended && avail > 0) this.#discard(o, avail, 'end-of-stream');
+        return undefined;
+      }
+      const resolution = this.#resolution as Resolution;
+      const view = this.#view;
+      const layout = slotLayout(view, o, resolution);
+      if (layout !== INVALID) {
+        const fit = this.#headerFits(o);
+        if (fit && this.#knownLayout(layout)) return this.#emit(o, layout);
+        if (avail < 2 * FRAME_SIZE) {
+          if (!this.#ended) return undefined;
+          return this.#emit(o, layout);
+        }
+        if (slotLayout(view, o + FRAME_SIZE, resolution) !== INVALID && this.#pairConsistent(o, o + FRAME_SIZE)) {
+          if (!fit) this.#reinterpret(o);
+          return this.#emit(o, layout);
+        }
+      }
+      // This frame does not continue the stream: find where frames continue.
+      const q = this.#search(o);
+      if (q === NEED_MORE) return undefined;
+      this.#stats.resyncs++;
+      if (q < 0) {
+        // Nothing continues within reach: the format may have changed. Start over.
+        this.#locked = false;
+        this.#layoutCount = 0;
+        if (layout !== INVALID && this.#headerFits(o)) return this.#emit(o, layout);
+        continue;
+      }
+      this.#event({ type: 'resync', offset: this.#base + q });
+      if (layout !== INVALID && q >= o + FRAME_SIZE && this.#headerFits(o)) {
+        // The frame was good; what follows it up to q is noise.
+        const frame = this.#emit(o, layout);
+        if (q > o + FRAME_SIZE) this.#discard(o + FRAME_SIZE, q - o - FRAME_SIZE, 'noise');
+        return frame;
+      }
+      this.#stats.badFrames++;
+      this.#discard(o, q - o, q - o < FRAME_SIZE ? 'truncated-frame' : 'noise');
+    }
+  }
+
+  // ---- locked path -------------------------------------------------------------------------
+
+  /** Whether the header at `o` is what the lock expects (false: unsure, let the next frame decide). */
+  #headerFits(o: number): boolean {
+    const view = this.#view;
+    if (this.#remote === 'internal') {
+      if (view.getUint8(o + 1) !== this.#system) return false;
+      return this.#headerMode !== 'rssi' || view.getUint8(o) >= 0x80;
+    }
+    if (this.#lastFades < 0) return true;
+    return ((view.getUint16(o) - this.#lastFades) & 0xffff) < MAX_FADE_STEP;
+  }
+
+  /** Whether two frames' headers could be consecutive headers of one remote. */
+  #pairConsistent(a: number, b: number): boolean {
+    const view = this.#view;
+    const remote = this.#options.remote;
+    if (remote !== 'external' && view.getUint8(a + 1) === view.getUint8(b + 1)) return true;
+    return remote !== 'internal' && ((view.getUint16(b) - view.getUint16(a)) & 0xffff) < MAX_FADE_STEP;
+  }
+
+  /** A confirmed frame whose header surprised the lock: adopt what it says. */
+  #reinterpret(o: number): void {
+    const view = this.#view;
+    const b0 = view.getUint8(o);
+    const b1 = view.getUint8(o + 1);
+    const auto = this.#options;
+    if (this.#remote === 'internal' && b1 !== this.#system && auto.remote === 'auto') {
+      const sameNext = view.getUint8(o + FRAME_SIZE + 1) === b1;
+      if (sameNext && systemInfo(b1) !== undefined) {
+        this.#system = b1;
+      } else {
+        this.#remote = 'external';
+        this.#system = null;
+        this.#headerMode = 'fades';
+        this.#lastFades = -1;
+      }
+      if (this.#reason === 'system-byte' || this.#reason === 'system-byte-contradicted') this.#setReason(this.#resolution as Resolution);
+      this.#event({ type: 'format-changed', offset: this.#base + o, format: this.format });
+    } else if (this.#remote === 'internal' && this.#headerMode === 'rssi' && b0 < 0x80 && auto.headerMode === 'auto') {
+      // RSSI is never positive: byte 0 was a fade count after all.
+      this.#headerMode = 'fades';
+      this.#event({ type: 'format-changed', offset: this.#base + o, format: this.format });
+    }
+  }
+
+  /**
+   * The nearest offset after `o` where frames continue, or -1 when none within reach, or
+   * NEED_MORE when the answer depends on bytes that have not arrived. A frame with a known
+   * layout and a fitting header is the strong sign and is looked for first, so a run of two
+   * frames that only happen to parse (a truncated frame can make that happen) does not win
+   * over the real next frame a few bytes later. Two valid frames in a row with consistent
+   * headers are accepted only when no strong sign is within reach (a new layout, a rebind).
+   */
+  #search(o: number): number {
+    const view = this.#view;
+    const resolution = this.#resolution as Resolution;
+    const last = o + MAX_RESYNC_BYTES;
+    for (let q = o + 1; q <= last; q++) {
+      if (q + FRAME_SIZE > this.#tail) {
+        if (!this.#ended) return NEED_MORE;
+        break;
+      }
+      const layout = slotLayout(view, q, resolution);
+      if (layout !== INVALID && this.#headerFits(q) && this.#knownLayout(layout)) return q;
+    }
+    for (let q = o + 1; q <= last; q++) {
+      if (q + FRAME_SIZE > this.#tail) return -1;
+      if (slotLayout(view, q, resolution) === INVALID) continue;
+      if (q + 2 * FRAME_SIZE > this.#tail) {
+        if (!this.#ended) return NEED_MORE;
+        if (this.#headerFits(q)) return q;
+        continue;
+      }
+      if (slotLayout(view, q + FRAME_SIZE, resolution) !== INVALID && this.#pairConsistent(q, q + FRAME_SIZE)) {
+        return q;
+      }
+    }
+    return -1;
+  }
+
+  #knownLayout(layout: number): boolean {
+    const layouts = this.#layouts;
+    for (let i = 0; i < this.#layoutCount; i++) if (layouts[i] === layout) return true;
+    return false;
+  }
+
+  #learnLayout(layout: number): void {
+    if (this.#knownLayout(layout)) return;
+    this.#layouts[this.#layoutNext] = layout;
+    this.#layoutNext = (this.#layoutNext + 1) % LAYOUT_MEMORY;
+    if (this.#layoutCount < LAYOUT_MEMORY) this.#layoutCount++;
+  }
+
+  #emit(o: number, layout: number): DecodedFrame {
+    this.#learnLayout(layout);
+    const view = this.#view;
+    const frame = this.#frame;
+    const resolution = this.#resolution as Resolution;
+    frame.index++;
+    frame.offset = this.#base + o;
+    frame.timeUs = this.#times[o] as number;
+    frame.resolution = resolution;
+    const remote = this.#remote as RemoteKind;
+    frame.remote = remote;
+    let fades: number;
+    if (remote === 'internal') {
+      frame.system = view.getUint8(o + 1);
+      if (this.#headerMode === 'rssi') {
+        frame.rssi = view.getInt8(o);
+        frame.fades = null;
+        fades = -1;
+      } else {
+        fades = view.getUint8(o);
+        frame.rssi = null;
+        frame.fades = fades;
+      }
+      frame.fadesDelta = fades >= 0 && this.#lastFades >= 0 ? (fades - this.#lastFades) & 0xff : 0;
+    } else {
+      fades = view.getUint16(o);
+      frame.system = null;
+      frame.rssi = null;
+      frame.fades = fades;
+      frame.fadesDelta = this.#lastFades >= 0 ? (fades - this.#lastFades) & 0xffff : 0;
+    }
+    this.#lastFades = fades;
+    const empty = readSlots(frame, view, o, resolution, this.#vtx);
+    const s = this.#stats;
+    s.frames++;
+    s.frameBytes += FRAME_SIZE;
+    s.pendingBytes -= FRAME_SIZE;
+    s.emptySlots += empty;
+    if (frame.vtx !== null) s.vtxFrames++;
+    this.#head = o + FRAME_SIZE;
+    return frame;
+  }
+
+  #discard(o: number, length: number, reason: 'before-lock' | 'noise' | 'truncated-frame' | 'end-of-stream'): void {
+    this.#stats.discardedBytes += length;
+    this.#stats.pendingBytes -= length;
+    this.#head = o + length;
+    this.#event({ type: 'discarded', offset: this.#base + o, length, reason });
+  }
+
+  // ---- acquisition -------------------------------------------------------------------------
+
+  /** Tries to lock at the head. Returns false when it needs more bytes (or the stream is done). */
+  #acquire(): boolean {
+    const p = this.#head;
+    const avail = this.#tail - p;
+    const window = ACQUIRE_FRAMES * FRAME_SIZE + FRAME_SIZE - 1;
+    if (avail < window && !this.#ended) return false;
+    if (avail < FRAME_SIZE) {
+      if (avail > 0) this.#discard(p, avail, this.#everLocked ? 'end-of-stream' : 'before-lock');
+      return false;
+    }
+    const forced = this.#options.resolution;
+    const resolutions: readonly Resolution[] = forced === 'auto' ? [2048, 1024] : [forced];
+    let bestScore = -1;
+    let bestShift = 0;
+    let bestResolution: Resolution = 2048;
+    let bestInternal = false;
+    let bestRssi = false;
+    for (let shift = 0; shift < FRAME_SIZE; shift++) {
+      const frames = Math.min(ACQUIRE_FRAMES, Math.floor((avail - shift) / FRAME_SIZE));
+      if (frames < 1) break;
+      for (const resolution of resolutions) {
+        const score = this.#score(p + shift, resolution, frames);
+        if (score > bestScore) {
+          bestScore = score;
+          bestShift = shift;
+          bestResolution = resolution;
+          bestInternal = this.#candInternal;
+          bestRssi = this.#candRssi;
+        }
+      }
+    }
+    if (bestScore < 0) {
+      // No alignment starting in these 16 bytes works; any that does starts later.
+      this.#discard(p, Math.min(FRAME_SIZE, avail), this.#everLocked ? 'noise' : 'before-lock');
+      return true;
+    }
+    if (bestShift > 0) this.#discard(p, bestShift, this.#everLocked ? 'noise' : 'before-lock');
+    const o = p + bestShift;
+    const b1 = this.#view.getUint8(o + 1);
+    this.#locked = true;
+    this.#everLocked = true;
+    this.#resolution = bestResolution;
+    this.#remote = bestInternal ? 'internal' : 'external';
+    this.#system = bestInternal ? b1 : null;
+    this.#headerMode = bestRssi ? 'rssi' : 'fades';
+    this.#lastFades = -1;
+    this.#layoutCount = 0;
+    this.#setReason(bestResolution);
+    this.#event({ type: 'locked', offset: this.#base + o, format: this.format });
+    return true;
+  }
+
+  /**
+   * How well `frames` frames at `o` read as frames of one remote at `resolution`; -1 when any
+   * frame is invalid or the headers do not behave like headers. Leaves the header reading in
+   * #candInternal / #candRssi.
+   */
+  #score(o: number, resolution: Resolution, frames: number): number {
+    const view = this.#view;
+    const { remote, headerMode } = this.#options;
+    const b1 = view.getUint8(o + 1);
+    let internal = remote === 'internal' || (remote === 'auto' && systemInfo(b1) !== undefined);
+    let external = remote !== 'internal';
+    let rssi = headerMode === 'rssi' || (headerMode === 'auto' && plausibleRssi(view.getUint8(o)));
+    let channels = 0;
+    let zeroWords = 0;
+    let recurring = 0;
+    let prevFades = view.getUint16(o);
+    let layout1 = INVALID;
+    let layout2 = INVALID;
+    for (let k = 0; k < frames; k++) {
+      const f = o + k * FRAME_SIZE;
+      const layout = slotLayout(view, f, resolution);
+      if (layout === INVALID) return -1;
+      if (view.getUint8(f + 1) !== b1) internal = false;
+      if (headerMode === 'auto' && !plausibleRssi(view.getUint8(f))) rssi = false;
+      if (k > 0) {
+        const fades = view.getUint16(f);
+        if (((fades - prevFades) & 0xffff) >= MAX_FADE_STEP) external = false;
+        prevFades = fades;
+      }
+      if (layout === layout2) recurring++;
+      layout2 = layout1;
+      layout1 = layout;
+      channels |= layoutChannels(layout);
+      zeroWords += countZeroWords(view, f);
+    }
+    if (!internal && !external) return -1;
+    let score = 10 * frames + recurring - zeroWords;
+    if (internal) {
+      score += 4;
+      if (systemInfo(b1)?.resolution === resolution) score += 2;
+    } else if (view.getUint16(o) < 256) {
+      score += 1;
+    }
+    // Transmitters send channels 0…N-1: a contiguous set is the signature of the right reading.
+    if ((channels & (channels + 1)) === 0) score += 2;
+    this.#candInternal = internal;
+    this.#candRssi = internal && rssi;
+    return score;
+  }
+
+  #setReason(resolution: Resolution): void {
+    if (this.#options.resolution !== 'auto') {
+      this.#reason = 'override';
+      return;
+    }
+    const info = this.#system === null ? undefined : systemInfo(this.#system);
+    if (info === undefined) this.#reason = 'channel-ids';
+    else this.#reason = info.resolution === resolution ? 'system-byte' : 'system-byte-contradicted';
+  }
+
+  #explain(): string {
+    if (this.#resolution === null) return 'Not locked on to frames yet.';
+    const res = this.#resolution;
+    const sys = this.#system === null ? undefined : systemInfo(this.#system);
+    const hex = (v: number) => `0x${v.toString(16).padStart(2, '0').toUpperCase()}`;
+    const remote = this.#remote === 'internal'
+      ? `internal remote (system byte ${hex(this.#system ?? 0)}${sys ? `, ${sys.name}` : ''})`
+      : 'external remote (or a receiver that sends no system byte): bytes 0–1 are a UINT16 fade count';
+    switch (this.#reason) {
+      case 'override': return `${res} resolution set by the user; ${remote}.`;
+      case 'system-byte': return `${res} resolution from the system byte, confirmed by the channel IDs; ${remote}.`;
+      case 'system-byte-contradicted':
+        return `${res} resolution inferred from the channel IDs: the system byte says ${sys?.resolution ?? '?'} but its channel IDs only make sense at ${res}; ${remote}.`;
+      default: return `${res} resolution inferred from the channel IDs (no valid system byte); ${remote}.`;
+    }
+  }
+
+  #event(event: DecoderEvent): void {
+    if (this.#onEvent !== undefined) this.#onEvent(event);
+  }
+
+  /** Makes room for `n` more bytes: compacts first, grows (doubling) only when full. */
+  #reserve(n: number): void {
+    const need = this.#tail - this.#head + n;
+    if (this.#head > 0 && (this.#tail + n > this.#buf.length || this.#head >= this.#buf.length >> 1)) {
+      this.#buf.copyWithin(0, this.#head, this.#tail);
+      this.#times.copyWithin(0, this.#head, this.#tail);
+      this.#base += this.#head;
+      this.#tail -= this.#head;
+      this.#head = 0;
+    }
+    if (this.#tail + n <= this.#buf.length) return;
+    let capacity = this.#buf.length * 2;
+    while (capacity < need) capacity *= 2;
+    const buf = new Uint8Array(capacity);
+    buf.set(this.#buf.subarray(0, this.#tail));
+    const times = new Float64Array(capacity);
+    times.set(this.#times.subarray(0, this.#tail));
+    this.#buf = buf;
+    this.#times = times;
+    this.#view = new DataView(buf.buffer);
+  }
+}

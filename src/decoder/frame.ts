@@ -1,0 +1,165 @@
+/**
+ * Reading one 16-byte frame: slot validation (used to find frames without a sync byte) and
+ * filling the reusable `DecodedFrame`. Pure functions over a DataView and an offset.
+ */
+import {
+  EMPTY_SLOT, MASK_1024_SXPOS, MASK_2048_PHASE, MASK_2048_SXPOS, MAX_NORMAL_CHANNEL,
+  SLOTS_PER_FRAME, XPLUS_CHANNEL_ID, XPLUS_FIRST, type Resolution,
+} from './spec.js';
+import type { DecodedFrame, VtxControl } from './types.js';
+
+/** Slot codes inside a layout: 0–11 a channel ID, then these. */
+const CODE_XPLUS = 12;
+const CODE_EMPTY = 13;
+const CODE_VTX = 14;
+const CODE_BITS = 4;
+/** Bit 28 of a layout: the phase bit of the first slot (frames of a pair differ there). */
+const LAYOUT_PHASE_BIT = 1 << 28;
+
+/** A layout that is not one: the slots do not form a valid frame. */
+export const INVALID = -1;
+
+/**
+ * Whether bytes 12–15 carry Spektrum VTX control instead of two channels: both words' top
+ * nibble 0xE (mask 0xF000F000 = 0xE000E000) in a frame whose first slot has phase 0. The phase
+ * test keeps apart two X-Plus words X+5…X+8 (also 0xE…, but only sent in phase-1 frames).
+ */
+export function isVtxFrame(view: DataView, o: number): boolean {
+  return (view.getUint8(o + 12) & 0xf0) === 0xe0 &&
+    (view.getUint8(o + 14) & 0xf0) === 0xe0 &&
+    (view.getUint8(o + 2) & 0x80) === 0;
+}
+
+/**
+ * The frame's slot layout under `resolution`: a small integer naming which channel ID each
+ * slot holds (X-Plus, empty and VTX slots as codes of their own) plus the first slot's phase
+ * bit, or `INVALID` when a slot holds an impossible ID, an ID repeats, or no slot carries a
+ * channel. Frames of one transmitter repeat a few layouts, so a known layout is strong evidence
+ * that the decoder is aligned.
+ */
+export function slotLayout(view: DataView, o: number, resolution: Resolution): number {
+  const vtx = isVtxFrame(view, o);
+  const slots = vtx ? SLOTS_PER_FRAME - 2 : SLOTS_PER_FRAME;
+  let seen = 0;
+  let channels = 0;
+  let layout = 0;
+  for (let i = 0; i < slots; i++) {
+    const word = view.getUint16(o + 2 + 2 * i);
+    let code: number;
+    let channel: number;
+    if (word === EMPTY_SLOT) {
+      layout |= CODE_EMPTY << (CODE_BITS * i);
+      continue;
+    }
+    if (resolution === 2048) {
+      const id = (word >> 11) & 0x0f;
+      if (id <= MAX_NORMAL_CHANNEL) {
+        code = id;
+        channel = id;
+      } else if (id === XPLUS_CHANNEL_ID) {
+        code = CODE_XPLUS;
+        channel = XPLUS_FIRST + ((word >> 9) & 0x03) + ((word & MASK_2048_PHASE) !== 0 ? 4 : 0);
+      } else {
+        return INVALID;
+      }
+    } else {
+      const id = word >> 10;
+      if (id > MAX_NORMAL_CHANNEL) return INVALID;
+      code = id;
+      channel = id;
+    }
+    const bit = 1 << channel;
+    if ((seen & bit) !== 0) return INVALID;
+    seen |= bit;
+    channels++;
+    layout |= code << (CODE_BITS * i);
+  }
+  if (vtx) layout |= (CODE_VTX << (CODE_BITS * 5)) | (CODE_VTX << (CODE_BITS * 6));
+  else if (channels === 0) return INVALID;
+  if ((view.getUint8(o + 2) & 0x80) !== 0) layout |= LAYOUT_PHASE_BIT;
+  return layout;
+}
+
+/** Bit mask (bit n = channel n, normal channels 0–11 only) of the channels in a valid layout. */
+export function layoutChannels(layout: number): number {
+  let mask = 0;
+  for (let i = 0; i < SLOTS_PER_FRAME; i++) {
+    const code = (layout >> (CODE_BITS * i)) & 0x0f;
+    if (code <= MAX_NORMAL_CHANNEL) mask |= 1 << code;
+  }
+  return mask;
+}
+
+/** Whether a layout has a slot with a given raw 16-bit word of zero (a header read as a slot). */
+export function countZeroWords(view: DataView, o: number): number {
+  let n = 0;
+  for (let i = 0; i < SLOTS_PER_FRAME; i++) if (view.getUint16(o + 2 + 2 * i) === 0) n++;
+  return n;
+}
+
+/** A fresh, empty `DecodedFrame` whose arrays the decoder reuses. */
+export function createFrame(): DecodedFrame {
+  return {
+    index: -1, offset: 0, timeUs: NaN, remote: 'external', system: null, resolution: 2048,
+    fades: null, fadesDelta: 0, rssi: null, count: 0,
+    ids: new Uint8Array(SLOTS_PER_FRAME), positions: new Uint16Array(SLOTS_PER_FRAME),
+    words: new Uint16Array(SLOTS_PER_FRAME), vtx: null, bytes: new Uint8Array(16),
+  };
+}
+
+function createVtx(): VtxControl {
+  return { raw: 0, band: 0, channel: 0, power: 0, region: 0, pit: false };
+}
+
+/**
+ * Fills the slots of `frame` from the 16 bytes at `o` (header fields are the caller's). The
+ * slots must have passed `slotLayout` under the same resolution. Returns the number of empty slots.
+ */
+export function readSlots(frame: DecodedFrame, view: DataView, o: number, resolution: Resolution, vtxStore: VtxControl): number {
+  const vtx = isVtxFrame(view, o);
+  const slots = vtx ? SLOTS_PER_FRAME - 2 : SLOTS_PER_FRAME;
+  const { ids, positions, words, bytes } = frame;
+  for (let i = 0; i < 16; i++) bytes[i] = view.getUint8(o + i);
+  let count = 0;
+  let empty = 0;
+  for (let i = 0; i < SLOTS_PER_FRAME; i++) {
+    const word = view.getUint16(o + 2 + 2 * i);
+    words[i] = word;
+    if (i >= slots) continue;
+    if (word === EMPTY_SLOT) {
+      empty++;
+      continue;
+    }
+    if (resolution === 2048) {
+      const id = (word >> 11) & 0x0f;
+      if (id === XPLUS_CHANNEL_ID) {
+        // §8.6: two position bits extend the ID, the phase adds 4, 9 bits scale to 11.
+        ids[count] = XPLUS_FIRST + ((word >> 9) & 0x03) + ((word & MASK_2048_PHASE) !== 0 ? 4 : 0);
+        positions[count] = (word & 0x01ff) << 2;
+      } else {
+        ids[count] = id;
+        positions[count] = word & MASK_2048_SXPOS;
+      }
+    } else {
+      ids[count] = word >> 10;
+      positions[count] = word & MASK_1024_SXPOS;
+    }
+    count++;
+  }
+  frame.count = count;
+  if (vtx) {
+    const raw = view.getUint32(o + 12);
+    vtxStore.raw = raw;
+    vtxStore.band = (raw >>> 21) & 0x07;
+    vtxStore.channel = (raw >>> 16) & 0x0f;
+    vtxStore.pit = ((raw >>> 4) & 1) === 1;
+    vtxStore.region = (raw >>> 3) & 1;
+    vtxStore.power = raw & 0x07;
+    frame.vtx = vtxStore;
+  } else {
+    frame.vtx = null;
+  }
+  return empty;
+}
+
+export { createVtx };
