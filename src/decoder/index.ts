@@ -1,0 +1,17 @@
+/**
+ * satscope: decode Spektrum satellite ("remote receiver") serial streams.
+ * Every public name is exported here and only here.
+ */
+export { SpektrumDecoder, type DecoderOptions } from './decoder.js';
+export { LinkMonitor, type LinkEpisode, type LinkOptions, type LinkState, type LinkStats } from './link.js';
+export { copyFrame, type ChannelValue, type FrameSnapshot } from './snapshot.js';
+export { decodeStream, type TimedChunk } from './stream.js';
+export type {
+  DecodedFrame, DecoderEvent, DecoderStats, FormatInfo, HeaderMode, RemoteKind, ResolutionReason, VtxControl,
+} from './types.js';
+export {
+  BAUD_RATE, BYTE_TIME_US, CHANNEL_COUNT, CHANNEL_NAMES, EMPTY_SLOT, FAILSAFE_TIMEOUT_US, FRAME_SIZE,
+  PULSE_MAX_US, PULSE_MIN_US, SYSTEM_DSM2_11MS_2048, SYSTEM_DSM2_22MS_1024, SYSTEM_DSMX_11MS_2048,
+  SYSTEM_DSMX_22MS_2048, SYSTEM_TYPES, XPLUS_FIRST, XPLUS_LAST, channelName, servoToMicros, servoToPercent,
+  systemInfo, type Resolution, type SystemInfo,
+} from './spec.js';
