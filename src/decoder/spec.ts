@@ -37,11 +37,12 @@ export const MAX_NORMAL_CHANNEL = 11;
 export const CHANNEL_COUNT = 20;
 
 /**
- * Spektrum VTX control: when the last four bytes masked with 0xE000E000 equal 0xE000E000 the
- * last two slots carry VTX settings, not channels (as real satellites send them; PX4 and
- * Betaflight test the same bits).
+ * Spektrum VTX control (not in Rev G): when bytes 12–15 masked with 0xF000F000 equal
+ * 0xE000E000 (both words' top nibble 0xE) the last two slots carry VTX settings, not channels,
+ * as real satellites send them and as ArduPilot and Betaflight test.
  */
-export const VTX_MASK = 0xe000e000;
+export const VTX_MASK = 0xf000f000;
+export const VTX_MARKER = 0xe000e000;
 
 /** §8.3: the only allowed values of the internal remote's system byte. */
 export const SYSTEM_DSM2_22MS_1024 = 0x01;
