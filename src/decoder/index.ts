@@ -15,3 +15,12 @@ export {
   SYSTEM_DSMX_22MS_2048, SYSTEM_TYPES, XPLUS_FIRST, XPLUS_LAST, channelName, servoToMicros, servoToPercent,
   systemInfo, type Resolution, type SystemInfo,
 } from './spec.js';
+export {
+  CaptureFormatError, CaptureWriter, captureChunks, capturePorts, encodeCapture, importRaw, importSaleaeCsv,
+  parseCapture, readCapture, CAPTURE_FILE_EXTENSION, CAPTURE_FORMAT_VERSION,
+  type Capture, type CaptureChunk, type CaptureEvent, type CaptureIssue, type CaptureIssueKind, type CaptureKind,
+  type CaptureMeta, type CapturePortInfo, type CaptureRecordInput, type CaptureTiming, type ParsedCapture,
+} from './capture/index.js';
+export {
+  decodeCapture, summarizeCapture, type CaptureSummary, type ChannelSummary, type DecodeCaptureOptions,
+} from './summary.js';

@@ -196,11 +196,15 @@ export class LinkMonitor {
       times[PERIOD_WINDOW - 1] = t;
     }
     if (this.#periodCount >= 9) {
-      const n = this.#periodCount - 1;
-      s.periodUs = ((times[n] as number) - (times[0] as number)) / n;
-      if (!Number.isFinite(this.#systemPeriod)) {
-        s.nominalPeriodUs = s.periodUs < 16_500 ? FRAME_PERIOD_11MS_US : FRAME_PERIOD_22MS_US;
+      const span = (times[this.#periodCount - 1] as number) - (times[0] as number);
+      if (!Number.isFinite(this.#systemPeriod) && !Number.isFinite(s.nominalPeriodUs)) {
+        // First estimate, assuming no gap yet: snap the mean interval to 11 or 22 ms.
+        s.nominalPeriodUs = span / (this.#periodCount - 1) < 16_500 ? FRAME_PERIOD_11MS_US : FRAME_PERIOD_22MS_US;
       }
+      // Whole periods in the span (a missed frame makes one interval two periods long), so a
+      // short gap does not bias the measurement and chunk-time jitter averages out.
+      const periods = Math.max(1, Math.round(span / s.nominalPeriodUs));
+      s.periodUs = span / periods;
     }
     // Fade rate over a window of recent frames.
     const i = this.#rateNext;

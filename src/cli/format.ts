@@ -1,0 +1,79 @@
+/** Text forms of frames and summaries for the CLI. */
+import type { CaptureSummary } from '../decoder/summary.js';
+import { servoToMicros, systemInfo, CHANNEL_COUNT, XPLUS_FIRST } from '../decoder/spec.js';
+import type { DecodedFrame } from '../decoder/types.js';
+
+const seconds = (us: number): string => (Number.isFinite(us) ? String(us / 1e6) : 'null');
+const usOf = (f: DecodedFrame, i: number): number =>
+  servoToMicros(f.positions[i] as number, (f.ids[i] as number) >= XPLUS_FIRST ? 2048 : f.resolution);
+
+/**
+ * One frame as the documented JSONL line:
+ * {"t": s|null, "remote": …, "system": byte|null, "resolution": …, "fades": n|null, "rssi": dBm|null, "channels": [{"id", "pos", "us"}, …]}
+ */
+export function formatJsonLine(f: DecodedFrame): string {
+  let channels = '';
+  for (let i = 0; i < f.count; i++) {
+    if (i > 0) channels += ', ';
+    channels += `{"id": ${f.ids[i] as number}, "pos": ${f.positions[i] as number}, "us": ${usOf(f, i)}}`;
+  }
+  return `{"t": ${seconds(f.timeUs)}, "remote": "${f.remote}", "system": ${f.system ?? 'null'}, "resolution": ${f.resolution}, "fades": ${f.fades ?? 'null'}, "rssi": ${f.rssi ?? 'null'}, "channels": [${channels}]}`;
+}
+
+const CHANNEL_COLUMNS = Array.from({ length: CHANNEL_COUNT }, (_, id) => `ch${id}_us`);
+
+export function formatCsvHeader(): string {
+  return ['t', 'remote', 'system', 'resolution', 'fades', 'rssi', ...CHANNEL_COLUMNS].join(',');
+}
+
+/** One frame as a CSV row: pulse widths in µs per channel ID, empty where the frame has none. */
+export function formatCsvLine(f: DecodedFrame): string {
+  const cells: string[] = new Array<string>(CHANNEL_COUNT).fill('');
+  for (let i = 0; i < f.count; i++) cells[f.ids[i] as number] = String(usOf(f, i));
+  const t = Number.isFinite(f.timeUs) ? String(f.timeUs / 1e6) : '';
+  return [t, f.remote, f.system ?? '', f.resolution, f.fades ?? '', f.rssi ?? '', ...cells].join(',');
+}
+
+const ms = (us: number): string => `${(us / 1000).toFixed(us < 100_000 ? 2 : 0)} ms`;
+const hex = (v: number): string => `0x${v.toString(16).toUpperCase().padStart(2, '0')}`;
+
+/** The human summary `satscope info` prints. */
+export function formatSummary(s: CaptureSummary, name: string): string {
+  const lines: string[] = [];
+  const add = (label: string, value: string): void => {
+    lines.push(`${label.padEnd(14)}${value}`);
+  };
+  const timed = s.timing !== 'none';
+  add('File', `${name} (${s.kind}, ${s.bytes} bytes on port ${s.port}, timing ${s.timing})`);
+  if (timed && Number.isFinite(s.durationUs)) add('Duration', `${(s.durationUs / 1e6).toFixed(3)} s`);
+  const f = s.format;
+  if (!f.locked && s.decoder.frames === 0) {
+    add('Frames', `none found in ${s.bytes} bytes`);
+    return lines.join('\n');
+  }
+  const sys = f.system === null ? undefined : systemInfo(f.system);
+  add('System', f.system === null ? 'no system byte (external remote or a receiver that sends none)' : `${hex(f.system)}${sys ? ` ${sys.name}` : ' (not a valid system byte)'}`);
+  add('Remote', f.remote === 'internal' ? `internal (byte 0 = ${f.headerMode === 'rssi' ? 'RSSI in dBm, SPM4649T' : 'UINT8 fades'})` : 'external (bytes 0–1 = UINT16 fades)');
+  add('Resolution', `${f.resolution ?? '?'} — ${f.explanation}`);
+  const d = s.decoder;
+  add('Frames', `${d.frames} (${d.discardedBytes} bytes discarded, ${d.resyncs} resyncs, ${d.badFrames} bad frames, ${d.emptySlots} empty slots${d.vtxFrames ? `, ${d.vtxFrames} VTX frames` : ''})`);
+  if (s.formatChanges > 0) add('', `the format changed ${s.formatChanges} time(s) during the capture`);
+  add('Channels', s.channels.length === 0 ? 'none' : '');
+  for (const c of s.channels) lines.push(`  ${String(c.id).padStart(2)} ${c.name.padEnd(9)} ${String(c.frames).padStart(7)} frames  ${c.minUs}–${c.maxUs} µs  last ${c.lastUs} µs`);
+  const l = s.link;
+  if (f.headerMode === 'rssi') add('RSSI', `last ${l.rssi} dBm, lowest ${l.minRssi} dBm`);
+  else add('Fades', `${l.fades}${timed ? ` (${(l.fades / Math.max(s.durationUs / 60e6, 1e-9)).toFixed(1)} per minute)` : ''}`);
+  if (timed) {
+    add('Frame period', Number.isFinite(l.periodUs) ? `${ms(l.periodUs)} measured (${ms(l.nominalPeriodUs)} nominal)` : 'too few frames to measure');
+    add('Gaps', `${l.missedFrames} missed frames, longest gap ${ms(l.longestGapUs)}`);
+    add('Failsafe', `${l.holds} holds, ${l.failsafes} failsafes`);
+    for (const e of s.episodes) {
+      const end = e.endUs === null ? 'to the end' : `until ${(e.endUs / 1e6).toFixed(3)} s`;
+      lines.push(`  ${e.kind.padEnd(8)} from ${(e.startUs / 1e6).toFixed(3)} s ${end}`);
+    }
+  } else {
+    add('Timing', 'none in this file: no frame period, gaps or failsafe episodes');
+  }
+  if (s.issues.length > 0) add('File issues', `${s.issues.length} (damaged records skipped; see above)`);
+  return lines.join('\n');
+}

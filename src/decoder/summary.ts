@@ -1,0 +1,116 @@
+/**
+ * Decoding a whole capture, and the summary `satscope info` prints. Pure: the capture is
+ * already in memory, and the caller chooses how to show the result.
+ */
+import type { Capture, CaptureIssue } from './capture/index.js';
+import { captureChunks } from './capture/index.js';
+import { SpektrumDecoder, type DecoderOptions } from './decoder.js';
+import { LinkMonitor, type LinkEpisode, type LinkStats } from './link.js';
+import { channelName, CHANNEL_COUNT, servoToMicros, XPLUS_FIRST } from './spec.js';
+import type { DecodedFrame, DecoderEvent, DecoderStats, FormatInfo } from './types.js';
+
+export interface DecodeCaptureOptions extends Omit<DecoderOptions, 'onEvent'> {
+  /** Which serial port of a multi-port capture to decode. Default 0. */
+  port?: number;
+  onEvent?: (event: DecoderEvent) => void;
+}
+
+/** How late a chunk-timed frame can arrive from USB batching alone (an FTDI latency timer is 16 ms). */
+const CHUNK_JITTER_US = 20_000;
+
+/**
+ * Feeds one port of a capture through a decoder and a link monitor, chunk by chunk with the
+ * chunk's recorded time, as live data would arrive. `onFrame` gets each borrowed frame.
+ */
+export function decodeCapture(
+  capture: Capture,
+  options: DecodeCaptureOptions,
+  onFrame: (frame: DecodedFrame) => void,
+): { decoder: SpektrumDecoder; link: LinkMonitor } {
+  const { port = 0, ...decoderOptions } = options;
+  const decoder = new SpektrumDecoder(decoderOptions);
+  const link = new LinkMonitor({ jitterUs: capture.timing === 'per-chunk' ? CHUNK_JITTER_US : 0 });
+  const drain = (): void => {
+    for (let f = decoder.next(); f !== undefined; f = decoder.next()) {
+      link.frame(f);
+      onFrame(f);
+    }
+  };
+  for (const chunk of captureChunks(capture, port)) {
+    decoder.push(chunk.bytes, chunk.time);
+    drain();
+  }
+  decoder.end();
+  drain();
+  return { decoder, link };
+}
+
+export interface ChannelSummary {
+  id: number;
+  name: string;
+  frames: number;
+  minUs: number;
+  maxUs: number;
+  lastUs: number;
+}
+
+export interface CaptureSummary {
+  kind: Capture['kind'];
+  timing: Capture['timing'];
+  port: number;
+  bytes: number;
+  /** From the first to the last byte's time, µs; NaN without timing. */
+  durationUs: number;
+  format: FormatInfo;
+  decoder: DecoderStats;
+  link: LinkStats;
+  episodes: LinkEpisode[];
+  channels: ChannelSummary[];
+  /** Format changes the decoder made along the way (e.g. an external remote whose fades looked like a system byte). */
+  formatChanges: number;
+  issues: readonly CaptureIssue[];
+}
+
+/** Decodes a capture (one port) and sums it up. */
+export function summarizeCapture(capture: Capture, options: DecodeCaptureOptions = {}): CaptureSummary {
+  const frames = new Uint32Array(CHANNEL_COUNT);
+  const min = new Float64Array(CHANNEL_COUNT).fill(Infinity);
+  const max = new Float64Array(CHANNEL_COUNT).fill(-Infinity);
+  const last = new Float64Array(CHANNEL_COUNT);
+  let firstUs = NaN;
+  let lastUs = NaN;
+  let formatChanges = 0;
+  const userEvent = options.onEvent;
+  const { decoder, link } = decodeCapture(capture, {
+    ...options,
+    onEvent: (e) => {
+      if (e.type === 'format-changed') formatChanges++;
+      userEvent?.(e);
+    },
+  }, (f) => {
+    if (Number.isNaN(firstUs)) firstUs = f.timeUs;
+    lastUs = f.timeUs;
+    for (let i = 0; i < f.count; i++) {
+      const id = f.ids[i] as number;
+      const us = servoToMicros(f.positions[i] as number, id >= XPLUS_FIRST ? 2048 : f.resolution);
+      frames[id] = (frames[id] as number) + 1;
+      if (us < (min[id] as number)) min[id] = us;
+      if (us > (max[id] as number)) max[id] = us;
+      last[id] = us;
+    }
+  });
+  const channels: ChannelSummary[] = [];
+  for (let id = 0; id < CHANNEL_COUNT; id++) {
+    const n = frames[id] as number;
+    if (n > 0) channels.push({ id, name: channelName(id), frames: n, minUs: min[id] as number, maxUs: max[id] as number, lastUs: last[id] as number });
+  }
+  const port = options.port ?? 0;
+  let bytes = 0;
+  for (const chunk of captureChunks(capture, port)) bytes += chunk.bytes.length;
+  return {
+    kind: capture.kind, timing: capture.timing, port, bytes,
+    durationUs: lastUs - firstUs,
+    format: decoder.format, decoder: { ...decoder.stats }, link: { ...link.stats },
+    episodes: link.episodes.map((e) => ({ ...e })), channels, formatChanges, issues: capture.issues,
+  };
+}
