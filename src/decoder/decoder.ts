@@ -265,11 +265,17 @@ export class SpektrumDecoder {
     return ((view.getUint16(o) - this.#lastFades) & 0xffff) < MAX_FADE_STEP;
   }
 
-  /** Whether two frames' headers could be consecutive headers of one remote. */
+  /**
+   * Whether two frames' headers could be consecutive headers of one remote. While an internal
+   * remote's system byte still matches, the next frame must carry it too: a truncated frame
+   * followed by a shifted one can otherwise pass as a rising UINT16 fade count.
+   */
   #pairConsistent(a: number, b: number): boolean {
     const view = this.#view;
     const remote = this.#options.remote;
-    if (remote !== 'external' && view.getUint8(a + 1) === view.getUint8(b + 1)) return true;
+    const b1 = view.getUint8(a + 1);
+    if (this.#locked && this.#remote === 'internal' && b1 === this.#system) return view.getUint8(b + 1) === b1;
+    if (remote !== 'external' && b1 === view.getUint8(b + 1)) return true;
     return remote !== 'internal' && ((view.getUint16(b) - view.getUint16(a)) & 0xffff) < MAX_FADE_STEP;
   }
 
