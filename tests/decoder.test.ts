@@ -288,13 +288,13 @@ describe('finding frames without a sync byte', () => {
 
   it('emits a frame with a known layout as soon as its 16 bytes are in', () => {
     const decoder = new SpektrumDecoder();
-    const stream = dsmxStream(6);
-    decoder.push(stream.subarray(0, 96));
+    const stream = dsmxStream(8);
+    decoder.push(stream.subarray(0, 224));
     let n = 0;
     while (decoder.next()) n++;
-    decoder.push(stream.subarray(96, 112));
-    expect(decoder.next()?.offset).toBe(96);
-    expect(n).toBe(6);
+    decoder.push(stream.subarray(224, 240));
+    expect(decoder.next()?.offset).toBe(224);
+    expect(n).toBe(14);
   });
 
   it('reuses one frame object (a borrowed view) for every frame', () => {

@@ -7,8 +7,8 @@
  * starts, so the result is identical however the bytes are chunked and whatever times come
  * with them:
  *
- * - Unlocked, it looks at the next four frames' worth of bytes (plus 15) and scores each of
- *   the 16 alignments under both resolutions: every slot must hold a valid channel ID (or
+ * - Unlocked, it looks at four frames from each of the next 48 start offsets and scores each
+ *   under both resolutions: every slot must hold a valid channel ID (or
  *   0xFFFF, or VTX), no ID may repeat within a frame, the header bytes must behave like a header
  *   (the same valid system byte in every frame, or a slowly rising UINT16 fade count), and
  *   channel sets that are contiguous, layouts that recur every other frame and a system byte
@@ -40,6 +40,16 @@ export interface DecoderOptions {
 
 /** Frames looked at before the first lock. */
 const ACQUIRE_FRAMES = 4;
+/**
+ * Start offsets compared before locking. A damaged frame can hide the real alignment's first
+ * start while a shifted reading that happens to parse (a 1024-mode internal remote read two bytes
+ * late looks like an external one whose fade count is channel 0's position) starts earlier. The
+ * real start after damage lies at most a frame after any such reading, so candidates over three
+ * frames of starts are compared, but a lock is only taken in the first two: a best candidate in
+ * the third frame waits until the window has slid on.
+ */
+const ACQUIRE_SHIFTS = 3 * FRAME_SIZE;
+const ACQUIRE_COMMIT = 2 * FRAME_SIZE;
 /** A UINT16 fade count that rises by more than this between two frames is suspect (≈ 22 s of loss at 11 ms). */
 const MAX_FADE_STEP = 2048;
 /** How far a locked decoder searches for the next frame before it starts over. */
@@ -96,6 +106,7 @@ export class SpektrumDecoder {
   /** Acquisition scratch: the best candidate's header reading. */
   #candInternal = false;
   #candRssi = false;
+  #candSystem = 0;
 
   /**
    * @throws {TypeError} when an option has a value outside its documented set.
@@ -230,7 +241,7 @@ export class SpektrumDecoder {
         }
       }
       // This frame does not continue the stream: find where frames continue.
-      const q = this.#search(o);
+      const q = this.#search(o, layout !== INVALID && this.#headerFits(o));
       if (q === NEED_MORE) return undefined;
       this.#stats.resyncs++;
       if (q < 0) {
@@ -267,16 +278,32 @@ export class SpektrumDecoder {
 
   /**
    * Whether two frames' headers could be consecutive headers of one remote. While an internal
-   * remote's system byte still matches, the next frame must carry it too: a truncated frame
-   * followed by a shifted one can otherwise pass as a rising UINT16 fade count.
+   * remote's system byte matches, the next frame must carry it too (a truncated frame followed
+   * by a shifted one can otherwise pass as a rising UINT16 fade count). When it does not match,
+   * the next frame must not carry it either: one corrupted byte is a bad frame, not a new format.
    */
   #pairConsistent(a: number, b: number): boolean {
     const view = this.#view;
     const remote = this.#options.remote;
     const b1 = view.getUint8(a + 1);
-    if (this.#locked && this.#remote === 'internal' && b1 === this.#system) return view.getUint8(b + 1) === b1;
-    if (remote !== 'external' && b1 === view.getUint8(b + 1)) return true;
+    const next1 = view.getUint8(b + 1);
+    if (this.#locked && this.#remote === 'internal') {
+      if (b1 === this.#system) {
+        // RSSI turns into fades only if the next frame's byte 0 is positive too.
+        if (this.#headerMode === 'rssi' && view.getUint8(a) < 0x80) return next1 === b1 && view.getUint8(b) < 0x80;
+        return next1 === b1;
+      }
+      if (next1 === this.#system || remote === 'internal') return false;
+    }
+    if (remote !== 'external' && b1 === next1) return true;
     return remote !== 'internal' && ((view.getUint16(b) - view.getUint16(a)) & 0xffff) < MAX_FADE_STEP;
+  }
+
+  /** Whether the fade count (which only rises, with its wrap) could go from frame a to frame b. */
+  #fadesRise(a: number, b: number): boolean {
+    const view = this.#view;
+    if (this.#remote === 'internal') return this.#headerMode === 'rssi' || ((view.getUint8(b) - view.getUint8(a)) & 0xff) < 0x80;
+    return ((view.getUint16(b) - view.getUint16(a)) & 0xffff) < MAX_FADE_STEP;
   }
 
   /** A confirmed frame whose header surprised the lock: adopt what it says. */
@@ -306,13 +333,15 @@ export class SpektrumDecoder {
 
   /**
    * The nearest offset after `o` where frames continue, or -1 when none within reach, or
-   * NEED_MORE when the answer depends on bytes that have not arrived. A frame with a known
-   * layout and a fitting header is the strong sign and is looked for first, so a run of two
-   * frames that only happen to parse (a truncated frame can make that happen) does not win
-   * over the real next frame a few bytes later. Two valid frames in a row with consistent
-   * headers are accepted only when no strong sign is within reach (a new layout, a rebind).
+   * NEED_MORE when the answer depends on bytes that have not arrived. Evidence is tried from
+   * strong to weak, each over the whole reach, so a run of frames that only happen to parse (a
+   * truncated or shifted frame can make that happen) never wins over the real next frame a few
+   * bytes later:
+   * 1. a frame with a known layout and a header that fits the lock;
+   * 2. a frame whose header fits, confirmed by a valid next frame;
+   * 3. two valid frames in a row with consistent headers (a new layout, a rebind).
    */
-  #search(o: number): number {
+  #search(o: number, plausible: boolean): number {
     const view = this.#view;
     const resolution = this.#resolution as Resolution;
     const last = o + MAX_RESYNC_BYTES;
@@ -322,18 +351,31 @@ export class SpektrumDecoder {
         break;
       }
       const layout = slotLayout(view, q, resolution);
-      if (layout !== INVALID && this.#headerFits(q) && this.#knownLayout(layout)) return q;
-    }
-    for (let q = o + 1; q <= last; q++) {
-      if (q + FRAME_SIZE > this.#tail) return -1;
-      if (slotLayout(view, q, resolution) === INVALID) continue;
+      if (layout === INVALID || !this.#headerFits(q) || !this.#knownLayout(layout)) continue;
+      // Overlapping a frame that parses and sits where the last one ended says that frame lost
+      // bytes; the frame after q must agree (a frame made of one stray byte and the next frame's
+      // first fifteen reads a fade count that then goes backwards).
+      if (!plausible || q >= o + FRAME_SIZE) return q;
       if (q + 2 * FRAME_SIZE > this.#tail) {
         if (!this.#ended) return NEED_MORE;
-        if (this.#headerFits(q)) return q;
-        continue;
-      }
-      if (slotLayout(view, q + FRAME_SIZE, resolution) !== INVALID && this.#pairConsistent(q, q + FRAME_SIZE)) {
         return q;
+      }
+      if (slotLayout(view, q + FRAME_SIZE, resolution) !== INVALID && this.#pairConsistent(q, q + FRAME_SIZE) && this.#fadesRise(q, q + FRAME_SIZE)) return q;
+    }
+    for (let tier = 2; tier <= 3; tier++) {
+      for (let q = o + 1; q <= last; q++) {
+        if (q + FRAME_SIZE > this.#tail) break;
+        if (slotLayout(view, q, resolution) === INVALID) continue;
+        const fits = this.#headerFits(q);
+        if (tier === 2 && !fits) continue;
+        if (q + 2 * FRAME_SIZE > this.#tail) {
+          if (!this.#ended) return NEED_MORE;
+          if (fits) return q;
+          continue;
+        }
+        if (slotLayout(view, q + FRAME_SIZE, resolution) !== INVALID && this.#pairConsistent(q, q + FRAME_SIZE)) {
+          return q;
+        }
       }
     }
     return -1;
@@ -408,7 +450,7 @@ export class SpektrumDecoder {
   #acquire(): boolean {
     const p = this.#head;
     const avail = this.#tail - p;
-    const window = ACQUIRE_FRAMES * FRAME_SIZE + FRAME_SIZE - 1;
+    const window = ACQUIRE_FRAMES * FRAME_SIZE + ACQUIRE_SHIFTS - 1;
     if (avail < window && !this.#ended) return false;
     if (avail < FRAME_SIZE) {
       if (avail > 0) this.#discard(p, avail, this.#everLocked ? 'end-of-stream' : 'before-lock');
@@ -421,7 +463,8 @@ export class SpektrumDecoder {
     let bestResolution: Resolution = 2048;
     let bestInternal = false;
     let bestRssi = false;
-    for (let shift = 0; shift < FRAME_SIZE; shift++) {
+    let bestSystem = 0;
+    for (let shift = 0; shift < ACQUIRE_SHIFTS; shift++) {
       const frames = Math.min(ACQUIRE_FRAMES, Math.floor((avail - shift) / FRAME_SIZE));
       if (frames < 1) break;
       for (const resolution of resolutions) {
@@ -432,22 +475,22 @@ export class SpektrumDecoder {
           bestResolution = resolution;
           bestInternal = this.#candInternal;
           bestRssi = this.#candRssi;
+          bestSystem = this.#candSystem;
         }
       }
     }
-    if (bestScore < 0) {
-      // No alignment starting in these 16 bytes works; any that does starts later.
+    if (bestScore < 0 || (bestShift >= ACQUIRE_COMMIT && avail >= window)) {
+      // No alignment starting in these 16 bytes works (or the best starts too late to commit).
       this.#discard(p, Math.min(FRAME_SIZE, avail), this.#everLocked ? 'noise' : 'before-lock');
       return true;
     }
     if (bestShift > 0) this.#discard(p, bestShift, this.#everLocked ? 'noise' : 'before-lock');
     const o = p + bestShift;
-    const b1 = this.#view.getUint8(o + 1);
     this.#locked = true;
     this.#everLocked = true;
     this.#resolution = bestResolution;
     this.#remote = bestInternal ? 'internal' : 'external';
-    this.#system = bestInternal ? b1 : null;
+    this.#system = bestInternal ? bestSystem : null;
     this.#headerMode = bestRssi ? 'rssi' : 'fades';
     this.#lastFades = -1;
     this.#layoutCount = 0;
@@ -464,10 +507,19 @@ export class SpektrumDecoder {
   #score(o: number, resolution: Resolution, frames: number): number {
     const view = this.#view;
     const { remote, headerMode } = this.#options;
-    const b1 = view.getUint8(o + 1);
-    let internal = remote === 'internal' || (remote === 'auto' && systemInfo(b1) !== undefined);
+    // An internal remote sends one system byte; allow one corrupted frame among the four.
+    let b1 = view.getUint8(o + 1);
+    let same = 0;
+    for (let k = 0; k < frames; k++) if (view.getUint8(o + k * FRAME_SIZE + 1) === b1) same++;
+    if (same < frames - 1 && frames > 1) {
+      b1 = view.getUint8(o + FRAME_SIZE + 1);
+      same = 0;
+      for (let k = 0; k < frames; k++) if (view.getUint8(o + k * FRAME_SIZE + 1) === b1) same++;
+    }
+    const majority = same >= frames - 1 && same >= Math.min(2, frames);
+    const internal = remote === 'internal' ? majority : remote === 'auto' && majority && systemInfo(b1) !== undefined;
     let external = remote !== 'internal';
-    let rssi = headerMode === 'rssi' || (headerMode === 'auto' && plausibleRssi(view.getUint8(o)));
+    let implausibleRssi = 0;
     let channels = 0;
     let zeroWords = 0;
     let recurring = 0;
@@ -478,8 +530,7 @@ export class SpektrumDecoder {
       const f = o + k * FRAME_SIZE;
       const layout = slotLayout(view, f, resolution);
       if (layout === INVALID) return -1;
-      if (view.getUint8(f + 1) !== b1) internal = false;
-      if (headerMode === 'auto' && !plausibleRssi(view.getUint8(f))) rssi = false;
+      if (!plausibleRssi(view.getUint8(f))) implausibleRssi++;
       if (k > 0) {
         const fades = view.getUint16(f);
         if (((fades - prevFades) & 0xffff) >= MAX_FADE_STEP) external = false;
@@ -494,7 +545,8 @@ export class SpektrumDecoder {
     if (!internal && !external) return -1;
     let score = 10 * frames + recurring - zeroWords;
     if (internal) {
-      score += 4;
+      // A start on the corrupted frame scores below a start on clean ones.
+      score += 4 - 3 * (frames - same);
       if (systemInfo(b1)?.resolution === resolution) score += 2;
     } else if (view.getUint16(o) < 256) {
       score += 1;
@@ -502,7 +554,9 @@ export class SpektrumDecoder {
     // Transmitters send channels 0…N-1: a contiguous set is the signature of the right reading.
     if ((channels & (channels + 1)) === 0) score += 2;
     this.#candInternal = internal;
-    this.#candRssi = internal && rssi;
+    // §8.3.1: negative byte 0 from the start means RSSI (one corrupted frame allowed).
+    this.#candRssi = internal && (headerMode === 'rssi' || (headerMode === 'auto' && implausibleRssi <= (frames > 1 ? 1 : 0)));
+    this.#candSystem = b1;
     return score;
   }
 
