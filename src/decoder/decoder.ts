@@ -22,7 +22,7 @@
 import {
   BYTE_TIME_US, FRAME_SIZE, systemInfo, type Resolution,
 } from './spec.js';
-import { createFrame, createVtx, countZeroWords, INVALID, layoutChannels, readSlots, slotLayout } from './frame.js';
+import { createFrame, createVtx, countZeroWords, INVALID, isVtxFrame, layoutChannels, readSlots, slotLayout } from './frame.js';
 import type {
   DecodedFrame, DecoderEvent, DecoderStats, FormatInfo, HeaderMode, RemoteKind, ResolutionReason,
 } from './types.js';
@@ -74,7 +74,17 @@ export class SpektrumDecoder {
 
   #buf = new Uint8Array(INITIAL_CAPACITY);
   #view = new DataView(this.#buf.buffer);
-  #times = new Float64Array(INITIAL_CAPACITY);
+  /**
+   * Times are kept per pushed chunk, not per byte (filling a time for every byte cost a third of
+   * the decoder's throughput): each chunk's end offset in the stream and its time, or NaN. Only
+   * chunks pushed with per-byte times store them, in #byteTimes parallel to #buf.
+   */
+  #chunkEnds = new Float64Array(64);
+  #chunkTimes = new Float64Array(64);
+  #chunkPerByte = new Uint8Array(64);
+  #chunkHead = 0;
+  #chunkTail = 0;
+  #byteTimes: Float64Array | null = null;
   /** Index in #buf of the first byte not yet decided. */
   #head = 0;
   /** Index in #buf after the last byte pushed. */
@@ -151,15 +161,12 @@ export class SpektrumDecoder {
     this.#reserve(n);
     const at = this.#tail;
     this.#buf.set(bytes, at);
-    const times = this.#times;
-    if (time === undefined) {
-      times.fill(NaN, at, at + n);
-    } else if (typeof time === 'number') {
-      const first = time - (n - 1) * BYTE_TIME_US;
-      for (let i = 0; i < n; i++) times[at + i] = first + i * BYTE_TIME_US;
-    } else {
-      times.set(time, at);
+    const perByte = time instanceof Float64Array;
+    if (perByte) {
+      if (this.#byteTimes === null) this.#byteTimes = new Float64Array(this.#buf.length);
+      this.#byteTimes.set(time, at);
     }
+    this.#addChunk(this.#base + at + n, perByte ? NaN : (time ?? NaN), perByte);
     this.#tail = at + n;
     this.#stats.bytes += n;
     this.#stats.pendingBytes += n;
@@ -176,6 +183,7 @@ export class SpektrumDecoder {
   /** Forgets everything: buffered bytes, lock, format and counters. */
   reset(): void {
     this.#head = this.#tail = this.#base = 0;
+    this.#chunkHead = this.#chunkTail = 0;
     this.#ended = false;
     this.#locked = this.#everLocked = false;
     this.#resolution = null;
@@ -227,7 +235,7 @@ export class SpektrumDecoder {
       }
       const resolution = this.#resolution as Resolution;
       const view = this.#view;
-      const layout = slotLayout(view, o, resolution);
+      const layout = slotLayout(this.#buf, o, resolution);
       if (layout !== INVALID) {
         const fit = this.#headerFits(o);
         if (fit && this.#knownLayout(layout)) return this.#emit(o, layout);
@@ -235,7 +243,7 @@ export class SpektrumDecoder {
           if (!this.#ended) return undefined;
           return this.#emit(o, layout);
         }
-        if (slotLayout(view, o + FRAME_SIZE, resolution) !== INVALID && this.#pairConsistent(o, o + FRAME_SIZE)) {
+        if (slotLayout(this.#buf, o + FRAME_SIZE, resolution) !== INVALID && this.#pairConsistent(o, o + FRAME_SIZE)) {
           if (!fit) this.#reinterpret(o);
           return this.#emit(o, layout);
         }
@@ -350,7 +358,7 @@ export class SpektrumDecoder {
         if (!this.#ended) return NEED_MORE;
         break;
       }
-      const layout = slotLayout(view, q, resolution);
+      const layout = slotLayout(this.#buf, q, resolution);
       if (layout === INVALID || !this.#headerFits(q) || !this.#knownLayout(layout)) continue;
       // Overlapping a frame that parses and sits where the last one ended says that frame lost
       // bytes; the frame after q must agree (a frame made of one stray byte and the next frame's
@@ -360,12 +368,12 @@ export class SpektrumDecoder {
         if (!this.#ended) return NEED_MORE;
         return q;
       }
-      if (slotLayout(view, q + FRAME_SIZE, resolution) !== INVALID && this.#pairConsistent(q, q + FRAME_SIZE) && this.#fadesRise(q, q + FRAME_SIZE)) return q;
+      if (slotLayout(this.#buf, q + FRAME_SIZE, resolution) !== INVALID && this.#pairConsistent(q, q + FRAME_SIZE) && this.#fadesRise(q, q + FRAME_SIZE)) return q;
     }
     for (let tier = 2; tier <= 3; tier++) {
       for (let q = o + 1; q <= last; q++) {
         if (q + FRAME_SIZE > this.#tail) break;
-        if (slotLayout(view, q, resolution) === INVALID) continue;
+        if (slotLayout(this.#buf, q, resolution) === INVALID) continue;
         const fits = this.#headerFits(q);
         if (tier === 2 && !fits) continue;
         if (q + 2 * FRAME_SIZE > this.#tail) {
@@ -373,7 +381,7 @@ export class SpektrumDecoder {
           if (fits) return q;
           continue;
         }
-        if (slotLayout(view, q + FRAME_SIZE, resolution) !== INVALID && this.#pairConsistent(q, q + FRAME_SIZE)) {
+        if (slotLayout(this.#buf, q + FRAME_SIZE, resolution) !== INVALID && this.#pairConsistent(q, q + FRAME_SIZE)) {
           return q;
         }
       }
@@ -401,7 +409,7 @@ export class SpektrumDecoder {
     const resolution = this.#resolution as Resolution;
     frame.index++;
     frame.offset = this.#base + o;
-    frame.timeUs = this.#times[o] as number;
+    this.#stampTime(frame, o);
     frame.resolution = resolution;
     const remote = this.#remote as RemoteKind;
     frame.remote = remote;
@@ -426,7 +434,7 @@ export class SpektrumDecoder {
       frame.fadesDelta = this.#lastFades >= 0 ? (fades - this.#lastFades) & 0xffff : 0;
     }
     this.#lastFades = fades;
-    const empty = readSlots(frame, view, o, resolution, this.#vtx);
+    const empty = readSlots(frame, this.#buf, o, resolution, isVtxFrame(this.#buf, o), this.#vtx);
     const s = this.#stats;
     s.frames++;
     s.frameBytes += FRAME_SIZE;
@@ -528,7 +536,7 @@ export class SpektrumDecoder {
     let layout2 = INVALID;
     for (let k = 0; k < frames; k++) {
       const f = o + k * FRAME_SIZE;
-      const layout = slotLayout(view, f, resolution);
+      const layout = slotLayout(this.#buf, f, resolution);
       if (layout === INVALID) return -1;
       if (!plausibleRssi(view.getUint8(f))) implausibleRssi++;
       if (k > 0) {
@@ -540,7 +548,7 @@ export class SpektrumDecoder {
       layout2 = layout1;
       layout1 = layout;
       channels |= layoutChannels(layout);
-      zeroWords += countZeroWords(view, f);
+      zeroWords += countZeroWords(this.#buf, f);
     }
     if (!internal && !external) return -1;
     let score = 10 * frames + recurring - zeroWords;
@@ -591,12 +599,56 @@ export class SpektrumDecoder {
     if (this.#onEvent !== undefined) this.#onEvent(event);
   }
 
+  /** Records a pushed chunk's end (stream offset) and time. */
+  #addChunk(end: number, time: number, perByte: boolean): void {
+    if (this.#chunkTail === this.#chunkEnds.length) {
+      const live = this.#chunkTail - this.#chunkHead;
+      if (this.#chunkHead >= live) {
+        this.#chunkEnds.copyWithin(0, this.#chunkHead, this.#chunkTail);
+        this.#chunkTimes.copyWithin(0, this.#chunkHead, this.#chunkTail);
+        this.#chunkPerByte.copyWithin(0, this.#chunkHead, this.#chunkTail);
+      } else {
+        const size = this.#chunkEnds.length * 2;
+        const ends = new Float64Array(size);
+        const times = new Float64Array(size);
+        const perBytes = new Uint8Array(size);
+        ends.set(this.#chunkEnds.subarray(this.#chunkHead, this.#chunkTail));
+        times.set(this.#chunkTimes.subarray(this.#chunkHead, this.#chunkTail));
+        perBytes.set(this.#chunkPerByte.subarray(this.#chunkHead, this.#chunkTail));
+        this.#chunkEnds = ends;
+        this.#chunkTimes = times;
+        this.#chunkPerByte = perBytes;
+      }
+      this.#chunkTail = live;
+      this.#chunkHead = 0;
+    }
+    const i = this.#chunkTail++;
+    this.#chunkEnds[i] = end;
+    this.#chunkTimes[i] = time;
+    this.#chunkPerByte[i] = perByte ? 1 : 0;
+  }
+
+  /**
+   * Sets `frame.timeUs` to the time of the byte at buffer index `o`: its own time, or its
+   * chunk's time less one byte time for each byte after it in the chunk. Frames are emitted in
+   * stream order, so chunks before `o` are done with and dropped here. (It assigns rather than
+   * returns: a double returned from a call that is not inlined is boxed, one allocation a frame.)
+   */
+  #stampTime(frame: DecodedFrame, o: number): void {
+    const x = this.#base + o;
+    while (this.#chunkHead < this.#chunkTail - 1 && (this.#chunkEnds[this.#chunkHead] as number) <= x) this.#chunkHead++;
+    const i = this.#chunkHead;
+    if (this.#chunkPerByte[i] === 1) frame.timeUs = (this.#byteTimes as Float64Array)[o] as number;
+    else frame.timeUs = (this.#chunkTimes[i] as number) - ((this.#chunkEnds[i] as number) - 1 - x) * BYTE_TIME_US;
+  }
+
   /** Makes room for `n` more bytes: compacts first, grows (doubling) only when full. */
   #reserve(n: number): void {
     const need = this.#tail - this.#head + n;
+    const byteTimes = this.#byteTimes;
     if (this.#head > 0 && (this.#tail + n > this.#buf.length || this.#head >= this.#buf.length >> 1)) {
       this.#buf.copyWithin(0, this.#head, this.#tail);
-      this.#times.copyWithin(0, this.#head, this.#tail);
+      byteTimes?.copyWithin(0, this.#head, this.#tail);
       this.#base += this.#head;
       this.#tail -= this.#head;
       this.#head = 0;
@@ -606,10 +658,12 @@ export class SpektrumDecoder {
     while (capacity < need) capacity *= 2;
     const buf = new Uint8Array(capacity);
     buf.set(this.#buf.subarray(0, this.#tail));
-    const times = new Float64Array(capacity);
-    times.set(this.#times.subarray(0, this.#tail));
     this.#buf = buf;
-    this.#times = times;
     this.#view = new DataView(buf.buffer);
+    if (byteTimes !== null) {
+      const times = new Float64Array(capacity);
+      times.set(byteTimes.subarray(0, this.#tail));
+      this.#byteTimes = times;
+    }
   }
 }
