@@ -91,4 +91,15 @@ describe('the npm package', () => {
     expect(JSON.parse(run('node', ['use.mjs'], app))).toEqual({ system: 0xb2, first: 'Throttle', pos: 341 });
     expect(run(join(app, 'node_modules/.bin/satscope'), ['--help'], app)).toMatch(/satscope decode FILE/);
   });
+
+  it('runs the README example as written against the installed package', () => {
+    const readme = readFileSync(join(root, 'README.md'), 'utf8');
+    const block = /<!-- README example[^>]*-->\s*```js\n([\s\S]*?)```/.exec(readme);
+    expect(block, 'README example block').not.toBeNull();
+    const app = join(scratch, 'app');
+    writeFileSync(join(app, 'readme.mjs'), block![1]!);
+    const lines = run('node', ['readme.mjs'], app).trim().split('\n');
+    expect(lines[0]).toMatch(/^18\d frames, 2048 resolution, internal remote$/);
+    expect(lines[1]).toBe('Throttle is channel 0; period 11000 µs; state failsafe');
+  });
 });
