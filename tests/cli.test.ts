@@ -1,0 +1,142 @@
+/**
+ * The satscope command, run as a user would (node dist/cli/main.js), on captures of each kind
+ * made from the simulator. Needs `npm run build:lib` first (`npm test` does it).
+ */
+import { spawnSync } from 'node:child_process';
+import { mkdtempSync, rmSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join, resolve } from 'node:path';
+import { afterAll, beforeAll, describe, expect, it } from 'vitest';
+import { CaptureWriter } from '../src/decoder/index.js';
+import { preset, simulate } from '../src/simulator/index.js';
+
+const cli = resolve(import.meta.dirname, '../dist/cli/main.js');
+let dir = '';
+const sim = simulate({ ...preset('dropouts-failsafe'), seed: 3 }, 4_000_000, { truth: true });
+const intact = sim.truth!.frames.filter((f) => f.damage === null);
+
+function satscope(...args: string[]) {
+  const r = spawnSync(process.execPath, [cli, ...args], { encoding: 'utf8' });
+  return { code: r.status, out: r.stdout, err: r.stderr };
+}
+
+beforeAll(() => {
+  dir = mkdtempSync(join(tmpdir(), 'satscope-cli-'));
+  const writer = new CaptureWriter({ baudRate: 115200, source: 'test' });
+  const parts = [writer.header()];
+  for (let i = 0; i < sim.bytes.length; i += 48) {
+    const end = Math.min(sim.bytes.length, i + 48);
+    parts.push(writer.data(sim.bytes.subarray(i, end), sim.timesUs[end - 1]!));
+  }
+  const file = new Uint8Array(parts.reduce((n, p) => n + p.length, 0));
+  let at = 0;
+  for (const p of parts) { file.set(p, at); at += p.length; }
+  writeFileSync(join(dir, 'run.sscap'), file);
+  writeFileSync(join(dir, 'cut.sscap'), file.subarray(0, file.length - 30));
+  writeFileSync(join(dir, 'run.bin'), sim.bytes);
+  const csv = ['Time [s],Value,Parity Error,Framing Error', ...Array.from(sim.bytes, (b, i) => `${(sim.timesUs[i]! / 1e6).toFixed(9)},0x${b.toString(16).toUpperCase().padStart(2, '0')},,`)];
+  writeFileSync(join(dir, 'run.csv'), csv.join('\n'));
+  writeFileSync(join(dir, 'notes.txt'), 'these are my notes\nnot a capture\n');
+  writeFileSync(join(dir, 'empty.bin'), new Uint8Array(0));
+  writeFileSync(join(dir, 'noise.bin'), Uint8Array.from({ length: 500 }, (_, i) => (i * 37 + 11) & 0xff));
+});
+
+afterAll(() => rmSync(dir, { recursive: true, force: true }));
+
+describe('satscope decode', () => {
+  it('prints one JSONL line per intact frame, in the documented shape, from a .sscap', () => {
+    const r = satscope('decode', join(dir, 'run.sscap'));
+    expect(r.code).toBe(0);
+    const lines = r.out.trim().split('\n');
+    expect(lines).toHaveLength(intact.length);
+    expect(lines[0]).toMatch(/^\{"t": [\d.]+, "remote": "internal", "system": 178, "resolution": 2048, "fades": \d+, "rssi": null, "channels": \[\{"id": \d+, "pos": \d+, "us": \d+\}/);
+    const first = JSON.parse(lines[0]!);
+    expect(Object.keys(first)).toEqual(['t', 'remote', 'system', 'resolution', 'fades', 'rssi', 'channels']);
+    expect(first.channels.map((c: { id: number; pos: number }) => [c.id, c.pos])).toEqual(intact[0]!.channels.map((c) => [c.id, c.pos]));
+    // Chunk-timed: estimated from the chunk's arrival less 86.8 µs a byte after it, so never
+    // early, and late by at most the idle gaps to the chunk's end (under a frame period).
+    const late = lines.map((l, i) => JSON.parse(l).t * 1e6 - intact[i]!.timeUs);
+    expect(Math.min(...late)).toBeGreaterThan(-1);
+    expect(Math.max(...late)).toBeLessThan(11_000);
+  });
+
+  it('decodes the same frames from a raw .bin (t is null) and a Saleae CSV (exact t)', () => {
+    const fromSscap = satscope('decode', join(dir, 'run.sscap')).out.trim().split('\n').map((l) => JSON.parse(l));
+    const bin = satscope('decode', join(dir, 'run.bin')).out.trim().split('\n').map((l) => JSON.parse(l));
+    const csv = satscope('decode', join(dir, 'run.csv')).out.trim().split('\n').map((l) => JSON.parse(l));
+    expect(bin.map((f) => f.channels)).toEqual(fromSscap.map((f) => f.channels));
+    expect(csv.map((f) => f.channels)).toEqual(fromSscap.map((f) => f.channels));
+    expect(bin.every((f) => f.t === null)).toBe(true);
+    expect(csv.map((f) => Math.round(f.t * 1e6))).toEqual(intact.map((f) => Math.round(f.timeUs)));
+  });
+
+  it('writes CSV with a header and one µs column per channel', () => {
+    const r = satscope('decode', join(dir, 'run.bin'), '--format', 'csv');
+    const [header, row] = r.out.split('\n');
+    expect(header).toBe(`t,remote,system,resolution,fades,rssi,${Array.from({ length: 20 }, (_, i) => `ch${i}_us`).join(',')}`);
+    expect(row!.split(',')).toHaveLength(26);
+  });
+
+  it('honours --resolution and says how many bytes it dropped', () => {
+    const r = satscope('decode', join(dir, 'run.bin'), '--resolution', '2048');
+    expect(r.code).toBe(0);
+    expect(JSON.parse(r.out.split('\n')[0]!).resolution).toBe(2048);
+  });
+
+  it('keeps every intact record of a truncated capture and reports the cut', () => {
+    const r = satscope('decode', join(dir, 'cut.sscap'));
+    expect(r.code).toBe(0);
+    expect(r.err).toMatch(/cut\.sscap: the file ends inside a record .*cut off/);
+    const cut = r.out.trim().split('\n');
+    const full = satscope('decode', join(dir, 'run.sscap')).out.trim().split('\n');
+    // The last 48-byte record is lost: at most its three frames and the one it splits.
+    expect(cut.length).toBeGreaterThanOrEqual(full.length - 4);
+    expect(cut).toEqual(full.slice(0, cut.length));
+  });
+
+  it('rejects a text file, an empty file, a missing file and noise with a clear message', () => {
+    const text = satscope('decode', join(dir, 'notes.txt'));
+    expect(text.code).toBe(1);
+    expect(text.err).toMatch(/notes\.txt: .*(text|CSV)/i);
+    const empty = satscope('decode', join(dir, 'empty.bin'));
+    expect(empty.code).toBe(1);
+    expect(empty.err).toMatch(/empty/i);
+    const missing = satscope('decode', join(dir, 'nope.sscap'));
+    expect(missing.code).toBe(2);
+    expect(missing.err).toMatch(/cannot read .*nope\.sscap: no such file/);
+    const noise = satscope('decode', join(dir, 'noise.bin'));
+    expect(noise.code).toBe(1);
+    expect(noise.err).toMatch(/no Spektrum frames found in 500 bytes/);
+  });
+
+  it('explains bad usage', () => {
+    expect(satscope('decode').err).toMatch(/no FILE given/);
+    expect(satscope('decode', 'x', '--format', 'xml').err).toMatch(/--format must be jsonl or csv/);
+    expect(satscope('frobnicate', 'x').code).toBe(2);
+    expect(satscope('--help').out).toMatch(/satscope info FILE/);
+  });
+});
+
+describe('satscope info', () => {
+  it('sums up system, remote, resolution and why, channels, period, gaps and failsafe episodes', () => {
+    const r = satscope('info', join(dir, 'run.csv'));
+    expect(r.code).toBe(0);
+    expect(r.out).toMatch(/System\s+0xB2 DSMX 11 ms 2048/);
+    expect(r.out).toMatch(/Remote\s+internal \(byte 0 = UINT8 fades\)/);
+    expect(r.out).toMatch(/Resolution\s+2048 — 2048 resolution from the system byte/);
+    expect(r.out).toMatch(new RegExp(`Frames\\s+${intact.length} `));
+    expect(r.out).toMatch(/Frame period\s+11\.0\d ms measured \(11\.00 ms nominal\)/);
+    const gaps = sim.truth!.gaps.filter((g) => g.failsafe).length;
+    expect(gaps).toBeGreaterThan(0);
+    expect(r.out).toMatch(new RegExp(`Failsafe\\s+\\d+ holds, ${gaps} failsafes`));
+    expect(r.out).toMatch(/failsafe +from [\d.]+ s until [\d.]+ s/);
+    expect(r.out).toMatch(/ 0 Throttle/);
+  });
+
+  it('prints the summary as JSON with --json', () => {
+    const s = JSON.parse(satscope('info', join(dir, 'run.sscap'), '--json').out);
+    expect(s.kind).toBe('sscap');
+    expect(s.decoder.frames).toBe(intact.length);
+    expect(s.format.resolution).toBe(2048);
+  });
+});
