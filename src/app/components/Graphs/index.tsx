@@ -1,0 +1,142 @@
+/**
+ * Graphs over a chosen window: fade rate (or RSSI in dBm on an SPM4649T), frame period and
+ * lost frames, drawn with uPlot from the columnar buckets (100 ms each) with one setData per
+ * animation frame when new buckets arrived. The x axis is seconds before now.
+ */
+import type { Signal } from '@preact/signals';
+import { useEffect, useRef } from 'preact/hooks';
+import uPlot from 'uplot';
+import 'uplot/dist/uPlot.min.css';
+import { onFrame } from '../../frame-loop.js';
+import { live, type SeriesBuffer } from '../../live.js';
+import { status } from '../../store.js';
+import './style.css';
+
+export const WINDOWS = [
+  [10e6, '10 s'],
+  [60e6, '1 min'],
+  [600e6, '10 min'],
+] as const;
+
+interface ChartSpec {
+  key: 'fadeRate' | 'rssi' | 'periodMs' | 'lost';
+  title: string;
+  unit: string;
+  color: string;
+  range?: [number, number];
+  bars?: boolean;
+}
+
+function specs(rssi: boolean): ChartSpec[] {
+  return [
+    rssi
+      ? { key: 'rssi', title: 'RSSI', unit: 'dBm', color: '#7cc4ff', range: [-100, -30] }
+      : { key: 'fadeRate', title: 'Fades', unit: '/s', color: '#f0b429' },
+    { key: 'periodMs', title: 'Period', unit: 'ms', color: '#4fd1a5', range: [0, 30] },
+    { key: 'lost', title: 'Lost', unit: '/100 ms', color: '#ff6b6b', bars: true },
+  ];
+}
+
+function makeChart(el: HTMLElement, spec: ChartSpec, width: number, sync: uPlot.SyncPubSub): uPlot {
+  const opts: uPlot.Options = {
+    width,
+    height: 120,
+    cursor: { sync: { key: sync.key }, drag: { x: false, y: false } },
+    legend: { show: false },
+    scales: {
+      x: { time: false },
+      y: spec.range ? { range: () => spec.range as [number, number] } : { range: (_u, _min, max) => [0, Math.max(1, max * 1.15)] },
+    },
+    axes: [
+      {
+        stroke: '#8a97a8',
+        grid: { stroke: '#1e2835' },
+        ticks: { stroke: '#1e2835' },
+        values: (u, vals) => {
+          const end = u.scales.x?.max ?? 0;
+          return vals.map((v) => `${(v - end).toFixed(0)} s`);
+        },
+      },
+      { stroke: '#8a97a8', grid: { stroke: '#1e2835' }, ticks: { stroke: '#1e2835' }, size: 48, label: `${spec.title} ${spec.unit}`, labelSize: 18 },
+    ],
+    series: [
+      {},
+      {
+        label: spec.title,
+        stroke: spec.color,
+        width: 1.5,
+        fill: spec.bars ? `${spec.color}88` : undefined,
+        paths: spec.bars ? uPlot.paths.bars?.({ size: [1, Infinity] }) : undefined,
+        points: { show: false },
+        spanGaps: false,
+      },
+    ],
+  };
+  return new uPlot(opts, [[], []], el);
+}
+
+export function Graphs({ windowUs }: { windowUs: Signal<number> }) {
+  const host = useRef<HTMLDivElement>(null);
+  const rssi = status.value.format.headerMode === 'rssi';
+  useEffect(() => {
+    const el = host.current;
+    if (el === null) return undefined;
+    const sync = uPlot.sync('satscope');
+    const list = specs(rssi);
+    const width = () => Math.max(300, el.clientWidth - 4);
+    const charts = list.map((spec) => {
+      const box = document.createElement('div');
+      box.className = 'chart';
+      box.setAttribute('role', 'img');
+      box.setAttribute('aria-label', `${spec.title} over time`);
+      box.dataset.chart = spec.key;
+      el.append(box);
+      return makeChart(box, spec, width(), sync);
+    });
+    const resize = new ResizeObserver(() => charts.forEach((c) => c.setSize({ width: width(), height: 120 })));
+    resize.observe(el);
+    let version = -1;
+    let drawnAt = 0;
+    const stop = onFrame((nowMs) => {
+      // New buckets come ten times a second; the axis slides with time between them.
+      if (live.version === version && nowMs - drawnAt < 200) return;
+      version = live.version;
+      drawnAt = nowMs;
+      const s: SeriesBuffer = live.series;
+      const end = live.nowUs() / 1e6;
+      if (!Number.isFinite(end)) return;
+      const start = end - windowUs.value / 1e6;
+      const from = s.indexAt(start);
+      const x = s.t.subarray(from, s.length);
+      charts.forEach((chart, i) => {
+        const key = (list[i] as ChartSpec).key;
+        chart.batch(() => {
+          chart.setData([x as unknown as number[], s[key].subarray(from, s.length) as unknown as number[]], false);
+          chart.setScale('x', { min: start, max: end });
+        });
+      });
+    });
+    return () => {
+      stop();
+      resize.disconnect();
+      charts.forEach((c) => c.destroy());
+      el.replaceChildren();
+    };
+  }, [rssi, windowUs]);
+
+  return (
+    <section class="graphs" aria-label="Graphs">
+      <div class="graph-head">
+        <h2>Link over time</h2>
+        <div class="window" role="radiogroup" aria-label="Window">
+          {WINDOWS.map(([us, label]) => (
+            <button key={label} type="button" role="radio" aria-checked={windowUs.value === us} class={windowUs.value === us ? 'on' : ''} onClick={() => { windowUs.value = us; }}>
+              {label}
+            </button>
+          ))}
+        </div>
+      </div>
+      <div class="chart-host" ref={host} />
+    </section>
+  );
+}

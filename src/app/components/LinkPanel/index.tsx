@@ -1,0 +1,82 @@
+/**
+ * The failsafe state at a glance (spec §7.1): Live, Hold (frames missing, last values held) or
+ * Failsafe (a second without a frame), the time since the last frame, hold and failsafe counts,
+ * and a timeline of the episodes over the graphs' window.
+ */
+import type { Signal } from '@preact/signals';
+import { useEffect, useRef } from 'preact/hooks';
+import { onFrame } from '../../frame-loop.js';
+import { live } from '../../live.js';
+import { linkState } from '../../store.js';
+import './style.css';
+
+const LABEL = { waiting: 'Waiting', live: 'Live', hold: 'Hold', failsafe: 'Failsafe' } as const;
+const HINT = {
+  waiting: 'No frame yet',
+  live: 'Frames arriving',
+  hold: 'Frames missing: last values held',
+  failsafe: 'No frame for 1 s: failsafe',
+} as const;
+
+function ago(us: number): string {
+  if (!Number.isFinite(us)) return '—';
+  if (us < 1e6) return `${Math.round(us / 1000)} ms`;
+  return `${(us / 1e6).toFixed(1)} s`;
+}
+
+export function LinkPanel({ windowUs }: { windowUs: Signal<number> }) {
+  const since = useRef<HTMLSpanElement>(null);
+  const counts = useRef<HTMLSpanElement>(null);
+  const strip = useRef<HTMLDivElement>(null);
+  useEffect(() => {
+    let shown = '';
+    let stripVersion = -1;
+    let stripAt = 0;
+    return onFrame((nowMs) => {
+      const l = live.link;
+      const now = live.nowUs();
+      const text = l === null ? '—' : ago(now - l.lastFrameUs);
+      if (text !== shown && since.current !== null) {
+        since.current.textContent = text;
+        shown = text;
+      }
+      // The timeline moves with time: redraw it on new data or four times a second.
+      if (strip.current === null || (live.version === stripVersion && nowMs - stripAt < 250)) return;
+      stripVersion = live.version;
+      stripAt = nowMs;
+      if (counts.current !== null) counts.current.textContent = l === null ? '' : `${l.holds} holds · ${l.failsafes} failsafes`;
+      const span = windowUs.value;
+      const start = now - span;
+      const parts: string[] = [];
+      const el = strip.current;
+      el.replaceChildren();
+      for (const e of live.episodes.values()) {
+        const end = e.endUs ?? now;
+        if (end < start) continue;
+        const a = Math.max(0, (e.startUs - start) / span);
+        const b = Math.min(1, (end - start) / span);
+        const div = document.createElement('div');
+        div.className = `episode ${e.kind}`;
+        div.style.left = `${(a * 100).toFixed(3)}%`;
+        div.style.width = `${Math.max(0.3, (b - a) * 100).toFixed(3)}%`;
+        div.title = `${e.kind} ${ago(end - e.startUs)}`;
+        el.append(div);
+        parts.push(e.kind);
+      }
+      el.setAttribute('aria-label', parts.length === 0 ? 'No hold or failsafe in this window' : `${parts.filter((p) => p === 'failsafe').length} failsafe and ${parts.filter((p) => p === 'hold').length} hold episodes in this window`);
+    });
+  }, [windowUs]);
+
+  const state = linkState.value;
+  return (
+    <section class={`link ${state}`} aria-label="Link state">
+      <div class="state" role="status" aria-live="polite" data-testid="link-state">{LABEL[state]}</div>
+      <div class="hint">{HINT[state]}</div>
+      <dl>
+        <dt>Last frame</dt><dd><span ref={since}>—</span> ago</dd>
+        <dt>Episodes</dt><dd><span ref={counts} /></dd>
+      </dl>
+      <div class="timeline" ref={strip} role="img" aria-label="No hold or failsafe in this window" />
+    </section>
+  );
+}

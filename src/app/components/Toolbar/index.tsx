@@ -1,0 +1,121 @@
+/**
+ * Sources and recording: connect a receiver (WebSerial picker, or a port granted before), the
+ * demo, open a capture, record, export, and the resolution override.
+ */
+import { useEffect, useRef, useState } from 'preact/hooks';
+import { identify, pickPort, portLabel, serialUnavailable, USB_SERIAL_FILTERS } from '../../serial.js';
+import { notify, recording, resolutionOverride, send, status } from '../../store.js';
+import { openCapture } from '../../open-file.js';
+import './style.css';
+
+async function connect(port: SerialPort): Promise<void> {
+  send({ type: 'serial-open', port: await identify(port) });
+}
+
+async function choose(filtered: boolean): Promise<void> {
+  const missing = serialUnavailable();
+  if (missing !== null) {
+    notify('error', missing.title, missing.detail);
+    return;
+  }
+  const picked = await pickPort(filtered ? USB_SERIAL_FILTERS : []);
+  if ('problem' in picked) notify('warning', picked.problem.title, picked.problem.detail);
+  else await connect(picked);
+}
+
+function size(bytes: number): string {
+  return bytes < 1024 ? `${bytes} B` : bytes < 1 << 20 ? `${(bytes / 1024).toFixed(1)} kB` : `${(bytes / (1 << 20)).toFixed(2)} MB`;
+}
+
+function duration(us: number): string {
+  const s = Math.floor(us / 1e6);
+  return `${Math.floor(s / 60)}:${String(s % 60).padStart(2, '0')}`;
+}
+
+export function Toolbar({ granted }: { granted: SerialPort[] }) {
+  const file = useRef<HTMLInputElement>(null);
+  const [exported, setExported] = useState(false);
+  const s = status.value;
+  const rec = recording.value;
+  const live = s.kind === 'serial' || s.kind === 'demo';
+  useEffect(() => {
+    if (rec?.active) setExported(false);
+  }, [rec?.active]);
+  return (
+    <header class="toolbar">
+      <div class="brand">
+        <svg viewBox="0 0 64 64" width="26" height="26" aria-hidden="true"><path d="M10 44h8l5-22 7 30 6-38 6 30h12" fill="none" stroke="currentColor" stroke-width="5" stroke-linejoin="round" stroke-linecap="round" /></svg>
+        <span>SatScope</span>
+      </div>
+      <div class={`pill ${s.kind} ${s.state}`} role="status" data-testid="source-status">
+        {s.label}
+      </div>
+      <div class="actions">
+        {s.kind === 'serial' ? (
+          <button type="button" onClick={() => send({ type: 'serial-close' })}>Disconnect</button>
+        ) : (
+          <>
+            <button type="button" class="primary" onClick={() => void choose(true)}>Connect receiver</button>
+            <button type="button" class="link" onClick={() => void choose(false)}>any port…</button>
+            {granted.map((port, i) => (
+              <button key={i} type="button" onClick={() => void connect(port)} title="A port this page was allowed before">
+                {portLabel(port)}
+              </button>
+            ))}
+          </>
+        )}
+        {s.kind === 'demo' ? (
+          <button type="button" onClick={() => send({ type: 'demo-stop' })}>Stop demo</button>
+        ) : (
+          <button type="button" onClick={() => send({ type: 'demo-start' })}>Demo</button>
+        )}
+        <button type="button" onClick={() => file.current?.click()}>Open capture…</button>
+        <input ref={file} type="file" accept=".sscap,.bin,.csv,.txt" hidden onChange={(e) => {
+          const f = (e.currentTarget as HTMLInputElement).files?.[0];
+          if (f) void openCapture(f);
+          (e.currentTarget as HTMLInputElement).value = '';
+        }} />
+      </div>
+      <div class="recorder">
+        {rec?.active ? (
+          <button type="button" class="rec on" onClick={() => send({ type: 'record-stop' })} aria-label="Stop recording">
+            ■ Stop <span class="rec-info">{duration(rec.durationUs)} · {size(rec.bytes)}</span>
+          </button>
+        ) : (
+          <button type="button" class="rec" disabled={!live} onClick={() => send({ type: 'record-start' })} title={live ? 'Record raw bytes with their arrival times' : 'Connect a receiver or start the demo to record'}>
+            ● Record
+          </button>
+        )}
+        {rec !== null && !rec.active && rec.bytes > 0 ? (
+          <>
+            <button type="button" onClick={() => { send({ type: 'export', what: 'sscap', recording: 'last' }); setExported(true); }}>Export .sscap</button>
+            <button type="button" onClick={() => send({ type: 'export', what: 'raw', recording: 'last' })}>raw .bin</button>
+            {exported ? <span class="muted">saved</span> : null}
+          </>
+        ) : null}
+      </div>
+      <label class="resolution">
+        Resolution
+        <select value={String(resolutionOverride.value)} onChange={(e) => {
+          const v = (e.currentTarget as HTMLSelectElement).value;
+          const r = v === 'auto' ? 'auto' : (Number(v) as 1024 | 2048);
+          resolutionOverride.value = r;
+          send({ type: 'set-resolution', resolution: r });
+        }}>
+          <option value="auto">auto</option>
+          <option value="2048">2048</option>
+          <option value="1024">1024</option>
+        </select>
+      </label>
+      {rec?.recovered ? (
+        <div class="recovered" role="alert">
+          An unfinished recording from {new Date(rec.recovered.createdAt).toLocaleString()} ({size(rec.recovered.bytes)}) was kept.
+          <button type="button" onClick={() => send({ type: 'export', what: 'sscap', recording: 'recovered' })}>Export .sscap</button>
+          <button type="button" onClick={() => send({ type: 'export', what: 'raw', recording: 'recovered' })}>raw .bin</button>
+          <button type="button" class="link" onClick={() => send({ type: 'discard-recovered' })}>Discard</button>
+        </div>
+      ) : null}
+      {rec?.error ? <div class="recovered error" role="alert">{rec.error}</div> : null}
+    </header>
+  );
+}

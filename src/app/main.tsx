@@ -1,0 +1,21 @@
+/**
+ * Entry: starts the worker, renders the page, offers ports the origin was granted before, and
+ * starts the demo receiver when there are none, so a newcomer sees everything at once.
+ */
+import { render } from 'preact';
+import { App } from './components/App/index.js';
+import { serialUnavailable } from './serial.js';
+import { send, startWorker } from './store.js';
+
+async function main(): Promise<void> {
+  startWorker();
+  const granted = serialUnavailable() === null ? await navigator.serial.getPorts() : [];
+  render(<App granted={granted} />, document.getElementById('app') as HTMLElement);
+  const params = new URLSearchParams(location.search);
+  if (granted.length === 0 && params.get('demo') !== '0') send({ type: 'demo-start' });
+  if ('serviceWorker' in navigator && import.meta.env.PROD) {
+    navigator.serviceWorker.register('./sw.js').catch(() => undefined);
+  }
+}
+
+void main();

@@ -1,0 +1,69 @@
+/**
+ * The window's part of WebSerial: checking it exists, asking for a port (requestPort needs a
+ * user gesture, so it cannot happen in the worker), and naming granted ports for the worker.
+ */
+import type { PortIdentity } from '../worker/protocol.js';
+
+/** USB-serial chips people put on a satellite's DATA line, as picker hints; any port may be chosen. */
+export const USB_SERIAL_FILTERS: SerialPortFilter[] = [
+  { usbVendorId: 0x0403 }, // FTDI FT232R/FT231X
+  { usbVendorId: 0x10c4 }, // Silicon Labs CP210x
+  { usbVendorId: 0x1a86 }, // WCH CH340/CH341
+  { usbVendorId: 0x067b }, // Prolific PL2303
+  { usbVendorId: 0x2341 }, // Arduino
+  { usbVendorId: 0x239a }, // Adafruit
+  { usbVendorId: 0x0483 }, // STMicroelectronics (flight controllers in passthrough)
+];
+
+/** Why WebSerial cannot be used here, with what to do, or null when it can. */
+export function serialUnavailable(): { title: string; detail: string } | null {
+  if (!window.isSecureContext) {
+    return { title: 'Web Serial needs a secure page', detail: 'Open SatScope over https:// or from http://localhost; the browser hides serial ports from plain http pages.' };
+  }
+  if (!('serial' in navigator)) {
+    return { title: 'This browser has no Web Serial', detail: 'Use Chrome, Edge or Opera on a desktop computer. Firefox and Safari do not support it. Replay of saved captures works everywhere.' };
+  }
+  return null;
+}
+
+export async function identify(port: SerialPort): Promise<PortIdentity> {
+  const ports = await navigator.serial.getPorts();
+  const info = port.getInfo();
+  return { index: Math.max(0, ports.indexOf(port)), usbVendorId: info.usbVendorId, usbProductId: info.usbProductId };
+}
+
+/**
+ * Shows the browser's port picker, listing only `filters` (empty: every port). Returns the
+ * reason, for the user, when nothing was picked.
+ */
+export async function pickPort(filters: SerialPortFilter[]): Promise<SerialPort | { problem: { title: string; detail: string } }> {
+  try {
+    return await navigator.serial.requestPort({ filters });
+  } catch (error) {
+    const name = error instanceof Error ? error.name : '';
+    if (name === 'NotFoundError') {
+      return {
+        problem: {
+          title: 'No port chosen',
+          detail: filters.length > 0
+            ? 'Pick the USB-serial adapter wired to the satellite\'s DATA line (gray wire). If it is not in the list, use "any port…" to see every serial port.'
+            : 'Pick the USB-serial adapter wired to the satellite\'s DATA line (gray wire). If it is not listed, check the cable and its driver.',
+        },
+      };
+    }
+    if (name === 'SecurityError') return { problem: { title: 'Serial access is blocked', detail: 'The browser or an administrator policy blocks serial ports for this page. Check the site\'s permissions.' } };
+    return { problem: { title: 'Could not ask for a port', detail: String(error) } };
+  }
+}
+
+export function portLabel(port: SerialPort): string {
+  const { usbVendorId, usbProductId } = port.getInfo();
+  if (usbVendorId === undefined) return 'Serial port';
+  const hex = (v: number) => v.toString(16).padStart(4, '0');
+  const chip = USB_CHIPS[usbVendorId] ?? 'USB serial';
+  return `${chip} (${hex(usbVendorId)}:${hex(usbProductId ?? 0)})`;
+}
+
+const USB_CHIPS: Record<number, string> = {
+  0x0403: 'FTDI', 0x10c4: 'CP210x', 0x1a86: 'CH340', 0x067b: 'PL2303', 0x2341: 'Arduino', 0x239a: 'Adafruit', 0x0483: 'STM32',
+};

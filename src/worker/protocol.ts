@@ -1,0 +1,125 @@
+/**
+ * Every message between the page and the worker, both directions, as two discriminated unions.
+ * The worker owns the serial port, the decoder, the recorder and replay; the page owns the user
+ * gesture (requestPort) and the display. High-rate data crosses as typed arrays in batches, a
+ * few per animation frame at most, transferred, never one message per Spektrum frame.
+ */
+import type { FormatInfo, LinkState } from '../decoder/index.js';
+
+/** How the page names a port it was granted: its place in getPorts() and its USB IDs. */
+export interface PortIdentity {
+  index: number;
+  usbVendorId?: number;
+  usbProductId?: number;
+}
+
+export type SourceKind = 'none' | 'serial' | 'demo' | 'replay';
+
+export type ToWorker =
+  | { type: 'serial-open'; port: PortIdentity }
+  | { type: 'serial-close' }
+  | { type: 'demo-start' }
+  | { type: 'demo-stop' }
+  | { type: 'record-start' }
+  | { type: 'record-stop' }
+  | { type: 'export'; what: 'sscap' | 'raw'; recording: 'last' | 'recovered' }
+  | { type: 'discard-recovered' }
+  | { type: 'replay-open'; name: string; data: ArrayBuffer }
+  | { type: 'replay-play' }
+  | { type: 'replay-pause' }
+  /** Playback speed; 0 = as fast as possible. */
+  | { type: 'replay-speed'; speed: number }
+  | { type: 'replay-seek'; timeUs: number }
+  | { type: 'set-resolution'; resolution: 'auto' | 1024 | 2048 };
+
+/** Low-rate state of the source, sent when it changes. */
+export interface SourceStatus {
+  kind: SourceKind;
+  /** 'opening', 'reading', 'lost' (device gone), 'closed', 'playing', 'paused', 'ended'. */
+  state: string;
+  /** A line for the status pill, e.g. "FT232R 0403:6001 at 115200 baud". */
+  label: string;
+  /** How the source clock advances against wall time: 1 live, the speed in replay, 0 paused. */
+  clockRate: number;
+  format: FormatInfo;
+}
+
+/**
+ * Buckets of the graph series: the worker sums frames into 100 ms buckets, so a 10-minute
+ * window is 6000 points whatever the frame rate.
+ */
+export const BUCKET_US = 100_000;
+
+/** What changed since the last batch. All times are µs in the source's clock. */
+export interface Batch {
+  /** The source clock when the batch was made. */
+  nowUs: number;
+  /** performance.timeOrigin + performance.now() when the newest bytes in this batch arrived (ms), for latency measurement. */
+  arrivedMs: number;
+  /** Frames decoded since the last batch. */
+  frames: number;
+  /** Latest position of each channel 0–19 (X-Plus on the 2047 scale). */
+  positions: Uint16Array;
+  /** Time each channel was last seen, NaN if never. */
+  seenUs: Float64Array;
+  resolution: 1024 | 2048 | null;
+  link: {
+    state: LinkState;
+    lastFrameUs: number;
+    holds: number;
+    failsafes: number;
+    periodUs: number;
+    nominalPeriodUs: number;
+    fades: number;
+    fadeRate: number;
+    missedFrames: number;
+    rssi: number;
+  };
+  counters: { bytes: number; frames: number; resyncs: number; discardedBytes: number; badFrames: number };
+  /** Completed graph buckets: start time, fades/s, mean RSSI (NaN without), mean frame interval ms (NaN if <2 frames), lost frames. */
+  series: { t: Float64Array; fadeRate: Float32Array; rssi: Float32Array; periodMs: Float32Array; lost: Float32Array };
+  /** Hold and failsafe episodes that started or ended since the last batch. */
+  episodes: { id: number; kind: 'hold' | 'failsafe'; startUs: number; endUs: number | null }[];
+}
+
+export interface RecordingStatus {
+  active: boolean;
+  bytes: number;
+  records: number;
+  durationUs: number;
+  /** A recording from an earlier session that was never finished (page closed, crash, unplug). */
+  recovered: { name: string; bytes: number; createdAt: string } | null;
+  /** Storage problems (quota, no OPFS): the user is told. */
+  error: string | null;
+}
+
+export interface ReplayStatus {
+  name: string;
+  kind: string;
+  timing: string;
+  startUs: number;
+  endUs: number;
+  positionUs: number;
+  playing: boolean;
+  speed: number;
+  frames: number;
+  issues: string[];
+}
+
+/** Whole-capture series for the replay timeline, made once when a capture opens. */
+export interface Overview {
+  t: Float64Array;
+  fadeRate: Float32Array;
+  lost: Float32Array;
+  failsafe: { startUs: number; endUs: number }[];
+}
+
+export type FromWorker =
+  | { type: 'status'; status: SourceStatus }
+  | { type: 'batch'; batch: Batch }
+  | { type: 'reset' }
+  | { type: 'notice'; level: 'info' | 'warning' | 'error'; title: string; detail: string }
+  | { type: 'recording'; recording: RecordingStatus }
+  | { type: 'export-ready'; name: string; mime: string; data: ArrayBuffer }
+  | { type: 'replay'; replay: ReplayStatus | null }
+  | { type: 'overview'; overview: Overview };

@@ -1,0 +1,209 @@
+/**
+ * The recorder: raw bytes with their arrival times, written to the origin private file system
+ * as they arrive (a synchronous access handle, only available in workers), so memory does not
+ * grow with the recording and a reload, crash or unplug keeps everything written. Each record
+ * carries a CRC, so an unfinished file is simply a capture that ends early: a marker file names
+ * the recording in progress, and on the next start it is offered back.
+ */
+import { CaptureWriter, parseCapture, type CaptureMeta } from '../decoder/index.js';
+import type { RecordingStatus } from './protocol.js';
+
+const DIR = 'recordings';
+const MARKER = 'in-progress.json';
+/** Make written data durable about once a second. */
+const FLUSH_EVERY_US = 1_000_000;
+
+interface Marker {
+  name: string;
+  createdAt: string;
+}
+
+async function directory(): Promise<FileSystemDirectoryHandle> {
+  const root = await navigator.storage.getDirectory();
+  return root.getDirectoryHandle(DIR, { create: true });
+}
+
+async function readMarker(dir: FileSystemDirectoryHandle): Promise<Marker | null> {
+  try {
+    const file = await (await dir.getFileHandle(MARKER)).getFile();
+    return JSON.parse(await file.text()) as Marker;
+  } catch {
+    return null;
+  }
+}
+
+async function writeMarker(dir: FileSystemDirectoryHandle, marker: Marker | null): Promise<void> {
+  if (marker === null) {
+    await dir.removeEntry(MARKER).catch(() => undefined);
+    return;
+  }
+  const handle = await (await dir.getFileHandle(MARKER, { create: true })).createSyncAccessHandle();
+  try {
+    const bytes = new TextEncoder().encode(JSON.stringify(marker));
+    handle.truncate(0);
+    handle.write(bytes, { at: 0 });
+    handle.flush();
+  } finally {
+    handle.close();
+  }
+}
+
+export class Recorder {
+  #dir: FileSystemDirectoryHandle | undefined;
+  #handle: FileSystemSyncAccessHandle | undefined;
+  #writer: CaptureWriter | undefined;
+  #name = '';
+  #at = 0;
+  #records = 0;
+  #firstUs = NaN;
+  #lastUs = NaN;
+  #lastFlushUs = 0;
+  /** The last finished recording, for export. */
+  #last: string | null = null;
+  #recovered: (Marker & { bytes: number }) | null = null;
+  #error: string | null = null;
+
+  constructor(readonly onChange: (status: RecordingStatus) => void) {}
+
+  /** Looks for a recording an earlier session left unfinished. */
+  async init(): Promise<void> {
+    try {
+      const dir = (this.#dir = await directory());
+      const marker = await readMarker(dir);
+      if (marker !== null) {
+        try {
+          const file = await (await dir.getFileHandle(marker.name)).getFile();
+          this.#recovered = { ...marker, bytes: file.size };
+        } catch {
+          await writeMarker(dir, null);
+        }
+      }
+    } catch (error) {
+      this.#error = `Recording is not available: this browser gives the page no private file storage (${String(error)}).`;
+    }
+    this.#report();
+  }
+
+  get active(): boolean {
+    return this.#handle !== undefined;
+  }
+
+  status(): RecordingStatus {
+    return {
+      active: this.active,
+      bytes: this.#at,
+      records: this.#records,
+      durationUs: Number.isFinite(this.#firstUs) ? this.#lastUs - this.#firstUs : 0,
+      recovered: this.#recovered === null ? null : { name: this.#recovered.name, bytes: this.#recovered.bytes, createdAt: this.#recovered.createdAt },
+      error: this.#error,
+    };
+  }
+
+  #report(): void {
+    this.onChange(this.status());
+  }
+
+  async start(meta: CaptureMeta, createdAt: string): Promise<void> {
+    if (this.#handle !== undefined) return;
+    try {
+      const dir = this.#dir ?? (this.#dir = await directory());
+      const name = `satscope-${createdAt.replace(/[:.]/g, '-')}.sscap`;
+      const handle = await (await dir.getFileHandle(name, { create: true })).createSyncAccessHandle();
+      handle.truncate(0);
+      this.#writer = new CaptureWriter({ ...meta, createdAt });
+      this.#handle = handle;
+      this.#name = name;
+      this.#at = 0;
+      this.#records = 0;
+      this.#firstUs = this.#lastUs = NaN;
+      this.#write(this.#writer.header());
+      handle.flush();
+      await writeMarker(dir, { name, createdAt });
+      this.#error = null;
+    } catch (error) {
+      this.#handle?.close();
+      this.#handle = undefined;
+      this.#error = `Could not start recording: ${String(error)}`;
+    }
+    this.#report();
+  }
+
+  #write(bytes: Uint8Array): void {
+    const handle = this.#handle as FileSystemSyncAccessHandle;
+    const written = handle.write(bytes, { at: this.#at });
+    if (written !== bytes.length) throw new Error(`storage accepted ${written} of ${bytes.length} bytes (disk full?)`);
+    this.#at += written;
+  }
+
+  /** Appends raw bytes as they arrived. */
+  data(bytes: Uint8Array, timeUs: number, port = 0): void {
+    if (this.#handle === undefined || this.#writer === undefined) return;
+    try {
+      this.#write(this.#writer.data(bytes, timeUs, port));
+    } catch (error) {
+      this.#fail(error);
+      return;
+    }
+    this.#records++;
+    if (Number.isNaN(this.#firstUs)) this.#firstUs = timeUs;
+    this.#lastUs = timeUs;
+    if (timeUs - this.#lastFlushUs >= FLUSH_EVERY_US) {
+      this.#handle.flush();
+      this.#lastFlushUs = timeUs;
+      this.#report();
+    }
+  }
+
+  /** Notes something that happened to the port (lost, reconnected) in the recording. */
+  event(text: string, timeUs: number, port = 0): void {
+    if (this.#handle === undefined || this.#writer === undefined) return;
+    try {
+      this.#write(this.#writer.event(text, timeUs, port));
+      this.#handle.flush();
+    } catch (error) {
+      this.#fail(error);
+    }
+  }
+
+  #fail(error: unknown): void {
+    this.#error = `Recording stopped: ${String(error)}. Everything written before this point is kept.`;
+    void this.stop();
+  }
+
+  async stop(): Promise<void> {
+    const handle = this.#handle;
+    if (handle === undefined) return;
+    this.#handle = undefined;
+    try {
+      handle.flush();
+    } finally {
+      handle.close();
+    }
+    this.#last = this.#name;
+    if (this.#dir !== undefined) await writeMarker(this.#dir, null);
+    this.#report();
+  }
+
+  /**
+   * The bytes of the last (or recovered) recording: the .sscap file itself, or the raw serial
+   * bytes alone (every intact record's data, in order).
+   */
+  async export(which: 'last' | 'recovered', what: 'sscap' | 'raw'): Promise<{ name: string; data: ArrayBuffer } | string> {
+    const name = which === 'last' ? this.#last : this.#recovered?.name ?? null;
+    if (name === null || this.#dir === undefined) return which === 'last' ? 'Nothing recorded yet.' : 'No unfinished recording.';
+    const file = await (await this.#dir.getFileHandle(name)).getFile();
+    const data = await file.arrayBuffer();
+    if (what === 'sscap') return { name, data };
+    const capture = parseCapture(new Uint8Array(data));
+    return { name: name.replace(/\.sscap$/, '.bin'), data: capture.bytes.slice().buffer };
+  }
+
+  async discardRecovered(): Promise<void> {
+    const recovered = this.#recovered;
+    if (recovered === null || this.#dir === undefined) return;
+    await this.#dir.removeEntry(recovered.name).catch(() => undefined);
+    this.#recovered = null;
+    if (!this.active) await writeMarker(this.#dir, null);
+    this.#report();
+  }
+}
