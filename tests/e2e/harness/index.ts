@@ -1,0 +1,3 @@
+export * from './browser.js';
+export * from './policy.js';
+export * from './pty-serial.js';
