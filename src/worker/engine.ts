@@ -64,9 +64,19 @@ export class Engine {
 
   /** Bytes as they arrived: `timeUs` is the chunk's arrival (or per-byte times). */
   push(bytes: Uint8Array, time: number | Float64Array | undefined, arrivedMs: number): void {
-    const d = this.decoder;
-    d.push(bytes, time);
+    this.decoder.push(bytes, time);
     this.#arrivedMs = arrivedMs;
+    this.#drain();
+  }
+
+  /** End of the source: decide the bytes still held. */
+  end(): void {
+    this.decoder.end();
+    this.#drain();
+  }
+
+  #drain(): void {
+    const d = this.decoder;
     this.#changed = true;
     for (let f = d.next(); f !== undefined; f = d.next()) {
       const t = f.timeUs;
@@ -97,12 +107,6 @@ export class Engine {
       this.#bFrames++;
       this.#lastFrameUs = t;
     }
-  }
-
-  /** End of the source: decide the bytes still held. */
-  end(): void {
-    this.decoder.end();
-    this.push(new Uint8Array(0), undefined, this.#arrivedMs);
   }
 
   /** Closes buckets that end at or before `t` (also the empty ones of a dropout). */

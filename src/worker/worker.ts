@@ -43,7 +43,8 @@ const serial = new SerialSource(nowUs, {
   lineError: (name) => notice('warning', 'Line error survived', `${name}: some bytes may be lost; reading goes on.`),
   lost: () => {
     recorder.event('device lost', nowUs());
-    setStatus('serial', 'lost', `${label} — device lost`);
+    setStatus('serial', 'lost', `${label.replace(/ at 115200 baud$/, '')}: device lost`);
+    startReconnecting();
     notice('error', 'The receiver\'s adapter was unplugged', 'Reading stopped; everything recorded so far is kept. Plug it back in and it reconnects by itself.');
   },
   closed: () => undefined,
@@ -108,6 +109,7 @@ function stopIdleTicks(): void {
 /** Stops whatever source runs and starts a fresh decode. */
 async function stopSource(): Promise<void> {
   stopIdleTicks();
+  stopReconnecting();
   demo?.stop();
   demo = undefined;
   replay?.stop();
@@ -305,27 +307,43 @@ async function handle(message: ToWorker): Promise<void> {
   }
 }
 
-// A replugged adapter is picked up again without a new prompt.
-navigator.serial?.addEventListener('connect', (event) => {
-  const port = event.target as SerialPort;
-  const info = port.getInfo();
-  if (kind === 'serial' && state === 'lost' && serialIdentity !== undefined
-    && info.usbVendorId === serialIdentity.usbVendorId && info.usbProductId === serialIdentity.usbProductId) {
-    const identity = serialIdentity;
-    void (async () => {
-      try {
-        await serial.open(port);
-        recorder.event('device reconnected', nowUs());
-        setStatus('serial', 'reading', `${describePort(port)} at 115200 baud`);
-        notice('info', 'Reconnected', 'The adapter is back; reading again.');
-        serialIdentity = identity;
-      } catch (error) {
-        const problem = openProblem(error);
-        notice('error', problem.title, problem.detail);
-      }
-    })();
+// A replugged adapter is picked up again without a new prompt: after a loss the worker tries
+// the same port again every second (Chromium does not always fire 'connect', e.g. without udev,
+// and a replugged adapter keeps its grant), and at once when 'connect' does fire.
+const RECONNECT_MS = 1000;
+let reconnectTimer: ReturnType<typeof setInterval> | undefined;
+let reconnecting = false;
+
+function startReconnecting(): void {
+  stopReconnecting();
+  reconnectTimer = setInterval(() => void reconnect(), RECONNECT_MS);
+}
+
+function stopReconnecting(): void {
+  clearInterval(reconnectTimer);
+  reconnectTimer = undefined;
+}
+
+async function reconnect(): Promise<void> {
+  const identity = serialIdentity;
+  if (reconnecting || identity === undefined || kind !== 'serial' || state !== 'lost') return;
+  reconnecting = true;
+  try {
+    const port = await findPort(identity);
+    if (port === undefined) return;
+    await serial.open(port);
+    stopReconnecting();
+    recorder.event('device reconnected', nowUs());
+    setStatus('serial', 'reading', `${describePort(port)} at 115200 baud`);
+    notice('info', 'Reconnected', 'The adapter is back; reading again.');
+  } catch {
+    // Still gone: try again on the next tick.
+  } finally {
+    reconnecting = false;
   }
-});
+}
+
+navigator.serial?.addEventListener('connect', () => void reconnect());
 
 let queue: Promise<void> = Promise.resolve();
 scope.addEventListener('message', (event: MessageEvent<ToWorker>) => {

@@ -5,16 +5,17 @@
  */
 import { captureChunks, type Capture } from '../../decoder/index.js';
 
-/** Chunk views of one port, with the time argument the decoder takes. */
+/** Chunk views of one port, with their times. */
 interface Chunk {
   bytes: Uint8Array;
-  time: number | Float64Array | undefined;
-  /** Arrival time of the chunk's last byte, µs (for scheduling); NaN without timing. */
+  /** Per-byte times (logic-analyser captures): bytes are fed as their own times pass. */
+  byteTimes: Float64Array | undefined;
+  /** The chunk's arrival (its last byte), µs; NaN without timing. */
   atUs: number;
 }
 
 const TICK_MS = 10;
-/** At full speed, decode for this long per tick, then let messages through. */
+/** Decode for at most this long per tick, then let messages through. */
 const SLICE_MS = 12;
 /** A seek replays this much before the target so the graphs and failsafe state have history. */
 const SEEK_HISTORY_US = 10 * 60e6;
@@ -24,6 +25,8 @@ export class ReplaySource {
   readonly startUs: number;
   readonly endUs: number;
   #next = 0;
+  /** Bytes of chunk #next already fed (per-byte-timed chunks are fed a piece at a time). */
+  #nextByte = 0;
   #clockUs: number;
   #wallMs = 0;
   #speed = 1;
@@ -35,24 +38,17 @@ export class ReplaySource {
    * @param onTick after each tick that moved the clock (the worker sends a batch)
    * @param onEnd when the last chunk has been fed
    */
+  #lastFedUs = NaN;
+
   constructor(
     readonly capture: Capture,
-    readonly feed: (bytes: Uint8Array, time: number | Float64Array | undefined, atUs: number) => void,
+    readonly sink: (bytes: Uint8Array, time: number | Float64Array | undefined, atUs: number) => void,
     readonly onTick: (clockUs: number) => void,
     readonly onEnd: () => void,
   ) {
     for (const c of captureChunks(capture, 0)) {
       const atUs = c.byteTimesUs !== undefined ? (c.byteTimesUs[c.byteTimesUs.length - 1] ?? NaN) : c.timeUs;
-      if (c.byteTimesUs !== undefined && c.bytes.length > 4096) {
-        // Per-byte captures are one chunk: cut them into pieces that play at their times.
-        for (let i = 0; i < c.bytes.length; i += 64) {
-          const end = Math.min(c.bytes.length, i + 64);
-          const times = c.byteTimesUs.subarray(i, end);
-          this.chunks.push({ bytes: c.bytes.subarray(i, end), time: times, atUs: times[times.length - 1] as number });
-        }
-      } else {
-        this.chunks.push({ bytes: c.bytes, time: c.time, atUs });
-      }
+      this.chunks.push({ bytes: c.bytes, byteTimes: c.byteTimesUs, atUs });
     }
     const timed = this.chunks.filter((c) => Number.isFinite(c.atUs));
     this.startUs = timed.length > 0 ? (timed[0] as Chunk).atUs : 0;
@@ -60,6 +56,12 @@ export class ReplaySource {
     this.#clockUs = this.startUs;
     // Untimed captures (raw .bin) play as fast as possible: there is no clock to follow.
     if (timed.length === 0) this.#speed = 0;
+  }
+
+  /** Hands bytes to the sink and remembers the time of the last one fed. */
+  feed(bytes: Uint8Array, time: number | Float64Array | undefined, atUs: number): void {
+    if (Number.isFinite(atUs)) this.#lastFedUs = atUs;
+    this.sink(bytes, time, atUs);
   }
 
   get timed(): boolean {
@@ -104,17 +106,48 @@ export class ReplaySource {
    */
   seek(timeUs: number): void {
     const target = Math.min(Math.max(timeUs, this.startUs), this.endUs);
+    this.#next = 0;
+    this.#nextByte = 0;
+    // Skip what lies before the history window, then feed up to the target at once.
     const from = target - SEEK_HISTORY_US;
-    let i = 0;
-    while (i < this.chunks.length && (this.chunks[i] as Chunk).atUs < from) i++;
-    for (; i < this.chunks.length && (this.chunks[i] as Chunk).atUs <= target; i++) {
-      const c = this.chunks[i] as Chunk;
-      this.feed(c.bytes, c.time, c.atUs);
-    }
-    this.#next = i;
+    while (this.#next < this.chunks.length && (this.chunks[this.#next] as Chunk).atUs < from) this.#next++;
+    this.#feedUntil(target, Infinity);
     this.#clockUs = target;
     this.#wallMs = performance.now();
     this.onTick(this.#clockUs);
+  }
+
+  /**
+   * Feeds every byte whose time is at or before `clockUs` (a chunk-timed chunk whole once its
+   * arrival time has passed; a per-byte-timed one byte range by byte range), for at most
+   * `budgetMs` of wall time. Returns whether all chunks have been fed.
+   */
+  #feedUntil(clockUs: number, budgetMs: number): boolean {
+    const started = performance.now();
+    while (this.#next < this.chunks.length) {
+      if (budgetMs !== Infinity && performance.now() - started > budgetMs) return false;
+      const c = this.chunks[this.#next] as Chunk;
+      if (c.byteTimes === undefined) {
+        if (c.atUs > clockUs) return false;
+        this.feed(c.bytes, Number.isNaN(c.atUs) ? undefined : c.atUs, c.atUs);
+        this.#next++;
+        continue;
+      }
+      // Per-byte times: up to 4096 bytes whose time has come.
+      const times = c.byteTimes;
+      let end = this.#nextByte;
+      const limit = Math.min(times.length, this.#nextByte + 4096);
+      while (end < limit && !((times[end] as number) > clockUs)) end++;
+      if (end > this.#nextByte) this.feed(c.bytes.subarray(this.#nextByte, end), times.subarray(this.#nextByte, end), times[end - 1] as number);
+      this.#nextByte = end;
+      if (end === times.length) {
+        this.#next++;
+        this.#nextByte = 0;
+      } else if (end < limit) {
+        return false;
+      }
+    }
+    return true;
   }
 
   stop(): void {
@@ -123,22 +156,18 @@ export class ReplaySource {
 
   #tick(): void {
     const nowMs = performance.now();
+    let done: boolean;
     if (this.#speed === 0) {
       // As fast as possible, in slices so the worker stays responsive.
-      while (this.#next < this.chunks.length && performance.now() - nowMs < SLICE_MS) {
-        const c = this.chunks[this.#next++] as Chunk;
-        this.feed(c.bytes, c.time, c.atUs);
-        if (Number.isFinite(c.atUs)) this.#clockUs = c.atUs;
-      }
+      done = this.#feedUntil(Infinity, SLICE_MS);
+      const c = this.chunks[Math.min(this.#next, this.chunks.length - 1)];
+      if (c !== undefined && Number.isFinite(c.atUs)) this.#clockUs = done ? this.endUs : Math.max(this.#clockUs, this.#lastFedUs);
     } else {
       this.#clockUs += (nowMs - this.#wallMs) * 1000 * this.#speed;
-      while (this.#next < this.chunks.length && !((this.chunks[this.#next] as Chunk).atUs > this.#clockUs)) {
-        const c = this.chunks[this.#next++] as Chunk;
-        this.feed(c.bytes, c.time, c.atUs);
-      }
+      done = this.#feedUntil(this.#clockUs, SLICE_MS);
     }
     this.#wallMs = nowMs;
-    if (this.#next >= this.chunks.length) {
+    if (done) {
       this.#clockUs = Math.max(this.#clockUs, this.endUs);
       this.pause();
       this.onTick(this.#clockUs);

@@ -1,0 +1,79 @@
+/**
+ * What every browser test of the page needs: the built page (dist-app/, made by `npm run build`)
+ * served on 127.0.0.1, Debian's Chromium, and a place for screenshots.
+ */
+import { existsSync, mkdirSync, writeFileSync } from 'node:fs';
+import { join, resolve } from 'node:path';
+import type { Browser, Page } from 'playwright-core';
+import { CaptureWriter } from '../../src/decoder/index.js';
+import { chromiumAvailable, launchChromium, startStaticServer, type StaticServer } from './harness/browser.js';
+
+export const ROOT = resolve(import.meta.dirname, '../..');
+export const APP_DIR = join(ROOT, 'dist-app');
+export const SHOTS = join(ROOT, 'test-results/screenshots');
+export const SHARED_CAPTURES = resolve(ROOT, '../shared/captures/px4');
+
+/** Why the browser tests cannot run here, or null. */
+export function browserUnavailable(): string | null {
+  if (!chromiumAvailable()) return 'Debian chromium is not installed (/usr/lib/chromium/chromium): apt-get install chromium';
+  if (!existsSync(join(APP_DIR, 'index.html'))) return 'the page is not built: run `npm run build` (npm test does)';
+  return null;
+}
+
+export interface AppSession {
+  browser: Browser;
+  server: StaticServer;
+  close(): Promise<void>;
+}
+
+export async function startApp(): Promise<AppSession> {
+  mkdirSync(SHOTS, { recursive: true });
+  const server = await startStaticServer(APP_DIR);
+  const browser = await launchChromium();
+  return {
+    browser,
+    server,
+    async close() {
+      await browser.close();
+      await server.close();
+    },
+  };
+}
+
+export async function shot(page: Page, name: string): Promise<string> {
+  const path = join(SHOTS, `${name}.png`);
+  await page.screenshot({ path, fullPage: true });
+  return path;
+}
+
+/** The µs value each channel bar on the page shows (0–11 and X-Plus), by channel name (NaN: no data). */
+export async function barValues(page: Page): Promise<Record<string, number>> {
+  return page.$$eval('.channels [role="meter"]', (bars) => Object.fromEntries(bars.map((b) => [b.getAttribute('aria-label'), Number(b.getAttribute('aria-valuenow') ?? NaN)])));
+}
+
+/** Writes chunks as a .sscap file (as the recorder would), for replay tests. */
+export function writeCapture(path: string, chunks: { bytes: Uint8Array; timeUs: number }[]): void {
+  const writer = new CaptureWriter({ baudRate: 115200, source: 'test' });
+  const parts = [writer.header(), ...chunks.map((c) => writer.data(c.bytes, c.timeUs))];
+  const out = new Uint8Array(parts.reduce((n, p) => n + p.length, 0));
+  let at = 0;
+  for (const p of parts) {
+    out.set(p, at);
+    at += p.length;
+  }
+  writeFileSync(path, out);
+}
+
+/** Cuts a per-byte-timed stream into what a USB adapter delivers: one chunk per 16 ms window. */
+export function usbChunks(bytes: Uint8Array, timesUs: Float64Array, windowUs = 16_000): { bytes: Uint8Array; timeUs: number }[] {
+  const out: { bytes: Uint8Array; timeUs: number }[] = [];
+  let start = 0;
+  for (let i = 0; i <= bytes.length; i++) {
+    const deadline = Math.floor((timesUs[start] as number) / windowUs) * windowUs + windowUs;
+    if (i === bytes.length || (timesUs[i] as number) >= deadline) {
+      if (i > start) out.push({ bytes: bytes.subarray(start, i), timeUs: deadline });
+      start = i;
+    }
+  }
+  return out;
+}

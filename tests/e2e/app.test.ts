@@ -1,0 +1,186 @@
+/**
+ * The built page in Debian's Chromium: the demo source, replay of captures (ours and the real
+ * PX4 ones) checked against the library, the failsafe states, recording and recovery, bad
+ * files, CSP, no third-party requests, and offline use. Screenshots of each state go to
+ * test-results/screenshots/.
+ */
+import { existsSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import type { Page } from 'playwright-core';
+import { afterAll, beforeAll, describe, expect, it } from 'vitest';
+import { parseCapture, readCapture, summarizeCapture, channelName } from '../../src/decoder/index.js';
+import { preset, simulate } from '../../src/simulator/index.js';
+import { SHARED_CAPTURES, barValues, browserUnavailable, shot, startApp, usbChunks, writeCapture, type AppSession } from './app-fixture.js';
+
+const skip = browserUnavailable();
+if (skip !== null) console.warn(`skipping the page tests: ${skip}`);
+
+let app: AppSession;
+let dir = '';
+
+beforeAll(async () => {
+  if (skip !== null) return;
+  app = await startApp();
+  dir = mkdtempSync(join(tmpdir(), 'satscope-e2e-'));
+});
+
+afterAll(async () => {
+  if (skip !== null) return;
+  await app.close();
+  rmSync(dir, { recursive: true, force: true });
+});
+
+async function open(query = ''): Promise<{ page: Page; errors: string[]; requests: string[] }> {
+  const context = await app.browser.newContext({ viewport: { width: 1400, height: 1000 }, acceptDownloads: true });
+  const page = await context.newPage();
+  const errors: string[] = [];
+  const requests: string[] = [];
+  page.on('pageerror', (e) => errors.push(e.message));
+  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
+  page.on('request', (r) => requests.push(r.url()));
+  await page.goto(app.server.url(`/${query}`));
+  return { page, errors, requests };
+}
+
+async function replayFile(page: Page, path: string): Promise<void> {
+  await page.setInputFiles('input[type=file]', path);
+  await page.locator('section.replay').waitFor();
+}
+
+async function playToEnd(page: Page): Promise<void> {
+  await page.getByRole('radio', { name: 'max' }).click();
+  await page.locator('[data-testid="source-status"]', { hasText: '(end)' }).waitFor({ timeout: 20_000 });
+}
+
+describe.skipIf(skip !== null)('the page', () => {
+  it('starts the demo receiver when no port is granted and shows live bars, system and link state', async () => {
+    const { page, errors, requests } = await open();
+    await page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor({ timeout: 10_000 });
+    await page.waitForFunction(() => document.querySelectorAll('.channels [role="meter"][aria-valuenow]').length >= 12);
+    const bars = await barValues(page);
+    expect(Object.keys(bars).slice(0, 12)).toEqual(Array.from({ length: 12 }, (_, i) => channelName(i)));
+    for (const us of Object.values(bars).slice(0, 12)) {
+      expect(us).toBeGreaterThanOrEqual(903);
+      expect(us).toBeLessThanOrEqual(2097);
+    }
+    await expect(page.getByTestId('protocol').textContent()).resolves.toBe('DSMX 11 ms');
+    await expect(page.getByTestId('source-status').textContent()).resolves.toMatch(/Demo receiver/);
+    await page.waitForTimeout(1500);
+    await shot(page, 'live-demo');
+    // Strict CSP, everything from this origin, no violation.
+    await expect(page.locator('meta[http-equiv="Content-Security-Policy"]').getAttribute('content')).resolves.toMatch(/default-src 'self'; script-src 'self'/);
+    const origin = app.server.origin;
+    expect(requests.filter((u) => !u.startsWith(origin) && !u.startsWith('blob:') && !u.startsWith('data:'))).toEqual([]);
+    expect(errors).toEqual([]);
+    await page.context().close();
+  });
+
+  it('replays a real PX4 capture and its bars end on the values the library decodes', async () => {
+    const file = join(SHARED_CAPTURES, 'dsm_x_dx9_px4_binding_data.txt');
+    if (!existsSync(file)) {
+      console.warn(`skipping PX4 replay: ${file} is not here`);
+      return;
+    }
+    const expected = summarizeCapture(readCapture(new Uint8Array(readFileSync(file)), 'x.txt'));
+    const { page, errors } = await open('?demo=0');
+    await replayFile(page, file);
+    await playToEnd(page);
+    await page.locator('.channels').nth(1).waitFor();
+    const bars = await barValues(page);
+    for (const c of expected.channels) expect(bars[c.name], c.name).toBe(c.lastUs);
+    await expect(page.getByTestId('protocol').textContent()).resolves.toBe('DSMX 11 ms');
+    await expect(page.getByTestId('count-frames').textContent()).resolves.toBe(String(expected.decoder.frames));
+    await shot(page, 'replay-px4-xplus');
+    expect(errors).toEqual([]);
+    await page.context().close();
+  });
+
+  it('shows Hold inside a short gap and Failsafe a second into a long one, with the episodes', async () => {
+    const sim = simulate(preset('dropouts-failsafe'), undefined, { truth: true });
+    const path = join(dir, 'dropouts.sscap');
+    writeCapture(path, usbChunks(sim.bytes, sim.timesUs));
+    const failsafeGap = sim.truth!.gaps.find((g) => g.failsafe)!;
+    const { page } = await open('?demo=0');
+    await replayFile(page, path);
+    await page.getByRole('button', { name: 'Pause' }).click();
+    const seek = async (us: number) => {
+      await page.locator('input.seek').evaluate((el, v) => {
+        const input = el as HTMLInputElement;
+        input.value = String(v);
+        input.dispatchEvent(new Event('change', { bubbles: true }));
+      }, us);
+    };
+    await seek(failsafeGap.lastFrameUs! + 200_000);
+    await page.getByTestId('link-state').filter({ hasText: 'Hold' }).waitFor();
+    await shot(page, 'hold');
+    await seek(failsafeGap.lastFrameUs! + 1_200_000);
+    await page.getByTestId('link-state').filter({ hasText: 'Failsafe' }).waitFor();
+    await shot(page, 'failsafe');
+    await page.getByRole('button', { name: 'Play' }).click();
+    await playToEnd(page);
+    await page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor();
+    await expect(page.locator('.link dd').nth(1).textContent()).resolves.toMatch(/2 holds · 1 failsafes/);
+    await page.context().close();
+  });
+
+  it('records the demo to storage, exports it, and offers an unfinished recording back after a reload', async () => {
+    const { page, errors } = await open();
+    await page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor({ timeout: 10_000 });
+    await page.getByRole('button', { name: '● Record' }).click();
+    await page.waitForTimeout(2000);
+    await page.getByRole('button', { name: 'Stop recording' }).click();
+    const download = page.waitForEvent('download');
+    await page.getByRole('button', { name: 'Export .sscap' }).first().click();
+    const file = join(dir, 'recorded.sscap');
+    await (await download).saveAs(file);
+    const capture = parseCapture(new Uint8Array(readFileSync(file)));
+    expect(capture.issues).toEqual([]);
+    expect(capture.chunkEnds.length).toBeGreaterThan(50);
+    const summary = summarizeCapture(capture);
+    expect(summary.decoder.frames).toBeGreaterThan(120);
+    expect(summary.format.system).toBe(0xb2);
+
+    // Start again and reload without stopping: the recording is kept and offered back.
+    await page.getByRole('button', { name: '● Record' }).click();
+    await page.waitForTimeout(1500);
+    await page.reload();
+    const banner = page.locator('.recovered');
+    await banner.waitFor();
+    await expect(banner.textContent()).resolves.toMatch(/unfinished recording/);
+    const again = page.waitForEvent('download');
+    await banner.getByRole('button', { name: 'Export .sscap' }).click();
+    const kept = join(dir, 'kept.sscap');
+    await (await again).saveAs(kept);
+    const recovered = summarizeCapture(parseCapture(new Uint8Array(readFileSync(kept))));
+    expect(recovered.decoder.frames).toBeGreaterThan(80);
+    await banner.getByRole('button', { name: 'Discard' }).click();
+    await banner.waitFor({ state: 'detached' });
+    expect(errors).toEqual([]);
+    await page.context().close();
+  });
+
+  it('tells the user a file is not a capture and keeps the page usable', async () => {
+    const path = join(dir, 'notes.txt');
+    writeFileSync(path, 'shopping list\neggs\n');
+    const { page } = await open('?demo=0');
+    await page.setInputFiles('input[type=file]', path);
+    const alert = page.getByRole('alert').filter({ hasText: 'Cannot open notes.txt' });
+    await alert.waitFor();
+    await expect(alert.textContent()).resolves.toMatch(/not a Saleae|text/i);
+    await shot(page, 'bad-file');
+    await page.context().close();
+  });
+
+  it('works offline once loaded: the service worker serves the page', async () => {
+    const { page } = await open();
+    await page.waitForFunction(() => navigator.serviceWorker.controller !== null || navigator.serviceWorker.ready.then(() => true), undefined, { timeout: 10_000 });
+    await page.evaluate(() => navigator.serviceWorker.ready);
+    await page.reload();
+    await page.context().setOffline(true);
+    await page.reload();
+    await page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor({ timeout: 10_000 });
+    await page.context().close();
+  });
+
+});

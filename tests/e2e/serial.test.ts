@@ -1,0 +1,116 @@
+/**
+ * The page through Chromium's real WebSerial stack: a managed policy grants the test origin its
+ * ports, and a pseudo-terminal standing in for /dev/ttyS0 plays a receiver at real pace (the real
+ * PX4 capture when ../shared is here, else the simulator). Covers connect, live bars, recording,
+ * unplug (the feeding end closes) with the recording intact, and reconnect without a prompt.
+ */
+import { existsSync, mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import type { Browser, Page } from 'playwright-core';
+import { afterAll, beforeAll, describe, expect, it } from 'vitest';
+import { importRaw, importSaleaeCsv, parseCapture, summarizeCapture } from '../../src/decoder/index.js';
+import { preset, simulate } from '../../src/simulator/index.js';
+import { APP_DIR, SHARED_CAPTURES, barValues, browserUnavailable, shot } from './app-fixture.js';
+import { launchChromium, startStaticServer, type StaticServer } from './harness/browser.js';
+import { installSerialPolicy, type SerialPolicy } from './harness/policy.js';
+import { fakeSerialUnsupportedReason, openFakeSerialPort, type FakeSerialPort } from './harness/pty-serial.js';
+
+const skip = browserUnavailable() ?? fakeSerialUnsupportedReason();
+if (skip !== null) console.warn(`skipping the WebSerial tests: ${skip}`);
+
+let server: StaticServer;
+let policy: SerialPolicy;
+let fake: FakeSerialPort;
+let browser: Browser;
+let dir = '';
+
+/** A receiver's bytes with per-byte times: the real DX9 capture, or a simulated DSMX 11 ms link. */
+function receiverStream(): { bytes: Uint8Array; timesUs: Float64Array; source: string } {
+  const file = join(SHARED_CAPTURES, 'dsm_x_dx9_px4_binding_data.txt');
+  if (existsSync(file)) {
+    const c = importSaleaeCsv(new Uint8Array(readFileSync(file)));
+    return { bytes: c.bytes, timesUs: c.byteTimesUs!, source: 'PX4 DX9 capture' };
+  }
+  const s = simulate(preset('dsmx-11ms-2048-internal'), 5_000_000);
+  return { bytes: s.bytes, timesUs: s.timesUs, source: 'simulator' };
+}
+
+beforeAll(async () => {
+  if (skip !== null) return;
+  dir = mkdtempSync(join(tmpdir(), 'satscope-serial-'));
+  server = await startStaticServer(APP_DIR);
+  policy = await installSerialPolicy(server.origin);
+  fake = await openFakeSerialPort();
+  browser = await launchChromium();
+});
+
+afterAll(async () => {
+  if (skip !== null) return;
+  await browser?.close();
+  await fake?.close();
+  await policy?.remove();
+  await server?.close();
+  rmSync(dir, { recursive: true, force: true });
+});
+
+async function linkState(page: Page, state: string, timeout = 10_000): Promise<void> {
+  await page.getByTestId('link-state').filter({ hasText: state }).waitFor({ timeout });
+}
+
+describe.skipIf(skip !== null)('a receiver on a serial port', () => {
+  it('connects, shows live bars, records, survives an unplug with the recording intact, and reconnects', async () => {
+    const stream = receiverStream();
+    const context = await browser.newContext({ viewport: { width: 1400, height: 1000 }, acceptDownloads: true });
+    const page = await context.newPage();
+    const errors: string[] = [];
+    page.on('pageerror', (e) => errors.push(e.message));
+    await page.goto(server.url('/'));
+
+    // The granted port is offered at start, and no demo runs over it.
+    const offered = page.getByRole('button', { name: 'Serial port' });
+    await offered.waitFor();
+    await expect(page.getByTestId('source-status').textContent()).resolves.toBe('No receiver');
+    await offered.click();
+    await page.getByTestId('source-status').filter({ hasText: 'at 115200 baud' }).waitFor();
+
+    // First half of the capture at real pace; record from the start.
+    await page.getByRole('button', { name: '● Record' }).click();
+    await page.getByRole('button', { name: 'Stop recording' }).waitFor();
+    const half = Math.floor(stream.bytes.length / 2 / 16) * 16;
+    await fake.writePaced(stream.bytes.subarray(0, half), stream.timesUs.subarray(0, half));
+    await linkState(page, 'Live');
+    const bars = await barValues(page);
+    const expected = summarizeCapture(importRaw(stream.bytes.subarray(0, half)));
+    for (const c of expected.channels.filter((ch) => ch.id < 12)) expect(bars[c.name], c.name).toBe(c.lastUs);
+    await shot(page, 'serial-live');
+
+    // Unplug: the page says so, holds, then fails safe; the recording goes on and keeps every byte.
+    await fake.hangup();
+    await page.getByRole('alert').filter({ hasText: 'unplugged' }).waitFor();
+    await linkState(page, 'Failsafe', 5000);
+    await expect(page.getByTestId('source-status').textContent()).resolves.toMatch(/device lost/);
+    await shot(page, 'serial-unplugged');
+
+    // Plug back in: picked up again with no prompt; the rest of the capture arrives.
+    await fake.reconnect();
+    await page.getByTestId('source-status').filter({ hasText: 'at 115200 baud' }).waitFor({ timeout: 5000 });
+    await fake.writePaced(stream.bytes.subarray(half), stream.timesUs.subarray(half));
+    await linkState(page, 'Live');
+    await page.getByRole('button', { name: 'Stop recording' }).click();
+    const download = page.waitForEvent('download');
+    await page.getByRole('button', { name: 'Export .sscap' }).first().click();
+    const file = join(dir, 'serial.sscap');
+    await (await download).saveAs(file);
+
+    const capture = parseCapture(new Uint8Array(readFileSync(file)));
+    expect(capture.issues).toEqual([]);
+    // Every byte sent, in order, across the unplug.
+    expect(Buffer.from(capture.bytes).equals(Buffer.from(stream.bytes))).toBe(true);
+    expect(capture.events.map((e) => e.text)).toEqual(expect.arrayContaining(['device lost', 'device reconnected']));
+    const summary = summarizeCapture(capture);
+    expect(summary.link.failsafes).toBe(1);
+    expect(errors).toEqual([]);
+    await context.close();
+  });
+});
