@@ -24,3 +24,9 @@ export {
 export {
   decodeCapture, summarizeCapture, type CaptureSummary, type ChannelSummary, type DecodeCaptureOptions,
 } from './summary.js';
+export {
+  healthReport, reportHtml, REPORT_THRESHOLDS,
+  type FindingCode, type FindingLevel, type HealthReport, type HealthReportOptions, type RemoteReport, type ReportChannel,
+  type ReportEpisode, type ReportFinding, type ReportGlitch, type ReportPeriodStats, type ReportSeries, type ReportStatus,
+  type ReportThresholds,
+} from './report.js';

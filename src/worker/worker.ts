@@ -14,7 +14,7 @@ import { SerialSource, describePort, findPort, openProblem } from './sources/ser
 
 const scope = self as unknown as DedicatedWorkerGlobalScope;
 /** Batches at most this often: about one per display frame. */
-const MIN_BATCH_MS = 12;
+const MIN_BATCH_MS = 8;
 /** While a live source is quiet, still tick this often so hold/failsafe and ages advance. */
 const IDLE_TICK_MS = 50;
 /** USB adapters deliver in batches up to their latency timer (FTDI: 16 ms). */

@@ -3,7 +3,7 @@
  * recorded times, at 1×, 4× or as fast as possible, with pause and seek. The source clock is
  * the capture's own; a seek starts a fresh decode just before the target and skips ahead.
  */
-import { captureChunks, type Capture } from '../../decoder/index.js';
+import type { Capture } from '../../decoder/index.js';
 
 /** Chunk views of one port, with their times. */
 interface Chunk {
@@ -14,6 +14,39 @@ interface Chunk {
   atUs: number;
 }
 
+/**
+ * The chunks of port 0 straight from the capture's columns: an hour of USB batches is 225 000
+ * chunks, so they are read by index when fed, never turned into objects up front.
+ */
+class Chunks {
+  readonly length: number;
+  readonly #index: Uint32Array;
+  constructor(readonly capture: Capture) {
+    const ports = capture.chunkPorts;
+    let n = 0;
+    const index = new Uint32Array(ports.length);
+    for (let i = 0; i < ports.length; i++) if (ports[i] === 0) index[n++] = i;
+    this.#index = index.subarray(0, n);
+    this.length = n;
+  }
+
+  /** Arrival time of chunk k (µs), NaN without timing. */
+  atUs(k: number): number {
+    const i = this.#index[k] as number;
+    const times = this.capture.byteTimesUs;
+    if (times !== undefined) return times[(this.capture.chunkEnds[i] as number) - 1] ?? NaN;
+    return this.capture.chunkTimesUs[i] as number;
+  }
+
+  get(k: number): Chunk {
+    const i = this.#index[k] as number;
+    const c = this.capture;
+    const start = i === 0 ? 0 : (c.chunkEnds[i - 1] as number);
+    const end = c.chunkEnds[i] as number;
+    return { bytes: c.bytes.subarray(start, end), byteTimes: c.byteTimesUs?.subarray(start, end), atUs: this.atUs(k) };
+  }
+}
+
 const TICK_MS = 10;
 /** Decode for at most this long per tick, then let messages through. */
 const SLICE_MS = 12;
@@ -21,7 +54,7 @@ const SLICE_MS = 12;
 const SEEK_HISTORY_US = 10 * 60e6;
 
 export class ReplaySource {
-  readonly chunks: Chunk[] = [];
+  readonly chunks: Chunks;
   readonly startUs: number;
   readonly endUs: number;
   #next = 0;
@@ -46,16 +79,17 @@ export class ReplaySource {
     readonly onTick: (clockUs: number) => void,
     readonly onEnd: () => void,
   ) {
-    for (const c of captureChunks(capture, 0)) {
-      const atUs = c.byteTimesUs !== undefined ? (c.byteTimesUs[c.byteTimesUs.length - 1] ?? NaN) : c.timeUs;
-      this.chunks.push({ bytes: c.bytes, byteTimes: c.byteTimesUs, atUs });
-    }
-    const timed = this.chunks.filter((c) => Number.isFinite(c.atUs));
-    this.startUs = timed.length > 0 ? (timed[0] as Chunk).atUs : 0;
-    this.endUs = timed.length > 0 ? (timed[timed.length - 1] as Chunk).atUs : 0;
+    this.chunks = new Chunks(capture);
+    let first = 0;
+    while (first < this.chunks.length && !Number.isFinite(this.chunks.atUs(first))) first++;
+    let last = this.chunks.length - 1;
+    while (last >= 0 && !Number.isFinite(this.chunks.atUs(last))) last--;
+    const timed = first <= last;
+    this.startUs = timed ? this.chunks.atUs(first) : 0;
+    this.endUs = timed ? this.chunks.atUs(last) : 0;
     this.#clockUs = this.startUs;
     // Untimed captures (raw .bin) play as fast as possible: there is no clock to follow.
-    if (timed.length === 0) this.#speed = 0;
+    if (!timed) this.#speed = 0;
   }
 
   /** Hands bytes to the sink and remembers the time of the last one fed. */
@@ -110,7 +144,7 @@ export class ReplaySource {
     this.#nextByte = 0;
     // Skip what lies before the history window, then feed up to the target at once.
     const from = target - SEEK_HISTORY_US;
-    while (this.#next < this.chunks.length && (this.chunks[this.#next] as Chunk).atUs < from) this.#next++;
+    while (this.#next < this.chunks.length && this.chunks.atUs(this.#next) < from) this.#next++;
     this.#feedUntil(target, Infinity);
     this.#clockUs = target;
     this.#wallMs = performance.now();
@@ -126,7 +160,7 @@ export class ReplaySource {
     const started = performance.now();
     while (this.#next < this.chunks.length) {
       if (budgetMs !== Infinity && performance.now() - started > budgetMs) return false;
-      const c = this.chunks[this.#next] as Chunk;
+      const c = this.chunks.get(this.#next);
       if (c.byteTimes === undefined) {
         if (c.atUs > clockUs) return false;
         this.feed(c.bytes, Number.isNaN(c.atUs) ? undefined : c.atUs, c.atUs);
@@ -160,8 +194,7 @@ export class ReplaySource {
     if (this.#speed === 0) {
       // As fast as possible, in slices so the worker stays responsive.
       done = this.#feedUntil(Infinity, SLICE_MS);
-      const c = this.chunks[Math.min(this.#next, this.chunks.length - 1)];
-      if (c !== undefined && Number.isFinite(c.atUs)) this.#clockUs = done ? this.endUs : Math.max(this.#clockUs, this.#lastFedUs);
+      if (this.timed) this.#clockUs = done ? this.endUs : Math.max(this.#clockUs, this.#lastFedUs);
     } else {
       this.#clockUs += (nowMs - this.#wallMs) * 1000 * this.#speed;
       done = this.#feedUntil(this.#clockUs, SLICE_MS);

@@ -55,7 +55,8 @@ export function ReplayBar() {
       },
     }, [x, Array.from(o.lost), Array.from(o.fadeRate)], el);
     return () => plot.destroy();
-  }, [o]);
+    // The overview can arrive before the replay status that makes this bar (and its box) appear.
+  }, [o, r !== null]);
   if (r === null) return null;
   const span = Math.max(1, r.endUs - r.startUs);
   return (
