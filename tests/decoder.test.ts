@@ -356,3 +356,41 @@ describe('decodeStream', () => {
     expect(frames[0]).not.toBe(frames[1]);
   });
 });
+
+describe('setResolution', () => {
+  it('re-reads the stream at a resolution set while decoding, keeping the counters', () => {
+    const decoder = new SpektrumDecoder();
+    const stream = dsmxStream(8, 0x00, 0);
+    decoder.push(stream.subarray(0, 128));
+    while (decoder.next());
+    expect(decoder.format.resolutionReason).toBe('channel-ids');
+    decoder.setResolution(2048);
+    expect(decoder.format.resolutionReason).toBe('override');
+    const before = decoder.stats.frames;
+    decoder.setResolution(1024);
+    decoder.push(stream.subarray(128));
+    decoder.end();
+    let after = 0;
+    while (decoder.next()) after++;
+    // 1024 cannot read 11-bit frames: nothing after the switch decodes, and every byte is counted.
+    expect(after).toBe(0);
+    expect(decoder.format.locked).toBe(false);
+    expect(decoder.stats.frames).toBe(before);
+    expect(decoder.stats.frameBytes + decoder.stats.discardedBytes).toBe(stream.length);
+    expect(() => decoder.setResolution(4096 as never)).toThrow(TypeError);
+  });
+
+  it('keeps decoding when the resolution set agrees with the lock', () => {
+    const decoder = new SpektrumDecoder();
+    const stream = dsmxStream(8);
+    decoder.push(stream.subarray(0, 128));
+    let n = 0;
+    while (decoder.next()) n++;
+    decoder.setResolution(2048);
+    decoder.push(stream.subarray(128));
+    decoder.end();
+    while (decoder.next()) n++;
+    expect(n).toBe(16);
+    expect(decoder.stats.resyncs).toBe(0);
+  });
+});

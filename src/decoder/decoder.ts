@@ -69,7 +69,7 @@ function plausibleRssi(byte: number): boolean {
 }
 
 export class SpektrumDecoder {
-  readonly #options: Required<Omit<DecoderOptions, 'onEvent'>>;
+  #options: Required<Omit<DecoderOptions, 'onEvent'>>;
   readonly #onEvent: ((event: DecoderEvent) => void) | undefined;
 
   #buf = new Uint8Array(INITIAL_CAPACITY);
@@ -178,6 +178,28 @@ export class SpektrumDecoder {
    */
   end(): void {
     this.#ended = true;
+  }
+
+  /**
+   * Changes the resolution setting while decoding (the user's override, or the internal
+   * remote's resolution handed to an external one). When it contradicts the lock, the decoder
+   * looks for frames again from the next undecided byte; counters and buffered bytes are kept.
+   * @throws {TypeError} for a value outside 'auto', 1024, 2048.
+   */
+  setResolution(resolution: 'auto' | Resolution): void {
+    if (resolution !== 'auto' && resolution !== 1024 && resolution !== 2048) {
+      throw new TypeError(`resolution must be 'auto', 1024 or 2048, not ${String(resolution)}`);
+    }
+    const before = this.#options.resolution;
+    if (before === resolution) return;
+    this.#options.resolution = resolution;
+    if (!this.#locked) return;
+    if (resolution === 'auto' ? this.#reason === 'override' : resolution !== this.#resolution) {
+      this.#locked = false;
+      this.#layoutCount = 0;
+    } else {
+      this.#setReason(this.#resolution as Resolution);
+    }
   }
 
   /** Forgets everything: buffered bytes, lock, format and counters. */
