@@ -4,7 +4,7 @@
  * that drew them, in ms. Read by bench/page.bench.ts through window.__satscopeBench.
  */
 import { onFrame } from './frame-loop.js';
-import { live } from './live.js';
+import { current } from './store.js';
 
 declare global {
   interface Window {
@@ -18,6 +18,7 @@ export function startBenchHooks(): void {
   let version = -1;
   // Registered after the views, so it runs after they drew in the same frame.
   onFrame((nowMs) => {
+    const live = current();
     if (live.version === version) return;
     version = live.version;
     if (live.lastArrivedMs > 0) bench.latencies.push(performance.timeOrigin + nowMs - live.lastArrivedMs);

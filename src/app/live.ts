@@ -108,5 +108,3 @@ export class Live {
     return this.#clockUs + (performance.now() - this.#clockAtMs) * 1000 * this.clockRate;
   }
 }
-
-export const live = new Live();

@@ -1,10 +1,12 @@
 /**
- * Low-rate page state as signals (source status, recording, replay, notices), and the bridge to
- * the worker: one place sends commands and routes every message the worker posts.
+ * Low-rate page state as signals (sources, recording, replay, notices), the high-rate data of
+ * each remote (one Live each), and the bridge to the worker: one place sends commands and
+ * routes every message the worker posts. The views show the selected remote; the Remotes panel
+ * shows them all.
  */
-import { signal } from '@preact/signals';
+import { computed, signal } from '@preact/signals';
 import type { FromWorker, Overview, RecordingStatus, ReplayStatus, SourceStatus, ToWorker } from '../worker/protocol.js';
-import { live } from './live.js';
+import { Live } from './live.js';
 
 export interface Notice {
   id: number;
@@ -13,21 +15,64 @@ export interface Notice {
   detail: string;
 }
 
-export const status = signal<SourceStatus>({
-  kind: 'none', state: 'idle', label: 'No receiver', clockRate: 0,
-  format: { locked: false, resolution: null, resolutionReason: 'unknown', explanation: 'Not locked on to frames yet.', remote: null, system: null, headerMode: 'fades' },
-});
+export const sources = signal<SourceStatus[]>([]);
+/** The remote the channel bars, link panel, system badge and graphs show. */
+export const selected = signal(0);
 export const recording = signal<RecordingStatus | null>(null);
 export const replay = signal<ReplayStatus | null>(null);
 export const overview = signal<Overview | null>(null);
 export const notices = signal<Notice[]>([]);
-/** Set once X-Plus channels have been seen, so the panel appears and stays. */
-export const xplusSeen = signal(false);
 export const resolutionOverride = signal<'auto' | 1024 | 2048>('auto');
+
+const IDLE: SourceStatus = {
+  id: -1, label: '', kind: 'serial', state: 'idle', name: 'No receiver', clockRate: 0,
+  format: { locked: false, resolution: null, resolutionReason: 'unknown', explanation: 'Not locked on to frames yet.', remote: null, system: null, headerMode: 'fades' },
+};
+
+/** The selected remote's status (a placeholder when there is none). */
+export const status = computed(() => sources.value.find((s) => s.id === selected.value) ?? IDLE);
+
+/** Each remote's high-rate data, by source id. */
+const lives = new Map<number, Live>();
+const none = new Live();
+
+export function liveOf(id: number): Live {
+  let live = lives.get(id);
+  if (live === undefined) {
+    live = new Live();
+    lives.set(id, live);
+  }
+  return live;
+}
+
+/** The selected remote's data, for the renderers (read once per animation frame). */
+export function current(): Live {
+  return lives.get(selected.value) ?? none;
+}
+
+// Values of the selected remote that change rarely, as signals for the views that show them.
 /** The frame period the link runs at (11 or 22 ms, in µs), NaN until known. */
 export const nominalPeriodUs = signal(NaN);
-/** The failsafe state machine's state, for views that change only when it does. */
+/** The failsafe state machine's state. */
 export const linkState = signal<'waiting' | 'live' | 'hold' | 'failsafe'>('waiting');
+/** Set once X-Plus channels have been seen, so the panel appears and stays. */
+export const xplusSeen = signal(false);
+
+function refreshSelected(): void {
+  const live = current();
+  const l = live.link;
+  if (!Object.is(l?.nominalPeriodUs ?? NaN, nominalPeriodUs.value)) nominalPeriodUs.value = l?.nominalPeriodUs ?? NaN;
+  const state = l?.state ?? 'waiting';
+  if (state !== linkState.value) linkState.value = state;
+  let x = false;
+  for (let id = 12; id < 20; id++) if (Number.isFinite(live.seenUs[id])) x = true;
+  if (x !== xplusSeen.value) xplusSeen.value = x;
+}
+
+export function select(id: number): void {
+  selected.value = id;
+  refreshSelected();
+}
 
 let nextNotice = 1;
 export function notify(level: Notice['level'], title: string, detail: string): void {
@@ -57,21 +102,25 @@ function download(name: string, mime: string, data: ArrayBuffer): void {
 
 function receive(message: FromWorker): void {
   switch (message.type) {
-    case 'status':
-      status.value = message.status;
-      live.clockRate = message.status.clockRate;
+    case 'sources': {
+      sources.value = message.sources;
+      for (const s of message.sources) liveOf(s.id).clockRate = s.clockRate;
+      for (const id of lives.keys()) if (!message.sources.some((s) => s.id === id)) lives.delete(id);
+      // Keep the selection on a remote that exists, preferring the internal one.
+      if (!message.sources.some((s) => s.id === selected.value) && message.sources.length > 0) {
+        const internal = message.sources.find((s) => s.format.remote === 'internal');
+        select((internal ?? (message.sources[0] as SourceStatus)).id);
+      }
       break;
+    }
     case 'batch':
-      live.apply(message.batch);
-      if (!Object.is(message.batch.link.nominalPeriodUs, nominalPeriodUs.value)) nominalPeriodUs.value = message.batch.link.nominalPeriodUs;
-      if (message.batch.link.state !== linkState.value) linkState.value = message.batch.link.state;
-      if (!xplusSeen.value) for (let id = 12; id < 20; id++) if (Number.isFinite(live.seenUs[id])) xplusSeen.value = true;
+      liveOf(message.source).apply(message.batch);
+      if (message.source === selected.value) refreshSelected();
       break;
     case 'reset':
-      live.reset();
-      xplusSeen.value = false;
-      nominalPeriodUs.value = NaN;
-      linkState.value = 'waiting';
+      if (message.source === undefined) lives.clear();
+      else lives.get(message.source)?.reset();
+      refreshSelected();
       break;
     case 'notice':
       notify(message.level, message.title, message.detail);
@@ -94,6 +143,11 @@ function receive(message: FromWorker): void {
       throw new Error(`unknown message ${JSON.stringify(never)}`);
     }
   }
+}
+
+/** Every remote's data, for the views that show them side by side. */
+export function allLives(): ReadonlyMap<number, Live> {
+  return lives;
 }
 
 export function startWorker(): Worker {

@@ -13,13 +13,19 @@ export interface PortIdentity {
   usbProductId?: number;
 }
 
-export type SourceKind = 'none' | 'serial' | 'demo' | 'replay';
+export type SourceKind = 'serial' | 'demo' | 'replay';
+
+/** Remote labels as Spektrum names them (spec §7.3): A is the internal one; B, R, L external. */
+export const REMOTE_LABELS = ['A', 'B', 'R', 'L'] as const;
 
 export type ToWorker =
+  /** Opens a granted port as one more source (several remotes side by side). */
   | { type: 'serial-open'; port: PortIdentity }
-  | { type: 'serial-close' }
+  | { type: 'serial-close'; source: number }
+  | { type: 'close-all' }
   | { type: 'demo-start' }
   | { type: 'demo-stop' }
+  | { type: 'set-label'; source: number; label: string }
   | { type: 'record-start' }
   | { type: 'record-stop' }
   | { type: 'export'; what: 'sscap' | 'raw'; recording: 'last' | 'recovered' }
@@ -32,13 +38,17 @@ export type ToWorker =
   | { type: 'replay-seek'; timeUs: number }
   | { type: 'set-resolution'; resolution: 'auto' | 1024 | 2048 };
 
-/** Low-rate state of the source, sent when it changes. */
+/** Low-rate state of one source (one remote), sent when it changes. */
 export interface SourceStatus {
-  kind: SourceKind;
-  /** 'opening', 'reading', 'lost' (device gone), 'closed', 'playing', 'paused', 'ended'. */
-  state: string;
-  /** A line for the status pill, e.g. "FT232R 0403:6001 at 115200 baud". */
+  /** The source's id: also its port number in recordings and multi-port captures. */
+  id: number;
+  /** A, B, R, L… */
   label: string;
+  kind: SourceKind;
+  /** 'opening', 'reading', 'lost' (device gone), 'playing', 'paused', 'ended'. */
+  state: string;
+  /** What it is, e.g. "USB 0403:6001 at 115200 baud". */
+  name: string;
   /** How the source clock advances against wall time: 1 live, the speed in replay, 0 paused. */
   clockRate: number;
   format: FormatInfo;
@@ -115,9 +125,11 @@ export interface Overview {
 }
 
 export type FromWorker =
-  | { type: 'status'; status: SourceStatus }
-  | { type: 'batch'; batch: Batch }
-  | { type: 'reset' }
+  /** Every source, whenever any of them changes (a handful at most). */
+  | { type: 'sources'; sources: SourceStatus[] }
+  | { type: 'batch'; source: number; batch: Batch }
+  /** A source's decode started over (or all of them when `source` is undefined). */
+  | { type: 'reset'; source?: number }
   | { type: 'notice'; level: 'info' | 'warning' | 'error'; title: string; detail: string }
   | { type: 'recording'; recording: RecordingStatus }
   | { type: 'export-ready'; name: string; mime: string; data: ArrayBuffer }

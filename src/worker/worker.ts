@@ -1,86 +1,134 @@
 /**
- * The worker: owns the serial port, the decoder, the recorder and replay. The page sends
- * commands (protocol.ts) and gets batches at display rate. One source at a time feeds the
- * engine: a serial port, the demo, or a capture being replayed.
+ * The worker: owns the serial ports, the decoders, the recorder and replay. The page sends
+ * commands (protocol.ts) and gets batches at display rate. Several sources can run side by side,
+ * one per remote: serial ports (each opened on its own), the two-remote demo, or the ports of a
+ * capture being replayed. A source's id is its port number in recordings.
  */
 /// <reference lib="webworker" />
-import { CaptureFormatError, decodeCapture, readCapture, type Capture, type FormatInfo } from '../decoder/index.js';
+import { CaptureFormatError, decodeCapture, readCapture, systemInfo, type Capture } from '../decoder/index.js';
 import { Engine } from './engine.js';
-import type { FromWorker, Overview, PortIdentity, SourceKind, ToWorker } from './protocol.js';
+import { REMOTE_LABELS, type FromWorker, type Overview, type PortIdentity, type SourceKind, type SourceStatus, type ToWorker } from './protocol.js';
 import { Recorder } from './recorder.js';
 import { DemoSource } from './sources/demo.js';
 import { ReplaySource } from './sources/replay.js';
 import { SerialSource, describePort, findPort, openProblem } from './sources/serial.js';
 
 const scope = self as unknown as DedicatedWorkerGlobalScope;
-/** Batches at most this often: about one per display frame. */
+/** Batches at most this often (a display frame is 16.7 ms at 60 Hz). */
 const MIN_BATCH_MS = 8;
-/** While a live source is quiet, still tick this often so hold/failsafe and ages advance. */
+/** While live sources are quiet, still tick this often so hold/failsafe and ages advance. */
 const IDLE_TICK_MS = 50;
 /** USB adapters deliver in batches up to their latency timer (FTDI: 16 ms). */
 const USB_JITTER_US = 20_000;
+/** After a device is lost, try its port again this often (Chromium does not always fire 'connect'). */
+const RECONNECT_MS = 1000;
 
 function post(message: FromWorker, transfer: Transferable[] = []): void {
   scope.postMessage(message, transfer);
 }
 
-const nowUs = (): number => performance.now() * 1000;
-
-let resolution: 'auto' | 1024 | 2048 = 'auto';
-let engine = new Engine({ resolution, jitterUs: USB_JITTER_US });
-let kind: SourceKind = 'none';
-let state = 'idle';
-let label = 'No receiver';
-let lastFormat = '';
-let lastBatchMs = 0;
-let flushTimer: ReturnType<typeof setTimeout> | undefined;
-let idleTimer: ReturnType<typeof setInterval> | undefined;
-let demo: DemoSource | undefined;
-let replay: ReplaySource | undefined;
-let serialIdentity: PortIdentity | undefined;
-const serial = new SerialSource(nowUs, {
-  data: (bytes, timeUs) => onLiveData(bytes, timeUs),
-  lineError: (name) => notice('warning', 'Line error survived', `${name}: some bytes may be lost; reading goes on.`),
-  lost: () => {
-    recorder.event('device lost', nowUs());
-    setStatus('serial', 'lost', `${label.replace(/ at 115200 baud$/, '')}: device lost`);
-    startReconnecting();
-    notice('error', 'The receiver\'s adapter was unplugged', 'Reading stopped; everything recorded so far is kept. Plug it back in and it reconnects by itself.');
-  },
-  closed: () => undefined,
-});
-const recorder = new Recorder((recording) => post({ type: 'recording', recording }));
-
 function notice(level: 'info' | 'warning' | 'error', title: string, detail: string): void {
   post({ type: 'notice', level, title, detail });
 }
 
-function sourceClock(): number {
-  if (kind === 'replay' && replay !== undefined) return replay.positionUs;
-  return nowUs();
+const nowUs = (): number => performance.now() * 1000;
+
+/** One remote being decoded. */
+interface Source {
+  id: number;
+  kind: SourceKind;
+  label: string;
+  state: string;
+  name: string;
+  engine: Engine;
+  serial?: SerialSource;
+  identity?: PortIdentity;
 }
 
-function setStatus(k: SourceKind, s: string, l: string): void {
-  kind = k;
-  state = s;
-  label = l;
-  sendStatus(engine.decoder.format);
+let resolution: 'auto' | 1024 | 2048 = 'auto';
+const sources = new Map<number, Source>();
+let lastSent = '';
+let lastBatchMs = 0;
+let flushTimer: ReturnType<typeof setTimeout> | undefined;
+let idleTimer: ReturnType<typeof setInterval> | undefined;
+let reconnectTimer: ReturnType<typeof setInterval> | undefined;
+let demo: DemoSource | undefined;
+let replay: ReplaySource | undefined;
+let replayName = '';
+const recorder = new Recorder((recording) => post({ type: 'recording', recording }));
+
+function freeId(): number {
+  let id = 0;
+  while (sources.has(id)) id++;
+  return id;
 }
 
-function sendStatus(format: FormatInfo): void {
-  const clockRate = kind === 'replay' ? (replay?.playing === true ? replay.speed || 1 : 0) : kind === 'none' ? 0 : 1;
-  lastFormat = JSON.stringify(format);
-  post({ type: 'status', status: { kind, state, label, clockRate, format } });
+function defaultLabel(id: number): string {
+  return REMOTE_LABELS[id] ?? `R${id}`;
+}
+
+function addSource(kind: SourceKind, id: number, name: string, jitterUs: number): Source {
+  const source: Source = { id, kind, label: defaultLabel(id), state: 'opening', name, engine: new Engine({ resolution, jitterUs }) };
+  sources.set(id, source);
+  post({ type: 'reset', source: id });
+  return source;
+}
+
+function clockUs(): number {
+  return replay !== undefined ? replay.positionUs : nowUs();
+}
+
+function clockRate(): number {
+  if (replay !== undefined) return replay.playing ? replay.speed || 1 : 0;
+  return sources.size > 0 ? 1 : 0;
+}
+
+/** Sends the list of sources when anything in it changed. */
+function sendSources(): void {
+  const list: SourceStatus[] = [...sources.values()].map((s) => ({
+    id: s.id, label: s.label, kind: s.kind, state: s.state, name: s.name, clockRate: clockRate(), format: s.engine.decoder.format,
+  }));
+  const key = JSON.stringify(list);
+  if (key === lastSent) return;
+  lastSent = key;
+  post({ type: 'sources', sources: list });
+}
+
+function setState(source: Source, state: string, name = source.name): void {
+  source.state = state;
+  source.name = name;
+  sendSources();
+}
+
+/**
+ * External remotes take their resolution from the internal remote when one is connected
+ * (spec §8: "the internal remote provides the key for … all remotes").
+ */
+function shareResolution(): void {
+  let key: 1024 | 2048 | undefined;
+  for (const s of sources.values()) {
+    const f = s.engine.decoder.format;
+    const info = f.remote === 'internal' && f.system !== null ? systemInfo(f.system) : undefined;
+    if (info !== undefined && f.resolution !== null) key = f.resolution;
+  }
+  for (const s of sources.values()) {
+    const f = s.engine.decoder.format;
+    if (f.remote === 'internal' || resolution !== 'auto') continue;
+    s.engine.decoder.setResolution(key ?? 'auto');
+  }
 }
 
 /** Sends what changed, at most every MIN_BATCH_MS. */
 function flush(): void {
   flushTimer = undefined;
   lastBatchMs = performance.now();
-  const out = engine.batch(sourceClock());
-  if (out !== null) post({ type: 'batch', batch: out.batch }, out.transfer);
-  const format = engine.decoder.format;
-  if (JSON.stringify(format) !== lastFormat) sendStatus(format);
+  const now = clockUs();
+  for (const s of sources.values()) {
+    const out = s.engine.batch(now);
+    if (out !== null) post({ type: 'batch', source: s.id, batch: out.batch }, out.transfer);
+  }
+  if (sources.size > 1) shareResolution();
+  sendSources();
 }
 
 function scheduleFlush(): void {
@@ -90,107 +138,210 @@ function scheduleFlush(): void {
   else flushTimer = setTimeout(flush, wait);
 }
 
-function onLiveData(bytes: Uint8Array, timeUs: number): void {
-  engine.push(bytes, timeUs, performance.timeOrigin + timeUs / 1000);
-  recorder.data(bytes, timeUs);
+function onLiveData(source: Source, bytes: Uint8Array, timeUs: number): void {
+  source.engine.push(bytes, timeUs, performance.timeOrigin + timeUs / 1000);
+  recorder.data(bytes, timeUs, source.id);
   scheduleFlush();
 }
 
-function startIdleTicks(): void {
-  stopIdleTicks();
-  idleTimer = setInterval(scheduleFlush, IDLE_TICK_MS);
+function startTicks(): void {
+  if (idleTimer === undefined) idleTimer = setInterval(scheduleFlush, IDLE_TICK_MS);
 }
 
-function stopIdleTicks(): void {
+async function closeSource(id: number): Promise<void> {
+  const s = sources.get(id);
+  if (s === undefined) return;
+  sources.delete(id);
+  await s.serial?.close();
+  post({ type: 'reset', source: id });
+  if (sources.size === 0) stopTimers();
+  sendSources();
+}
+
+function stopTimers(): void {
   clearInterval(idleTimer);
   idleTimer = undefined;
+  clearInterval(reconnectTimer);
+  reconnectTimer = undefined;
+  clearTimeout(flushTimer);
+  flushTimer = undefined;
 }
 
-/** Stops whatever source runs and starts a fresh decode. */
-async function stopSource(): Promise<void> {
-  stopIdleTicks();
-  stopReconnecting();
+/** Stops every source: the demo, replay and all ports. */
+async function closeAll(): Promise<void> {
+  stopTimers();
   demo?.stop();
   demo = undefined;
   replay?.stop();
+  if (replay !== undefined) post({ type: 'replay', replay: null });
   replay = undefined;
-  post({ type: 'replay', replay: null });
-  await serial.close();
-  serialIdentity = undefined;
-  resetEngine(USB_JITTER_US);
-  setStatus('none', 'idle', 'No receiver');
+  for (const s of sources.values()) await s.serial?.close();
+  sources.clear();
+  post({ type: 'reset' });
+  sendSources();
 }
 
-function resetEngine(jitterUs: number): void {
-  clearTimeout(flushTimer);
-  flushTimer = undefined;
-  engine = new Engine({ resolution, jitterUs });
-  post({ type: 'reset' });
-}
+// ---- serial ---------------------------------------------------------------------------------
 
 async function openSerial(identity: PortIdentity): Promise<void> {
-  await stopSource();
+  // Ports join each other, but not the demo or a replay.
+  if (demo !== undefined || replay !== undefined) await closeAll();
   const port = await findPort(identity);
   if (port === undefined) {
     notice('error', 'The port is not available', 'It may have been unplugged. Plug it in and connect again.');
     return;
   }
-  setStatus('serial', 'opening', describePort(port));
+  for (const s of sources.values()) {
+    if (s.serial?.port === port) {
+      notice('info', 'Already connected', `${describePort(port)} is remote ${s.label}.`);
+      return;
+    }
+  }
+  const id = freeId();
+  const source = addSource('serial', id, describePort(port), USB_JITTER_US);
+  source.identity = identity;
+  source.serial = new SerialSource(nowUs, {
+    data: (bytes, timeUs) => onLiveData(source, bytes, timeUs),
+    lineError: (name) => notice('warning', `Line error on ${source.label}`, `${name}: some bytes may be lost; reading goes on.`),
+    lost: () => {
+      recorder.event('device lost', nowUs(), id);
+      setState(source, 'lost');
+      notice('error', `Remote ${source.label}: the adapter was unplugged`, 'Reading stopped; everything recorded so far is kept. Plug it back in and it reconnects by itself.');
+      if (reconnectTimer === undefined) reconnectTimer = setInterval(() => void reconnectLost(), RECONNECT_MS);
+    },
+    closed: () => undefined,
+  });
+  sendSources();
   try {
-    await serial.open(port);
+    await source.serial.open(port);
   } catch (error) {
+    sources.delete(id);
+    post({ type: 'reset', source: id });
+    sendSources();
     const problem = openProblem(error);
     notice('error', problem.title, problem.detail);
-    setStatus('none', 'idle', 'No receiver');
     return;
   }
-  serialIdentity = identity;
-  recorder.event('port opened', nowUs());
-  setStatus('serial', 'reading', `${describePort(port)} at 115200 baud`);
-  startIdleTicks();
+  recorder.event('port opened', nowUs(), id);
+  setState(source, 'reading', `${describePort(port)} at 115200 baud`);
+  startTicks();
 }
 
-function overviewOf(capture: Capture): Overview {
+let reconnecting = false;
+
+/** Tries the ports of lost sources again: a replugged adapter comes back without a prompt. */
+async function reconnectLost(): Promise<void> {
+  if (reconnecting) return;
+  reconnecting = true;
+  try {
+    for (const s of sources.values()) {
+      if (s.state !== 'lost' || s.serial === undefined || s.identity === undefined) continue;
+      try {
+        const port = await findPort(s.identity);
+        if (port === undefined) continue;
+        await s.serial.open(port);
+        recorder.event('device reconnected', nowUs(), s.id);
+        setState(s, 'reading', `${describePort(port)} at 115200 baud`);
+        notice('info', `Remote ${s.label} reconnected`, 'The adapter is back; reading again.');
+      } catch {
+        // Still gone: try again on the next tick.
+      }
+    }
+    if (![...sources.values()].some((s) => s.state === 'lost')) {
+      clearInterval(reconnectTimer);
+      reconnectTimer = undefined;
+    }
+  } finally {
+    reconnecting = false;
+  }
+}
+
+navigator.serial?.addEventListener('connect', () => void reconnectLost());
+
+// ---- demo -----------------------------------------------------------------------------------
+
+async function startDemo(): Promise<void> {
+  await closeAll();
+  const d = new DemoSource(nowUs, (remote, bytes, timeUs) => {
+    const s = sources.get(remote);
+    if (s !== undefined) onLiveData(s, bytes, timeUs);
+  });
+  for (let i = 0; i < d.remotes; i++) {
+    const s = addSource('demo', i, i === 0 ? 'Demo remote (internal, DSMX 11 ms)' : 'Demo remote (external)', USB_JITTER_US);
+    s.state = 'reading';
+  }
+  demo = d;
+  d.start();
+  startTicks();
+  sendSources();
+}
+
+// ---- replay ---------------------------------------------------------------------------------
+
+/** Whole-capture series for the replay timeline (every port on one time axis). */
+function overviewOf(capture: Capture, ports: readonly number[]): Overview {
   const BIN_US = 1_000_000;
   const t: number[] = [];
   const fades: number[] = [];
   const frames: number[] = [];
+  const failsafe: Overview['failsafe'] = [];
   let first = NaN;
-  const { link } = decodeCapture(capture, { resolution }, (f) => {
-    if (!Number.isFinite(f.timeUs)) return;
-    if (Number.isNaN(first)) first = Math.floor(f.timeUs / BIN_US) * BIN_US;
-    const bin = Math.floor((f.timeUs - first) / BIN_US);
-    while (t.length <= bin) {
-      t.push(first + t.length * BIN_US);
-      fades.push(0);
-      frames.push(0);
-    }
-    fades[bin] = (fades[bin] as number) + f.fadesDelta;
-    frames[bin] = (frames[bin] as number) + 1;
-  });
-  const period = link.stats.nominalPeriodUs;
+  let expectedPerBin = 0;
+  for (const port of ports) {
+    const { link } = decodeCapture(capture, { resolution, port }, (f) => {
+      if (!Number.isFinite(f.timeUs)) return;
+      if (Number.isNaN(first)) first = Math.floor(f.timeUs / BIN_US) * BIN_US;
+      const bin = Math.max(0, Math.floor((f.timeUs - first) / BIN_US));
+      while (t.length <= bin) {
+        t.push(first + t.length * BIN_US);
+        fades.push(0);
+        frames.push(0);
+      }
+      fades[bin] = (fades[bin] as number) + f.fadesDelta;
+      frames[bin] = (frames[bin] as number) + 1;
+    });
+    const period = link.stats.nominalPeriodUs;
+    if (Number.isFinite(period)) expectedPerBin += BIN_US / period;
+    for (const e of link.episodes) if (e.kind === 'failsafe') failsafe.push({ startUs: e.startUs, endUs: e.endUs ?? e.startUs });
+  }
   return {
     t: Float64Array.from(t),
     fadeRate: Float32Array.from(fades),
-    lost: Float32Array.from(frames, (n) => (Number.isFinite(period) ? Math.max(0, Math.round(BIN_US / period - n)) : 0)),
-    failsafe: link.episodes.filter((e) => e.kind === 'failsafe').map((e) => ({ startUs: e.startUs, endUs: e.endUs ?? e.startUs })),
+    lost: Float32Array.from(frames, (n) => Math.max(0, Math.round(expectedPerBin - n))),
+    failsafe,
   };
 }
 
 function replayStatus(): void {
   if (replay === undefined) return;
   const c = replay.capture;
+  let frames = 0;
+  for (const s of sources.values()) frames += s.engine.decoder.stats.frames;
   post({
     type: 'replay',
     replay: {
-      name: c.meta.note !== undefined ? String(c.meta.note) : currentReplayName, kind: c.kind, timing: c.timing,
-      startUs: replay.startUs, endUs: replay.endUs, positionUs: replay.positionUs, playing: replay.playing, speed: replay.speed,
-      frames: engine.decoder.stats.frames, issues: c.issues.map((i) => i.message),
+      name: replayName, kind: c.kind, timing: c.timing, startUs: replay.startUs, endUs: replay.endUs,
+      positionUs: replay.positionUs, playing: replay.playing, speed: replay.speed, frames, issues: c.issues.map((i) => i.message),
     },
   });
 }
 
-let currentReplayName = '';
+function replayJitter(capture: Capture): number {
+  return capture.timing === 'per-chunk' ? USB_JITTER_US : 0;
+}
+
+/** Fresh decodes for every port of the replayed capture. */
+function resetReplaySources(capture: Capture, ports: readonly number[]): void {
+  sources.clear();
+  post({ type: 'reset' });
+  for (const port of ports) {
+    const s = addSource('replay', port, `${replayName}${ports.length > 1 ? ` port ${port}` : ''}`, replayJitter(capture));
+    // The label the remote had when it was recorded.
+    const saved = capture.meta.ports?.[port]?.name;
+    if (typeof saved === 'string' && saved !== '') s.label = saved;
+    s.state = replay?.playing === false ? 'paused' : 'playing';
+  }
+}
 
 async function openReplay(name: string, data: ArrayBuffer): Promise<void> {
   let capture: Capture;
@@ -201,33 +352,42 @@ async function openReplay(name: string, data: ArrayBuffer): Promise<void> {
     notice('error', `Cannot open ${name}`, why);
     return;
   }
-  await stopSource();
-  currentReplayName = name;
-  resetEngine(capture.timing === 'per-chunk' ? USB_JITTER_US : 0);
+  await closeAll();
+  replayName = name;
   if (capture.issues.length > 0) {
     notice('warning', `${name}: ${capture.issues.length} damaged part(s) skipped`, `${capture.issues[0]?.message ?? ''} Every intact record is kept.`);
   }
-  const overview = overviewOf(capture);
-  post({ type: 'overview', overview }, [overview.t.buffer, overview.fadeRate.buffer, overview.lost.buffer]);
-  replay = new ReplaySource(
+  const r = new ReplaySource(
     capture,
-    (bytes, time, atUs) => engine.push(bytes, time, performance.timeOrigin + performance.now()),
+    (port, bytes, time) => sources.get(port)?.engine.push(bytes, time, performance.timeOrigin + performance.now()),
     () => {
       flush();
       replayStatus();
     },
     () => {
-      engine.end();
+      for (const s of sources.values()) {
+        s.engine.end();
+        s.state = 'ended';
+      }
       flush();
-      setStatus('replay', 'ended', `${name} (end)`);
       replayStatus();
     },
   );
-  setStatus('replay', 'playing', name);
-  replay.play();
-  sendStatus(engine.decoder.format);
+  replay = r;
+  const overview = overviewOf(capture, r.ports);
+  post({ type: 'overview', overview }, [overview.t.buffer, overview.fadeRate.buffer, overview.lost.buffer]);
+  resetReplaySources(capture, r.ports);
+  r.play();
+  setReplayState('playing');
   replayStatus();
 }
+
+function setReplayState(state: string): void {
+  for (const s of sources.values()) s.state = state;
+  sendSources();
+}
+
+// ---- commands -------------------------------------------------------------------------------
 
 async function handle(message: ToWorker): Promise<void> {
   switch (message.type) {
@@ -235,25 +395,46 @@ async function handle(message: ToWorker): Promise<void> {
       await openSerial(message.port);
       break;
     case 'serial-close':
-      await stopSource();
+      await closeSource(message.source);
+      break;
+    case 'close-all':
+      await closeAll();
       break;
     case 'demo-start':
-      await stopSource();
-      demo = new DemoSource(nowUs, onLiveData);
-      demo.start();
-      setStatus('demo', 'reading', 'Demo receiver (simulated DSMX 11 ms)');
-      startIdleTicks();
+      await startDemo();
       break;
     case 'demo-stop':
-      await stopSource();
+      await closeAll();
       break;
-    case 'record-start':
-      if (kind !== 'serial' && kind !== 'demo') {
+    case 'set-label': {
+      const s = sources.get(message.source);
+      if (s !== undefined) {
+        s.label = message.label.slice(0, 8);
+        sendSources();
+      }
+      break;
+    }
+    case 'record-start': {
+      const live = [...sources.values()].filter((s) => s.kind === 'serial' || s.kind === 'demo');
+      if (live.length === 0) {
         notice('warning', 'Nothing to record', 'Connect a receiver (or start the demo) first.');
         break;
       }
-      await recorder.start({ baudRate: 115200, source: kind, note: label, usbVendorId: serialIdentity?.usbVendorId, usbProductId: serialIdentity?.usbProductId }, new Date().toISOString());
+      const first = live[0]?.identity;
+      // One entry per port number (= source id): the remote's label and its adapter.
+      const ports = Array.from({ length: Math.max(...live.map((s) => s.id)) + 1 }, (_, id) => {
+        const s = sources.get(id);
+        return s === undefined ? {} : { name: s.label, baudRate: 115200, usbVendorId: s.identity?.usbVendorId, usbProductId: s.identity?.usbProductId };
+      });
+      await recorder.start({
+        baudRate: 115200,
+        source: live[0]?.kind === 'demo' ? 'demo' : 'webserial',
+        usbVendorId: first?.usbVendorId,
+        usbProductId: first?.usbProductId,
+        ports,
+      }, new Date().toISOString());
       break;
+    }
     case 'record-stop':
       await recorder.stop();
       break;
@@ -272,33 +453,35 @@ async function handle(message: ToWorker): Promise<void> {
     case 'replay-play':
       if (replay !== undefined) {
         replay.play();
-        setStatus('replay', 'playing', currentReplayName);
+        setReplayState('playing');
         replayStatus();
       }
       break;
     case 'replay-pause':
       if (replay !== undefined) {
         replay.pause();
-        setStatus('replay', 'paused', currentReplayName);
+        setReplayState('paused');
         replayStatus();
       }
       break;
     case 'replay-speed':
       replay?.setSpeed(message.speed);
-      sendStatus(engine.decoder.format);
+      sendSources();
       replayStatus();
       break;
     case 'replay-seek':
       if (replay !== undefined) {
-        resetEngine(replay.capture.timing === 'per-chunk' ? USB_JITTER_US : 0);
+        const state = replay.playing ? 'playing' : 'paused';
+        resetReplaySources(replay.capture, replay.ports);
         replay.seek(message.timeUs);
+        setReplayState(state);
         replayStatus();
       }
       break;
     case 'set-resolution':
       resolution = message.resolution;
-      resetEngine(kind === 'replay' ? 0 : USB_JITTER_US);
-      if (replay !== undefined) replay.seek(replay.positionUs);
+      for (const s of sources.values()) s.engine.decoder.setResolution(resolution);
+      scheduleFlush();
       break;
     default: {
       const never: never = message;
@@ -307,51 +490,13 @@ async function handle(message: ToWorker): Promise<void> {
   }
 }
 
-// A replugged adapter is picked up again without a new prompt: after a loss the worker tries
-// the same port again every second (Chromium does not always fire 'connect', e.g. without udev,
-// and a replugged adapter keeps its grant), and at once when 'connect' does fire.
-const RECONNECT_MS = 1000;
-let reconnectTimer: ReturnType<typeof setInterval> | undefined;
-let reconnecting = false;
-
-function startReconnecting(): void {
-  stopReconnecting();
-  reconnectTimer = setInterval(() => void reconnect(), RECONNECT_MS);
-}
-
-function stopReconnecting(): void {
-  clearInterval(reconnectTimer);
-  reconnectTimer = undefined;
-}
-
-async function reconnect(): Promise<void> {
-  const identity = serialIdentity;
-  if (reconnecting || identity === undefined || kind !== 'serial' || state !== 'lost') return;
-  reconnecting = true;
-  try {
-    const port = await findPort(identity);
-    if (port === undefined) return;
-    await serial.open(port);
-    stopReconnecting();
-    recorder.event('device reconnected', nowUs());
-    setStatus('serial', 'reading', `${describePort(port)} at 115200 baud`);
-    notice('info', 'Reconnected', 'The adapter is back; reading again.');
-  } catch {
-    // Still gone: try again on the next tick.
-  } finally {
-    reconnecting = false;
-  }
-}
-
-navigator.serial?.addEventListener('connect', () => void reconnect());
-
 let queue: Promise<void> = Promise.resolve();
 scope.addEventListener('message', (event: MessageEvent<ToWorker>) => {
-  // Commands run one after another: opening a port while the last one closes would race.
+  // Commands run one after another: opening a port while another closes would race.
   queue = queue.then(() => handle(event.data)).catch((error: unknown) => {
     notice('error', 'Something went wrong in the worker', String(error));
   });
 });
 
 void recorder.init();
-setStatus('none', 'idle', 'No receiver');
+sendSources();

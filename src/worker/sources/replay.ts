@@ -1,11 +1,12 @@
 /**
  * Replay: a capture file played back through exactly the live path, chunk by chunk at the
- * recorded times, at 1×, 4× or as fast as possible, with pause and seek. The source clock is
- * the capture's own; a seek starts a fresh decode just before the target and skips ahead.
+ * recorded times, at 1×, 4× or as fast as possible, with pause and seek. A capture may hold
+ * several ports (remotes) with one common clock: each port feeds its own decode, and all of
+ * them advance with the one replay clock.
  */
-import type { Capture } from '../../decoder/index.js';
+import { capturePorts, type Capture } from '../../decoder/index.js';
 
-/** Chunk views of one port, with their times. */
+/** One chunk's bytes with their times. */
 interface Chunk {
   bytes: Uint8Array;
   /** Per-byte times (logic-analyser captures): bytes are fed as their own times pass. */
@@ -15,17 +16,21 @@ interface Chunk {
 }
 
 /**
- * The chunks of port 0 straight from the capture's columns: an hour of USB batches is 225 000
+ * The chunks of one port straight from the capture's columns: an hour of USB batches is 225 000
  * chunks, so they are read by index when fed, never turned into objects up front.
  */
-class Chunks {
+class PortChunks {
   readonly length: number;
   readonly #index: Uint32Array;
-  constructor(readonly capture: Capture) {
+  /** Next chunk to feed, and bytes of it already fed (per-byte-timed chunks go piece by piece). */
+  next = 0;
+  nextByte = 0;
+
+  constructor(readonly capture: Capture, readonly port: number) {
     const ports = capture.chunkPorts;
     let n = 0;
     const index = new Uint32Array(ports.length);
-    for (let i = 0; i < ports.length; i++) if (ports[i] === 0) index[n++] = i;
+    for (let i = 0; i < ports.length; i++) if (ports[i] === port) index[n++] = i;
     this.#index = index.subarray(0, n);
     this.length = n;
   }
@@ -45,7 +50,13 @@ class Chunks {
     const end = c.chunkEnds[i] as number;
     return { bytes: c.bytes.subarray(start, end), byteTimes: c.byteTimesUs?.subarray(start, end), atUs: this.atUs(k) };
   }
+
+  get done(): boolean {
+    return this.next >= this.length;
+  }
 }
+
+export type ReplaySink = (port: number, bytes: Uint8Array, time: number | Float64Array | undefined, atUs: number) => void;
 
 const TICK_MS = 10;
 /** Decode for at most this long per tick, then let messages through. */
@@ -54,48 +65,54 @@ const SLICE_MS = 12;
 const SEEK_HISTORY_US = 10 * 60e6;
 
 export class ReplaySource {
-  readonly chunks: Chunks;
+  readonly ports: readonly number[];
+  readonly #chunks: PortChunks[];
   readonly startUs: number;
   readonly endUs: number;
-  #next = 0;
-  /** Bytes of chunk #next already fed (per-byte-timed chunks are fed a piece at a time). */
-  #nextByte = 0;
   #clockUs: number;
   #wallMs = 0;
   #speed = 1;
   #playing = false;
+  #lastFedUs = NaN;
   #timer: ReturnType<typeof setInterval> | undefined;
 
   /**
-   * @param feed gets each chunk's bytes and time argument, and the chunk's time
-   * @param onTick after each tick that moved the clock (the worker sends a batch)
-   * @param onEnd when the last chunk has been fed
+   * @param sink gets each piece of a port's bytes with its time argument and arrival time
+   * @param onTick after each tick that moved the clock (the worker sends batches)
+   * @param onEnd when every port's last chunk has been fed
    */
-  #lastFedUs = NaN;
-
   constructor(
     readonly capture: Capture,
-    readonly sink: (bytes: Uint8Array, time: number | Float64Array | undefined, atUs: number) => void,
+    readonly sink: ReplaySink,
     readonly onTick: (clockUs: number) => void,
     readonly onEnd: () => void,
   ) {
-    this.chunks = new Chunks(capture);
-    let first = 0;
-    while (first < this.chunks.length && !Number.isFinite(this.chunks.atUs(first))) first++;
-    let last = this.chunks.length - 1;
-    while (last >= 0 && !Number.isFinite(this.chunks.atUs(last))) last--;
-    const timed = first <= last;
-    this.startUs = timed ? this.chunks.atUs(first) : 0;
-    this.endUs = timed ? this.chunks.atUs(last) : 0;
+    this.ports = capturePorts(capture);
+    this.#chunks = this.ports.map((p) => new PortChunks(capture, p));
+    let start = Infinity;
+    let end = -Infinity;
+    for (const c of this.#chunks) {
+      for (let k = 0; k < c.length; k++) {
+        const t = c.atUs(k);
+        if (Number.isFinite(t)) {
+          start = Math.min(start, t);
+          break;
+        }
+      }
+      for (let k = c.length - 1; k >= 0; k--) {
+        const t = c.atUs(k);
+        if (Number.isFinite(t)) {
+          end = Math.max(end, t);
+          break;
+        }
+      }
+    }
+    const timed = start <= end;
+    this.startUs = timed ? start : 0;
+    this.endUs = timed ? end : 0;
     this.#clockUs = this.startUs;
     // Untimed captures (raw .bin) play as fast as possible: there is no clock to follow.
     if (!timed) this.#speed = 0;
-  }
-
-  /** Hands bytes to the sink and remembers the time of the last one fed. */
-  feed(bytes: Uint8Array, time: number | Float64Array | undefined, atUs: number): void {
-    if (Number.isFinite(atUs)) this.#lastFedUs = atUs;
-    this.sink(bytes, time, atUs);
   }
 
   get timed(): boolean {
@@ -115,8 +132,7 @@ export class ReplaySource {
   }
 
   play(): void {
-    if (this.#playing) return;
-    if (this.#next >= this.chunks.length) return;
+    if (this.#playing || this.#chunks.every((c) => c.done)) return;
     this.#playing = true;
     this.#wallMs = performance.now();
     this.#timer = setInterval(() => this.#tick(), TICK_MS);
@@ -140,61 +156,68 @@ export class ReplaySource {
    */
   seek(timeUs: number): void {
     const target = Math.min(Math.max(timeUs, this.startUs), this.endUs);
-    this.#next = 0;
-    this.#nextByte = 0;
-    // Skip what lies before the history window, then feed up to the target at once.
     const from = target - SEEK_HISTORY_US;
-    while (this.#next < this.chunks.length && this.chunks.atUs(this.#next) < from) this.#next++;
+    for (const c of this.#chunks) {
+      c.next = 0;
+      c.nextByte = 0;
+      while (c.next < c.length && c.atUs(c.next) < from) c.next++;
+    }
     this.#feedUntil(target, Infinity);
     this.#clockUs = target;
     this.#wallMs = performance.now();
     this.onTick(this.#clockUs);
   }
 
+  stop(): void {
+    this.pause();
+  }
+
+  #feed(port: number, bytes: Uint8Array, time: number | Float64Array | undefined, atUs: number): void {
+    if (Number.isFinite(atUs) && !(atUs <= this.#lastFedUs)) this.#lastFedUs = atUs;
+    this.sink(port, bytes, time, atUs);
+  }
+
   /**
-   * Feeds every byte whose time is at or before `clockUs` (a chunk-timed chunk whole once its
-   * arrival time has passed; a per-byte-timed one byte range by byte range), for at most
-   * `budgetMs` of wall time. Returns whether all chunks have been fed.
+   * Feeds every byte whose time is at or before `clockUs`, port by port (a chunk-timed chunk
+   * whole once its arrival has passed; a per-byte-timed one range by range), for at most
+   * `budgetMs` of wall time. Returns whether everything has been fed.
    */
   #feedUntil(clockUs: number, budgetMs: number): boolean {
     const started = performance.now();
-    while (this.#next < this.chunks.length) {
-      if (budgetMs !== Infinity && performance.now() - started > budgetMs) return false;
-      const c = this.chunks.get(this.#next);
-      if (c.byteTimes === undefined) {
-        if (c.atUs > clockUs) return false;
-        this.feed(c.bytes, Number.isNaN(c.atUs) ? undefined : c.atUs, c.atUs);
-        this.#next++;
-        continue;
-      }
-      // Per-byte times: up to 4096 bytes whose time has come.
-      const times = c.byteTimes;
-      let end = this.#nextByte;
-      const limit = Math.min(times.length, this.#nextByte + 4096);
-      while (end < limit && !((times[end] as number) > clockUs)) end++;
-      if (end > this.#nextByte) this.feed(c.bytes.subarray(this.#nextByte, end), times.subarray(this.#nextByte, end), times[end - 1] as number);
-      this.#nextByte = end;
-      if (end === times.length) {
-        this.#next++;
-        this.#nextByte = 0;
-      } else if (end < limit) {
-        return false;
+    for (const c of this.#chunks) {
+      while (c.next < c.length) {
+        if (budgetMs !== Infinity && performance.now() - started > budgetMs) return false;
+        const chunk = c.get(c.next);
+        if (chunk.byteTimes === undefined) {
+          if (chunk.atUs > clockUs) break;
+          this.#feed(c.port, chunk.bytes, Number.isNaN(chunk.atUs) ? undefined : chunk.atUs, chunk.atUs);
+          c.next++;
+          continue;
+        }
+        const times = chunk.byteTimes;
+        const limit = Math.min(times.length, c.nextByte + 4096);
+        let end = c.nextByte;
+        while (end < limit && !((times[end] as number) > clockUs)) end++;
+        if (end > c.nextByte) this.#feed(c.port, chunk.bytes.subarray(c.nextByte, end), times.subarray(c.nextByte, end), times[end - 1] as number);
+        c.nextByte = end;
+        if (end === times.length) {
+          c.next++;
+          c.nextByte = 0;
+        } else if (end < limit) {
+          break;
+        }
       }
     }
-    return true;
-  }
-
-  stop(): void {
-    this.pause();
+    return this.#chunks.every((c) => c.done);
   }
 
   #tick(): void {
     const nowMs = performance.now();
     let done: boolean;
     if (this.#speed === 0) {
-      // As fast as possible, in slices so the worker stays responsive.
+      // As fast as possible, in slices so the worker stays responsive; the clock follows the data.
       done = this.#feedUntil(Infinity, SLICE_MS);
-      if (this.timed) this.#clockUs = done ? this.endUs : Math.max(this.#clockUs, this.#lastFedUs);
+      if (this.timed && Number.isFinite(this.#lastFedUs)) this.#clockUs = Math.max(this.#clockUs, this.#lastFedUs);
     } else {
       this.#clockUs += (nowMs - this.#wallMs) * 1000 * this.#speed;
       done = this.#feedUntil(this.#clockUs, SLICE_MS);

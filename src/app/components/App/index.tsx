@@ -5,12 +5,13 @@
 import { signal } from '@preact/signals';
 import { useEffect, useState } from 'preact/hooks';
 import { openCapture } from '../../open-file.js';
-import { xplusSeen } from '../../store.js';
+import { sources, status, xplusSeen } from '../../store.js';
 import { ChannelBars } from '../ChannelBars/index.js';
 import { Counters } from '../Counters/index.js';
 import { Graphs } from '../Graphs/index.js';
 import { LinkPanel } from '../LinkPanel/index.js';
 import { Notices } from '../Notices/index.js';
+import { Remotes } from '../Remotes/index.js';
 import { ReplayBar } from '../ReplayBar/index.js';
 import { SystemBadge } from '../SystemBadge/index.js';
 import { Toolbar } from '../Toolbar/index.js';
@@ -59,7 +60,8 @@ export function App({ granted }: { granted: SerialPort[] }) {
           <div class="panel"><h2>Counters</h2><Counters /></div>
         </aside>
         <div class="main">
-          <div class="panel"><h2>Channels</h2><ChannelBars ids={NORMAL} label="Channels 0–11" /></div>
+          {sources.value.length > 1 ? <div class="panel"><Remotes windowUs={windowUs} /></div> : null}
+          <div class="panel"><h2>Channels{sources.value.length > 1 ? ` — remote ${status.value.label}` : ''}</h2><ChannelBars ids={NORMAL} label="Channels 0–11" /></div>
           {xplusSeen.value ? <div class="panel"><h2>X-Plus</h2><ChannelBars ids={XPLUS} label="X-Plus channels" /></div> : null}
           <div class="panel"><Graphs windowUs={windowUs} /></div>
         </div>

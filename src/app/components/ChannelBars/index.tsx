@@ -7,7 +7,7 @@
 import { useEffect, useRef } from 'preact/hooks';
 import { channelName, PULSE_MAX_US, PULSE_MIN_US, servoToMicros, servoToPercent, XPLUS_FIRST } from '../../../decoder/index.js';
 import { onFrame } from '../../frame-loop.js';
-import { live } from '../../live.js';
+import { current } from '../../store.js';
 import './style.css';
 
 /** A channel is stale when it has not come for this long (a few frame pairs). */
@@ -36,6 +36,7 @@ export function ChannelBars({ ids, label }: { ids: number[]; label: string }) {
       return { root, fill: q('.fill'), us: q('.us'), raw: q('.raw'), pct: q('.pct'), age: q('.age'), shown: '' };
     });
     return onFrame(() => {
+      const live = current();
       const now = live.nowUs();
       ids.forEach((id, i) => {
         const row = rows[i] as Row;

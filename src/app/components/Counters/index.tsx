@@ -1,7 +1,8 @@
 /** Decoder and link counters, written once per animation frame when they change. */
 import { useEffect, useRef } from 'preact/hooks';
 import { onFrame } from '../../frame-loop.js';
-import { live } from '../../live.js';
+import type { Live } from '../../live.js';
+import { current } from '../../store.js';
 import './style.css';
 
 const ROWS = [
@@ -20,9 +21,12 @@ export function Counters() {
   const list = useRef<HTMLDListElement>(null);
   useEffect(() => {
     let version = -1;
+    let shown: Live | undefined;
     return onFrame(() => {
-      if (live.version === version || list.current === null) return;
+      const live = current();
+      if ((live === shown && live.version === version) || list.current === null) return;
       version = live.version;
+      shown = live;
       const c = live.counters;
       const l = live.link;
       const values: Record<(typeof ROWS)[number][0], string> = {

@@ -8,8 +8,8 @@ import { useEffect, useRef } from 'preact/hooks';
 import uPlot from 'uplot';
 import 'uplot/dist/uPlot.min.css';
 import { onFrame } from '../../frame-loop.js';
-import { live, type SeriesBuffer } from '../../live.js';
-import { status } from '../../store.js';
+import type { Live, SeriesBuffer } from '../../live.js';
+import { current, status } from '../../store.js';
 import './style.css';
 
 export const WINDOWS = [
@@ -97,10 +97,13 @@ export function Graphs({ windowUs }: { windowUs: Signal<number> }) {
     resize.observe(el);
     let version = -1;
     let drawnAt = 0;
+    let drawn: Live | undefined;
     const stop = onFrame((nowMs) => {
+      const live = current();
       // New buckets come ten times a second; the axis slides with time between them.
-      if (live.version === version && nowMs - drawnAt < 200) return;
+      if (live === drawn && live.version === version && nowMs - drawnAt < 200) return;
       version = live.version;
+      drawn = live;
       drawnAt = nowMs;
       const s: SeriesBuffer = live.series;
       const end = live.nowUs() / 1e6;

@@ -6,8 +6,8 @@
 import type { Signal } from '@preact/signals';
 import { useEffect, useRef } from 'preact/hooks';
 import { onFrame } from '../../frame-loop.js';
-import { live } from '../../live.js';
-import { linkState } from '../../store.js';
+import type { Live } from '../../live.js';
+import { current, linkState } from '../../store.js';
 import './style.css';
 
 const LABEL = { waiting: 'Waiting', live: 'Live', hold: 'Hold', failsafe: 'Failsafe' } as const;
@@ -32,7 +32,9 @@ export function LinkPanel({ windowUs }: { windowUs: Signal<number> }) {
     let shown = '';
     let stripVersion = -1;
     let stripAt = 0;
+    let stripLive: Live | undefined;
     return onFrame((nowMs) => {
+      const live = current();
       const l = live.link;
       const now = live.nowUs();
       const text = l === null ? '—' : ago(now - l.lastFrameUs);
@@ -41,8 +43,9 @@ export function LinkPanel({ windowUs }: { windowUs: Signal<number> }) {
         shown = text;
       }
       // The timeline moves with time: redraw it on new data or four times a second.
-      if (strip.current === null || (live.version === stripVersion && nowMs - stripAt < 250)) return;
+      if (strip.current === null || (live === stripLive && live.version === stripVersion && nowMs - stripAt < 250)) return;
       stripVersion = live.version;
+      stripLive = live;
       stripAt = nowMs;
       if (counts.current !== null) counts.current.textContent = l === null ? '' : `${l.holds} holds · ${l.failsafes} failsafes`;
       const span = windowUs.value;

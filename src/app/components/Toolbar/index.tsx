@@ -4,7 +4,8 @@
  */
 import { useEffect, useRef, useState } from 'preact/hooks';
 import { identify, pickPort, portLabel, serialUnavailable, USB_SERIAL_FILTERS } from '../../serial.js';
-import { notify, recording, resolutionOverride, send, status } from '../../store.js';
+import type { SourceStatus } from '../../../worker/protocol.js';
+import { notify, recording, replay, resolutionOverride, send, sources } from '../../store.js';
 import { openCapture } from '../../open-file.js';
 import './style.css';
 
@@ -32,12 +33,28 @@ function duration(us: number): string {
   return `${Math.floor(s / 60)}:${String(s % 60).padStart(2, '0')}`;
 }
 
+/** One line for the status pill: what feeds the page now. */
+function summary(list: SourceStatus[]): { text: string; tone: string } {
+  const first = list[0];
+  if (first === undefined) return { text: 'No receiver', tone: 'idle' };
+  if (first.kind === 'demo') return { text: `Demo receiver: ${list.length} simulated remotes (DSMX 11 ms)`, tone: 'demo' };
+  if (first.kind === 'replay') {
+    const r = replay.value;
+    const state = first.state === 'ended' ? ' (end)' : first.state === 'paused' ? ' (paused)' : '';
+    return { text: `${r?.name ?? 'Replay'}${state}`, tone: 'replay' };
+  }
+  const lost = list.some((s) => s.state === 'lost');
+  return { text: list.map((s) => `${s.label}: ${s.state === 'lost' ? `${s.name}: device lost` : s.name}`).join(' · '), tone: lost ? 'serial lost' : 'serial reading' };
+}
+
 export function Toolbar({ granted }: { granted: SerialPort[] }) {
   const file = useRef<HTMLInputElement>(null);
   const [exported, setExported] = useState(false);
-  const s = status.value;
+  const list = sources.value;
+  const kind = list[0]?.kind;
   const rec = recording.value;
-  const live = s.kind === 'serial' || s.kind === 'demo';
+  const live = kind === 'serial' || kind === 'demo';
+  const pill = summary(list);
   useEffect(() => {
     if (rec?.active) setExported(false);
   }, [rec?.active]);
@@ -47,24 +64,19 @@ export function Toolbar({ granted }: { granted: SerialPort[] }) {
         <svg viewBox="0 0 64 64" width="26" height="26" aria-hidden="true"><path d="M10 44h8l5-22 7 30 6-38 6 30h12" fill="none" stroke="currentColor" stroke-width="5" stroke-linejoin="round" stroke-linecap="round" /></svg>
         <span>SatScope</span>
       </div>
-      <div class={`pill ${s.kind} ${s.state}`} role="status" data-testid="source-status">
-        {s.label}
+      <div class={`pill ${pill.tone}`} role="status" data-testid="source-status">
+        {pill.text}
       </div>
       <div class="actions">
-        {s.kind === 'serial' ? (
-          <button type="button" onClick={() => send({ type: 'serial-close' })}>Disconnect</button>
-        ) : (
-          <>
-            <button type="button" class="primary" onClick={() => void choose(true)}>Connect receiver</button>
-            <button type="button" class="link" onClick={() => void choose(false)}>any port…</button>
-            {granted.map((port, i) => (
-              <button key={i} type="button" onClick={() => void connect(port)} title="A port this page was allowed before">
-                {portLabel(port)}
-              </button>
-            ))}
-          </>
-        )}
-        {s.kind === 'demo' ? (
+        <button type="button" class="primary" onClick={() => void choose(true)}>{kind === 'serial' ? 'Add receiver' : 'Connect receiver'}</button>
+        <button type="button" class="link" onClick={() => void choose(false)}>any port…</button>
+        {granted.map((port, i) => (
+          <button key={i} type="button" onClick={() => void connect(port)} title="A port this page was allowed before: connect it (several can run side by side)">
+            {portLabel(port)}
+          </button>
+        ))}
+        {kind === 'serial' ? <button type="button" onClick={() => send({ type: 'close-all' })}>Disconnect all</button> : null}
+        {kind === 'demo' ? (
           <button type="button" onClick={() => send({ type: 'demo-stop' })}>Stop demo</button>
         ) : (
           <button type="button" onClick={() => send({ type: 'demo-start' })}>Demo</button>
