@@ -394,3 +394,20 @@ describe('setResolution', () => {
     expect(decoder.stats.resyncs).toBe(0);
   });
 });
+
+describe('resolution from the internal remote', () => {
+  it('says when the resolution came from the internal remote of the same system', () => {
+    const decoder = new SpektrumDecoder();
+    decoder.push(dsmxStream(6, 0x00, 0));
+    while (decoder.next());
+    decoder.setResolution(2048, 'internal-remote');
+    expect(decoder.format.resolutionReason).toBe('internal-remote');
+    expect(decoder.format.explanation).toMatch(/from the internal remote/);
+    decoder.setResolution('auto');
+    expect(decoder.format.resolutionReason).toBe('unknown');
+    decoder.push(dsmxStream(6, 0x00, 0));
+    decoder.end();
+    while (decoder.next());
+    expect(decoder.format.resolutionReason).toBe('channel-ids');
+  });
+});

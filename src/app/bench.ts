@@ -4,16 +4,16 @@
  * that drew them, in ms. Read by bench/page.bench.ts through window.__satscopeBench.
  */
 import { onFrame } from './frame-loop.js';
-import { current } from './store.js';
+import { allLives, current } from './store.js';
 
 declare global {
   interface Window {
-    __satscopeBench?: { latencies: number[] };
+    __satscopeBench?: { latencies: number[]; lives: typeof allLives };
   }
 }
 
 export function startBenchHooks(): void {
-  const bench = { latencies: [] as number[] };
+  const bench = { latencies: [] as number[], lives: allLives };
   window.__satscopeBench = bench;
   let version = -1;
   // Registered after the views, so it runs after they drew in the same frame.

@@ -117,6 +117,8 @@ export class SpektrumDecoder {
   #candInternal = false;
   #candRssi = false;
   #candSystem = 0;
+  /** Who fixed the resolution, when it is fixed. */
+  #fixedBy: 'user' | 'internal-remote' = 'user';
 
   /**
    * @throws {TypeError} when an option has a value outside its documented set.
@@ -184,19 +186,24 @@ export class SpektrumDecoder {
    * Changes the resolution setting while decoding (the user's override, or the internal
    * remote's resolution handed to an external one). When it contradicts the lock, the decoder
    * looks for frames again from the next undecided byte; counters and buffered bytes are kept.
+   * `by` says where a fixed resolution comes from, for `format`: the user, or the internal
+   * remote of the same system.
    * @throws {TypeError} for a value outside 'auto', 1024, 2048.
    */
-  setResolution(resolution: 'auto' | Resolution): void {
+  setResolution(resolution: 'auto' | Resolution, by: 'user' | 'internal-remote' = 'user'): void {
     if (resolution !== 'auto' && resolution !== 1024 && resolution !== 2048) {
       throw new TypeError(`resolution must be 'auto', 1024 or 2048, not ${String(resolution)}`);
     }
     const before = this.#options.resolution;
-    if (before === resolution) return;
+    const fixedBy = resolution === 'auto' ? 'user' : by;
+    if (before === resolution && this.#fixedBy === fixedBy) return;
     this.#options.resolution = resolution;
+    this.#fixedBy = fixedBy;
     if (!this.#locked) return;
-    if (resolution === 'auto' ? this.#reason === 'override' : resolution !== this.#resolution) {
+    if (resolution === 'auto' ? this.#reason === 'override' || this.#reason === 'internal-remote' : resolution !== this.#resolution) {
       this.#locked = false;
       this.#layoutCount = 0;
+      this.#reason = 'unknown';
     } else {
       this.#setReason(this.#resolution as Resolution);
     }
@@ -592,7 +599,7 @@ export class SpektrumDecoder {
 
   #setReason(resolution: Resolution): void {
     if (this.#options.resolution !== 'auto') {
-      this.#reason = 'override';
+      this.#reason = this.#fixedBy === 'internal-remote' ? 'internal-remote' : 'override';
       return;
     }
     const info = this.#system === null ? undefined : systemInfo(this.#system);
@@ -602,6 +609,7 @@ export class SpektrumDecoder {
 
   #explain(): string {
     if (this.#resolution === null) return 'Not locked on to frames yet.';
+    if (!this.#locked) return 'Looking for frames again: the format changed or the frames stopped making sense.';
     const res = this.#resolution;
     const sys = this.#system === null ? undefined : systemInfo(this.#system);
     const hex = (v: number) => `0x${v.toString(16).padStart(2, '0').toUpperCase()}`;
@@ -610,6 +618,7 @@ export class SpektrumDecoder {
       : 'external remote (or a receiver that sends no system byte): bytes 0–1 are a UINT16 fade count';
     switch (this.#reason) {
       case 'override': return `${res} resolution set by the user; ${remote}.`;
+      case 'internal-remote': return `${res} resolution from the internal remote's system byte (on another port: it holds the key for every remote); ${remote}.`;
       case 'system-byte': return `${res} resolution from the system byte, confirmed by the channel IDs; ${remote}.`;
       case 'system-byte-contradicted':
         return `${res} resolution inferred from the channel IDs: the system byte says ${sys?.resolution ?? '?'} but its channel IDs only make sense at ${res}; ${remote}.`;

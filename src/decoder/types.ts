@@ -71,6 +71,8 @@ export interface DecodedFrame {
 export type ResolutionReason =
   /** The caller fixed it. */
   | 'override'
+  /** Taken from the internal remote of the same system (another port): it holds the key for all remotes (§8). */
+  | 'internal-remote'
   /** The internal remote's system byte names it and the channel IDs agree (or cannot tell). */
   | 'system-byte'
   /** No valid system byte: inferred from which reading gives consistent channel IDs. */

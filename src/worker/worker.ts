@@ -114,7 +114,7 @@ function shareResolution(): void {
   for (const s of sources.values()) {
     const f = s.engine.decoder.format;
     if (f.remote === 'internal' || resolution !== 'auto') continue;
-    s.engine.decoder.setResolution(key ?? 'auto');
+    s.engine.decoder.setResolution(key ?? 'auto', 'internal-remote');
   }
 }
 

@@ -9,7 +9,7 @@ import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import type { Page } from 'playwright-core';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
-import { parseCapture, readCapture, summarizeCapture, channelName } from '../../src/decoder/index.js';
+import { CaptureWriter, capturePorts, parseCapture, readCapture, summarizeCapture, channelName } from '../../src/decoder/index.js';
 import { preset, simulate } from '../../src/simulator/index.js';
 import { SHARED_CAPTURES, barValues, browserUnavailable, shot, startApp, usbChunks, writeCapture, type AppSession } from './app-fixture.js';
 
@@ -140,6 +140,10 @@ describe.skipIf(skip !== null)('the page', () => {
     const summary = summarizeCapture(capture);
     expect(summary.decoder.frames).toBeGreaterThan(120);
     expect(summary.format.system).toBe(0xb2);
+    // Both demo remotes, each its own port on the one clock, labelled.
+    expect(capturePorts(capture)).toEqual([0, 1]);
+    expect(summarizeCapture(capture, { port: 1 }).format.remote).toBe('external');
+    expect(capture.meta.ports?.map((p) => p.name)).toEqual(['A', 'B']);
 
     // Start again and reload without stopping: the recording is kept and offered back.
     await page.getByRole('button', { name: '● Record' }).click();
@@ -156,6 +160,57 @@ describe.skipIf(skip !== null)('the page', () => {
     expect(recovered.decoder.frames).toBeGreaterThan(80);
     await banner.getByRole('button', { name: 'Discard' }).click();
     await banner.waitFor({ state: 'detached' });
+    expect(errors).toEqual([]);
+    await page.context().close();
+  });
+
+  it('shows the two demo remotes side by side and switches the views to the one clicked', async () => {
+    const { page, errors } = await open();
+    const rows = page.locator('.remotes tbody tr');
+    await rows.nth(1).waitFor({ timeout: 10_000 });
+    await expect(rows.count()).resolves.toBe(2);
+    await page.locator('.remotes .state-chip', { hasText: 'live' }).nth(1).waitFor({ timeout: 10_000 });
+    await expect(page.getByTestId('remote').count()).resolves.toBe(1);
+    await expect(page.getByTestId('remote').textContent()).resolves.toBe('Internal remote');
+    await page.getByTestId('remote-B').click();
+    await page.locator('.panel h2', { hasText: 'remote B' }).waitFor();
+    await expect(page.getByTestId('remote').textContent()).resolves.toBe('External remote');
+    await page.waitForTimeout(1000);
+    await shot(page, 'remotes-demo');
+    expect(errors).toEqual([]);
+    await page.context().close();
+  });
+
+  it('replays a two-port capture on one clock, each remote with its own values', async () => {
+    const a = simulate({ ...preset('dropouts-failsafe'), seed: 11 }, 3_000_000);
+    const b = simulate({ ...preset('dsmx-11ms-2048-external'), seed: 12, dropouts: [{ atUs: 2_000_000, durationUs: 300_000 }] }, 3_000_000);
+    const writer = new CaptureWriter({ source: 'test', ports: [{ name: 'A' }, { name: 'R' }] });
+    const parts = [writer.header()];
+    const chunksA = usbChunks(a.bytes, a.timesUs).map((c) => ({ ...c, port: 0 }));
+    const chunksB = usbChunks(b.bytes, b.timesUs).map((c) => ({ ...c, port: 1 }));
+    for (const c of [...chunksA, ...chunksB].sort((x, y) => x.timeUs - y.timeUs)) parts.push(writer.data(c.bytes, c.timeUs, c.port));
+    const path = join(dir, 'two.sscap');
+    writeFileSync(path, Buffer.concat(parts));
+    const capture = parseCapture(new Uint8Array(readFileSync(path)));
+    const expectA = summarizeCapture(capture, { port: 0 });
+    const expectB = summarizeCapture(capture, { port: 1 });
+    const { page, errors } = await open('?demo=0');
+    await replayFile(page, path);
+    await playToEnd(page);
+    await page.getByTestId('remote-R').waitFor();
+    const check = async (expected: typeof expectA) => {
+      const bars = await barValues(page);
+      for (const c of expected.channels.filter((ch) => ch.id < 12)) expect(bars[c.name], c.name).toBe(c.lastUs);
+    };
+    await check(expectA);
+    await page.getByTestId('remote-R').click();
+    await page.locator('.panel h2', { hasText: 'remote R' }).waitFor();
+    await check(expectB);
+    await expect(page.getByTestId('count-frames').textContent()).resolves.toBe(String(expectB.decoder.frames));
+    // The external remote takes its resolution from the internal one on the other port.
+    await expect(page.getByTestId('resolution').textContent()).resolves.toMatch(/2048 from the internal remote/);
+    await page.waitForTimeout(500);
+    await shot(page, 'remotes-replay');
     expect(errors).toEqual([]);
     await page.context().close();
   });

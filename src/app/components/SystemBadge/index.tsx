@@ -24,7 +24,7 @@ export function SystemBadge() {
       </section>
     );
   }
-  const inferred = format.resolutionReason !== 'system-byte' && format.resolutionReason !== 'override';
+  const inferred = format.resolutionReason === 'channel-ids' || format.resolutionReason === 'system-byte-contradicted';
   const hex = format.system === null ? null : `0x${format.system.toString(16).toUpperCase().padStart(2, '0')}`;
   return (
     <section class="badge" aria-label="System" title={format.explanation}>
@@ -33,6 +33,7 @@ export function SystemBadge() {
         {format.resolution ?? '?'}
         {inferred ? <em> inferred</em> : null}
         {format.resolutionReason === 'override' ? <em> set by you</em> : null}
+        {format.resolutionReason === 'internal-remote' ? <em> from the internal remote</em> : null}
       </span>
       <span class="chip" data-testid="remote">{format.remote === 'internal' ? 'Internal remote' : 'External remote'}</span>
       {hex !== null ? <span class="chip">system {hex}</span> : null}
