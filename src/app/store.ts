@@ -5,7 +5,7 @@
  * shows them all.
  */
 import { computed, signal } from '@preact/signals';
-import type { FromWorker, Overview, RecordingStatus, ReplayStatus, SourceStatus, ToWorker } from '../worker/protocol.js';
+import type { BindProgress, FromWorker, Overview, RecordingStatus, ReplayStatus, SourceStatus, ToWorker } from '../worker/protocol.js';
 import { Live } from './live.js';
 
 export interface Notice {
@@ -23,6 +23,8 @@ export const replay = signal<ReplayStatus | null>(null);
 export const overview = signal<Overview | null>(null);
 export const notices = signal<Notice[]>([]);
 export const resolutionOverride = signal<'auto' | 1024 | 2048>('auto');
+/** The steps of the bind in progress (or the last one). */
+export const bindLog = signal<BindProgress[]>([]);
 
 const IDLE: SourceStatus = {
   id: -1, label: '', kind: 'serial', state: 'idle', name: 'No receiver', clockRate: 0,
@@ -137,6 +139,9 @@ function receive(message: FromWorker): void {
       break;
     case 'overview':
       overview.value = message.overview;
+      break;
+    case 'bind':
+      bindLog.value = message.progress.step === 'open' ? [message.progress] : [...bindLog.value, message.progress];
       break;
     default: {
       const never: never = message;

@@ -1,4 +1,5 @@
 /** Text forms of frames and summaries for the CLI. */
+import type { HealthReport, ReportFinding } from '../decoder/report.js';
 import type { CaptureSummary } from '../decoder/summary.js';
 import { servoToMicros, systemInfo, CHANNEL_COUNT, XPLUS_FIRST } from '../decoder/spec.js';
 import type { DecodedFrame } from '../decoder/types.js';
@@ -75,5 +76,16 @@ export function formatSummary(s: CaptureSummary, name: string): string {
     add('Timing', 'none in this file: no frame period, gaps or failsafe episodes');
   }
   if (s.issues.length > 0) add('File issues', `${s.issues.length} (damaged records skipped; see above)`);
+  return lines.join('\n');
+}
+
+const STATUS_WORD: Record<HealthReport['status'], string> = { good: 'good', fair: 'fair', poor: 'poor', 'no-data': 'no data' };
+const MARK: Record<ReportFinding['level'], string> = { problem: 'PROBLEM', warning: 'warning', info: 'info', ok: 'ok' };
+
+/** What `satscope report --out FILE` prints: where the report went, the overall status and the findings. */
+export function formatReportVerdict(r: HealthReport, written: string): string {
+  const remotes = r.remotes.length;
+  const lines = [`Report written to ${written}: link ${STATUS_WORD[r.status]} (${remotes} ${remotes === 1 ? 'port' : 'ports'})`];
+  for (const f of r.verdict) lines.push(`  ${MARK[f.level].padEnd(9)}${f.text}`);
   return lines.join('\n');
 }

@@ -93,6 +93,13 @@ export const SPIKE_RETURN_PERCENT = 5;
 export const SPIKE_WINDOW_US = 100_000;
 /** The same window in decoded frames, for captures without timing. */
 export const SPIKE_WINDOW_FRAMES = 9;
+/**
+ * How many more fades than frames due (by the clock, since the previous frame) a frame's fade
+ * counter may add before the rise is taken for a corrupted header and left out: a satellite can
+ * count a fade it recovered from without dropping a frame, and chunk times blur a gap by a
+ * frame or two. A bit flipped in the counter adds 2^n (and takes it back on the next frame).
+ */
+export const FADE_DELTA_SLACK = 3;
 /** At most this many glitches are listed (all are counted). */
 export const MAX_LISTED_GLITCHES = 200;
 /** At most this many hold episodes are listed (all are counted). */
@@ -119,6 +126,7 @@ export interface ReportThresholds {
   spikeWindowUs: number;
   spikeWindowFrames: number;
   chunkTimingAllowanceUs: number;
+  fadeDeltaSlack: number;
 }
 
 export const REPORT_THRESHOLDS: Readonly<ReportThresholds> = Object.freeze({
@@ -134,6 +142,7 @@ export const REPORT_THRESHOLDS: Readonly<ReportThresholds> = Object.freeze({
   spikeWindowUs: SPIKE_WINDOW_US,
   spikeWindowFrames: SPIKE_WINDOW_FRAMES,
   chunkTimingAllowanceUs: CHUNK_TIMING_ALLOWANCE_US,
+  fadeDeltaSlack: FADE_DELTA_SLACK,
 });
 
 // ---------------------------------------------------------------------------------------------
@@ -263,12 +272,24 @@ export interface RemoteReport {
   lostRatio: number | null;
   /** 11000 or 22000 µs. */
   nominalPeriodUs: number | null;
-  /** The receiver's fade counter: total over the capture and per minute of `durationUs`; `null` for an RSSI receiver. */
-  fades: { total: number; perMinute: number | null } | null;
+  /**
+   * The receiver's fade counter: total over the capture and per minute of `durationUs`;
+   * `null` for an RSSI receiver. `counterMoved` is false when every frame said 0 (a receiver
+   * that does not count, e.g. a clone's 00 00 header, or simply a perfect link).
+   * `implausibleJumps` counts frames whose counter rose by more than the frames due since the
+   * previous one allow (`FADE_DELTA_SLACK`): a corrupted header, left out of `total`.
+   */
+  fades: { total: number; perMinute: number | null; counterMoved: boolean; implausibleJumps: number } | null;
   /** SPM4649T RSSI over the frames that carried a level (−128 loss reports counted apart); `null` without RSSI. */
   rssi: { minDbm: number | null; meanDbm: number | null; maxDbm: number | null; frames: number; lossReports: number } | null;
-  /** Hold episodes (last values held; every failsafe starts as one): count, the longest, the list. */
-  holds: { count: number; longestUs: number | null; longestAtUs: number | null; episodes: ReportEpisode[] };
+  /**
+   * Hold episodes (last values held). Every failsafe starts as a hold, so `count` includes
+   * those; `recovered` counts the holds the link came back from before failsafe, and
+   * `longestUs`/`longestAtUs` is the longest of those (`null` when there is none: a hold that
+   * became a failsafe lasted the hold state's full ~1 s, and is reported as a failsafe). The
+   * list holds every hold episode, up to `MAX_LISTED_HOLDS`.
+   */
+  holds: { count: number; recovered: number; longestUs: number | null; longestAtUs: number | null; episodes: ReportEpisode[] };
   /** Failsafe episodes (over 1 s without a frame), oldest first. */
   failsafes: ReportEpisode[];
   /** Longest silence between two frames, µs. */
@@ -309,7 +330,11 @@ export interface HealthReport {
   timeline: { originUs: number | null; durationUs: number | null; binUs: number; bins: number };
   /** The worst status of any remote. */
   status: ReportStatus;
-  /** Every remote's findings, worst first; prefixed with the port's label when there are several. */
+  /**
+   * Every remote's findings, worst first. With several remotes each is prefixed with the
+   * port's label, and one that several remotes share word for word is given once, with their
+   * labels ("All ports: …") and `port: null`.
+   */
   verdict: ReportFinding[];
   remotes: RemoteReport[];
   thresholds: ReportThresholds;
@@ -393,6 +418,8 @@ interface PortData {
   glitchFrames: number;
   formatChanges: number;
   bytes: number;
+  /** Whether any frame carried a fade counter other than 0. */
+  fadeCounterMoved: boolean;
 }
 
 /** Decodes one port, keeping what the report needs per frame, and finds spikes as it goes. */
@@ -415,6 +442,7 @@ function decodePort(capture: Capture, port: number, resolution: 'auto' | Resolut
   let glitchFrames = 0;
   let lastGlitchFrame = -1;
   let formatChanges = 0;
+  let fadeCounterMoved = false;
   const remote = decodeCapture(capture, {
     port,
     resolution,
@@ -425,6 +453,7 @@ function decodePort(capture: Capture, port: number, resolution: 'auto' | Resolut
     times.push(f.timeUs);
     fades.push(f.fadesDelta);
     rssi.push(f.rssi ?? NaN);
+    if (f.fades !== null && f.fades !== 0) fadeCounterMoved = true;
     for (let i = 0; i < f.count; i++) {
       const id = f.ids[i] as number;
       const res: Resolution = id >= XPLUS_FIRST ? 2048 : f.resolution;
@@ -476,7 +505,7 @@ function decodePort(capture: Capture, port: number, resolution: 'auto' | Resolut
   for (const chunk of captureChunks(capture, port)) bytes += chunk.bytes.length;
   return {
     port, times: times.view(), fadesDelta: fades.view(), rssi: rssi.view(), remote,
-    channelFrames, channelMin, channelMax, channelSum, glitchesRaw, glitchCount, glitchFrames, formatChanges, bytes,
+    channelFrames, channelMin, channelMax, channelSum, glitchesRaw, glitchCount, glitchFrames, formatChanges, bytes, fadeCounterMoved,
   };
 }
 
@@ -508,9 +537,10 @@ export function formatClock(us: number): string {
   return `${m}:${sec}`;
 }
 
-/** "2.4 s", "350 ms", "1.20 ms". */
+/** "2.4 s", "350 ms", "1.20 ms", "6.7 µs". */
 export function formatDuration(us: number): string {
   if (!Number.isFinite(us)) return '?';
+  if (us < 1000) return `${us < 100 ? (Math.round(us * 10) / 10).toString() : Math.round(us).toString()} µs`;
   if (us >= 1e6) return `${(us / 1e6).toFixed(us >= 100e6 ? 0 : 1)} s`;
   if (us >= 10_000) return `${Math.round(us / 1000)} ms`;
   return `${(us / 1000).toFixed(2)} ms`;
@@ -518,7 +548,7 @@ export function formatDuration(us: number): string {
 
 const plural = (n: number, one: string, many = `${one}s`): string => `${n} ${n === 1 ? one : many}`;
 const pctText = (ratio: number): string => `${(ratio * 100).toFixed(ratio < 0.001 && ratio > 0 ? 3 : ratio < 0.1 ? 2 : 1)} %`;
-const rate = (x: number): string => (x >= 10 ? x.toFixed(0) : x.toFixed(1));
+const rate = (x: number): string => (x === 0 ? '0' : x >= 10 ? x.toFixed(0) : x.toFixed(1));
 
 function remoteFindings(r: RemoteReport, timing: CaptureTiming): ReportFinding[] {
   const out: ReportFinding[] = [];
@@ -536,20 +566,23 @@ function remoteFindings(r: RemoteReport, timing: CaptureTiming): ReportFinding[]
       for (const e of r.failsafes) if (e.durationUs > longest.durationUs) longest = e;
       const n = r.failsafes.length;
       const ongoing = r.failsafes.some((e) => e.ongoing) ? '; the capture ends in failsafe' : '';
-      add('problem', 'failsafe', `${plural(n, 'failsafe episode')}, ${n > 1 ? 'longest ' : ''}${formatDuration(longest.durationUs)} at ${formatClock(longest.startUs)}${ongoing}`);
+      const outage = longest.ongoing ? '' : ` (${formatDuration(longest.endUs - longest.lastFrameUs)} without frames from ${formatClock(longest.lastFrameUs)})`;
+      add('problem', 'failsafe', `${plural(n, 'failsafe episode')}, ${n > 1 ? 'longest ' : ''}${formatDuration(longest.durationUs)} at ${formatClock(longest.startUs)}${outage}${ongoing}`);
     } else {
       add('ok', 'failsafe', 'No failsafe');
     }
-    const holdsOnly = r.holds.count - r.failsafes.length;
-    if (holdsOnly > 0) {
-      add('warning', 'holds', `${plural(holdsOnly, 'hold')} (last values held) without failsafe${r.holds.longestUs !== null && r.holds.longestAtUs !== null ? `; longest hold ${formatDuration(r.holds.longestUs)} at ${formatClock(r.holds.longestAtUs)}` : ''}`);
+    const h = r.holds;
+    if (h.recovered > 0 && h.longestUs !== null && h.longestAtUs !== null) {
+      add('warning', 'holds', `${plural(h.recovered, 'hold')} (last values held, recovered before failsafe), ${h.recovered > 1 ? 'longest ' : ''}${formatDuration(h.longestUs)} at ${formatClock(h.longestAtUs)}`);
     }
     if (r.lostRatio !== null && r.missedFrames !== null && r.expectedFrames !== null) {
       const level: FindingLevel = r.lostRatio >= LOST_RATIO_PROBLEM ? 'problem' : r.lostRatio >= LOST_RATIO_WARN ? 'warning' : 'ok';
       const judged = level === 'problem' ? ' is high' : level === 'warning' ? ' is more than a healthy link loses' : '';
       add(level, 'lost-frames', `${pctText(r.lostRatio)} of frames lost (${r.missedFrames} of ${r.expectedFrames})${judged}`);
     }
-    if (r.fades !== null && r.fades.perMinute !== null) {
+    if (r.fades !== null && !r.fades.counterMoved && (r.missedFrames ?? 0) > 0) {
+      add('info', 'fade-rate', `The fade counter stayed at 0 although ${plural(r.missedFrames ?? 0, 'frame was', 'frames were')} lost: this receiver does not seem to count fades (a 00 00 header?)`);
+    } else if (r.fades !== null && r.fades.perMinute !== null) {
       const high = r.fades.perMinute > FADE_RATE_HIGH_PER_MIN;
       add(high ? 'warning' : 'ok', 'fade-rate', `Fade rate ${rate(r.fades.perMinute)}/min${high ? ` is high (over ${FADE_RATE_HIGH_PER_MIN}/min)` : ''} (${plural(r.fades.total, 'fade')})`);
     }
@@ -573,6 +606,9 @@ function remoteFindings(r: RemoteReport, timing: CaptureTiming): ReportFinding[]
       add('ok', 'rssi', `RSSI ${r.rssi.minDbm}…${r.rssi.maxDbm ?? '?'} dBm, mean ${r.rssi.meanDbm ?? '?'} dBm`);
     }
     if (r.rssi.lossReports > 0) add('info', 'rssi', `${plural(r.rssi.lossReports, 'frame')} reported a loss (RSSI −128)`);
+  }
+  if (r.fades !== null && r.fades.implausibleJumps > 0) {
+    add('warning', 'glitches', `${plural(r.fades.implausibleJumps, 'implausible jump')} of the fade counter left out (corrupted frame headers)`);
   }
   if (r.glitches.count > 0) {
     const first = r.glitches.listed[0];
@@ -660,11 +696,23 @@ export function healthReport(capture: Capture, options: HealthReportOptions = {}
     let rssiTotal = 0;
     let missed = 0;
     let longestGap = 0;
+    let fadesTotal = 0;
+    let fadeJumps = 0;
     const threshold = 1.5 * period + allowance;
     const intervals = new Column();
     for (let i = 0; i < n; i++) {
       const t = d.times[i] as number;
       const rs = d.rssi[i] as number;
+      let fd = d.fadesDelta[i] as number;
+      if (havePeriod && i > 0 && fd > 0) {
+        // A counter cannot count more fades than frames were due since the last frame.
+        const due = Math.max(0, Math.round((t - (d.times[i - 1] as number)) / period) - 1);
+        if (fd > due + FADE_DELTA_SLACK) {
+          fadeJumps++;
+          fd = 0;
+        }
+      }
+      fadesTotal += fd;
       if (!Number.isNaN(rs)) {
         if (rs === -128) rssiLoss++;
         else {
@@ -677,7 +725,7 @@ export function healthReport(capture: Capture, options: HealthReportOptions = {}
       if (!hasClock || !Number.isFinite(t)) continue;
       const b = binOf(t);
       framesS[b] = (framesS[b] as number) + 1;
-      if (fadesS) fadesS[b] = (fadesS[b] as number) + (d.fadesDelta[i] as number);
+      if (fadesS) fadesS[b] = (fadesS[b] as number) + fd;
       if (!Number.isNaN(rs) && rs !== -128) {
         rssiSum[b] = (rssiSum[b] as number) + rs;
         rssiN[b] = (rssiN[b] as number) + 1;
@@ -735,8 +783,11 @@ export function healthReport(capture: Capture, options: HealthReportOptions = {}
     const episodes = link.episodes;
     const failsafes = hasClock ? episodes.filter((e) => e.kind === 'failsafe').map((e) => episodeOf(e, origin, end)) : [];
     const holdEpisodes = hasClock ? episodes.filter((e) => e.kind === 'hold').map((e) => episodeOf(e, origin, end)) : [];
+    // A hold that became a failsafe ends where the failsafe starts, after the same last frame;
+    // one still open at the end of the capture did not recover either.
+    const recovered = holdEpisodes.filter((h) => !h.ongoing && !failsafes.some((f) => f.lastFrameUs === h.lastFrameUs));
     let longestHold: ReportEpisode | null = null;
-    for (const e of holdEpisodes) if (longestHold === null || e.durationUs > longestHold.durationUs) longestHold = e;
+    for (const e of recovered) if (longestHold === null || e.durationUs > longestHold.durationUs) longestHold = e;
 
     const channels: ReportChannel[] = [];
     for (let id = 0; id < CHANNEL_COUNT; id++) {
@@ -770,8 +821,10 @@ export function healthReport(capture: Capture, options: HealthReportOptions = {}
       lostRatio: havePeriod ? Math.round((missed / Math.max(1, stats.frames + missed)) * 1e6) / 1e6 : null,
       nominalPeriodUs: havePeriod ? period : null,
       fades: rssiMode ? null : {
-        total: link.stats.fades,
-        perMinute: Number.isFinite(duration) && duration > 0 ? r3(link.stats.fades / (duration / 60e6)) : null,
+        total: fadesTotal,
+        perMinute: Number.isFinite(duration) && duration > 0 ? r3(fadesTotal / (duration / 60e6)) : null,
+        counterMoved: d.fadeCounterMoved,
+        implausibleJumps: fadeJumps,
       },
       rssi: rssiMode || rssiFrames > 0 ? {
         minDbm: finite(rssiLo), maxDbm: finite(rssiHi), meanDbm: rssiFrames > 0 ? Math.round((rssiTotal / rssiFrames) * 10) / 10 : null,
@@ -779,6 +832,7 @@ export function healthReport(capture: Capture, options: HealthReportOptions = {}
       } : null,
       holds: {
         count: holdEpisodes.length,
+        recovered: recovered.length,
         longestUs: longestHold?.durationUs ?? null,
         longestAtUs: longestHold?.startUs ?? null,
         episodes: holdEpisodes.slice(0, MAX_LISTED_HOLDS),
@@ -817,8 +871,21 @@ export function healthReport(capture: Capture, options: HealthReportOptions = {}
   if (ports.length === 0) {
     verdict.push({ level: 'problem', code: 'no-frames', port: null, text: 'The capture holds no data' });
   }
-  for (const r of remotes) {
-    for (const f of r.findings) verdict.push(remotes.length > 1 ? { ...f, text: `${r.label}: ${f.text}` } : f);
+  if (remotes.length > 1) {
+    // A finding several remotes share word for word (e.g. the timing note) is said once, for all of them.
+    const done = new Set<string>();
+    for (const r of remotes) {
+      for (const f of r.findings) {
+        const key = `${f.level}|${f.code}|${f.text}`;
+        if (done.has(key)) continue;
+        done.add(key);
+        const same = remotes.filter((x) => x.findings.some((g) => g.level === f.level && g.code === f.code && g.text === f.text));
+        const who = same.length === remotes.length ? 'All ports' : same.map((x) => x.label).join(', ');
+        verdict.push({ ...f, port: same.length === 1 ? f.port : null, text: `${who}: ${f.text}` });
+      }
+    }
+  } else {
+    for (const r of remotes) verdict.push(...r.findings);
   }
   verdict.sort((a, b) => LEVEL_ORDER[a.level] - LEVEL_ORDER[b.level]);
   const order: ReportStatus[] = ['no-data', 'poor', 'fair', 'good'];
@@ -948,7 +1015,7 @@ function graphsSvg(report: HealthReport): string {
   const left = 44;
   const right = 12;
   const legendH = 18;
-  const panelH = panels.length > 4 ? 56 : 74;
+  const panelH = panels.length <= 2 ? 62 : panels.length <= 4 ? 46 : 40;
   const gapH = 8;
   const axisH = 22;
   const plotW = W - left - right;
@@ -960,10 +1027,10 @@ function graphsSvg(report: HealthReport): string {
   const parts: string[] = [];
   parts.push(`<svg viewBox="0 0 ${W} ${H}" width="100%" role="img" aria-label="Link quality over time" font-family="Helvetica, Arial, sans-serif" font-size="10">`);
   // Legend.
-  const legend: [string, string, boolean][] = [
-    ['Lost frames', COLORS.lost, false], ['Fades', COLORS.fades, false], ['RSSI', COLORS.rssi, false],
-    ['Hold', COLORS.hold, true], ['Failsafe', COLORS.failsafe, true],
-  ];
+  const legend: [string, string][] = [['Lost frames', COLORS.lost]];
+  if (panels.some((p) => p.color === COLORS.fades)) legend.push(['Fades', COLORS.fades]);
+  if (panels.some((p) => p.kind === 'rssi')) legend.push(['RSSI mean', COLORS.rssi], ['RSSI lowest', COLORS.rssiMin]);
+  legend.push(['Hold', COLORS.hold], ['Failsafe', COLORS.failsafe]);
   let lx = left;
   for (const [name, color] of legend) {
     parts.push(`<rect x="${lx}" y="4" width="10" height="10" fill="${color}"/><text x="${lx + 14}" y="13" fill="${COLORS.text}">${escapeHtml(name)}</text>`);
@@ -1046,6 +1113,7 @@ function graphsSvg(report: HealthReport): string {
       parts.push(`<text x="${left - 4}" y="${top + pad + 4}" text-anchor="end" fill="${COLORS.axis}">${hi}</text>`);
       parts.push(`<text x="${left - 4}" y="${bottom}" text-anchor="end" fill="${COLORS.axis}">${lo}</text>`);
     }
+    parts.push(`<rect x="${left + 1}" y="${top + 1}" width="${f1(8 + p.title.length * 5.4)}" height="12" fill="#fff" fill-opacity="0.8"/>`);
     parts.push(`<text x="${left + 4}" y="${top + 10}" fill="${COLORS.text}" font-weight="bold">${escapeHtml(p.title)}</text>`);
     parts.push(`</g>`);
   });
@@ -1066,52 +1134,138 @@ const LEVEL_MARK: Record<FindingLevel, string> = { problem: '✖', warning: '▲
 
 const hex2 = (v: number): string => `0x${v.toString(16).toUpperCase().padStart(2, '0')}`;
 
-function remoteHtml(r: RemoteReport, report: HealthReport): string {
-  const e = escapeHtml;
+/** Short forms of the decoder's resolution reasons (the reason code itself for any other). */
+const REASON_SHORT: Partial<Record<ResolutionReason, string>> = {
+  override: 'set by the user', 'system-byte': 'system byte', 'channel-ids': 'from the channel IDs',
+  'internal-remote': 'from the internal remote',
+  'system-byte-contradicted': 'system byte contradicted', unknown: 'undecided',
+};
+
+/** The metrics of one remote as label/value rows; `compact` for the side-by-side table of several remotes. */
+function metricRows(r: RemoteReport, timed: boolean, compact: boolean): [string, string][] {
   const rows: [string, string][] = [];
-  const sys = r.system.byte === null ? 'none (external remote or no system byte)' : `${hex2(r.system.byte)} ${r.system.name ?? '(not a valid system byte)'}`;
+  const sys = r.system.byte === null ? (compact ? 'none' : 'none (external remote or no system byte)') : `${hex2(r.system.byte)} ${r.system.name ?? '(not a valid system byte)'}`;
   rows.push(['System', sys]);
-  rows.push(['Remote', r.remote === null ? '?' : `${r.remote}${r.headerMode === 'rssi' ? ', RSSI in byte 0 (SPM4649T)' : ''}`]);
-  rows.push(['Resolution', `${r.resolution.value ?? '?'}: ${r.resolution.explanation}`]);
-  if (r.durationUs !== null) rows.push(['Duration', `${formatDuration(r.durationUs)} (${formatClock(r.firstFrameUs ?? 0)}–${formatClock(r.lastFrameUs ?? 0)})`]);
-  rows.push(['Frames', r.expectedFrames !== null ? `${r.frames} of ${r.expectedFrames} expected` : String(r.frames)]);
-  if (r.lostRatio !== null) rows.push(['Lost frames', `${r.missedFrames} (${pctText(r.lostRatio)})`]);
-  if (r.fades) rows.push(['Fades', `${r.fades.total}${r.fades.perMinute !== null ? ` (${rate(r.fades.perMinute)}/min)` : ''}`]);
-  if (r.rssi) rows.push(['RSSI', r.rssi.minDbm === null ? 'no level reported' : `${r.rssi.minDbm} / ${r.rssi.meanDbm} / ${r.rssi.maxDbm} dBm (min / mean / max)${r.rssi.lossReports ? `, ${r.rssi.lossReports} loss reports` : ''}`]);
-  if (report.timeline.bins > 0) {
-    rows.push(['Holds', `${r.holds.count}${r.holds.longestUs !== null ? `, longest ${formatDuration(r.holds.longestUs)} at ${formatClock(r.holds.longestAtUs ?? 0)}` : ''}`]);
-    rows.push(['Failsafes', String(r.failsafes.length)]);
-    if (r.longestGapUs !== null) rows.push(['Longest gap', formatDuration(r.longestGapUs)]);
+  rows.push(['Remote', r.remote === null ? '?' : `${r.remote}${r.headerMode === 'rssi' ? (compact ? ', RSSI' : ', RSSI in byte 0 (SPM4649T)') : ''}`]);
+  rows.push(['Resolution', `${r.resolution.value ?? '?'} (${REASON_SHORT[r.resolution.reason] ?? r.resolution.reason})`]);
+  rows.push(['Duration', r.durationUs === null ? '–' : `${formatDuration(r.durationUs)} (${formatClock(r.firstFrameUs ?? 0)}–${formatClock(r.lastFrameUs ?? 0)})`]);
+  rows.push(['Frames', r.expectedFrames !== null ? `${r.frames} of ${r.expectedFrames}${compact ? '' : ' expected'}` : String(r.frames)]);
+  if (timed) rows.push(['Lost frames', r.lostRatio === null ? '–' : `${r.missedFrames} (${pctText(r.lostRatio)})`]);
+  rows.push(['Fades', r.fades === null ? '–' : `${r.fades.total}${r.fades.perMinute !== null ? ` (${rate(r.fades.perMinute)}/min)` : ''}${r.fades.implausibleJumps ? `; ${plural(r.fades.implausibleJumps, 'counter jump')} ignored` : ''}`]);
+  if (r.rssi || !compact) {
+    if (r.rssi) rows.push(['RSSI', r.rssi.minDbm === null ? 'no level reported' : `${r.rssi.minDbm} / ${r.rssi.meanDbm} / ${r.rssi.maxDbm} dBm${compact ? '' : ' (min / mean / max)'}${r.rssi.lossReports ? `, ${r.rssi.lossReports} loss reports` : ''}`]);
+  } else {
+    rows.push(['RSSI', '–']);
   }
-  const fp = r.framePeriod;
-  if (fp) {
-    rows.push(['Frame period', `${(fp.meanUs / 1000).toFixed(3)} ms mean, jitter ${(fp.stdDevUs / 1000).toFixed(3)} ms${fp.basis === 'per-chunk' ? ' (USB chunk times)' : ''}`]);
-    rows.push(['Intervals', `p50 ${(fp.p50Us / 1000).toFixed(2)} · p95 ${(fp.p95Us / 1000).toFixed(2)} · p99 ${(fp.p99Us / 1000).toFixed(2)} ms (${fp.intervals}, gaps excluded)`]);
+  if (timed) {
+    const hd = r.holds;
+    const became = hd.count - hd.recovered - hd.episodes.filter((h) => h.ongoing).length;
+    rows.push(['Holds', `${hd.count}${became > 0 ? ` (${became} became ${became === 1 ? 'a failsafe' : 'failsafes'})` : ''}${hd.longestUs !== null ? `; longest recovered ${formatDuration(hd.longestUs)} at ${formatClock(hd.longestAtUs ?? 0)}` : ''}`]);
+    rows.push(['Failsafes', r.failsafes.length === 0 ? '0' : `${r.failsafes.length}, ${formatDuration(r.failsafes.reduce((a, x) => a + x.durationUs, 0))} in all`]);
+    rows.push(['Longest gap', r.longestGapUs === null ? '–' : formatDuration(r.longestGapUs)]);
+    const fp = r.framePeriod;
+    const chunk = fp?.basis === 'per-chunk' ? ' (USB chunk times)' : '';
+    const pcts = fp === null ? '–' : `p50 ${(fp.p50Us / 1000).toFixed(2)} · p95 ${(fp.p95Us / 1000).toFixed(2)} · p99 ${(fp.p99Us / 1000).toFixed(2)} ms`;
+    if (compact) {
+      rows.push(['Frame period', fp === null ? '–' : `${(fp.meanUs / 1000).toFixed(3)} ms, jitter ${formatDuration(fp.stdDevUs)}; ${pcts}${chunk}`]);
+    } else {
+      rows.push(['Frame period', fp === null ? '–' : `${(fp.meanUs / 1000).toFixed(3)} ms mean, jitter ${formatDuration(fp.stdDevUs)}${chunk}`]);
+      rows.push(['Intervals', fp === null ? '–' : `${pcts} (${fp.intervals}, gaps excluded)`]);
+    }
   }
   const d = r.decoder;
   rows.push(['Decoder', `${d.bytes} bytes, ${d.discardedBytes} discarded, ${d.resyncs} resyncs, ${d.badFrames} bad frames${d.formatChanges ? `, ${d.formatChanges} format changes` : ''}`]);
   rows.push(['Glitches', r.glitches.count === 0 ? 'none' : `${r.glitches.count} spikes in ${r.glitches.frames} frames`]);
-  const kv = rows.map(([k, v]) => `<tr><th>${e(k)}</th><td>${e(v)}</td></tr>`).join('');
-  const ch = r.channels.length === 0 ? '<p class="muted">No channels.</p>' : `<table class="grid"><thead><tr><th>Ch</th><th>Name</th><th class="n">Frames</th><th class="n">Min µs</th><th class="n">Mean</th><th class="n">Max</th></tr></thead><tbody>${r.channels.map((c) => `<tr><td class="n">${c.id}</td><td>${e(c.name)}</td><td class="n">${c.frames}</td><td class="n">${c.minUs}</td><td class="n">${Math.round(c.meanUs)}</td><td class="n">${c.maxUs}</td></tr>`).join('')}</tbody></table>`;
-  const LIST = 6;
-  const fs = r.failsafes.length === 0 ? '' : `<div><h3>Failsafe episodes</h3><table class="grid"><thead><tr><th class="n">#</th><th class="n">Last frame</th><th class="n">Failsafe from</th><th class="n">Until</th><th class="n">Duration</th></tr></thead><tbody>${r.failsafes.slice(0, LIST).map((x, i) => `<tr><td class="n">${i + 1}</td><td class="n">${formatClock(x.lastFrameUs)}</td><td class="n">${formatClock(x.startUs)}</td><td class="n">${x.ongoing ? 'end of capture' : formatClock(x.endUs)}</td><td class="n">${e(formatDuration(x.durationUs))}</td></tr>`).join('')}</tbody></table>${r.failsafes.length > LIST ? `<p class="muted">and ${r.failsafes.length - LIST} more (see the JSON report)</p>` : ''}</div>`;
-  const gl = r.glitches.count === 0 ? '' : `<div><h3>Glitches</h3><table class="grid"><thead><tr><th class="n">Time</th><th>Channel</th><th class="n">Before</th><th class="n">Spike</th><th class="n">After µs</th></tr></thead><tbody>${r.glitches.listed.slice(0, LIST).map((g) => `<tr><td class="n">${g.timeUs === null ? `frame ${g.frameIndex}` : formatClock(g.timeUs)}</td><td>${e(g.name)}</td><td class="n">${g.beforeUs}</td><td class="n">${g.spikeUs}</td><td class="n">${g.afterUs}</td></tr>`).join('')}</tbody></table>${r.glitches.count > LIST ? `<p class="muted">and ${r.glitches.count - LIST} more (see the JSON report)</p>` : ''}</div>`;
-  const extra = fs === '' && gl === '' ? '' : `<div class="cols">${fs}${gl}</div>`;
-  const title = `${r.label}${r.system.name ? ` · ${r.system.name}` : ''}${r.remote ? ` · ${r.remote} remote` : ''}`;
-  return `<section class="remote"><h2><span class="badge ${r.status}">${e(STATUS_TEXT[r.status])}</span> ${e(title)}</h2><div class="cols"><table class="kv">${kv}</table>${ch}</div>${extra}</section>`;
+  if (compact) rows.push(['Channels', channelList(r)]);
+  return rows;
+}
+
+/** "0–11, X+1–X+4 (16)": the channel IDs seen, as runs. */
+function channelList(r: RemoteReport): string {
+  if (r.channels.length === 0) return 'none';
+  const runs: string[] = [];
+  const ids = r.channels.map((c) => c.id);
+  for (let i = 0; i < ids.length;) {
+    let j = i;
+    while (j + 1 < ids.length && ids[j + 1] === (ids[j] as number) + 1 && ((ids[j + 1] as number) < XPLUS_FIRST) === ((ids[i] as number) < XPLUS_FIRST)) j++;
+    const a = ids[i] as number;
+    const b = ids[j] as number;
+    const name = (id: number): string => (id >= XPLUS_FIRST ? channelName(id) : String(id));
+    runs.push(a === b ? name(a) : `${name(a)}–${name(b)}`);
+    i = j + 1;
+  }
+  return `${runs.join(', ')} (${ids.length})`;
+}
+
+/** Rows listed per table in the page; the JSON has them all. */
+const LIST_ROWS = 5;
+
+function moreNote(shown: number, total: number): string {
+  return total > shown ? `<p class="muted">and ${total - shown} more (see the JSON report)</p>` : '';
+}
+
+/** Failsafe episodes of every remote (a Port column when there are several). */
+function failsafeTable(report: HealthReport): string {
+  const e = escapeHtml;
+  const many = report.remotes.length > 1;
+  const all = report.remotes.flatMap((r) => r.failsafes.map((x) => ({ r, x }))).sort((a, b) => a.x.startUs - b.x.startUs);
+  if (all.length === 0) return '';
+  const rows = all.slice(0, LIST_ROWS).map(({ r, x }, i) => `<tr>${many ? `<td>${e(r.label)}</td>` : `<td class="n">${i + 1}</td>`}<td class="n">${formatClock(x.lastFrameUs)}</td><td class="n">${formatClock(x.startUs)}</td><td class="n">${x.ongoing ? 'end of capture' : formatClock(x.endUs)}</td><td class="n">${e(formatDuration(x.durationUs))}</td></tr>`).join('');
+  return `<div><h3>Failsafe episodes</h3><table class="grid"><thead><tr>${many ? '<th>Port</th>' : '<th class="n">#</th>'}<th class="n">Last frame</th><th class="n">Failsafe from</th><th class="n">Until</th><th class="n">Duration</th></tr></thead><tbody>${rows}</tbody></table>${moreNote(Math.min(LIST_ROWS, all.length), all.length)}</div>`;
+}
+
+/** Glitches of every remote. */
+function glitchTable(report: HealthReport): string {
+  const e = escapeHtml;
+  const many = report.remotes.length > 1;
+  const all = report.remotes.flatMap((r) => r.glitches.listed.map((g) => ({ r, g })));
+  const total = report.remotes.reduce((n, r) => n + r.glitches.count, 0);
+  if (total === 0) return '';
+  const rows = all.slice(0, LIST_ROWS).map(({ r, g }) => `<tr>${many ? `<td>${e(r.label)}</td>` : ''}<td class="n">${g.timeUs === null ? `frame ${g.frameIndex}` : formatClock(g.timeUs)}</td><td>${e(g.name)}</td><td class="n">${g.beforeUs}</td><td class="n">${g.spikeUs}</td><td class="n">${g.afterUs}</td></tr>`).join('');
+  return `<div><h3>Glitches</h3><table class="grid"><thead><tr>${many ? '<th>Port</th>' : ''}<th class="n">Time</th><th>Channel</th><th class="n">Before</th><th class="n">Spike</th><th class="n">After µs</th></tr></thead><tbody>${rows}</tbody></table>${moreNote(Math.min(LIST_ROWS, all.length), total)}</div>`;
+}
+
+/** The channels one remote sent, with frames and pulse widths. */
+function channelTable(r: RemoteReport): string {
+  const e = escapeHtml;
+  if (r.channels.length === 0) return '<p class="muted">No channels.</p>';
+  return `<table class="grid"><thead><tr><th>Ch</th><th>Name</th><th class="n">Frames</th><th class="n">Min µs</th><th class="n">Mean</th><th class="n">Max</th></tr></thead><tbody>${r.channels.map((c) => `<tr><td class="n">${c.id}</td><td>${e(c.name)}</td><td class="n">${c.frames}</td><td class="n">${c.minUs}</td><td class="n">${Math.round(c.meanUs)}</td><td class="n">${c.maxUs}</td></tr>`).join('')}</tbody></table>`;
+}
+
+/** Everything below the graphs: one remote's metrics beside its channels, or several remotes side by side (channel ranges are in the JSON). */
+function detailsHtml(report: HealthReport): string {
+  const e = escapeHtml;
+  const timed = report.timeline.bins > 0;
+  const remotes = report.remotes;
+  if (remotes.length === 0) return '';
+  const extra = [failsafeTable(report), glitchTable(report)].filter((x) => x !== '');
+  const extraHtml = extra.length === 0 ? '' : `<div class="cols">${extra.join('')}</div>`;
+  if (remotes.length === 1) {
+    const r = remotes[0] as RemoteReport;
+    const kv = metricRows(r, timed, false).map(([k, v]) => `<tr><th>${e(k)}</th><td>${e(v)}</td></tr>`).join('');
+    const title = `${r.label}${r.system.name ? ` · ${r.system.name}` : ''}${r.remote ? ` · ${r.remote} remote` : ''}`;
+    return `<section class="remote"><h2><span class="badge ${r.status}">${e(STATUS_TEXT[r.status])}</span> ${e(title)}</h2><p class="why">${e(r.resolution.explanation)}</p><div class="cols"><table class="kv">${kv}</table>${channelTable(r)}</div>${extraHtml}</section>`;
+  }
+  const columns = remotes.map((r) => metricRows(r, timed, true));
+  const labels = (columns[0] ?? []).map(([k]) => k);
+  const head = remotes.map((r) => `<th>${e(r.label)} <span class="badge ${r.status}">${e(STATUS_TEXT[r.status])}</span></th>`).join('');
+  const body = labels.map((k, i) => `<tr><th>${e(k)}</th>${columns.map((c) => `<td>${e(c[i]?.[1] ?? '')}</td>`).join('')}</tr>`).join('');
+  const why = remotes.map((r) => `<li>${e(r.label)}: ${e(r.resolution.explanation)}</li>`).join('');
+  return `<section class="remote"><h2>Remotes</h2><table class="grid compare"><thead><tr><th></th>${head}</tr></thead><tbody>${body}</tbody></table>` +
+    `<ul class="why">${why}</ul>${extraHtml}</section>`;
 }
 
 const CSS = `
-@page { size: auto; margin: 10mm; }
+@page { size: auto; margin: 8mm; }
 * { box-sizing: border-box; }
 html { background: #eee; }
-body { margin: 0; font: 9pt/1.35 Helvetica, Arial, sans-serif; color: #222; -webkit-print-color-adjust: exact; print-color-adjust: exact; }
+body { margin: 0; font: 8.5pt/1.3 Helvetica, Arial, sans-serif; color: #222; -webkit-print-color-adjust: exact; print-color-adjust: exact; }
 main { background: #fff; max-width: 190mm; margin: 8mm auto; padding: 8mm; }
 header { display: flex; align-items: flex-start; justify-content: space-between; gap: 4mm; border-bottom: 2px solid #222; padding-bottom: 2mm; margin-bottom: 3mm; }
 h1 { font-size: 15pt; margin: 0 0 1mm; }
-h2 { font-size: 11pt; margin: 4mm 0 1.5mm; }
+h2 { font-size: 10.5pt; margin: 2.5mm 0 1mm; }
 h3 { font-size: 9.5pt; margin: 2mm 0 1mm; }
-.file { margin: 0; color: #555; word-break: break-all; }
+.file { margin: 0; color: #555; overflow-wrap: anywhere; }
 .status { font-size: 13pt; font-weight: bold; padding: 1.5mm 4mm; border-radius: 2mm; white-space: nowrap; }
 .good { background: #dff3e4; color: #17602c; }
 .fair { background: #fff1cc; color: #7a5300; }
@@ -1119,7 +1273,7 @@ h3 { font-size: 9.5pt; margin: 2mm 0 1mm; }
 .no-data { background: #e6e6e6; color: #444; }
 .badge { font-size: 8pt; padding: 0.3mm 1.5mm; border-radius: 1mm; vertical-align: 1px; }
 ul.verdict { list-style: none; margin: 0; padding: 0; columns: 1; }
-ul.verdict li { padding: 0.4mm 0 0.4mm 5mm; text-indent: -5mm; }
+ul.verdict li { padding: 0.25mm 0 0.25mm 5mm; text-indent: -5mm; }
 ul.verdict .mark { display: inline-block; width: 5mm; text-indent: 0; font-weight: bold; }
 li.problem .mark { color: #c01818; } li.warning .mark { color: #c07a00; } li.info .mark { color: #2f6fb7; } li.ok .mark { color: #2e8b57; }
 li.problem { font-weight: bold; }
@@ -1127,14 +1281,17 @@ li.problem { font-weight: bold; }
 .graphs svg { display: block; }
 .cols { display: grid; grid-template-columns: 1fr 1fr; gap: 4mm; align-items: start; }
 table { border-collapse: collapse; width: 100%; }
-table.kv th { text-align: left; font-weight: normal; color: #666; padding: 0.3mm 2mm 0.3mm 0; vertical-align: top; white-space: nowrap; }
-table.kv td { padding: 0.3mm 0; }
-table.grid { font-size: 8pt; }
+table.kv th { text-align: left; font-weight: normal; color: #666; padding: 0.15mm 2mm 0.15mm 0; vertical-align: top; white-space: nowrap; }
+table.kv td { padding: 0.15mm 0; }
+table.grid { font-size: 7.5pt; line-height: 1.25; }
+.why { margin: 0 0 1.5mm; padding: 0; list-style: none; color: #555; font-size: 7.5pt; }
 table.grid th { text-align: left; border-bottom: 1px solid #999; padding: 0.3mm 1mm; font-weight: bold; }
-table.grid td { border-bottom: 1px solid #eee; padding: 0.2mm 1mm; }
+table.grid td { border-bottom: 1px solid #eee; padding: 0.1mm 1mm; }
 table.grid .n { text-align: right; font-variant-numeric: tabular-nums; }
+table.compare th, table.compare td { vertical-align: top; }
+table.compare tbody th { font-weight: normal; color: #666; white-space: nowrap; border-bottom: 1px solid #eee; }
 .muted { color: #777; margin: 1mm 0; }
-footer { margin-top: 4mm; border-top: 1px solid #ccc; padding-top: 1.5mm; color: #777; font-size: 7.5pt; }
+footer { margin-top: 3mm; border-top: 1px solid #ccc; padding-top: 1.5mm; color: #777; font-size: 7.5pt; }
 section.remote { break-inside: avoid; }
 @media print { html { background: #fff; } main { margin: 0; padding: 0; max-width: none; } }
 `;
@@ -1150,7 +1307,7 @@ export function reportHtml(report: HealthReport): string {
   const facts: string[] = [s.kind, `timing ${s.timing}`, `${s.bytes} bytes`, plural(s.ports.length, 'port')];
   if (report.timeline.durationUs !== null) facts.push(formatDuration(report.timeline.durationUs));
   if (s.createdAt) facts.push(`recorded ${s.createdAt}`);
-  if (s.recordedFrom) facts.push(`from ${s.recordedFrom}`);
+  if (s.recordedFrom && s.recordedFrom !== s.kind) facts.push(`from ${s.recordedFrom}`);
   const verdict = report.verdict.length === 0 ? '<p class="muted">Nothing to report.</p>'
     : `<ul class="verdict">${report.verdict.map((f) => `<li class="${f.level}"><span class="mark">${LEVEL_MARK[f.level]}</span>${e(f.text)}</li>`).join('')}</ul>`;
   const svg = graphsSvg(report);
@@ -1175,7 +1332,7 @@ export function reportHtml(report: HealthReport): string {
 <h2>Findings</h2>
 ${verdict}
 ${graphs}
-${report.remotes.map((r) => remoteHtml(r, report)).join('\n')}
+${detailsHtml(report)}
 <footer>${e(footer)}</footer>
 </main>
 </body>

@@ -26,6 +26,8 @@ export type ToWorker =
   | { type: 'demo-start' }
   | { type: 'demo-stop' }
   | { type: 'set-label'; source: number; label: string }
+  /** Bind a satellite on this port (spec §7.2), then read it live. */
+  | { type: 'bind'; port: PortIdentity; pulses: number; powerLine: 'rts' | 'dtr'; polarity: 'asserted' | 'deasserted' }
   | { type: 'record-start' }
   | { type: 'record-stop' }
   | { type: 'export'; what: 'sscap' | 'raw'; recording: 'last' | 'recovered' }
@@ -124,6 +126,16 @@ export interface Overview {
   failsafe: { startUs: number; endUs: number }[];
 }
 
+/** One step of a bind as it happened. */
+export interface BindProgress {
+  step: 'open' | 'power-off' | 'power-on' | 'write' | 'reopen' | 'live' | 'failed';
+  text: string;
+  /** ms since the bind started. */
+  atMs: number;
+  /** ms since the satellite was powered on, null before. */
+  sincePowerOnMs: number | null;
+}
+
 export type FromWorker =
   /** Every source, whenever any of them changes (a handful at most). */
   | { type: 'sources'; sources: SourceStatus[] }
@@ -134,4 +146,5 @@ export type FromWorker =
   | { type: 'recording'; recording: RecordingStatus }
   | { type: 'export-ready'; name: string; mime: string; data: ArrayBuffer }
   | { type: 'replay'; replay: ReplayStatus | null }
-  | { type: 'overview'; overview: Overview };
+  | { type: 'overview'; overview: Overview }
+  | { type: 'bind'; progress: BindProgress };

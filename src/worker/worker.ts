@@ -7,7 +7,8 @@
 /// <reference lib="webworker" />
 import { CaptureFormatError, decodeCapture, readCapture, systemInfo, type Capture } from '../decoder/index.js';
 import { Engine } from './engine.js';
-import { REMOTE_LABELS, type FromWorker, type Overview, type PortIdentity, type SourceKind, type SourceStatus, type ToWorker } from './protocol.js';
+import { runBind } from './bind.js';
+import { REMOTE_LABELS, type BindProgress, type FromWorker, type Overview, type PortIdentity, type SourceKind, type SourceStatus, type ToWorker } from './protocol.js';
 import { Recorder } from './recorder.js';
 import { DemoSource } from './sources/demo.js';
 import { ReplaySource } from './sources/replay.js';
@@ -183,7 +184,7 @@ async function closeAll(): Promise<void> {
 
 // ---- serial ---------------------------------------------------------------------------------
 
-async function openSerial(identity: PortIdentity): Promise<void> {
+async function openSerial(identity: PortIdentity, signals?: SerialOutputSignals): Promise<void> {
   // Ports join each other, but not the demo or a replay.
   if (demo !== undefined || replay !== undefined) await closeAll();
   const port = await findPort(identity);
@@ -213,7 +214,7 @@ async function openSerial(identity: PortIdentity): Promise<void> {
   });
   sendSources();
   try {
-    await source.serial.open(port);
+    await source.serial.open(port, signals);
   } catch (error) {
     sources.delete(id);
     post({ type: 'reset', source: id });
@@ -257,6 +258,31 @@ async function reconnectLost(): Promise<void> {
 }
 
 navigator.serial?.addEventListener('connect', () => void reconnectLost());
+
+// ---- bind -----------------------------------------------------------------------------------
+
+async function bind(message: Extract<ToWorker, { type: 'bind' }>): Promise<void> {
+  if (demo !== undefined || replay !== undefined) await closeAll();
+  const port = await findPort(message.port);
+  if (port === undefined) {
+    notice('error', 'The port is not available', 'Plug the adapter in and choose it again.');
+    return;
+  }
+  // The bind needs the port to itself: close it if it is being read.
+  for (const s of sources.values()) if (s.serial?.port === port) await closeSource(s.id);
+  const report = (progress: BindProgress) => post({ type: 'bind', progress });
+  let keepOn: SerialOutputSignals;
+  try {
+    keepOn = await runBind(port, message, report);
+  } catch (error) {
+    const problem = openProblem(error);
+    report({ step: 'failed', text: `${problem.title}: ${problem.detail}`, atMs: 0, sincePowerOnMs: null });
+    notice('error', `Bind failed: ${problem.title}`, problem.detail);
+    return;
+  }
+  await openSerial(message.port, keepOn);
+  report({ step: 'live', text: 'reading at 115200: the satellite blinks until the transmitter binds, then frames appear', atMs: 0, sincePowerOnMs: null });
+}
 
 // ---- demo -----------------------------------------------------------------------------------
 
@@ -405,6 +431,9 @@ async function handle(message: ToWorker): Promise<void> {
       break;
     case 'demo-stop':
       await closeAll();
+      break;
+    case 'bind':
+      await bind(message);
       break;
     case 'set-label': {
       const s = sources.get(message.source);

@@ -75,9 +75,13 @@ export class SerialSource {
     return this.#port;
   }
 
-  /** Opens the port and starts reading. @throws the port's own error when it cannot be opened. */
-  async open(port: SerialPort): Promise<void> {
+  /**
+   * Opens the port and starts reading; `signals` are set at once after opening (after a bind,
+   * the line that powers the satellite). @throws the port's own error when it cannot be opened.
+   */
+  async open(port: SerialPort, signals?: SerialOutputSignals): Promise<void> {
     await port.open({ baudRate: BAUD_RATE, dataBits: 8, stopBits: 1, parity: 'none', flowControl: 'none', bufferSize: 1 << 20 });
+    if (signals !== undefined) await port.setSignals(signals);
     this.#port = port;
     this.#closing = false;
     this.#done = this.#readLoop(port);

@@ -6,6 +6,7 @@ import { signal } from '@preact/signals';
 import { useEffect, useState } from 'preact/hooks';
 import { openCapture } from '../../open-file.js';
 import { sources, status, xplusSeen } from '../../store.js';
+import { BindPanel } from '../Bind/index.js';
 import { ChannelBars } from '../ChannelBars/index.js';
 import { Counters } from '../Counters/index.js';
 import { Graphs } from '../Graphs/index.js';
@@ -21,6 +22,8 @@ const NORMAL = [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11];
 const XPLUS = [12, 13, 14, 15, 16, 17, 18, 19];
 /** The graphs' (and the episode timeline's) window, µs. */
 const windowUs = signal(60e6);
+/** Whether the bind panel is open. */
+export const binding = signal(false);
 
 export function App({ granted }: { granted: SerialPort[] }) {
   const [dragging, setDragging] = useState(false);
@@ -50,7 +53,8 @@ export function App({ granted }: { granted: SerialPort[] }) {
   }, []);
   return (
     <>
-      <Toolbar granted={granted} />
+      <Toolbar granted={granted} onBind={() => { binding.value = !binding.value; }} />
+      {binding.value ? <BindPanel granted={granted} onClose={() => { binding.value = false; }} /> : null}
       <ReplayBar />
       <Notices />
       <main class="grid">

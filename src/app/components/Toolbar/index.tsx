@@ -47,7 +47,7 @@ function summary(list: SourceStatus[]): { text: string; tone: string } {
   return { text: list.map((s) => `${s.label}: ${s.state === 'lost' ? `${s.name}: device lost` : s.name}`).join(' · '), tone: lost ? 'serial lost' : 'serial reading' };
 }
 
-export function Toolbar({ granted }: { granted: SerialPort[] }) {
+export function Toolbar({ granted, onBind }: { granted: SerialPort[]; onBind(): void }) {
   const file = useRef<HTMLInputElement>(null);
   const [exported, setExported] = useState(false);
   const list = sources.value;
@@ -82,6 +82,7 @@ export function Toolbar({ granted }: { granted: SerialPort[] }) {
           <button type="button" onClick={() => send({ type: 'demo-start' })}>Demo</button>
         )}
         <button type="button" onClick={() => file.current?.click()}>Open capture…</button>
+        <button type="button" onClick={onBind} title="Put a satellite into bind mode through the adapter (spec §7.2)">Bind…</button>
         <input ref={file} type="file" accept=".sscap,.bin,.csv,.txt" hidden onChange={(e) => {
           const f = (e.currentTarget as HTMLInputElement).files?.[0];
           if (f) void openCapture(f);

@@ -1,0 +1,192 @@
+/**
+ * Frame inspector: the recent stream as the decoder saw it, one row per frame or event. Each
+ * frame's 16 bytes are printed in hex, grouped by field and coloured by kind, with a tag under
+ * each group and a tooltip saying what it decodes to, and the whole frame decoded beside it.
+ * Discarded bytes, resyncs, locks and format changes appear inline at their stream offsets.
+ * Meant for someone comparing their own firmware decoder byte by byte.
+ *
+ * The entries arrive as snapshots (the parent asks the worker); nothing here runs per Spektrum
+ * frame. Rows are keyed by stream offset and never re-render once drawn, so a refresh while
+ * following only draws the new rows.
+ */
+import { Component } from 'preact';
+import { useLayoutEffect, useRef } from 'preact/hooks';
+import type { InspectEntry } from '../../../worker/inspector.js';
+import { describeFrame } from '../../inspect.js';
+import './style.css';
+
+const REASONS: Record<string, string> = {
+  'before-lock': 'before lock',
+  noise: 'noise',
+  'truncated-frame': 'truncated frame',
+  'end-of-stream': 'end of stream',
+};
+
+/** A scroll this far from the bottom is the user's, and pauses following. */
+const AWAY_PX = 32;
+
+const time = (us: number) => (Number.isFinite(us) ? (us / 1e6).toFixed(3) : '—');
+
+function hex(bytes: Uint8Array, from = 0, to = bytes.length): string {
+  let s = '';
+  for (let i = from; i < to; i++) s += (i > from ? ' ' : '') + (bytes[i] as number).toString(16).toUpperCase().padStart(2, '0');
+  return s;
+}
+
+function FrameCells({ e }: { e: InspectEntry }) {
+  if (e.bytes === null || e.bytes.length < 16) {
+    return <td colSpan={2} class="gone">bytes no longer held (older than the raw buffer)</td>;
+  }
+  const d = describeFrame(e.bytes, e.resolution ?? 2048, e.remote ?? 'internal', e.headerMode ?? 'fades');
+  const b = e.bytes;
+  return (
+    <>
+      <td class="hexcell">
+        {d.header.map((h) => (
+          <span key={h.first} class={`g k-header${h.valid ? '' : ' k-invalid'}`} title={h.title}>
+            <span class="hx">{hex(b, h.first, h.last + 1)}</span>
+            <span class="tag">{h.label}</span>
+          </span>
+        ))}
+        {d.slots.map((s) => (
+          <span key={s.first} class={`g k-${s.kind}`} title={s.title}>
+            <span class="hx">{hex(b, s.first, s.last + 1)}</span>
+            <span class="tag">{s.label}</span>
+          </span>
+        ))}
+      </td>
+      <td class="summary">{d.summary}</td>
+    </>
+  );
+}
+
+function EventCells({ e }: { e: InspectEntry }) {
+  switch (e.kind) {
+    case 'discarded':
+      return (
+        <td colSpan={2}>
+          <strong>discarded {e.length} byte{e.length === 1 ? '' : 's'}</strong> ({REASONS[e.reason ?? ''] ?? e.reason})
+          {e.bytes !== null
+            ? <span class="raw">{hex(e.bytes)}{e.truncated ? ` … (first ${e.bytes.length} shown)` : ''}</span>
+            : <span class="gone"> bytes no longer held</span>}
+        </td>
+      );
+    case 'resync':
+      return <td colSpan={2}><strong>resync</strong>: frames continue here (the bytes before did not fit the stream)</td>;
+    case 'locked':
+      return <td colSpan={2}><strong>locked on</strong>: {e.text ?? ''}</td>;
+    default:
+      return <td colSpan={2}><strong>format changed</strong>: {e.text ?? ''}</td>;
+  }
+}
+
+const ROW_CLASS: Record<InspectEntry['kind'], string> = {
+  frame: 'frame', discarded: 'discard', resync: 'resync', locked: 'info', 'format-changed': 'info',
+};
+
+/** One row. Its entry is fixed by its key, so it only redraws when a discard grows or bytes expire. */
+class Row extends Component<{ e: InspectEntry }> {
+  override shouldComponentUpdate(next: { e: InspectEntry }): boolean {
+    const a = this.props.e;
+    const b = next.e;
+    return a.kind !== b.kind || a.offset !== b.offset || a.length !== b.length ||
+      (a.bytes === null) !== (b.bytes === null) || !Object.is(a.timeUs, b.timeUs);
+  }
+
+  override render() {
+    const { e } = this.props;
+    return (
+      <tr class={ROW_CLASS[e.kind]}>
+        <td class="num">{time(e.timeUs)}</td>
+        <td class="num">{e.offset}</td>
+        {e.kind === 'frame' ? <FrameCells e={e} /> : <EventCells e={e} />}
+      </tr>
+    );
+  }
+}
+
+const LEGEND: [string, string][] = [
+  ['k-header', 'header (fades / RSSI, system)'],
+  ['k-channel', 'channel'],
+  ['k-xplus', 'X-Plus'],
+  ['k-empty', 'empty 0xFFFF'],
+  ['k-vtx', 'VTX'],
+  ['k-invalid', 'invalid'],
+  ['l-discard', 'discarded bytes'],
+  ['l-resync', 'resync'],
+  ['l-info', 'lock / format'],
+];
+
+export function Inspector({ entries, onRefresh, following, onFollow }: {
+  entries: InspectEntry[] | null;
+  onRefresh(): void;
+  following: boolean;
+  onFollow(on: boolean): void;
+}) {
+  const scroller = useRef<HTMLDivElement>(null);
+  useLayoutEffect(() => {
+    const el = scroller.current;
+    if (following && el !== null) el.scrollTop = el.scrollHeight;
+  }, [entries, following]);
+
+  const onScroll = () => {
+    const el = scroller.current;
+    // Scrolling up to read pauses: the rows stop moving under the reader.
+    if (following && el !== null && el.scrollHeight - el.scrollTop - el.clientHeight > AWAY_PX) onFollow(false);
+  };
+
+  let prev = '';
+  let dup = 0;
+  const rows = entries?.map((e) => {
+    // Two entries of one kind at one offset are rare (but possible): keep keys unique.
+    let key = `${e.offset}${e.kind}`;
+    if (key === prev) key += `#${++dup}`;
+    else {
+      prev = key;
+      dup = 0;
+    }
+    return <Row key={key} e={e} />;
+  });
+
+  return (
+    <section class="inspector" aria-label="Frame inspector">
+      <div class="insp-head">
+        <h2>Frame inspector</h2>
+        <span class="insp-state" aria-live="polite">
+          {following ? 'Following: newest at the bottom' : 'Paused: scroll through the rows; Refresh to update'}
+        </span>
+        <div class="insp-actions">
+          <button type="button" class={following ? 'on' : ''} aria-pressed={following} onClick={() => onFollow(!following)}>
+            Follow
+          </button>
+          <button type="button" onClick={onRefresh}>Refresh</button>
+        </div>
+      </div>
+      <ul class="insp-legend" aria-label="Colour key">
+        {LEGEND.map(([cls, label]) => (
+          <li key={cls}><span class={`swatch ${cls}`} aria-hidden="true" />{label}</li>
+        ))}
+        <li class="muted">tag “p”: phase bit set · hover a byte group for its decode</li>
+      </ul>
+      <div class="insp-scroll" ref={scroller} onScroll={onScroll} tabIndex={0} role="region" aria-label="Recent frames and decoder events">
+        {entries === null ? (
+          <p class="insp-empty">No snapshot yet: press Refresh.</p>
+        ) : entries.length === 0 ? (
+          <p class="insp-empty">Nothing received yet.</p>
+        ) : (
+          <table>
+            <thead>
+              <tr>
+                <th scope="col" class="num">Time (s)</th>
+                <th scope="col" class="num">Offset</th>
+                <th scope="col">Bytes</th>
+                <th scope="col">Decoded</th>
+              </tr>
+            </thead>
+            <tbody>{rows}</tbody>
+          </table>
+        )}
+      </div>
+    </section>
+  );
+}
