@@ -23,6 +23,7 @@ export async function runBind(
   const plan = planPulses(options.pulses, { chips: chipsForUsbId(info.usbVendorId, info.usbProductId) });
   const steps: BindStep[] = bindTimeline(options.pulses, { powerLine: options.powerLine, polarity: options.polarity, plan });
   const start = performance.now();
+  let powerOffAt = NaN;
   let powerOnAt = NaN;
   let keepOn: SerialOutputSignals = {};
   const done = (step: BindStep, text: string) => {
@@ -31,8 +32,13 @@ export async function runBind(
   };
   try {
     for (const step of steps) {
-      // The write is timed from when power-on really happened, not from the plan's start.
-      const due = step.action === 'write' || step.action === 'reopen' ? powerOnAt + step.sincePowerOnMs : start + step.atMs;
+      // Each step is timed from when the one it depends on really happened, not from the plan's
+      // start: power-on from power-off (the satellite must be off long enough to reset), the
+      // pulses and the reopen from power-on (they must land in the bind window).
+      const offMs = -(steps.find((s) => s.action === 'power-off')?.sincePowerOnMs ?? 0);
+      const due = step.action === 'power-on' ? powerOffAt + offMs
+        : step.action === 'write' || step.action === 'reopen' ? powerOnAt + step.sincePowerOnMs
+          : start + step.atMs;
       await sleepUntil(due);
       switch (step.action) {
         case 'open':
@@ -41,6 +47,7 @@ export async function runBind(
           break;
         case 'power-off':
           await port.setSignals(step.signals);
+          powerOffAt = performance.now();
           done(step, 'satellite off');
           break;
         case 'power-on':

@@ -54,7 +54,9 @@ describe.skipIf(skip !== null)('binding a satellite', () => {
     await shot(page, 'bind-panel');
     const since = fake.signalChanges.length;
     await page.getByRole('button', { name: 'Bind on Serial port' }).click();
-    await page.locator('.bind .progress li.live').waitFor({ timeout: 5000 });
+    const result = page.locator('.bind .progress li.live, .bind .progress li.failed');
+    await result.first().waitFor({ timeout: 5000 });
+    await expect(page.locator('.bind .progress li.failed').count(), await page.locator('.bind .progress').textContent() ?? '').resolves.toBe(0);
 
     // What reached the wire, in order, with the shim's and the pty's monotonic times.
     const changes = fake.signalChanges.slice(since).filter((c) => c.op === 'set');
@@ -69,8 +71,9 @@ describe.skipIf(skip !== null)('binding a satellite', () => {
     const bytes = Uint8Array.from(pulses.flatMap((w) => Array.from(w.bytes)));
     expect(Array.from(bytes)).toEqual(Array.from(planPulses(9).bytes)); // 9 × 0xF0: nothing else
     const writeMs = (pulses[0]!.tUs - on.tUs) / 1000;
+    // Sent 60 ms after power-on as firmware does; Chromium's serial pipeline adds 0–40 ms here.
     expect(writeMs).toBeGreaterThan(55); // the satellite has settled…
-    expect(writeMs).toBeLessThan(150); // …and the pulses land in the bind window
+    expect(writeMs).toBeLessThan(140); // …and the pulses land in the bind window (20–140 ms)
     // After the reopen at 115200 the power line is asserted again, after the pulses.
     const again = changes.slice(onAt + 1).find((c) => c.requestToSend && c.tUs > pulses[0]!.tUs);
     expect(again).toBeDefined();
