@@ -74,7 +74,7 @@ export interface SlotField {
   name: string | null;
   /** What is wrong with an invalid slot. */
   problem: string | null;
-  /** A short tag to print under the bytes: "1p", "X+2", "—", "VTX", "!". */
+  /** A short tag to print under the bytes: "1p", "X+2", "empty", "VTX", "!". */
   label: string;
   /** The slot in the one-line summary (empty for the second VTX slot). */
   text: string;
@@ -203,7 +203,7 @@ export function describeFrame(bytes: Uint8Array, resolution: Resolution, remote:
     }
     if (word === EMPTY_SLOT) {
       s.kind = 'empty';
-      s.label = '—';
+      s.label = 'empty';
       s.text = 'empty';
       s.title = `${where}: empty slot (0xFFFF: unused, not a channel)`;
       slots.push(s);

@@ -31,6 +31,8 @@ export type ToWorker =
   | { type: 'record-start' }
   | { type: 'record-stop' }
   | { type: 'export'; what: 'sscap' | 'raw'; recording: 'last' | 'recovered' }
+  /** A health report of the capture being replayed, or of the live session's recording. */
+  | { type: 'report'; format: 'html' | 'json' }
   | { type: 'discard-recovered' }
   | { type: 'replay-open'; name: string; data: ArrayBuffer }
   | { type: 'replay-play' }

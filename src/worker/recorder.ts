@@ -198,6 +198,23 @@ export class Recorder {
     return { name: name.replace(/\.sscap$/, '.bin'), data: capture.bytes.slice().buffer };
   }
 
+  /**
+   * The recording so far (while recording, read through the open handle) or the last finished
+   * one, for a report on the live session; null when nothing was recorded.
+   */
+  async current(): Promise<Uint8Array | null> {
+    const handle = this.#handle;
+    if (handle !== undefined) {
+      handle.flush();
+      const out = new Uint8Array(this.#at);
+      handle.read(out, { at: 0 });
+      return out;
+    }
+    if (this.#last === null || this.#dir === undefined) return null;
+    const file = await (await this.#dir.getFileHandle(this.#last)).getFile();
+    return new Uint8Array(await file.arrayBuffer());
+  }
+
   async discardRecovered(): Promise<void> {
     const recovered = this.#recovered;
     if (recovered === null || this.#dir === undefined) return;

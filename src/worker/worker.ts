@@ -5,7 +5,7 @@
  * capture being replayed. A source's id is its port number in recordings.
  */
 /// <reference lib="webworker" />
-import { CaptureFormatError, decodeCapture, readCapture, systemInfo, type Capture } from '../decoder/index.js';
+import { CaptureFormatError, decodeCapture, healthReport, parseCapture, readCapture, reportHtml, systemInfo, type Capture } from '../decoder/index.js';
 import { Engine } from './engine.js';
 import { runBind } from './bind.js';
 import { REMOTE_LABELS, type BindProgress, type FromWorker, type Overview, type PortIdentity, type SourceKind, type SourceStatus, type ToWorker } from './protocol.js';
@@ -471,6 +471,27 @@ async function handle(message: ToWorker): Promise<void> {
       const result = await recorder.export(message.recording, message.what);
       if (typeof result === 'string') notice('warning', 'Nothing to export', result);
       else post({ type: 'export-ready', name: result.name, mime: 'application/octet-stream', data: result.data }, [result.data]);
+      break;
+    }
+    case 'report': {
+      let capture: Capture | undefined = replay?.capture;
+      let name = replayName;
+      if (capture === undefined) {
+        const recorded = await recorder.current();
+        if (recorded !== null) {
+          capture = parseCapture(recorded);
+          name = 'live session';
+        }
+      }
+      if (capture === undefined) {
+        notice('warning', 'Nothing to report on yet', 'Record the live session (● Record) or open a capture; the report covers what was recorded.');
+        break;
+      }
+      const report = healthReport(capture, { resolution, name });
+      const base = (name.replace(/\.[^.]+$/, '') || 'satscope').replace(/[^\w.-]+/g, '-');
+      const text = message.format === 'html' ? reportHtml(report) : `${JSON.stringify(report, null, 2)}\n`;
+      const data = new TextEncoder().encode(text).buffer as ArrayBuffer;
+      post({ type: 'export-ready', name: `${base}.report.${message.format}`, mime: message.format === 'html' ? 'text/html' : 'application/json', data }, [data]);
       break;
     }
     case 'discard-recovered':

@@ -121,6 +121,20 @@ describe.skipIf(skip !== null)('the page', () => {
     await playToEnd(page);
     await page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor();
     await expect(page.locator('.link dd').nth(1).textContent()).resolves.toMatch(/2 holds · 1 failsafes/);
+    // The health report of the capture, as a page and as JSON.
+    const html = page.waitForEvent('download');
+    await page.getByRole('button', { name: 'Report', exact: true }).click();
+    const htmlFile = join(dir, 'report.html');
+    await (await html).saveAs(htmlFile);
+    const text = readFileSync(htmlFile, 'utf8');
+    expect(text).toMatch(/<svg/);
+    expect(text).not.toMatch(/<script/i);
+    const json = page.waitForEvent('download');
+    await page.getByRole('button', { name: 'json', exact: true }).click();
+    const jsonFile = join(dir, 'report.json');
+    await (await json).saveAs(jsonFile);
+    const report = JSON.parse(readFileSync(jsonFile, 'utf8')) as { remotes: { failsafes: unknown[] }[] };
+    expect(report.remotes[0]?.failsafes).toHaveLength(1);
     await page.context().close();
   });
 

@@ -35,27 +35,23 @@ function hex(bytes: Uint8Array, from = 0, to = bytes.length): string {
 
 function FrameCells({ e }: { e: InspectEntry }) {
   if (e.bytes === null || e.bytes.length < 16) {
-    return <td colSpan={2} class="gone">bytes no longer held (older than the raw buffer)</td>;
+    return <span role="cell" class="wide gone">bytes no longer held (older than the raw buffer)</span>;
   }
   const d = describeFrame(e.bytes, e.resolution ?? 2048, e.remote ?? 'internal', e.headerMode ?? 'fades');
   const b = e.bytes;
+  // One element per byte group: its tag is drawn by CSS from data-tag (a third of the elements
+  // of a hex span plus a tag span, which matters at a thousand rows).
   return (
     <>
-      <td class="hexcell">
+      <span role="cell" class="hexcell">
         {d.header.map((h) => (
-          <span key={h.first} class={`g k-header${h.valid ? '' : ' k-invalid'}`} title={h.title}>
-            <span class="hx">{hex(b, h.first, h.last + 1)}</span>
-            <span class="tag">{h.label}</span>
-          </span>
+          <span key={h.first} class={`g k-header${h.valid ? '' : ' k-invalid'}`} title={h.title} data-tag={h.label}>{hex(b, h.first, h.last + 1)}</span>
         ))}
         {d.slots.map((s) => (
-          <span key={s.first} class={`g k-${s.kind}`} title={s.title}>
-            <span class="hx">{hex(b, s.first, s.last + 1)}</span>
-            <span class="tag">{s.label}</span>
-          </span>
+          <span key={s.first} class={`g k-${s.kind}`} title={s.title} data-tag={s.label}>{hex(b, s.first, s.last + 1)}</span>
         ))}
-      </td>
-      <td class="summary">{d.summary}</td>
+      </span>
+      <span role="cell" class="summary">{d.summary}</span>
     </>
   );
 }
@@ -64,19 +60,19 @@ function EventCells({ e }: { e: InspectEntry }) {
   switch (e.kind) {
     case 'discarded':
       return (
-        <td colSpan={2}>
+        <span role="cell" class="wide">
           <strong>discarded {e.length} byte{e.length === 1 ? '' : 's'}</strong> ({REASONS[e.reason ?? ''] ?? e.reason})
           {e.bytes !== null
             ? <span class="raw">{hex(e.bytes)}{e.truncated ? ` … (first ${e.bytes.length} shown)` : ''}</span>
             : <span class="gone"> bytes no longer held</span>}
-        </td>
+        </span>
       );
     case 'resync':
-      return <td colSpan={2}><strong>resync</strong>: frames continue here (the bytes before did not fit the stream)</td>;
+      return <span role="cell" class="wide"><strong>resync</strong>: frames continue here (the bytes before did not fit the stream)</span>;
     case 'locked':
-      return <td colSpan={2}><strong>locked on</strong>: {e.text ?? ''}</td>;
+      return <span role="cell" class="wide"><strong>locked on</strong>: {e.text ?? ''}</span>;
     default:
-      return <td colSpan={2}><strong>format changed</strong>: {e.text ?? ''}</td>;
+      return <span role="cell" class="wide"><strong>format changed</strong>: {e.text ?? ''}</span>;
   }
 }
 
@@ -96,11 +92,11 @@ class Row extends Component<{ e: InspectEntry }> {
   override render() {
     const { e } = this.props;
     return (
-      <tr class={ROW_CLASS[e.kind]}>
-        <td class="num">{time(e.timeUs)}</td>
-        <td class="num">{e.offset}</td>
+      <div role="row" class={`row ${ROW_CLASS[e.kind]}`}>
+        <span role="cell" class="num">{time(e.timeUs)}</span>
+        <span role="cell" class="num">{e.offset}</span>
         {e.kind === 'frame' ? <FrameCells e={e} /> : <EventCells e={e} />}
-      </tr>
+      </div>
     );
   }
 }
@@ -174,17 +170,17 @@ export function Inspector({ entries, onRefresh, following, onFollow }: {
         ) : entries.length === 0 ? (
           <p class="insp-empty">Nothing received yet.</p>
         ) : (
-          <table>
-            <thead>
-              <tr>
-                <th scope="col" class="num">Time (s)</th>
-                <th scope="col" class="num">Offset</th>
-                <th scope="col">Bytes</th>
-                <th scope="col">Decoded</th>
-              </tr>
-            </thead>
-            <tbody>{rows}</tbody>
-          </table>
+          <div role="table" class="insp-table" aria-label="Frames and decoder events, oldest first" aria-rowcount={entries.length + 1}>
+            <div role="rowgroup" class="insp-thead">
+              <div role="row" class="row">
+                <span role="columnheader" class="num">Time (s)</span>
+                <span role="columnheader" class="num">Offset</span>
+                <span role="columnheader">Bytes</span>
+                <span role="columnheader">Decoded</span>
+              </div>
+            </div>
+            <div role="rowgroup">{rows}</div>
+          </div>
         )}
       </div>
     </section>

@@ -107,6 +107,10 @@ export function Toolbar({ granted, onBind }: { granted: SerialPort[]; onBind(): 
           </>
         ) : null}
       </div>
+      <div class="report">
+        <button type="button" disabled={list.length === 0 && rec?.bytes === undefined} onClick={() => send({ type: 'report', format: 'html' })} title="One-page link-quality report of the capture being replayed, or of what was recorded live">Report</button>
+        <button type="button" class="link" disabled={list.length === 0 && rec?.bytes === undefined} onClick={() => send({ type: 'report', format: 'json' })}>json</button>
+      </div>
       <label class="resolution">
         Resolution
         <select value={String(resolutionOverride.value)} onChange={(e) => {
