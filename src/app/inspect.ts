@@ -143,8 +143,8 @@ function describeHeader(b: Uint8Array, resolution: Resolution, remote: RemoteKin
       const loss = dBm === -128;
       return {
         field: 'rssi' as const, first: 0, last: 0, raw: b0, value: dBm, valid: true, label: 'RSSI',
-        text: `RSSI ${dBm} dBm${loss ? ' (loss)' : ''}`,
-        title: `byte 0: RSSI, INT8 dBm (SPM4649T, §8.3.1) = ${dBm} dBm${loss ? ': connection or packet loss' : dBm >= 0 ? ': not negative, so not RSSI?' : ''}`,
+        text: `RSSI ${dBm}\u00a0dBm${loss ? ' (loss)' : ''}`,
+        title: `byte 0: RSSI, INT8 dBm (SPM4649T, §8.3.1) = ${dBm}\u00a0dBm${loss ? ': connection or packet loss' : dBm >= 0 ? ': not negative, so not RSSI?' : ''}`,
       };
     })()
     : {
@@ -249,18 +249,18 @@ export function describeFrame(bytes: Uint8Array, resolution: Resolution, remote:
       const decoded = s.channel !== null ? `; reads as ${s.name} ${s.position}` : '';
       s.kind = 'invalid';
       s.label = '!';
-      s.text = `invalid 0x${s.hex}`;
+      s.text = `invalid 0x${s.hex} (${s.channel !== null ? `${s.name} again` : `ID ${s.id}`})`;
       s.title = `${where}${phaseNote}: invalid: ${s.problem}${decoded}`;
     } else if (s.kind === 'xplus') {
       s.label = s.name as string;
-      s.text = `${s.name} ${s.position} ${s.us} µs`;
+      s.text = `${s.name} ${s.position} ${s.us}\u00a0µs`;
       s.title = `${where}${phaseNote}, channel ID 12 = X-Plus (§8.6): sub-ID ${s.subId}${s.phase === 1 ? ' + 4 for phase 1' : ''} → channel ${s.channel} (${s.name}), ` +
-        `9-bit value ${s.value9} × 4 = ${s.position} = ${s.us} µs`;
+        `9-bit value ${s.value9} × 4 = ${s.position} = ${s.us}\u00a0µs`;
     } else {
       const p = s.phase === 1 ? 'p' : '';
       s.label = `${s.channel}${p}`;
-      s.text = `${s.channel}${p} ${s.name} ${s.position} ${s.us} µs`;
-      s.title = `${where}${phaseNote}, channel ID ${s.channel} (${s.name}), position ${s.position} of ${resolution - 1} = ${s.us} µs`;
+      s.text = `${s.channel}${p} ${s.name} ${s.position} ${s.us}\u00a0µs`;
+      s.title = `${where}${phaseNote}, channel ID ${s.channel} (${s.name}), position ${s.position} of ${resolution - 1} = ${s.us}\u00a0µs`;
     }
     slots.push(s);
   }

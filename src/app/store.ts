@@ -5,6 +5,7 @@
  * shows them all.
  */
 import { computed, signal } from '@preact/signals';
+import type { InspectEntry } from '../worker/inspector.js';
 import type { BindProgress, FromWorker, Overview, RecordingStatus, ReplayStatus, SourceStatus, ToWorker } from '../worker/protocol.js';
 import { Live } from './live.js';
 
@@ -23,6 +24,8 @@ export const replay = signal<ReplayStatus | null>(null);
 export const overview = signal<Overview | null>(null);
 export const notices = signal<Notice[]>([]);
 export const resolutionOverride = signal<'auto' | 1024 | 2048>('auto');
+/** The frame inspector's last snapshot of the selected remote (null: none asked for yet). */
+export const inspection = signal<InspectEntry[] | null>(null);
 /** The steps of the bind in progress (or the last one). */
 export const bindLog = signal<BindProgress[]>([]);
 
@@ -139,6 +142,9 @@ function receive(message: FromWorker): void {
       break;
     case 'overview':
       overview.value = message.overview;
+      break;
+    case 'inspection':
+      if (message.source === selected.value) inspection.value = message.entries;
       break;
     case 'bind':
       bindLog.value = message.progress.step === 'open' ? [message.progress] : [...bindLog.value, message.progress];

@@ -6,6 +6,7 @@
 import {
   CHANNEL_COUNT, LinkMonitor, SpektrumDecoder, type LinkEpisode,
 } from '../decoder/index.js';
+import { InspectorLog } from './inspector.js';
 import { BUCKET_US, type Batch } from './protocol.js';
 
 export interface EngineOptions {
@@ -33,6 +34,8 @@ class Series {
 
 export class Engine {
   readonly decoder: SpektrumDecoder;
+  /** The recent frames, discards and resyncs with their bytes, for the frame inspector. */
+  readonly inspector = new InspectorLog();
   readonly link: LinkMonitor;
   readonly #positions = new Uint16Array(CHANNEL_COUNT);
   readonly #seenUs = new Float64Array(CHANNEL_COUNT).fill(NaN);
@@ -58,12 +61,14 @@ export class Engine {
   #episodesOpenSent = new Set<number>();
 
   constructor(readonly options: EngineOptions) {
-    this.decoder = new SpektrumDecoder({ resolution: options.resolution });
+    this.decoder = new SpektrumDecoder({ resolution: options.resolution, onEvent: (e) => this.inspector.onEvent(e) });
     this.link = new LinkMonitor({ jitterUs: options.jitterUs });
   }
 
   /** Bytes as they arrived: `timeUs` is the chunk's arrival (or per-byte times). */
   push(bytes: Uint8Array, time: number | Float64Array | undefined, arrivedMs: number): void {
+    // The log first: the decoder's events (fired in next()) take their times from these chunks.
+    this.inspector.onBytes(bytes, time);
     this.decoder.push(bytes, time);
     this.#arrivedMs = arrivedMs;
     this.#drain();
@@ -79,6 +84,7 @@ export class Engine {
     const d = this.decoder;
     this.#changed = true;
     for (let f = d.next(); f !== undefined; f = d.next()) {
+      this.inspector.onFrame(f);
       const t = f.timeUs;
       if (Number.isFinite(t)) this.#closeBuckets(t);
       const missed = this.link.stats.missedFrames;

@@ -90,12 +90,16 @@ export class InspectorLog {
 
   // The raw byte ring: stream offset x lives at x % rawBytes while x >= #end - rawBytes.
   readonly #raw: Uint8Array;
+  /** Per-byte times beside the raw ring, made the first time a chunk brings them (captures). */
+  #rawTime: Float64Array | null = null;
   /** Stream offset after the last byte seen. */
   #end = 0;
 
   // Chunk ends (stream offsets) and times, a ring, to time the events.
   readonly #chunkEnd = new Float64Array(CHUNKS);
   readonly #chunkTime = new Float64Array(CHUNKS);
+  /** 1 where the chunk came with per-byte times (kept in #rawTime). */
+  readonly #chunkPerByte = new Uint8Array(CHUNKS);
   #chunks = 0;
 
   /**
@@ -135,8 +139,8 @@ export class InspectorLog {
 
   /**
    * Every chunk pushed to the decoder, in order, with the time given to `push` (a chunk time:
-   * that of its last byte; per-byte times: the last one is used). Times only place the events;
-   * frames bring their own.
+   * that of its last byte; or per-byte times, kept beside the bytes). Times only place the
+   * events; frames bring their own.
    */
   onBytes(bytes: Uint8Array, time?: number | Float64Array): void {
     const n = bytes.length;
@@ -145,18 +149,22 @@ export class InspectorLog {
     const size = this.rawBytes;
     // Only the last `size` bytes of a huge chunk can stay.
     const skip = n > size ? n - size : 0;
+    const perByte = time instanceof Float64Array;
+    if (perByte && this.#rawTime === null) this.#rawTime = new Float64Array(size);
     let at = (this.#end + skip) % size;
     let from = skip;
     while (from < n) {
       const take = Math.min(n - from, size - at);
       raw.set(bytes.subarray(from, from + take), at);
+      if (perByte) (this.#rawTime as Float64Array).set(time.subarray(from, from + take), at);
       from += take;
       at = 0;
     }
     this.#end += n;
     const i = this.#chunks++ % CHUNKS;
     this.#chunkEnd[i] = this.#end;
-    this.#chunkTime[i] = typeof time === 'number' ? time : time instanceof Float64Array ? (time[n - 1] as number) : NaN;
+    this.#chunkTime[i] = typeof time === 'number' ? time : perByte ? (time[n - 1] as number) : NaN;
+    this.#chunkPerByte[i] = perByte ? 1 : 0;
   }
 
   /** Each frame `next()` returns, right away (it is borrowed: only numbers are kept). */
@@ -206,7 +214,7 @@ export class InspectorLog {
    * ArrayBuffer for all the bytes and one small object per entry.
    */
   snapshot(limit: number): InspectEntry[] {
-    const n = Math.max(0, Math.min(Math.floor(limit), this.#count));
+    const n = Number.isNaN(limit) ? 0 : Math.max(0, Math.min(Math.floor(limit), this.#count));
     const cap = this.capacity;
     const start = this.#first + this.#count - n;
     const oldest = this.#end - this.rawBytes;
@@ -311,9 +319,9 @@ export class InspectorLog {
   }
 
   /**
-   * Time of the byte at stream offset `x` from the chunk that brought it: the chunk's time less
-   * a byte time for each byte after it, as the decoder times frames. NaN when that chunk had no
-   * time or is no longer remembered.
+   * Time of the byte at stream offset `x`: its own time when it came with one, else its chunk's
+   * time less a byte time for each byte after it, as the decoder times frames. NaN when that
+   * chunk had no time or is no longer remembered.
    */
   #timeAt(x: number): number {
     // The oldest remembered chunk's start is the end of one already overwritten: not usable.
@@ -322,7 +330,10 @@ export class InspectorLog {
       const i = c % CHUNKS;
       const end = this.#chunkEnd[i] as number;
       const prevEnd = c > 0 ? (this.#chunkEnd[(c - 1) % CHUNKS] as number) : 0;
-      if (x >= prevEnd && x < end) return (this.#chunkTime[i] as number) - (end - 1 - x) * BYTE_TIME_US;
+      if (x >= prevEnd && x < end) {
+        if (this.#chunkPerByte[i] === 1 && this.#rawTime !== null && x >= this.#end - this.rawBytes) return this.#rawTime[x % this.rawBytes] as number;
+        return (this.#chunkTime[i] as number) - (end - 1 - x) * BYTE_TIME_US;
+      }
       if (x >= end) return NaN;
     }
     return NaN;

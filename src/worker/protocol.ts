@@ -5,6 +5,7 @@
  * few per animation frame at most, transferred, never one message per Spektrum frame.
  */
 import type { FormatInfo, LinkState } from '../decoder/index.js';
+import type { InspectEntry } from './inspector.js';
 
 /** How the page names a port it was granted: its place in getPorts() and its USB IDs. */
 export interface PortIdentity {
@@ -31,6 +32,8 @@ export type ToWorker =
   | { type: 'record-start' }
   | { type: 'record-stop' }
   | { type: 'export'; what: 'sscap' | 'raw'; recording: 'last' | 'recovered' }
+  /** The frame inspector's view of a remote: its newest `limit` frames, discards and resyncs. */
+  | { type: 'inspect'; source: number; limit: number }
   /** A health report of the capture being replayed, or of the live session's recording. */
   | { type: 'report'; format: 'html' | 'json' }
   | { type: 'discard-recovered' }
@@ -149,4 +152,5 @@ export type FromWorker =
   | { type: 'export-ready'; name: string; mime: string; data: ArrayBuffer }
   | { type: 'replay'; replay: ReplayStatus | null }
   | { type: 'overview'; overview: Overview }
-  | { type: 'bind'; progress: BindProgress };
+  | { type: 'bind'; progress: BindProgress }
+  | { type: 'inspection'; source: number; entries: InspectEntry[] };

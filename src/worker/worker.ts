@@ -473,6 +473,13 @@ async function handle(message: ToWorker): Promise<void> {
       else post({ type: 'export-ready', name: result.name, mime: 'application/octet-stream', data: result.data }, [result.data]);
       break;
     }
+    case 'inspect': {
+      const entries = sources.get(message.source)?.engine.inspector.snapshot(message.limit) ?? [];
+      // All entries of a snapshot share one buffer: transfer it once.
+      const buffer = entries.find((e) => e.bytes !== null)?.bytes?.buffer;
+      post({ type: 'inspection', source: message.source, entries }, buffer instanceof ArrayBuffer ? [buffer] : []);
+      break;
+    }
     case 'report': {
       let capture: Capture | undefined = replay?.capture;
       let name = replayName;

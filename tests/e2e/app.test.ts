@@ -9,9 +9,9 @@ import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import type { Page } from 'playwright-core';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
-import { CaptureWriter, capturePorts, parseCapture, readCapture, summarizeCapture, channelName } from '../../src/decoder/index.js';
+import { CaptureWriter, capturePorts, decodeCapture, parseCapture, readCapture, summarizeCapture, channelName } from '../../src/decoder/index.js';
 import { preset, simulate } from '../../src/simulator/index.js';
-import { SHARED_CAPTURES, barValues, browserUnavailable, shot, startApp, usbChunks, writeCapture, type AppSession } from './app-fixture.js';
+import { SHARED_CAPTURES, SHOTS as SHOTS_DIR, barValues, browserUnavailable, shot, startApp, usbChunks, writeCapture, type AppSession } from './app-fixture.js';
 
 const skip = browserUnavailable();
 if (skip !== null) console.warn(`skipping the page tests: ${skip}`);
@@ -225,6 +225,37 @@ describe.skipIf(skip !== null)('the page', () => {
     await expect(page.getByTestId('resolution').textContent()).resolves.toMatch(/2048 from the internal remote/);
     await page.waitForTimeout(500);
     await shot(page, 'remotes-replay');
+    expect(errors).toEqual([]);
+    await page.context().close();
+  });
+
+  it('inspects frames in hex with discarded bytes and resyncs where the decoder met them', async () => {
+    // A damaged line: truncated frames, noise and flipped bits between good frames.
+    const sim = simulate({ ...preset('damaged-line'), seed: 21 }, 1_000_000);
+    const path = join(dir, 'damaged.sscap');
+    writeCapture(path, usbChunks(sim.bytes, sim.timesUs));
+    const expected = { discarded: [] as { offset: number; length: number }[], frames: [] as number[] };
+    const { decoder } = decodeCapture(readCapture(new Uint8Array(readFileSync(path)), 'd.sscap'), {
+      onEvent: (e) => { if (e.type === 'discarded') expected.discarded.push({ offset: e.offset, length: e.length }); },
+    }, (f) => expected.frames.push(f.offset));
+    expect(expected.discarded.length).toBeGreaterThan(2);
+    const { page, errors } = await open('?demo=0');
+    await replayFile(page, path);
+    await playToEnd(page);
+    await page.getByRole('button', { name: 'Inspect frames…' }).click();
+    const rows = page.locator('.insp-body [role="row"]');
+    await rows.first().waitFor();
+    await page.waitForTimeout(600);
+    const shown = await rows.evaluateAll((els) => els.map((el) => ({ cls: el.className, offset: Number(el.children[1]?.textContent), text: el.textContent ?? '' })));
+    const frames = shown.filter((r) => r.cls.includes('frame')).map((r) => r.offset);
+    expect(frames).toEqual(expected.frames);
+    // Every discard the library reports is shown at its offset (runs of one reason merged).
+    for (const d of expected.discarded) expect(shown.some((r) => r.cls.includes('discard') && r.offset <= d.offset && r.text.includes('discarded')), `discard at ${d.offset}`).toBe(true);
+    expect(shown.some((r) => r.text.includes('resync'))).toBe(true);
+    expect(decoder.stats.frames).toBe(frames.length);
+    const panel = page.locator('.panel', { has: page.getByText('Frame inspector') }).last();
+    await panel.scrollIntoViewIfNeeded();
+    await panel.screenshot({ path: join(SHOTS_DIR, 'inspector.png') });
     expect(errors).toEqual([]);
     await page.context().close();
   });

@@ -4,9 +4,9 @@
  */
 import { signal } from '@preact/signals';
 import { useEffect, useState } from 'preact/hooks';
+import { lazy } from '../../lazy.js';
 import { openCapture } from '../../open-file.js';
 import { sources, status, xplusSeen } from '../../store.js';
-import { BindPanel } from '../Bind/index.js';
 import { ChannelBars } from '../ChannelBars/index.js';
 import { Counters } from '../Counters/index.js';
 import { Graphs } from '../Graphs/index.js';
@@ -17,6 +17,9 @@ import { ReplayBar } from '../ReplayBar/index.js';
 import { SystemBadge } from '../SystemBadge/index.js';
 import { Toolbar } from '../Toolbar/index.js';
 import './style.css';
+
+const BindPanel = lazy(() => import('../Bind/index.js').then((m) => m.BindPanel));
+const InspectorPanel = lazy(() => import('../InspectorPanel/index.js').then((m) => m.InspectorPanel));
 
 const NORMAL = [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11];
 const XPLUS = [12, 13, 14, 15, 16, 17, 18, 19];
@@ -68,6 +71,7 @@ export function App({ granted }: { granted: SerialPort[] }) {
           <div class="panel"><h2>Channels{sources.value.length > 1 ? ` — remote ${status.value.label}` : ''}</h2><ChannelBars ids={NORMAL} label="Channels 0–11" /></div>
           {xplusSeen.value ? <div class="panel"><h2>X-Plus</h2><ChannelBars ids={XPLUS} label="X-Plus channels" /></div> : null}
           <div class="panel"><Graphs windowUs={windowUs} /></div>
+          <div class="panel"><InspectorPanel /></div>
         </div>
       </main>
       {dragging ? <div class="drop" aria-hidden="true">Drop a capture (.sscap, raw .bin, Saleae CSV) to replay it</div> : null}

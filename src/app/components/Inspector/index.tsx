@@ -6,11 +6,11 @@
  * Meant for someone comparing their own firmware decoder byte by byte.
  *
  * The entries arrive as snapshots (the parent asks the worker); nothing here runs per Spektrum
- * frame. Rows are keyed by stream offset and never re-render once drawn, so a refresh while
- * following only draws the new rows.
+ * frame. Rows are keyed by stream offset and skip re-rendering when their entry is unchanged,
+ * so a refresh while following only draws the new rows; rows out of view are not laid out.
  */
 import { Component } from 'preact';
-import { useLayoutEffect, useRef } from 'preact/hooks';
+import { useEffect, useLayoutEffect, useRef } from 'preact/hooks';
 import type { InspectEntry } from '../../../worker/inspector.js';
 import { describeFrame } from '../../inspect.js';
 import './style.css';
@@ -22,7 +22,7 @@ const REASONS: Record<string, string> = {
   'end-of-stream': 'end of stream',
 };
 
-/** A scroll this far from the bottom is the user's, and pauses following. */
+/** A user's scroll that leaves the list this far from the bottom pauses following. */
 const AWAY_PX = 32;
 
 const time = (us: number) => (Number.isFinite(us) ? (us / 1e6).toFixed(3) : '—');
@@ -43,7 +43,7 @@ function FrameCells({ e }: { e: InspectEntry }) {
   // of a hex span plus a tag span, which matters at a thousand rows).
   return (
     <>
-      <span role="cell" class="hexcell">
+      <span role="cell" class="hexcell hexw">
         {d.header.map((h) => (
           <span key={h.first} class={`g k-header${h.valid ? '' : ' k-invalid'}`} title={h.title} data-tag={h.label}>{hex(b, h.first, h.last + 1)}</span>
         ))}
@@ -80,13 +80,26 @@ const ROW_CLASS: Record<InspectEntry['kind'], string> = {
   frame: 'frame', discarded: 'discard', resync: 'resync', locked: 'info', 'format-changed': 'info',
 };
 
-/** One row. Its entry is fixed by its key, so it only redraws when a discard grows or bytes expire. */
+/** Whether two byte copies hold the same bytes (a frame's 16, a discard's first 256 at most). */
+function sameBytes(a: Uint8Array | null, b: Uint8Array | null): boolean {
+  if (a === null || b === null) return a === b;
+  if (a.length !== b.length) return false;
+  for (let i = 0; i < a.length; i++) if (a[i] !== b[i]) return false;
+  return true;
+}
+
+/**
+ * One row. A snapshot's entries are new objects each time, but an entry at a given key rarely
+ * changes (a discard that grew, bytes that expired, another remote's stream at the same
+ * offset): the row redraws only then.
+ */
 class Row extends Component<{ e: InspectEntry }> {
   override shouldComponentUpdate(next: { e: InspectEntry }): boolean {
     const a = this.props.e;
     const b = next.e;
-    return a.kind !== b.kind || a.offset !== b.offset || a.length !== b.length ||
-      (a.bytes === null) !== (b.bytes === null) || !Object.is(a.timeUs, b.timeUs);
+    return a.kind !== b.kind || a.offset !== b.offset || a.length !== b.length || !Object.is(a.timeUs, b.timeUs) ||
+      a.resolution !== b.resolution || a.remote !== b.remote || a.headerMode !== b.headerMode || a.text !== b.text ||
+      !sameBytes(a.bytes, b.bytes);
   }
 
   override render() {
@@ -120,16 +133,39 @@ export function Inspector({ entries, onRefresh, following, onFollow }: {
   onFollow(on: boolean): void;
 }) {
   const scroller = useRef<HTMLDivElement>(null);
+  /** When the user last wheeled, touched, clicked or keyed in the list (ms). */
+  const intent = useRef(-Infinity);
+  const follow = useRef({ following, onFollow });
+  follow.current = { following, onFollow };
+
   useLayoutEffect(() => {
     const el = scroller.current;
-    if (following && el !== null) el.scrollTop = el.scrollHeight;
+    if (!following || el === null) return undefined;
+    el.scrollTop = el.scrollHeight;
+    // Rows out of view are laid out at an estimated height until they come into view: once the
+    // newest rows have been drawn at their real height, pin to the bottom again.
+    const id = requestAnimationFrame(() => { el.scrollTop = el.scrollHeight; });
+    return () => cancelAnimationFrame(id);
   }, [entries, following]);
 
-  const onScroll = () => {
+  useEffect(() => {
     const el = scroller.current;
-    // Scrolling up to read pauses: the rows stop moving under the reader.
-    if (following && el !== null && el.scrollHeight - el.scrollTop - el.clientHeight > AWAY_PX) onFollow(false);
-  };
+    if (el === null) return undefined;
+    // Scrolling away from the bottom pauses following, so rows stop moving under the reader;
+    // only a scroll the user made, not one from rows coming, going or resizing.
+    const mark = () => { intent.current = performance.now(); };
+    const scroll = () => {
+      const { following: on, onFollow: set } = follow.current;
+      if (on && performance.now() - intent.current < 1000 && el.scrollHeight - el.scrollTop - el.clientHeight > AWAY_PX) set(false);
+    };
+    const events = ['wheel', 'touchmove', 'keydown', 'pointerdown'] as const;
+    for (const type of events) el.addEventListener(type, mark, { passive: true });
+    el.addEventListener('scroll', scroll, { passive: true });
+    return () => {
+      for (const type of events) el.removeEventListener(type, mark);
+      el.removeEventListener('scroll', scroll);
+    };
+  }, []);
 
   let prev = '';
   let dup = 0;
@@ -164,22 +200,22 @@ export function Inspector({ entries, onRefresh, following, onFollow }: {
         ))}
         <li class="muted">tag “p”: phase bit set · hover a byte group for its decode</li>
       </ul>
-      <div class="insp-scroll" ref={scroller} onScroll={onScroll} tabIndex={0} role="region" aria-label="Recent frames and decoder events">
+      <div class="insp-scroll" ref={scroller} tabIndex={0} role="region" aria-label="Recent frames and decoder events">
         {entries === null ? (
           <p class="insp-empty">No snapshot yet: press Refresh.</p>
         ) : entries.length === 0 ? (
           <p class="insp-empty">Nothing received yet.</p>
         ) : (
-          <div role="table" class="insp-table" aria-label="Frames and decoder events, oldest first" aria-rowcount={entries.length + 1}>
+          <div role="table" class="insp-table" aria-label="Frames and decoder events, oldest first">
             <div role="rowgroup" class="insp-thead">
               <div role="row" class="row">
                 <span role="columnheader" class="num">Time (s)</span>
                 <span role="columnheader" class="num">Offset</span>
-                <span role="columnheader">Bytes</span>
+                <span role="columnheader" class="hexw"><span class="label">Bytes</span></span>
                 <span role="columnheader">Decoded</span>
               </div>
             </div>
-            <div role="rowgroup">{rows}</div>
+            <div role="rowgroup" class="insp-body">{rows}</div>
           </div>
         )}
       </div>
