@@ -17,6 +17,7 @@ import {
   utf8Encode,
 } from '../src/decoder/capture/index.js';
 import type { Capture, CaptureMeta, CaptureRecordInput } from '../src/decoder/capture/index.js';
+import { concatBytes } from './bytes.js';
 
 // ---------------------------------------------------------------------------------------------
 // Helpers
@@ -36,15 +37,7 @@ function randomBytes(length: number, seed: number): Uint8Array {
   return out;
 }
 
-function concat(...parts: Uint8Array[]): Uint8Array {
-  const out = new Uint8Array(parts.reduce((n, p) => n + p.length, 0));
-  let o = 0;
-  for (const p of parts) {
-    out.set(p, o);
-    o += p.length;
-  }
-  return out;
-}
+const concat = (...parts: Uint8Array[]): Uint8Array => concatBytes(parts);
 
 const ascii = (text: string): Uint8Array => new TextEncoder().encode(text);
 

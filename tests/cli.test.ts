@@ -9,6 +9,7 @@ import { join, resolve } from 'node:path';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { CaptureWriter } from '../src/decoder/index.js';
 import { preset, simulate } from '../src/simulator/index.js';
+import { concatBytes } from './bytes.js';
 
 const cli = resolve(import.meta.dirname, '../dist/cli/main.js');
 let dir = '';
@@ -33,9 +34,7 @@ beforeAll(() => {
       start = i;
     }
   }
-  const file = new Uint8Array(parts.reduce((n, p) => n + p.length, 0));
-  let at = 0;
-  for (const p of parts) { file.set(p, at); at += p.length; }
+  const file = concatBytes(parts);
   writeFileSync(join(dir, 'run.sscap'), file);
   writeFileSync(join(dir, 'cut.sscap'), file.subarray(0, file.length - 30));
   writeFileSync(join(dir, 'run.bin'), sim.bytes);

@@ -6,17 +6,8 @@ import {
 import {
   encodeExternalFrame, encodeInternalFrame, encodeServo1024, encodeServo2048, encodeXPlus, vtxWords,
 } from '../src/simulator/encode.js';
+import { concatBytes as join } from './bytes.js';
 
-/** Concatenates frames. */
-function join(frames: Uint8Array[]): Uint8Array {
-  const out = new Uint8Array(frames.reduce((n, f) => n + f.length, 0));
-  let at = 0;
-  for (const f of frames) {
-    out.set(f, at);
-    at += f.length;
-  }
-  return out;
-}
 
 /** Decodes bytes fed in one piece, then end(): owned snapshots. */
 function decodeAll(bytes: Uint8Array, decoder = new SpektrumDecoder(), time?: number | Float64Array): FrameSnapshot[] {

@@ -5,16 +5,8 @@ import {
   encodeExternalFrame, encodeInternalFrame, encodeServo1024, encodeServo2048, encodeXPlus, vtxWords,
 } from '../src/simulator/encode.js';
 import { DISCARD_BYTES_CAP, InspectorLog, type InspectEntry } from '../src/worker/inspector.js';
+import { concatBytes as join } from './bytes.js';
 
-function join(parts: Uint8Array[]): Uint8Array {
-  const out = new Uint8Array(parts.reduce((n, p) => n + p.length, 0));
-  let at = 0;
-  for (const p of parts) {
-    out.set(p, at);
-    at += p.length;
-  }
-  return out;
-}
 
 /** A DSMX 11 ms frame pair: phase bit on the first slot of the first frame. */
 function pair(t: number, fades = 3): Uint8Array[] {

@@ -6,6 +6,7 @@ import { existsSync, mkdirSync, writeFileSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 import type { Browser, Page } from 'playwright-core';
 import { CaptureWriter } from '../../src/decoder/index.js';
+import { concatBytes } from '../bytes.js';
 import { chromiumAvailable, launchChromium, startStaticServer, type StaticServer } from './harness/browser.js';
 
 export const ROOT = resolve(import.meta.dirname, '../..');
@@ -54,14 +55,7 @@ export async function barValues(page: Page): Promise<Record<string, number>> {
 /** Writes chunks as a .sscap file (as the recorder would), for replay tests. */
 export function writeCapture(path: string, chunks: { bytes: Uint8Array; timeUs: number }[]): void {
   const writer = new CaptureWriter({ baudRate: 115200, source: 'test' });
-  const parts = [writer.header(), ...chunks.map((c) => writer.data(c.bytes, c.timeUs))];
-  const out = new Uint8Array(parts.reduce((n, p) => n + p.length, 0));
-  let at = 0;
-  for (const p of parts) {
-    out.set(p, at);
-    at += p.length;
-  }
-  writeFileSync(path, out);
+  writeFileSync(path, concatBytes([writer.header(), ...chunks.map((c) => writer.data(c.bytes, c.timeUs))]));
 }
 
 /** Cuts a per-byte-timed stream into what a USB adapter delivers: one chunk per 16 ms window. */
