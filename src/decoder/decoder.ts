@@ -478,6 +478,8 @@ export class SpektrumDecoder {
     this.#stats.discardedBytes += length;
     this.#stats.pendingBytes -= length;
     this.#head = o + length;
+    // A stream that never locks emits nothing: its chunk records must go with its bytes.
+    this.#dropChunksBefore(this.#base + this.#head);
     this.#event({ type: 'discarded', offset: this.#base + o, length, reason });
   }
 
@@ -667,10 +669,15 @@ export class SpektrumDecoder {
    */
   #stampTime(frame: DecodedFrame, o: number): void {
     const x = this.#base + o;
-    while (this.#chunkHead < this.#chunkTail - 1 && (this.#chunkEnds[this.#chunkHead] as number) <= x) this.#chunkHead++;
+    this.#dropChunksBefore(x);
     const i = this.#chunkHead;
     if (this.#chunkPerByte[i] === 1) frame.timeUs = (this.#byteTimes as Float64Array)[o] as number;
     else frame.timeUs = (this.#chunkTimes[i] as number) - ((this.#chunkEnds[i] as number) - 1 - x) * BYTE_TIME_US;
+  }
+
+  /** Forgets the records of chunks that end at or before stream offset `x` (keeps the last one). */
+  #dropChunksBefore(x: number): void {
+    while (this.#chunkHead < this.#chunkTail - 1 && (this.#chunkEnds[this.#chunkHead] as number) <= x) this.#chunkHead++;
   }
 
   /** Makes room for `n` more bytes: compacts first, grows (doubling) only when full. */

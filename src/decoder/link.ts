@@ -197,8 +197,9 @@ export class LinkMonitor {
     }
     if (this.#periodCount >= 9) {
       const span = (times[this.#periodCount - 1] as number) - (times[0] as number);
-      if (!Number.isFinite(this.#systemPeriod) && !Number.isFinite(s.nominalPeriodUs)) {
-        // First estimate, assuming no gap yet: snap the mean interval to 11 or 22 ms.
+      if (!Number.isFinite(this.#systemPeriod) && (!Number.isFinite(s.nominalPeriodUs) || this.#periodCount === PERIOD_WINDOW)) {
+        // Without a system byte: snap the mean interval to 11 or 22 ms, first over 8 intervals,
+        // then again over every full window, so a few frames missing early do not stick.
         s.nominalPeriodUs = span / (this.#periodCount - 1) < 16_500 ? FRAME_PERIOD_11MS_US : FRAME_PERIOD_22MS_US;
       }
       // Whole periods in the span (a missed frame makes one interval two periods long), so a

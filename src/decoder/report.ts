@@ -12,7 +12,7 @@
 import type { Capture, CaptureKind, CaptureTiming } from './capture/index.js';
 import { captureChunks, capturePorts } from './capture/index.js';
 import type { LinkEpisode } from './link.js';
-import { BYTE_TIME_US, CHANNEL_COUNT, FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US, XPLUS_FIRST, channelName, servoToMicros, servoToPercent, systemInfo, type Resolution } from './spec.js';
+import { BYTE_TIME_US, CHANNEL_COUNT, FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US, XPLUS_FIRST, channelName, servoToMicros, servoToPercent, systemInfo, type Resolution, USB_CHUNK_JITTER_US } from './spec.js';
 import { decodeCapture } from './summary.js';
 import type { HeaderMode, RemoteKind, ResolutionReason } from './types.js';
 
@@ -110,7 +110,7 @@ export const MAX_LISTED_HOLDS = 200;
  * `decodeCapture` allows the same): gaps shorter than 1.5 periods plus this are not missed
  * frames, and the longer intervals are left out of the period statistics.
  */
-export const CHUNK_TIMING_ALLOWANCE_US = 20_000;
+export const CHUNK_TIMING_ALLOWANCE_US = USB_CHUNK_JITTER_US;
 
 /** Every threshold the report used, as the report records them. */
 export interface ReportThresholds {

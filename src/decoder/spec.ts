@@ -12,6 +12,12 @@ export const BYTE_TIME_US = 10_000_000 / BAUD_RATE;
 /** §7.1: a frame every 11 or 22 ms. */
 export const FRAME_PERIOD_11MS_US = 11_000;
 export const FRAME_PERIOD_22MS_US = 22_000;
+/**
+ * How late a chunk's arrival time can be from USB batching alone: an FTDI adapter's latency
+ * timer holds bytes up to 16 ms, plus scheduling. Use it as `LinkMonitor`'s `jitterUs` for
+ * chunk-timed (WebSerial, .sscap) data; 0 for logic-analyser times.
+ */
+export const USB_CHUNK_JITTER_US = 20_000;
 /** §7.1: Spektrum's failsafe timer: one second of "hold last", then failsafe. */
 export const FAILSAFE_TIMEOUT_US = 1_000_000;
 /** §8: seven 16-bit servo slots follow the two header bytes. */

@@ -6,17 +6,13 @@ import type { Capture, CaptureIssue } from './capture/index.js';
 import { captureChunks } from './capture/index.js';
 import { SpektrumDecoder, type DecoderOptions } from './decoder.js';
 import { LinkMonitor, type LinkEpisode, type LinkStats } from './link.js';
-import { channelName, CHANNEL_COUNT, servoToMicros, XPLUS_FIRST } from './spec.js';
-import type { DecodedFrame, DecoderEvent, DecoderStats, FormatInfo } from './types.js';
+import { channelName, CHANNEL_COUNT, servoToMicros, USB_CHUNK_JITTER_US, XPLUS_FIRST } from './spec.js';
+import type { DecodedFrame, DecoderStats, FormatInfo } from './types.js';
 
-export interface DecodeCaptureOptions extends Omit<DecoderOptions, 'onEvent'> {
+export interface DecodeCaptureOptions extends DecoderOptions {
   /** Which serial port of a multi-port capture to decode. Default 0. */
   port?: number;
-  onEvent?: (event: DecoderEvent) => void;
 }
-
-/** How late a chunk-timed frame can arrive from USB batching alone (an FTDI latency timer is 16 ms). */
-const CHUNK_JITTER_US = 20_000;
 
 /**
  * Feeds one port of a capture through a decoder and a link monitor, chunk by chunk with the
@@ -29,7 +25,7 @@ export function decodeCapture(
 ): { decoder: SpektrumDecoder; link: LinkMonitor } {
   const { port = 0, ...decoderOptions } = options;
   const decoder = new SpektrumDecoder(decoderOptions);
-  const link = new LinkMonitor({ jitterUs: capture.timing === 'per-chunk' ? CHUNK_JITTER_US : 0 });
+  const link = new LinkMonitor({ jitterUs: capture.timing === 'per-chunk' ? USB_CHUNK_JITTER_US : 0 });
   const drain = (): void => {
     for (let f = decoder.next(); f !== undefined; f = decoder.next()) {
       link.frame(f);
@@ -59,7 +55,7 @@ export interface CaptureSummary {
   timing: Capture['timing'];
   port: number;
   bytes: number;
-  /** From the first to the last byte's time, µs; NaN without timing. */
+  /** From the first to the last frame's time, µs; NaN without timing. */
   durationUs: number;
   format: FormatInfo;
   decoder: DecoderStats;

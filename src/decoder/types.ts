@@ -26,11 +26,11 @@ export interface VtxControl {
 
 /**
  * One decoded frame. The decoder hands out the same object each time: it is a borrowed view,
- * valid until the next call to `next()`, `push()` or `finish()`. Copy what you keep
+ * valid until the next call to `next()`, `push()`, `end()` or `reset()`. Copy what you keep
  * (`copyFrame()` does it for you).
  */
 export interface DecodedFrame {
-  /** Sequence number of the frame since the decoder was created (0, 1, 2, …). */
+  /** Sequence number of the frame since the decoder was created or last reset (0, 1, 2, …). */
   index: number;
   /** Byte offset of the frame's first byte in the stream pushed so far. */
   offset: number;
