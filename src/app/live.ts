@@ -6,6 +6,8 @@
 import { CHANNEL_COUNT } from '../decoder/index.js';
 import type { Batch } from '../worker/protocol.js';
 
+/** Episodes are kept as long as the longest graph window (10 min). */
+const EPISODE_KEEP_US = 600e6;
 /** Ten minutes of 100 ms buckets, twice over so that sliding is a rare copy. */
 const SERIES_CAPACITY = 2 * 6000;
 
@@ -85,6 +87,8 @@ export class Live {
     this.resolution = batch.resolution;
     this.series.append(batch.series);
     for (const e of batch.episodes) this.episodes.set(e.id, { kind: e.kind, startUs: e.startUs, endUs: e.endUs });
+    // Nothing shows episodes older than the longest window: a long session must not pile them up.
+    for (const [id, e] of this.episodes) if (e.endUs !== null && e.endUs < batch.nowUs - EPISODE_KEEP_US) this.episodes.delete(id);
     this.#clockUs = batch.nowUs;
     this.#clockAtMs = performance.now();
     this.lastArrivedMs = batch.arrivedMs;

@@ -70,11 +70,12 @@ function refreshSelected(): void {
   const state = l?.state ?? 'waiting';
   if (state !== linkState.value) linkState.value = state;
   let x = false;
-  for (let id = 12; id < 20; id++) if (Number.isFinite(live.seenUs[id])) x = true;
+  for (let id = 12; id < 20; id++) if (!Number.isNaN(live.seenUs[id])) x = true;
   if (x !== xplusSeen.value) xplusSeen.value = x;
 }
 
 export function select(id: number): void {
+  if (id !== selected.value) inspection.value = null;
   selected.value = id;
   refreshSelected();
 }
@@ -125,6 +126,8 @@ function receive(message: FromWorker): void {
     case 'reset':
       if (message.source === undefined) lives.clear();
       else lives.get(message.source)?.reset();
+      // Source ids are reused: what the inspector shows belonged to the old source.
+      if (message.source === undefined || message.source === selected.value) inspection.value = null;
       refreshSelected();
       break;
     case 'notice':

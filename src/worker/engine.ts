@@ -96,7 +96,8 @@ export class Engine {
       for (let i = 0; i < f.count; i++) {
         const id = f.ids[i] as number;
         this.#positions[id] = f.positions[i] as number;
-        this.#seenUs[id] = t;
+        // Untimed data (a raw .bin) still marks the channel as seen, at an unknown time.
+        this.#seenUs[id] = Number.isFinite(t) ? t : Infinity;
       }
       this.#bFades += f.fadesDelta;
       if (f.rssi !== null) {

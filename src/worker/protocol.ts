@@ -77,7 +77,7 @@ export interface Batch {
   frames: number;
   /** Latest position of each channel 0–19 (X-Plus on the 2047 scale). */
   positions: Uint16Array;
-  /** Time each channel was last seen, NaN if never. */
+  /** Time each channel was last seen, NaN if never, +Infinity when seen in data without times. */
   seenUs: Float64Array;
   resolution: 1024 | 2048 | null;
   link: {

@@ -9,7 +9,10 @@ import { CaptureWriter, parseCapture, type CaptureMeta } from '../decoder/index.
 import type { RecordingStatus } from './protocol.js';
 
 const DIR = 'recordings';
+/** Names the recordings not finished yet (the one in progress, and any a crash or reload left). */
 const MARKER = 'in-progress.json';
+/** Finished recordings kept in the private storage (older ones are deleted at start-up). */
+const KEEP_FINISHED = 5;
 /** Make written data durable about once a second. */
 const FLUSH_EVERY_US = 1_000_000;
 
@@ -23,23 +26,26 @@ async function directory(): Promise<FileSystemDirectoryHandle> {
   return root.getDirectoryHandle(DIR, { create: true });
 }
 
-async function readMarker(dir: FileSystemDirectoryHandle): Promise<Marker | null> {
+async function readMarkers(dir: FileSystemDirectoryHandle): Promise<Marker[]> {
   try {
     const file = await (await dir.getFileHandle(MARKER)).getFile();
-    return JSON.parse(await file.text()) as Marker;
+    const parsed: unknown = JSON.parse(await file.text());
+    // Version 1 of this file held one object; now a list.
+    const list = Array.isArray(parsed) ? parsed : [parsed];
+    return list.filter((m): m is Marker => typeof m === 'object' && m !== null && typeof (m as Marker).name === 'string');
   } catch {
-    return null;
+    return [];
   }
 }
 
-async function writeMarker(dir: FileSystemDirectoryHandle, marker: Marker | null): Promise<void> {
-  if (marker === null) {
+async function writeMarkers(dir: FileSystemDirectoryHandle, markers: readonly Marker[]): Promise<void> {
+  if (markers.length === 0) {
     await dir.removeEntry(MARKER).catch(() => undefined);
     return;
   }
   const handle = await (await dir.getFileHandle(MARKER, { create: true })).createSyncAccessHandle();
   try {
-    const bytes = new TextEncoder().encode(JSON.stringify(marker));
+    const bytes = new TextEncoder().encode(JSON.stringify(markers));
     handle.truncate(0);
     handle.write(bytes, { at: 0 });
     handle.flush();
@@ -48,11 +54,22 @@ async function writeMarker(dir: FileSystemDirectoryHandle, marker: Marker | null
   }
 }
 
+/** Deletes all but the newest finished recordings (names sort by their start time). */
+async function pruneFinished(dir: FileSystemDirectoryHandle, unfinished: readonly Marker[]): Promise<void> {
+  const names: string[] = [];
+  for await (const name of (dir as unknown as { keys(): AsyncIterable<string> }).keys()) {
+    if (name.endsWith('.sscap') && !unfinished.some((m) => m.name === name)) names.push(name);
+  }
+  names.sort();
+  for (const name of names.slice(0, Math.max(0, names.length - KEEP_FINISHED))) await dir.removeEntry(name).catch(() => undefined);
+}
+
 export class Recorder {
   #dir: FileSystemDirectoryHandle | undefined;
   #handle: FileSystemSyncAccessHandle | undefined;
   #writer: CaptureWriter | undefined;
   #name = '';
+  #createdAt = '';
   #at = 0;
   #records = 0;
   #firstUs = NaN;
@@ -60,28 +77,43 @@ export class Recorder {
   #lastFlushUs = 0;
   /** The last finished recording, for export. */
   #last: string | null = null;
-  #recovered: (Marker & { bytes: number }) | null = null;
+  /** Unfinished recordings from earlier sessions, newest last; the newest is offered. */
+  #unfinished: (Marker & { bytes: number })[] = [];
   #error: string | null = null;
 
   constructor(readonly onChange: (status: RecordingStatus) => void) {}
 
-  /** Looks for a recording an earlier session left unfinished. */
+  /** Looks for recordings an earlier session left unfinished, and tidies the storage. */
   async init(): Promise<void> {
     try {
       const dir = (this.#dir = await directory());
-      const marker = await readMarker(dir);
-      if (marker !== null) {
+      const kept: (Marker & { bytes: number })[] = [];
+      for (const marker of await readMarkers(dir)) {
         try {
           const file = await (await dir.getFileHandle(marker.name)).getFile();
-          this.#recovered = { ...marker, bytes: file.size };
+          kept.push({ ...marker, bytes: file.size });
         } catch {
-          await writeMarker(dir, null);
+          // The file is gone: forget its marker.
         }
       }
+      this.#unfinished = kept;
+      await writeMarkers(dir, kept);
+      await pruneFinished(dir, kept);
     } catch (error) {
       this.#error = `Recording is not available: this browser gives the page no private file storage (${String(error)}).`;
     }
     this.#report();
+  }
+
+  get #recovered(): (Marker & { bytes: number }) | null {
+    return this.#unfinished.at(-1) ?? null;
+  }
+
+  /** The markers of every unfinished recording, this one included while it runs. */
+  #markers(): Marker[] {
+    const list: Marker[] = this.#unfinished.map(({ name, createdAt }) => ({ name, createdAt }));
+    if (this.#handle !== undefined) list.push({ name: this.#name, createdAt: this.#createdAt });
+    return list;
   }
 
   get active(): boolean {
@@ -105,23 +137,25 @@ export class Recorder {
 
   async start(meta: CaptureMeta, createdAt: string): Promise<void> {
     if (this.#handle !== undefined) return;
+    let handle: FileSystemSyncAccessHandle | undefined;
     try {
       const dir = this.#dir ?? (this.#dir = await directory());
       const name = `satscope-${createdAt.replace(/[:.]/g, '-')}.sscap`;
-      const handle = await (await dir.getFileHandle(name, { create: true })).createSyncAccessHandle();
+      handle = await (await dir.getFileHandle(name, { create: true })).createSyncAccessHandle();
       handle.truncate(0);
       this.#writer = new CaptureWriter({ ...meta, createdAt });
       this.#handle = handle;
       this.#name = name;
+      this.#createdAt = createdAt;
       this.#at = 0;
       this.#records = 0;
       this.#firstUs = this.#lastUs = NaN;
       this.#write(this.#writer.header());
       handle.flush();
-      await writeMarker(dir, { name, createdAt });
+      await writeMarkers(dir, this.#markers());
       this.#error = null;
     } catch (error) {
-      this.#handle?.close();
+      handle?.close();
       this.#handle = undefined;
       this.#error = `Could not start recording: ${String(error)}`;
     }
@@ -180,7 +214,7 @@ export class Recorder {
       handle.close();
     }
     this.#last = this.#name;
-    if (this.#dir !== undefined) await writeMarker(this.#dir, null);
+    if (this.#dir !== undefined) await writeMarkers(this.#dir, this.#markers());
     this.#report();
   }
 
@@ -219,8 +253,8 @@ export class Recorder {
     const recovered = this.#recovered;
     if (recovered === null || this.#dir === undefined) return;
     await this.#dir.removeEntry(recovered.name).catch(() => undefined);
-    this.#recovered = null;
-    if (!this.active) await writeMarker(this.#dir, null);
+    this.#unfinished = this.#unfinished.filter((m) => m.name !== recovered.name);
+    await writeMarkers(this.#dir, this.#markers());
     this.#report();
   }
 }

@@ -5,11 +5,12 @@
  * capture being replayed. A source's id is its port number in recordings.
  */
 /// <reference lib="webworker" />
-import { CaptureFormatError, decodeCapture, healthReport, parseCapture, readCapture, reportHtml, systemInfo, type Capture } from '../decoder/index.js';
+import { CaptureFormatError, LinkMonitor, USB_CHUNK_JITTER_US, decodeCapture, readCapture, systemInfo, type Capture } from '../decoder/index.js';
 import { Engine } from './engine.js';
 import { runBind } from './bind.js';
 import { REMOTE_LABELS, type BindProgress, type FromWorker, type Overview, type PortIdentity, type SourceKind, type SourceStatus, type ToWorker } from './protocol.js';
 import { Recorder } from './recorder.js';
+import type { ReportReply, ReportRequest } from './report-worker.js';
 import { DemoSource } from './sources/demo.js';
 import { ReplaySource } from './sources/replay.js';
 import { SerialSource, describePort, findPort, openProblem } from './sources/serial.js';
@@ -19,8 +20,6 @@ const scope = self as unknown as DedicatedWorkerGlobalScope;
 const MIN_BATCH_MS = 8;
 /** While live sources are quiet, still tick this often so hold/failsafe and ages advance. */
 const IDLE_TICK_MS = 50;
-/** USB adapters deliver in batches up to their latency timer (FTDI: 16 ms). */
-const USB_JITTER_US = 20_000;
 /** After a device is lost, try its port again this often (Chromium does not always fire 'connect'). */
 const RECONNECT_MS = 1000;
 
@@ -44,6 +43,8 @@ interface Source {
   engine: Engine;
   serial?: SerialSource;
   identity?: PortIdentity;
+  /** Signals to set whenever the port is (re)opened: the satellite's power after a bind. */
+  signals?: SerialOutputSignals;
 }
 
 let resolution: 'auto' | 1024 | 2048 = 'auto';
@@ -56,6 +57,8 @@ let reconnectTimer: ReturnType<typeof setInterval> | undefined;
 let demo: DemoSource | undefined;
 let replay: ReplaySource | undefined;
 let replayName = '';
+/** The replayed file's bytes, for a report on it. */
+let replayBytes: Uint8Array | null = null;
 const recorder = new Recorder((recording) => post({ type: 'recording', recording }));
 
 function freeId(): number {
@@ -128,7 +131,7 @@ function flush(): void {
     const out = s.engine.batch(now);
     if (out !== null) post({ type: 'batch', source: s.id, batch: out.batch }, out.transfer);
   }
-  if (sources.size > 1) shareResolution();
+  shareResolution();
   sendSources();
 }
 
@@ -171,6 +174,8 @@ function stopTimers(): void {
 /** Stops every source: the demo, replay and all ports. */
 async function closeAll(): Promise<void> {
   stopTimers();
+  // A recording belongs to the sources it began with: it ends with them.
+  await recorder.stop();
   demo?.stop();
   demo = undefined;
   replay?.stop();
@@ -184,23 +189,44 @@ async function closeAll(): Promise<void> {
 
 // ---- serial ---------------------------------------------------------------------------------
 
-async function openSerial(identity: PortIdentity, signals?: SerialOutputSignals): Promise<void> {
+/** Whether two identities name the same adapter. */
+function sameAdapter(a: PortIdentity | undefined, b: PortIdentity): boolean {
+  if (a === undefined) return false;
+  // USB IDs survive a replug (the place in getPorts() may not); without them, the place it is.
+  if (a.usbVendorId !== undefined || b.usbVendorId !== undefined) return a.usbVendorId === b.usbVendorId && a.usbProductId === b.usbProductId;
+  return a.index === b.index;
+}
+
+/**
+ * Opens a granted port as a source (or again, for a source whose adapter was lost). `signals`
+ * are set right after opening (after a bind: the line that powers the satellite), and kept for
+ * later reconnects. Returns whether the port is being read.
+ */
+async function openSerial(identity: PortIdentity, signals?: SerialOutputSignals): Promise<boolean> {
   // Ports join each other, but not the demo or a replay.
   if (demo !== undefined || replay !== undefined) await closeAll();
   const port = await findPort(identity);
   if (port === undefined) {
     notice('error', 'The port is not available', 'It may have been unplugged. Plug it in and connect again.');
-    return;
+    return false;
   }
   for (const s of sources.values()) {
     if (s.serial?.port === port) {
       notice('info', 'Already connected', `${describePort(port)} is remote ${s.label}.`);
-      return;
+      return true;
     }
   }
+  // A lost remote's adapter, connected by hand: that remote comes back (same label, same port
+  // in the recording) instead of a second row.
+  const lost = [...sources.values()].find((s) => s.state === 'lost' && sameAdapter(s.identity, identity));
+  if (lost !== undefined) {
+    if (signals !== undefined) lost.signals = signals;
+    return reopen(lost, port);
+  }
   const id = freeId();
-  const source = addSource('serial', id, describePort(port), USB_JITTER_US);
+  const source = addSource('serial', id, describePort(port), USB_CHUNK_JITTER_US);
   source.identity = identity;
+  source.signals = signals;
   source.serial = new SerialSource(nowUs, {
     data: (bytes, timeUs) => onLiveData(source, bytes, timeUs),
     lineError: (name) => notice('warning', `Line error on ${source.label}`, `${name}: some bytes may be lost; reading goes on.`),
@@ -208,9 +234,8 @@ async function openSerial(identity: PortIdentity, signals?: SerialOutputSignals)
       recorder.event('device lost', nowUs(), id);
       setState(source, 'lost');
       notice('error', `Remote ${source.label}: the adapter was unplugged`, 'Reading stopped; everything recorded so far is kept. Plug it back in and it reconnects by itself.');
-      if (reconnectTimer === undefined) reconnectTimer = setInterval(() => void reconnectLost(), RECONNECT_MS);
+      if (reconnectTimer === undefined) reconnectTimer = setInterval(() => enqueue(reconnectLost), RECONNECT_MS);
     },
-    closed: () => undefined,
   });
   sendSources();
   try {
@@ -221,43 +246,46 @@ async function openSerial(identity: PortIdentity, signals?: SerialOutputSignals)
     sendSources();
     const problem = openProblem(error);
     notice('error', problem.title, problem.detail);
-    return;
+    return false;
   }
   recorder.event('port opened', nowUs(), id);
   setState(source, 'reading', `${describePort(port)} at 115200 baud`);
   startTicks();
+  return true;
 }
 
-let reconnecting = false;
+/** Opens a lost source's adapter again; its decode, graphs and recording port carry on. */
+async function reopen(s: Source, port: SerialPort): Promise<boolean> {
+  try {
+    await (s.serial as SerialSource).open(port, s.signals);
+  } catch {
+    return false;
+  }
+  // Closed while the port was opening: let it go again.
+  if (sources.get(s.id) !== s) {
+    await s.serial?.close();
+    return false;
+  }
+  recorder.event('device reconnected', nowUs(), s.id);
+  setState(s, 'reading', `${describePort(port)} at 115200 baud`);
+  notice('info', `Remote ${s.label} reconnected`, 'The adapter is back; reading again.');
+  return true;
+}
 
 /** Tries the ports of lost sources again: a replugged adapter comes back without a prompt. */
 async function reconnectLost(): Promise<void> {
-  if (reconnecting) return;
-  reconnecting = true;
-  try {
-    for (const s of sources.values()) {
-      if (s.state !== 'lost' || s.serial === undefined || s.identity === undefined) continue;
-      try {
-        const port = await findPort(s.identity);
-        if (port === undefined) continue;
-        await s.serial.open(port);
-        recorder.event('device reconnected', nowUs(), s.id);
-        setState(s, 'reading', `${describePort(port)} at 115200 baud`);
-        notice('info', `Remote ${s.label} reconnected`, 'The adapter is back; reading again.');
-      } catch {
-        // Still gone: try again on the next tick.
-      }
-    }
-    if (![...sources.values()].some((s) => s.state === 'lost')) {
-      clearInterval(reconnectTimer);
-      reconnectTimer = undefined;
-    }
-  } finally {
-    reconnecting = false;
+  for (const s of [...sources.values()]) {
+    if (s.state !== 'lost' || s.identity === undefined) continue;
+    const port = await findPort(s.identity);
+    if (port !== undefined && sources.get(s.id) === s && s.state === 'lost') await reopen(s, port);
+  }
+  if (![...sources.values()].some((s) => s.state === 'lost')) {
+    clearInterval(reconnectTimer);
+    reconnectTimer = undefined;
   }
 }
 
-navigator.serial?.addEventListener('connect', () => void reconnectLost());
+navigator.serial?.addEventListener('connect', () => enqueue(reconnectLost));
 
 // ---- bind -----------------------------------------------------------------------------------
 
@@ -268,8 +296,8 @@ async function bind(message: Extract<ToWorker, { type: 'bind' }>): Promise<void>
     notice('error', 'The port is not available', 'Plug the adapter in and choose it again.');
     return;
   }
-  // The bind needs the port to itself: close it if it is being read.
-  for (const s of sources.values()) if (s.serial?.port === port) await closeSource(s.id);
+  // The bind needs the port to itself: close it if it is being read (or was, before it was lost).
+  for (const s of [...sources.values()]) if (s.serial?.port === port || sameAdapter(s.identity, message.port)) await closeSource(s.id);
   const report = (progress: BindProgress) => post({ type: 'bind', progress });
   let keepOn: SerialOutputSignals;
   try {
@@ -280,8 +308,11 @@ async function bind(message: Extract<ToWorker, { type: 'bind' }>): Promise<void>
     notice('error', `Bind failed: ${problem.title}`, problem.detail);
     return;
   }
-  await openSerial(message.port, keepOn);
-  report({ step: 'live', text: 'reading at 115200: the satellite blinks until the transmitter binds, then frames appear', atMs: 0, sincePowerOnMs: null });
+  if (await openSerial(message.port, keepOn)) {
+    report({ step: 'live', text: 'reading at 115200: the satellite blinks until the transmitter binds, then frames appear', atMs: 0, sincePowerOnMs: null });
+  } else {
+    report({ step: 'failed', text: 'the pulses were sent, but the port could not be opened again at 115200', atMs: 0, sincePowerOnMs: null });
+  }
 }
 
 // ---- demo -----------------------------------------------------------------------------------
@@ -293,7 +324,7 @@ async function startDemo(): Promise<void> {
     if (s !== undefined) onLiveData(s, bytes, timeUs);
   });
   for (let i = 0; i < d.remotes; i++) {
-    const s = addSource('demo', i, i === 0 ? 'Demo remote (internal, DSMX 11 ms)' : 'Demo remote (external)', USB_JITTER_US);
+    const s = addSource('demo', i, i === 0 ? 'Demo remote (internal, DSMX 11 ms)' : 'Demo remote (external)', USB_CHUNK_JITTER_US);
     s.state = 'reading';
   }
   demo = d;
@@ -304,42 +335,46 @@ async function startDemo(): Promise<void> {
 
 // ---- replay ---------------------------------------------------------------------------------
 
-/** Whole-capture series for the replay timeline (every port on one time axis). */
+/**
+ * Whole-capture series for the replay timeline, every port on one time axis in 1 s bins: fades,
+ * and frames missing by the clock counted where each gap ends (so a port that starts late, or a
+ * partial first or last second, shows no loss that is not there), and the failsafe episodes.
+ */
 function overviewOf(capture: Capture, ports: readonly number[]): Overview {
   const BIN_US = 1_000_000;
   const t: number[] = [];
   const fades: number[] = [];
-  const frames: number[] = [];
+  const lost: number[] = [];
   const failsafe: Overview['failsafe'] = [];
   let first = NaN;
-  let expectedPerBin = 0;
+  const jitterUs = replayJitter(capture);
   for (const port of ports) {
-    const { link } = decodeCapture(capture, { resolution, port }, (f) => {
+    const link = new LinkMonitor({ jitterUs });
+    decodeCapture(capture, { resolution, port }, (f) => {
+      const missed = link.stats.missedFrames;
+      link.frame(f);
       if (!Number.isFinite(f.timeUs)) return;
       if (Number.isNaN(first)) first = Math.floor(f.timeUs / BIN_US) * BIN_US;
       const bin = Math.max(0, Math.floor((f.timeUs - first) / BIN_US));
       while (t.length <= bin) {
         t.push(first + t.length * BIN_US);
         fades.push(0);
-        frames.push(0);
+        lost.push(0);
       }
       fades[bin] = (fades[bin] as number) + f.fadesDelta;
-      frames[bin] = (frames[bin] as number) + 1;
+      lost[bin] = (lost[bin] as number) + link.stats.missedFrames - missed;
     });
-    const period = link.stats.nominalPeriodUs;
-    if (Number.isFinite(period)) expectedPerBin += BIN_US / period;
     for (const e of link.episodes) if (e.kind === 'failsafe') failsafe.push({ startUs: e.startUs, endUs: e.endUs ?? e.startUs });
   }
-  return {
-    t: Float64Array.from(t),
-    fadeRate: Float32Array.from(fades),
-    lost: Float32Array.from(frames, (n) => Math.max(0, Math.round(expectedPerBin - n))),
-    failsafe,
-  };
+  return { t: Float64Array.from(t), fadeRate: Float32Array.from(fades), lost: Float32Array.from(lost), failsafe };
 }
+
+const REPLAY_STATUS_MS = 200;
+let lastReplayStatusMs = 0;
 
 function replayStatus(): void {
   if (replay === undefined) return;
+  lastReplayStatusMs = performance.now();
   const c = replay.capture;
   let frames = 0;
   for (const s of sources.values()) frames += s.engine.decoder.stats.frames;
@@ -353,7 +388,7 @@ function replayStatus(): void {
 }
 
 function replayJitter(capture: Capture): number {
-  return capture.timing === 'per-chunk' ? USB_JITTER_US : 0;
+  return capture.timing === 'per-chunk' ? USB_CHUNK_JITTER_US : 0;
 }
 
 /** Fresh decodes for every port of the replayed capture. */
@@ -380,6 +415,7 @@ async function openReplay(name: string, data: ArrayBuffer): Promise<void> {
   }
   await closeAll();
   replayName = name;
+  replayBytes = new Uint8Array(data);
   if (capture.issues.length > 0) {
     notice('warning', `${name}: ${capture.issues.length} damaged part(s) skipped`, `${capture.issues[0]?.message ?? ''} Every intact record is kept.`);
   }
@@ -388,7 +424,8 @@ async function openReplay(name: string, data: ArrayBuffer): Promise<void> {
     (port, bytes, time) => sources.get(port)?.engine.push(bytes, time, performance.timeOrigin + performance.now()),
     () => {
       flush();
-      replayStatus();
+      // The position moves every tick; the page needs it a few times a second.
+      if (performance.now() - lastReplayStatusMs >= REPLAY_STATUS_MS) replayStatus();
     },
     () => {
       for (const s of sources.values()) {
@@ -411,6 +448,30 @@ async function openReplay(name: string, data: ArrayBuffer): Promise<void> {
 function setReplayState(state: string): void {
   for (const s of sources.values()) s.state = state;
   sendSources();
+}
+
+// ---- reports ------------------------------------------------------------------------------
+
+/**
+ * Builds a health report in a worker of its own: decoding a long capture takes a good part of a
+ * second, and this worker must keep reading ports meanwhile (a stall shows as a gap in the
+ * data and in the recording).
+ */
+function makeReport(bytes: Uint8Array, name: string, format: 'html' | 'json'): void {
+  const helper = new Worker(new URL('./report-worker.ts', import.meta.url), { type: 'module', name: 'satscope-report' });
+  const copy = bytes.slice();
+  helper.addEventListener('message', (event: MessageEvent<ReportReply>) => {
+    helper.terminate();
+    const reply = event.data;
+    if (reply.error !== undefined) {
+      notice('error', 'The report could not be made', reply.error);
+      return;
+    }
+    const base = (name.replace(/\.[^.]+$/, '') || 'satscope').replace(/[^\w.-]+/g, '-');
+    post({ type: 'export-ready', name: `${base}.report.${format}`, mime: format === 'html' ? 'text/html' : 'application/json', data: reply.data }, [reply.data]);
+  });
+  const request: ReportRequest = { bytes: copy, name, format, resolution };
+  helper.postMessage(request, [copy.buffer]);
 }
 
 // ---- commands -------------------------------------------------------------------------------
@@ -481,24 +542,19 @@ async function handle(message: ToWorker): Promise<void> {
       break;
     }
     case 'report': {
-      let capture: Capture | undefined = replay?.capture;
+      let bytes: Uint8Array | null = null;
       let name = replayName;
-      if (capture === undefined) {
-        const recorded = await recorder.current();
-        if (recorded !== null) {
-          capture = parseCapture(recorded);
-          name = 'live session';
-        }
+      if (replay !== undefined) {
+        bytes = replayBytes;
+      } else {
+        bytes = await recorder.current();
+        name = 'live session';
       }
-      if (capture === undefined) {
+      if (bytes === null) {
         notice('warning', 'Nothing to report on yet', 'Record the live session (● Record) or open a capture; the report covers what was recorded.');
         break;
       }
-      const report = healthReport(capture, { resolution, name });
-      const base = (name.replace(/\.[^.]+$/, '') || 'satscope').replace(/[^\w.-]+/g, '-');
-      const text = message.format === 'html' ? reportHtml(report) : `${JSON.stringify(report, null, 2)}\n`;
-      const data = new TextEncoder().encode(text).buffer as ArrayBuffer;
-      post({ type: 'export-ready', name: `${base}.report.${message.format}`, mime: message.format === 'html' ? 'text/html' : 'application/json', data }, [data]);
+      makeReport(bytes, name, message.format);
       break;
     }
     case 'discard-recovered':
@@ -548,12 +604,18 @@ async function handle(message: ToWorker): Promise<void> {
 }
 
 let queue: Promise<void> = Promise.resolve();
-scope.addEventListener('message', (event: MessageEvent<ToWorker>) => {
-  // Commands run one after another: opening a port while another closes would race.
-  queue = queue.then(() => handle(event.data)).catch((error: unknown) => {
+
+/**
+ * Runs `task` after everything queued before it: commands and reconnects one after another,
+ * since opening a port while another command closes it would race.
+ */
+function enqueue(task: () => Promise<void>): void {
+  queue = queue.then(task).catch((error: unknown) => {
     notice('error', 'Something went wrong in the worker', String(error));
   });
-});
+}
+
+scope.addEventListener('message', (event: MessageEvent<ToWorker>) => enqueue(() => handle(event.data)));
 
 void recorder.init();
 sendSources();

@@ -158,6 +158,14 @@ describe.skipIf(skip !== null)('the page', () => {
     expect(capturePorts(capture)).toEqual([0, 1]);
     expect(summarizeCapture(capture, { port: 1 }).format.remote).toBe('external');
     expect(capture.meta.ports?.map((p) => p.name)).toEqual(['A', 'B']);
+    // A report on the live session's recording, made off the reading worker.
+    const reportDownload = page.waitForEvent('download');
+    await page.getByRole('button', { name: 'json', exact: true }).click();
+    const reportFile = join(dir, 'live.report.json');
+    await (await reportDownload).saveAs(reportFile);
+    const liveReport = JSON.parse(readFileSync(reportFile, 'utf8')) as { remotes: { frames: number }[] };
+    expect(liveReport.remotes).toHaveLength(2);
+    expect(liveReport.remotes[0]!.frames).toBe(summary.decoder.frames);
 
     // Start again and reload without stopping: the recording is kept and offered back.
     await page.getByRole('button', { name: '● Record' }).click();
@@ -256,6 +264,21 @@ describe.skipIf(skip !== null)('the page', () => {
     const panel = page.locator('.panel', { has: page.getByText('Frame inspector') }).last();
     await panel.scrollIntoViewIfNeeded();
     await panel.screenshot({ path: join(SHOTS_DIR, 'inspector.png') });
+    expect(errors).toEqual([]);
+    await page.context().close();
+  });
+
+  it('replays a raw .bin (no timing) and shows its channels', async () => {
+    const sim = simulate({ ...preset('xplus-dx9'), seed: 5 }, 1_000_000);
+    const path = join(dir, 'dump.bin');
+    writeFileSync(path, sim.bytes);
+    const expected = summarizeCapture(readCapture(sim.bytes, 'dump.bin'));
+    const { page, errors } = await open('?demo=0');
+    await replayFile(page, path);
+    await page.locator('[data-testid="source-status"]', { hasText: '(end)' }).waitFor({ timeout: 10_000 });
+    await page.locator('.channels').nth(1).waitFor();
+    const bars = await barValues(page);
+    for (const c of expected.channels) expect(bars[c.name], c.name).toBe(c.lastUs);
     expect(errors).toEqual([]);
     await page.context().close();
   });

@@ -61,6 +61,8 @@ export type ReplaySink = (port: number, bytes: Uint8Array, time: number | Float6
 const TICK_MS = 10;
 /** Decode for at most this long per tick, then let messages through. */
 const SLICE_MS = 12;
+/** The most wall time one tick may move the replay clock by. */
+const MAX_STEP_MS = 100;
 /** A seek replays this much before the target so the graphs and failsafe state have history. */
 const SEEK_HISTORY_US = 10 * 60e6;
 
@@ -156,6 +158,7 @@ export class ReplaySource {
    */
   seek(timeUs: number): void {
     const target = Math.min(Math.max(timeUs, this.startUs), this.endUs);
+    this.#lastFedUs = NaN;
     const from = target - SEEK_HISTORY_US;
     for (const c of this.#chunks) {
       c.next = 0;
@@ -219,7 +222,9 @@ export class ReplaySource {
       done = this.#feedUntil(Infinity, SLICE_MS);
       if (this.timed && Number.isFinite(this.#lastFedUs)) this.#clockUs = Math.max(this.#clockUs, this.#lastFedUs);
     } else {
-      this.#clockUs += (nowMs - this.#wallMs) * 1000 * this.#speed;
+      // A stall (a long task, a background tab) must not jump the clock past silent data: that
+      // would show a hold or failsafe that is not in the capture.
+      this.#clockUs += Math.min(nowMs - this.#wallMs, MAX_STEP_MS) * 1000 * this.#speed;
       done = this.#feedUntil(this.#clockUs, SLICE_MS);
     }
     this.#wallMs = nowMs;

@@ -22,8 +22,6 @@ export interface SerialEvents {
   lineError(name: string): void;
   /** The device went away (unplugged): reading stopped, the port is closed. */
   lost(): void;
-  /** Reading ended because `close()` was called. */
-  closed(): void;
 }
 
 /** Finds a granted port by its identity (USB IDs first, then its place in the list). */
@@ -81,7 +79,14 @@ export class SerialSource {
    */
   async open(port: SerialPort, signals?: SerialOutputSignals): Promise<void> {
     await port.open({ baudRate: BAUD_RATE, dataBits: 8, stopBits: 1, parity: 'none', flowControl: 'none', bufferSize: 1 << 20 });
-    if (signals !== undefined) await port.setSignals(signals);
+    if (signals !== undefined) {
+      try {
+        await port.setSignals(signals);
+      } catch (error) {
+        await port.close().catch(() => undefined);
+        throw error;
+      }
+    }
     this.#port = port;
     this.#closing = false;
     this.#done = this.#readLoop(port);
@@ -109,10 +114,7 @@ export class SerialSource {
         this.#reader = undefined;
       }
     }
-    if (this.#closing) {
-      this.events.closed();
-      return;
-    }
+    if (this.#closing) return;
     try {
       await port.close();
     } catch {

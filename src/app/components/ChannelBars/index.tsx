@@ -43,17 +43,19 @@ export function ChannelBars({ ids, label }: { ids: number[]; label: string }) {
         const seen = live.seenUs[id] as number;
         const resolution = id >= XPLUS_FIRST ? 2048 : (live.resolution ?? 2048);
         const pos = live.positions[id] as number;
-        const age = now - seen;
-        const stale = !Number.isFinite(seen) || age > STALE_US;
+        const never = Number.isNaN(seen);
+        // Seen in data without times (+Infinity): shown, never stale.
+        const age = seen === Infinity ? 0 : now - seen;
+        const stale = never || age > STALE_US;
         // The key of what is on screen: redraw only when it changes.
-        const ageText = !Number.isFinite(seen) ? 'no data' : stale ? `stale ${(age / 1e6).toFixed(1)} s` : '';
+        const ageText = never ? 'no data' : stale ? `stale ${(age / 1e6).toFixed(1)} s` : '';
         const key = `${pos}|${resolution}|${ageText}`;
         if (key === row.shown) return;
         row.shown = key;
         row.root.classList.toggle('stale', stale);
-        row.root.classList.toggle('never', !Number.isFinite(seen));
+        row.root.classList.toggle('never', never);
         row.age.textContent = ageText;
-        if (!Number.isFinite(seen)) {
+        if (never) {
           row.us.textContent = '—';
           row.raw.textContent = '';
           row.pct.textContent = '';

@@ -107,7 +107,11 @@ export function Graphs({ windowUs }: { windowUs: Signal<number> }) {
       drawnAt = nowMs;
       const s: SeriesBuffer = live.series;
       const end = live.nowUs() / 1e6;
-      if (!Number.isFinite(end)) return;
+      if (!Number.isFinite(end)) {
+        // A new source with no data yet: show nothing rather than the last source's curves.
+        for (const chart of charts) chart.setData([[], []]);
+        return;
+      }
       const start = end - windowUs.value / 1e6;
       const from = s.indexAt(start);
       const x = s.t.subarray(from, s.length);

@@ -20,8 +20,10 @@ function refresh(): void {
 export function InspectorPanel() {
   const id = selected.value;
   useEffect(() => {
-    if (!open.value || !following.value) return undefined;
+    if (!open.value) return undefined;
+    // Paused: one snapshot of the remote now shown; following: one four times a second.
     refresh();
+    if (!following.value) return undefined;
     const timer = setInterval(refresh, FOLLOW_MS);
     return () => clearInterval(timer);
   }, [open.value, following.value, id]);

@@ -2,7 +2,7 @@
  * Replay controls: play/pause, speed (1×, 4×, as fast as possible) and a timeline of the whole
  * capture (fades and lost frames per second, failsafe episodes) to seek on.
  */
-import { useEffect, useRef } from 'preact/hooks';
+import { useEffect, useRef, useState } from 'preact/hooks';
 import uPlot from 'uplot';
 import { overview, replay, send } from '../../store.js';
 import './style.css';
@@ -21,6 +21,7 @@ function clock(us: number): string {
 export function ReplayBar() {
   const r = replay.value;
   const chart = useRef<HTMLDivElement>(null);
+  const [dragging, setDragging] = useState<number | null>(null);
   const o = overview.value;
   useEffect(() => {
     const el = chart.current;
@@ -88,8 +89,13 @@ export function ReplayBar() {
         min={r.startUs}
         max={r.endUs}
         step={Math.max(1, Math.round(span / 2000))}
-        value={r.positionUs}
-        onChange={(e) => send({ type: 'replay-seek', timeUs: Number((e.currentTarget as HTMLInputElement).value) })}
+        value={dragging ?? r.positionUs}
+        // While the thumb is held, the position updates must not pull it back.
+        onInput={(e) => setDragging(Number((e.currentTarget as HTMLInputElement).value))}
+        onChange={(e) => {
+          setDragging(null);
+          send({ type: 'replay-seek', timeUs: Number((e.currentTarget as HTMLInputElement).value) });
+        }}
       />
     </section>
   );

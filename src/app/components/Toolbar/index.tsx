@@ -44,7 +44,9 @@ function summary(list: SourceStatus[]): { text: string; tone: string } {
     return { text: `${r?.name ?? 'Replay'}${state}`, tone: 'replay' };
   }
   const lost = list.some((s) => s.state === 'lost');
-  return { text: list.map((s) => `${s.label}: ${s.state === 'lost' ? `${s.name}: device lost` : s.name}`).join(' · '), tone: lost ? 'serial lost' : 'serial reading' };
+  const opening = list.some((s) => s.state === 'opening');
+  const text = list.map((s) => `${s.label}: ${s.name}${s.state === 'lost' ? ': device lost' : s.state === 'opening' ? ': opening…' : ''}`).join(' · ');
+  return { text, tone: lost ? 'serial lost' : opening ? 'serial opening' : 'serial reading' };
 }
 
 export function Toolbar({ granted, onBind }: { granted: SerialPort[]; onBind(): void }) {
@@ -55,6 +57,8 @@ export function Toolbar({ granted, onBind }: { granted: SerialPort[]; onBind(): 
   const rec = recording.value;
   const live = kind === 'serial' || kind === 'demo';
   const pill = summary(list);
+  // A report covers a replayed capture or what was recorded.
+  const canReport = kind === 'replay' || (rec !== null && rec.bytes > 0);
   useEffect(() => {
     if (rec?.active) setExported(false);
   }, [rec?.active]);
@@ -108,8 +112,8 @@ export function Toolbar({ granted, onBind }: { granted: SerialPort[]; onBind(): 
         ) : null}
       </div>
       <div class="report">
-        <button type="button" disabled={list.length === 0 && rec?.bytes === undefined} onClick={() => send({ type: 'report', format: 'html' })} title="One-page link-quality report of the capture being replayed, or of what was recorded live">Report</button>
-        <button type="button" class="link" disabled={list.length === 0 && rec?.bytes === undefined} onClick={() => send({ type: 'report', format: 'json' })}>json</button>
+        <button type="button" disabled={!canReport} onClick={() => send({ type: 'report', format: 'html' })} title="One-page link-quality report of the capture being replayed, or of what was recorded live">Report</button>
+        <button type="button" class="link" disabled={!canReport} onClick={() => send({ type: 'report', format: 'json' })}>json</button>
       </div>
       <label class="resolution">
         Resolution

@@ -1,0 +1,31 @@
+/**
+ * A short-lived worker that makes one health report (library: healthReport, reportHtml), so the
+ * worker reading the ports never stalls on it.
+ */
+/// <reference lib="webworker" />
+import { healthReport, readCapture, reportHtml } from '../decoder/index.js';
+
+export interface ReportRequest {
+  bytes: Uint8Array;
+  name: string;
+  format: 'html' | 'json';
+  resolution: 'auto' | 1024 | 2048;
+}
+
+export type ReportReply = { data: ArrayBuffer; error?: undefined } | { error: string; data?: undefined };
+
+const scope = self as unknown as DedicatedWorkerGlobalScope;
+
+scope.addEventListener('message', (event: MessageEvent<ReportRequest>) => {
+  const { bytes, name, format, resolution } = event.data;
+  try {
+    const report = healthReport(readCapture(bytes, name), { resolution, name });
+    const text = format === 'html' ? reportHtml(report) : `${JSON.stringify(report, null, 2)}\n`;
+    const data = new TextEncoder().encode(text).buffer as ArrayBuffer;
+    const reply: ReportReply = { data };
+    scope.postMessage(reply, [data]);
+  } catch (error) {
+    const reply: ReportReply = { error: String(error) };
+    scope.postMessage(reply);
+  }
+});
