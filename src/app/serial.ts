@@ -2,7 +2,7 @@
  * The window's part of WebSerial: checking it exists, asking for a port (requestPort needs a
  * user gesture, so it cannot happen in the worker), and naming granted ports for the worker.
  */
-import type { PortIdentity } from '../worker/protocol.js';
+import { portName, type PortIdentity } from '../worker/protocol.js';
 
 /** USB-serial chips people put on a satellite's DATA line, as picker hints; any port may be chosen. */
 export const USB_SERIAL_FILTERS: SerialPortFilter[] = [
@@ -57,13 +57,5 @@ export async function pickPort(filters: SerialPortFilter[]): Promise<SerialPort 
 }
 
 export function portLabel(port: SerialPort): string {
-  const { usbVendorId, usbProductId } = port.getInfo();
-  if (usbVendorId === undefined) return 'Serial port';
-  const hex = (v: number) => v.toString(16).padStart(4, '0');
-  const chip = USB_CHIPS[usbVendorId] ?? 'USB serial';
-  return `${chip} (${hex(usbVendorId)}:${hex(usbProductId ?? 0)})`;
+  return portName(port.getInfo());
 }
-
-const USB_CHIPS: Record<number, string> = {
-  0x0403: 'FTDI', 0x10c4: 'CP210x', 0x1a86: 'CH340', 0x067b: 'PL2303', 0x2341: 'Arduino', 0x239a: 'Adafruit', 0x0483: 'STM32',
-};

@@ -5,7 +5,7 @@
  * the session: a fresh reader is taken from the new `port.readable`.
  */
 import { BAUD_RATE } from '../../decoder/index.js';
-import type { PortIdentity } from '../protocol.js';
+import { portName, type PortIdentity } from '../protocol.js';
 
 /** Errors after which `port.readable` is replaced and reading goes on (WebSerial spec). */
 const RECOVERABLE = new Set(['BufferOverrunError', 'FramingError', 'BreakError', 'ParityError']);
@@ -37,9 +37,7 @@ export async function findPort(identity: PortIdentity): Promise<SerialPort | und
 }
 
 export function describePort(port: SerialPort): string {
-  const { usbVendorId, usbProductId } = port.getInfo();
-  const hex = (v: number) => v.toString(16).padStart(4, '0');
-  return usbVendorId === undefined ? 'serial port' : `USB ${hex(usbVendorId)}:${hex(usbProductId ?? 0)}`;
+  return portName(port.getInfo());
 }
 
 /** Explains why `open()` failed, in terms of what the user can do. */

@@ -10,6 +10,7 @@ import 'uplot/dist/uPlot.min.css';
 import { onFrame } from '../../frame-loop.js';
 import type { Live, SeriesBuffer } from '../../live.js';
 import { current, status } from '../../store.js';
+import { SECONDS_BEFORE_NOW_AXIS, valueAxis } from '../../timeline.js';
 import './style.css';
 
 export const WINDOWS = [
@@ -47,18 +48,7 @@ function makeChart(el: HTMLElement, spec: ChartSpec, width: number, sync: uPlot.
       x: { time: false },
       y: spec.range ? { range: () => spec.range as [number, number] } : { range: (_u, _min, max) => [0, Math.max(1, max * 1.15)] },
     },
-    axes: [
-      {
-        stroke: '#8a97a8',
-        grid: { stroke: '#1e2835' },
-        ticks: { stroke: '#1e2835' },
-        values: (u, vals) => {
-          const end = u.scales.x?.max ?? 0;
-          return vals.map((v) => `${(v - end).toFixed(0)} s`);
-        },
-      },
-      { stroke: '#8a97a8', grid: { stroke: '#1e2835' }, ticks: { stroke: '#1e2835' }, size: 48, label: `${spec.title} ${spec.unit}`, labelSize: 18 },
-    ],
+    axes: [SECONDS_BEFORE_NOW_AXIS, valueAxis(`${spec.title} ${spec.unit}`)],
     series: [
       {},
       {

@@ -8,6 +8,7 @@ import { useEffect, useRef } from 'preact/hooks';
 import { onFrame } from '../../frame-loop.js';
 import type { Live } from '../../live.js';
 import { current, linkState } from '../../store.js';
+import { drawEpisodes } from '../../timeline.js';
 import './style.css';
 
 const LABEL = { waiting: 'Waiting', live: 'Live', hold: 'Hold', failsafe: 'Failsafe' } as const;
@@ -48,24 +49,8 @@ export function LinkPanel({ windowUs }: { windowUs: Signal<number> }) {
       stripLive = live;
       stripAt = nowMs;
       if (counts.current !== null) counts.current.textContent = l === null ? '' : `${l.holds} holds · ${l.failsafes} failsafes`;
-      const span = windowUs.value;
-      const start = now - span;
-      const parts: string[] = [];
+      const parts = drawEpisodes(strip.current, live.episodes.values(), now, windowUs.value);
       const el = strip.current;
-      el.replaceChildren();
-      for (const e of live.episodes.values()) {
-        const end = e.endUs ?? now;
-        if (end < start) continue;
-        const a = Math.max(0, (e.startUs - start) / span);
-        const b = Math.min(1, (end - start) / span);
-        const div = document.createElement('div');
-        div.className = `episode ${e.kind}`;
-        div.style.left = `${(a * 100).toFixed(3)}%`;
-        div.style.width = `${Math.max(0.3, (b - a) * 100).toFixed(3)}%`;
-        div.title = `${e.kind} ${ago(end - e.startUs)}`;
-        el.append(div);
-        parts.push(e.kind);
-      }
       el.setAttribute('aria-label', parts.length === 0 ? 'No hold or failsafe in this window' : `${parts.filter((p) => p === 'failsafe').length} failsafe and ${parts.filter((p) => p === 'hold').length} hold episodes in this window`);
     });
   }, [windowUs]);

@@ -11,6 +11,7 @@ import { REMOTE_LABELS } from '../../../worker/protocol.js';
 import { onFrame } from '../../frame-loop.js';
 import type { Live } from '../../live.js';
 import { allLives, select, selected, send, sources } from '../../store.js';
+import { drawEpisodes, SECONDS_BEFORE_NOW_AXIS, valueAxis } from '../../timeline.js';
 import './style.css';
 
 const COLORS = ['#4fd1a5', '#f0b429', '#7cc4ff', '#ff8fab', '#c3a6ff'];
@@ -37,8 +38,8 @@ export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
       cursor: { drag: { x: false, y: false } },
       scales: { x: { time: false }, y: { range: (_u, _min, max) => [0, Math.max(1, max * 1.15)] } },
       axes: [
-        { stroke: '#8a97a8', grid: { stroke: '#1e2835' }, ticks: { stroke: '#1e2835' }, values: (u, vals) => vals.map((v) => `${(v - (u.scales.x?.max ?? 0)).toFixed(0)} s`) },
-        { stroke: '#8a97a8', grid: { stroke: '#1e2835' }, ticks: { stroke: '#1e2835' }, size: 48, label: 'Fades /s', labelSize: 18 },
+        SECONDS_BEFORE_NOW_AXIS,
+        valueAxis('Fades /s'),
       ],
       series: [{}, ...order.map((id, i) => ({ label: list[i]?.label ?? String(id), stroke: COLORS[i % COLORS.length], width: 1.5, points: { show: false } }))],
     }, [[], ...order.map(() => [])], box);
@@ -84,19 +85,7 @@ export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
         const lane = el.children[i]?.querySelector('.lane-strip');
         const live = lives.get(id);
         if (!(lane instanceof HTMLElement) || live === undefined) return;
-        lane.replaceChildren();
-        const now = live.nowUs();
-        const span = windowUs.value;
-        for (const e of live.episodes.values()) {
-          const a = Math.max(0, (e.startUs - (now - span)) / span);
-          const b = Math.min(1, ((e.endUs ?? now) - (now - span)) / span);
-          if (b <= 0) continue;
-          const div = document.createElement('div');
-          div.className = `episode ${e.kind}`;
-          div.style.left = `${(a * 100).toFixed(3)}%`;
-          div.style.width = `${Math.max(0.3, (b - a) * 100).toFixed(3)}%`;
-          lane.append(div);
-        }
+        drawEpisodes(lane, live.episodes.values(), live.nowUs(), windowUs.value);
       });
     });
     return () => {
