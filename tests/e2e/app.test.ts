@@ -283,6 +283,21 @@ describe.skipIf(skip !== null)('the page', () => {
     await page.context().close();
   });
 
+  it('tells a browser without Web Serial what to do, and still runs the demo', async () => {
+    const context = await app.browser.newContext({ viewport: { width: 1400, height: 1000 } });
+    // What Firefox and Safari look like to the page.
+    await context.addInitScript(() => { delete (Navigator.prototype as unknown as { serial?: unknown }).serial; });
+    const page = await context.newPage();
+    await page.goto(app.server.url('/?demo=0'));
+    await page.getByRole('button', { name: 'Connect receiver' }).click();
+    const alert = page.getByRole('alert').filter({ hasText: 'This browser has no Web Serial' });
+    await alert.waitFor();
+    await expect(alert.textContent()).resolves.toMatch(/Use Chrome, Edge or Opera/);
+    await page.getByRole('button', { name: 'Demo', exact: true }).click();
+    await page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor({ timeout: 10_000 });
+    await context.close();
+  });
+
   it('tells the user a file is not a capture and keeps the page usable', async () => {
     const path = join(dir, 'notes.txt');
     writeFileSync(path, 'shopping list\neggs\n');
