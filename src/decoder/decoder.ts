@@ -30,6 +30,8 @@ import type {
 export interface DecoderOptions {
   /** Fix the servo resolution instead of inferring it (e.g. from the internal remote). Default 'auto'. */
   resolution?: 'auto' | Resolution;
+  /** Who fixed `resolution`, for `format`: the user (default) or the internal remote of the system. */
+  resolutionFrom?: 'user' | 'internal-remote';
   /** Fix the remote kind instead of inferring it from the header bytes. Default 'auto'. */
   remote?: 'auto' | RemoteKind;
   /** What byte 0 of an internal remote carries. 'auto' (default) detects SPM4649T RSSI. */
@@ -69,7 +71,7 @@ function plausibleRssi(byte: number): boolean {
 }
 
 export class SpektrumDecoder {
-  #options: Required<Omit<DecoderOptions, 'onEvent'>>;
+  #options: Required<Omit<DecoderOptions, 'onEvent' | 'resolutionFrom'>>;
   readonly #onEvent: ((event: DecoderEvent) => void) | undefined;
 
   #buf = new Uint8Array(INITIAL_CAPACITY);
@@ -140,6 +142,7 @@ export class SpektrumDecoder {
       throw new TypeError('onEvent must be a function');
     }
     this.#options = { resolution, remote, headerMode };
+    this.#fixedBy = options.resolutionFrom === 'internal-remote' ? 'internal-remote' : 'user';
     this.#onEvent = options.onEvent;
   }
 

@@ -423,7 +423,7 @@ interface PortData {
 }
 
 /** Decodes one port, keeping what the report needs per frame, and finds spikes as it goes. */
-function decodePort(capture: Capture, port: number, resolution: 'auto' | Resolution): PortData {
+function decodePort(capture: Capture, port: number, resolution: 'auto' | Resolution, resolutionFrom: 'user' | 'internal-remote' = 'user'): PortData {
   const times = new Column();
   const fades = new Column();
   const rssi = new Column();
@@ -446,6 +446,7 @@ function decodePort(capture: Capture, port: number, resolution: 'auto' | Resolut
   const remote = decodeCapture(capture, {
     port,
     resolution,
+    resolutionFrom,
     onEvent: (e) => {
       if (e.type === 'format-changed') formatChanges++;
     },
@@ -642,7 +643,20 @@ export function healthReport(capture: Capture, options: HealthReportOptions = {}
   const ports = capturePorts(capture);
   const timed = capture.timing !== 'none';
   const allowance = capture.timing === 'per-chunk' ? CHUNK_TIMING_ALLOWANCE_US : 0;
-  const decoded = ports.map((p) => decodePort(capture, p, options.resolution ?? 'auto'));
+  let decoded = ports.map((p) => decodePort(capture, p, options.resolution ?? 'auto'));
+  // §8: the internal remote holds the key for every remote; external ports take its resolution.
+  if ((options.resolution ?? 'auto') === 'auto' && ports.length > 1) {
+    const key = decoded.map((d) => d.remote.decoder.format).find((f) => f.remote === 'internal' && f.system !== null && systemInfo(f.system) !== undefined)?.resolution;
+    if (key != null) {
+      decoded = decoded.map((d, i) => {
+        if (d.remote.decoder.format.remote === 'internal') return d;
+        // Kept only if it reads at least as many frames: a port of another system (or a
+        // capture put together from unrelated receivers) keeps its own reading.
+        const keyed = decodePort(capture, ports[i] as number, key, 'internal-remote');
+        return keyed.remote.decoder.stats.frames >= d.remote.decoder.stats.frames ? keyed : d;
+      });
+    }
+  }
 
   // The shared clock: from the earliest to the latest time recorded on any port.
   const span = captureSpan(capture);

@@ -45,6 +45,11 @@ interface Source {
   identity?: PortIdentity;
   /** Signals to set whenever the port is (re)opened: the satellite's power after a bind. */
   signals?: SerialOutputSignals;
+  /** The internal remote's resolution this (external) remote was given, and its counters then. */
+  sharedKey?: 1024 | 2048;
+  sharedAt?: { frames: number; discarded: number };
+  /** A resolution that did not fit this remote's bytes: not given again. */
+  refusedKey?: 1024 | 2048;
 }
 
 let resolution: 'auto' | 1024 | 2048 = 'auto';
@@ -116,11 +121,24 @@ function shareResolution(): void {
     if (info !== undefined && f.resolution !== null) key = f.resolution;
   }
   for (const s of sources.values()) {
-    const f = s.engine.decoder.format;
-    if (f.remote === 'internal' || resolution !== 'auto') continue;
-    s.engine.decoder.setResolution(key ?? 'auto', 'internal-remote');
+    const d = s.engine.decoder;
+    if (d.format.remote === 'internal' || resolution !== 'auto' || (key !== undefined && s.refusedKey === key)) continue;
+    if (s.sharedKey !== key) {
+      d.setResolution(key ?? 'auto', 'internal-remote');
+      s.sharedKey = key;
+      s.sharedAt = { frames: d.stats.frames, discarded: d.stats.discardedBytes };
+    } else if (s.sharedAt !== undefined && d.stats.frames === s.sharedAt.frames && d.stats.discardedBytes - s.sharedAt.discarded > REFUSE_AFTER_BYTES) {
+      // Its bytes do not read at that resolution (a remote of another system?): its own reading wins.
+      d.setResolution('auto');
+      s.refusedKey = key;
+      s.sharedKey = undefined;
+      notice('warning', `Remote ${s.label} does not read at the internal remote's resolution`, `Its frames only make sense at the other resolution; it is decoded on its own (${key ?? ''} did not fit). Are both remotes bound to the same transmitter?`);
+    }
   }
 }
+
+/** Bytes an external remote may discard at the internal remote's resolution before it is given up. */
+const REFUSE_AFTER_BYTES = 512;
 
 /** Sends what changed, at most every MIN_BATCH_MS. */
 function flush(): void {

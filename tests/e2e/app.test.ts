@@ -268,6 +268,28 @@ describe.skipIf(skip !== null)('the page', () => {
     await page.context().close();
   });
 
+  it('gives up the internal remote\'s resolution for a remote whose bytes do not read at it', async () => {
+    const a = simulate({ ...preset('dsmx-11ms-2048-internal'), seed: 31 }, 2_000_000);
+    const b = simulate({ ...preset('dsm2-22ms-1024-external'), seed: 32 }, 2_000_000);
+    const writer = new CaptureWriter({ source: 'test', ports: [{ name: 'A' }, { name: 'B' }] });
+    const chunks = [...usbChunks(a.bytes, a.timesUs).map((c) => ({ ...c, port: 0 })), ...usbChunks(b.bytes, b.timesUs).map((c) => ({ ...c, port: 1 }))];
+    const path = join(dir, 'mixed.sscap');
+    writeFileSync(path, Buffer.concat([writer.header(), ...chunks.sort((x, y) => x.timeUs - y.timeUs).map((c) => writer.data(c.bytes, c.timeUs, c.port))]));
+    const expectB = summarizeCapture(parseCapture(new Uint8Array(readFileSync(path))), { port: 1 });
+    const { page } = await open('?demo=0');
+    await replayFile(page, path);
+    await page.getByRole('radio', { name: '4×' }).click();
+    await page.getByRole('alert').or(page.getByRole('status')).filter({ hasText: 'does not read at the internal remote' }).first().waitFor({ timeout: 10_000 });
+    await page.getByRole('radio', { name: 'max' }).click();
+    await page.locator('[data-testid="source-status"]', { hasText: '(end)' }).waitFor({ timeout: 20_000 });
+    await page.getByTestId('remote-B').click();
+    await page.locator('.panel h2', { hasText: 'remote B' }).waitFor();
+    await expect(page.getByTestId('resolution').textContent()).resolves.toMatch(/^1024/);
+    const bars = await barValues(page);
+    for (const c of expectB.channels) expect(bars[c.name], c.name).toBe(c.lastUs);
+    await page.context().close();
+  });
+
   it('replays a raw .bin (no timing) and shows its channels', async () => {
     const sim = simulate({ ...preset('xplus-dx9'), seed: 5 }, 1_000_000);
     const path = join(dir, 'dump.bin');
