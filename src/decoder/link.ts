@@ -11,6 +11,8 @@ export type LinkState = 'waiting' | 'live' | 'hold' | 'failsafe';
 
 /** A stretch without frames. `endUs` is null while it lasts. */
 export interface LinkEpisode {
+  /** 0, 1, 2, … in the order the episodes began (stays with an episode when older ones are dropped). */
+  id: number;
   kind: 'hold' | 'failsafe';
   /** When the hold (last frame + hold threshold) or the failsafe (last frame + 1 s) began, µs. */
   startUs: number;
@@ -27,6 +29,11 @@ export interface LinkOptions {
   holdAfterUs?: number;
   /** Gap before failsafe, µs. Default 1 s (§7.1). */
   failsafeAfterUs?: number;
+  /**
+   * Episodes kept in `episodes` (the oldest go first); the counts in `stats` keep counting.
+   * Default: all of them. A live view that runs for days sets a bound.
+   */
+  maxEpisodes?: number;
   /**
    * How late a frame may arrive from timing jitter alone, µs (16 ms for an FTDI adapter's
    * latency timer, 0 for a logic analyser). Gaps shorter than 1.5 periods plus this do not
@@ -75,6 +82,8 @@ export class LinkMonitor {
   #rateCount = 0;
   #rateNext = 0;
   readonly #episodes: LinkEpisode[] = [];
+  readonly #maxEpisodes: number;
+  #nextEpisode = 0;
   #open: LinkEpisode | null = null;
   readonly #stats: LinkStats = {
     frames: 0, fades: 0, missedFrames: 0, holds: 0, failsafes: 0, periodUs: NaN,
@@ -83,13 +92,14 @@ export class LinkMonitor {
 
   /** @throws {TypeError} when a duration is not a positive finite number. */
   constructor(options: LinkOptions = {}) {
-    for (const key of ['holdAfterUs', 'failsafeAfterUs', 'jitterUs'] as const) {
+    for (const key of ['holdAfterUs', 'failsafeAfterUs', 'jitterUs', 'maxEpisodes'] as const) {
       const v = options[key];
       if (v !== undefined && !(Number.isFinite(v) && v >= 0)) throw new TypeError(`${key} must be a finite number ≥ 0, not ${String(v)}`);
     }
     this.#holdOption = options.holdAfterUs;
     this.#failsafeAfterUs = options.failsafeAfterUs ?? FAILSAFE_TIMEOUT_US;
     this.#jitterUs = options.jitterUs ?? 0;
+    this.#maxEpisodes = options.maxEpisodes ?? Infinity;
   }
 
   get state(): LinkState {
@@ -101,7 +111,7 @@ export class LinkMonitor {
     return this.#stats;
   }
 
-  /** Every hold and failsafe episode so far, oldest first (the last may still be open). */
+  /** The hold and failsafe episodes kept (all, unless `maxEpisodes`), oldest first; the last may still be open. */
   get episodes(): readonly LinkEpisode[] {
     return this.#episodes;
   }
@@ -180,8 +190,10 @@ export class LinkMonitor {
   }
 
   #openEpisode(kind: 'hold' | 'failsafe', startUs: number, lastFrameUs: number): void {
-    const episode: LinkEpisode = { kind, startUs, endUs: null, lastFrameUs };
+    const episode: LinkEpisode = { id: this.#nextEpisode++, kind, startUs, endUs: null, lastFrameUs };
     this.#episodes.push(episode);
+    // Drop the oldest in one go (an amortised splice), never the open one.
+    if (this.#episodes.length > this.#maxEpisodes * 1.25) this.#episodes.splice(0, this.#episodes.length - this.#maxEpisodes);
     this.#open = episode;
   }
 

@@ -56,13 +56,14 @@ export class Engine {
   #gapLost = 0;
   #lastFrameUs = NaN;
   readonly #series = new Series();
-  /** Episodes already reported as ended. */
+  /** Episode ids up to which every episode has been reported as ended; and open ones reported. */
   #episodesDone = 0;
   #episodesOpenSent = new Set<number>();
 
   constructor(readonly options: EngineOptions) {
     this.decoder = new SpektrumDecoder({ resolution: options.resolution, onEvent: (e) => this.inspector.onEvent(e) });
-    this.link = new LinkMonitor({ jitterUs: options.jitterUs });
+    // A live view may run for days: keep the newest episodes (the page shows ten minutes).
+    this.link = new LinkMonitor({ jitterUs: options.jitterUs, maxEpisodes: 1000 });
   }
 
   /** Bytes as they arrived: `timeUs` is the chunk's arrival (or per-byte times). */
@@ -186,15 +187,15 @@ export class Engine {
   #newEpisodes(): Batch['episodes'] {
     const all: readonly LinkEpisode[] = this.link.episodes;
     const out: Batch['episodes'] = [];
-    for (let i = this.#episodesDone; i < all.length; i++) {
-      const e = all[i] as LinkEpisode;
+    for (const e of all) {
+      if (e.id < this.#episodesDone) continue;
       if (e.endUs !== null) {
-        out.push({ id: i, kind: e.kind, startUs: e.startUs, endUs: e.endUs });
-        this.#episodesOpenSent.delete(i);
-        if (i === this.#episodesDone) this.#episodesDone++;
-      } else if (!this.#episodesOpenSent.has(i)) {
-        out.push({ id: i, kind: e.kind, startUs: e.startUs, endUs: null });
-        this.#episodesOpenSent.add(i);
+        out.push({ id: e.id, kind: e.kind, startUs: e.startUs, endUs: e.endUs });
+        this.#episodesOpenSent.delete(e.id);
+        if (e.id === this.#episodesDone) this.#episodesDone++;
+      } else if (!this.#episodesOpenSent.has(e.id)) {
+        out.push({ id: e.id, kind: e.kind, startUs: e.startUs, endUs: null });
+        this.#episodesOpenSent.add(e.id);
       }
     }
     return out;
