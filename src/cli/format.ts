@@ -1,12 +1,12 @@
 /** Text forms of frames and summaries for the CLI. */
 import type { HealthReport, ReportFinding } from '../decoder/report.js';
 import type { CaptureSummary } from '../decoder/summary.js';
-import { servoToMicros, systemInfo, CHANNEL_COUNT, XPLUS_FIRST } from '../decoder/spec.js';
+import { channelResolution, servoToMicros, systemInfo, CHANNEL_COUNT } from '../decoder/spec.js';
 import type { DecodedFrame } from '../decoder/types.js';
 
 const seconds = (us: number): string => (Number.isFinite(us) ? String(us / 1e6) : 'null');
 const usOf = (f: DecodedFrame, i: number): number =>
-  servoToMicros(f.positions[i] as number, (f.ids[i] as number) >= XPLUS_FIRST ? 2048 : f.resolution);
+  servoToMicros(f.positions[i] as number, channelResolution(f.ids[i] as number, f.resolution));
 
 /**
  * One frame as the documented JSONL line:

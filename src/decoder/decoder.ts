@@ -266,7 +266,6 @@ export class SpektrumDecoder {
         return undefined;
       }
       const resolution = this.#resolution as Resolution;
-      const view = this.#view;
       const layout = slotLayout(this.#buf, o, resolution);
       if (layout !== INVALID) {
         const fit = this.#headerFits(o);
@@ -382,7 +381,6 @@ export class SpektrumDecoder {
    * 3. two valid frames in a row with consistent headers (a new layout, a rebind).
    */
   #search(o: number, plausible: boolean): number {
-    const view = this.#view;
     const resolution = this.#resolution as Resolution;
     const last = o + MAX_RESYNC_BYTES;
     for (let q = o + 1; q <= last; q++) {

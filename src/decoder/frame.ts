@@ -107,7 +107,8 @@ export function createFrame(): DecodedFrame {
   };
 }
 
-function createVtx(): VtxControl {
+/** A fresh VTX record whose fields the decoder overwrites. */
+export function createVtx(): VtxControl {
   return { raw: 0, band: 0, channel: 0, power: 0, region: 0, pit: false };
 }
 
@@ -163,4 +164,3 @@ export function readSlots(frame: DecodedFrame, b: Uint8Array, o: number, resolut
   return empty;
 }
 
-export { createVtx };

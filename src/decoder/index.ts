@@ -10,7 +10,7 @@ export type {
   DecodedFrame, DecoderEvent, DecoderStats, FormatInfo, HeaderMode, RemoteKind, ResolutionReason, VtxControl,
 } from './types.js';
 export {
-  BAUD_RATE, BYTE_TIME_US, CHANNEL_COUNT, CHANNEL_NAMES, EMPTY_SLOT, FAILSAFE_TIMEOUT_US, FRAME_SIZE,
+  BAUD_RATE, BYTE_TIME_US, CHANNEL_COUNT, CHANNEL_NAMES, channelResolution, EMPTY_SLOT, FAILSAFE_TIMEOUT_US, FRAME_SIZE,
   FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US, PULSE_MAX_US, PULSE_MIN_US, USB_CHUNK_JITTER_US, SYSTEM_DSM2_11MS_2048, SYSTEM_DSM2_22MS_1024, SYSTEM_DSMX_11MS_2048,
   SYSTEM_DSMX_22MS_2048, SYSTEM_TYPES, XPLUS_FIRST, XPLUS_LAST, channelName, servoToMicros, servoToPercent,
   systemInfo, type Resolution, type SystemInfo,

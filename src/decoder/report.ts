@@ -12,7 +12,7 @@
 import type { Capture, CaptureKind, CaptureTiming } from './capture/index.js';
 import { captureChunks, capturePorts } from './capture/index.js';
 import type { LinkEpisode } from './link.js';
-import { BYTE_TIME_US, CHANNEL_COUNT, FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US, XPLUS_FIRST, channelName, servoToMicros, servoToPercent, systemInfo, type Resolution, USB_CHUNK_JITTER_US } from './spec.js';
+import { BYTE_TIME_US, CHANNEL_COUNT, channelResolution, FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US, XPLUS_FIRST, channelName, servoToMicros, servoToPercent, systemInfo, type Resolution, USB_CHUNK_JITTER_US } from './spec.js';
 import { decodeCapture } from './summary.js';
 import type { HeaderMode, RemoteKind, ResolutionReason } from './types.js';
 
@@ -457,7 +457,7 @@ function decodePort(capture: Capture, port: number, resolution: 'auto' | Resolut
     if (f.fades !== null && f.fades !== 0) fadeCounterMoved = true;
     for (let i = 0; i < f.count; i++) {
       const id = f.ids[i] as number;
-      const res: Resolution = id >= XPLUS_FIRST ? 2048 : f.resolution;
+      const res: Resolution = channelResolution(id, f.resolution);
       const pos = f.positions[i] as number;
       const u = servoToMicros(pos, res);
       const p = servoToPercent(pos, res);

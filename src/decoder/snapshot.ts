@@ -1,5 +1,5 @@
 /** Owned copies of frames, for anything that keeps a frame past the next `next()` call. */
-import { servoToMicros } from './spec.js';
+import { channelResolution, servoToMicros } from './spec.js';
 import type { DecodedFrame, RemoteKind, VtxControl } from './types.js';
 import type { Resolution } from './spec.js';
 
@@ -37,8 +37,7 @@ export function copyFrame(frame: DecodedFrame): FrameSnapshot {
   for (let i = 0; i < frame.count; i++) {
     const id = frame.ids[i] as number;
     const pos = frame.positions[i] as number;
-    // X-Plus values are on the 2047 scale whatever the link's resolution (§8.6).
-    channels.push({ id, pos, us: servoToMicros(pos, id >= 12 ? 2048 : frame.resolution) });
+    channels.push({ id, pos, us: servoToMicros(pos, channelResolution(id, frame.resolution)) });
   }
   return {
     index: frame.index, offset: frame.offset, timeUs: frame.timeUs, remote: frame.remote,

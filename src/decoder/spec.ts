@@ -96,6 +96,14 @@ export function channelName(id: number): string {
   return CHANNEL_NAMES[id] ?? `Ch ${id}`;
 }
 
+/**
+ * §8.6: the resolution a channel's position is on. X-Plus values (channels 12–19) are scaled to
+ * the 2047 scale whatever the link's resolution; channels 0–11 follow the link.
+ */
+export function channelResolution(id: number, linkResolution: Resolution): Resolution {
+  return id >= XPLUS_FIRST ? 2048 : linkResolution;
+}
+
 /** §9.1: full range 903–2097 µs; the offset is the pulse width of position 0. */
 export const PULSE_MIN_US = 903;
 export const PULSE_MAX_US = 2097;

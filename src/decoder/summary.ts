@@ -6,7 +6,7 @@ import type { Capture, CaptureIssue } from './capture/index.js';
 import { captureChunks } from './capture/index.js';
 import { SpektrumDecoder, type DecoderOptions } from './decoder.js';
 import { LinkMonitor, type LinkEpisode, type LinkStats } from './link.js';
-import { channelName, CHANNEL_COUNT, servoToMicros, USB_CHUNK_JITTER_US, XPLUS_FIRST } from './spec.js';
+import { channelName, channelResolution, CHANNEL_COUNT, servoToMicros, USB_CHUNK_JITTER_US } from './spec.js';
 import type { DecodedFrame, DecoderStats, FormatInfo } from './types.js';
 
 export interface DecodeCaptureOptions extends DecoderOptions {
@@ -16,12 +16,13 @@ export interface DecodeCaptureOptions extends DecoderOptions {
 
 /**
  * Feeds one port of a capture through a decoder and a link monitor, chunk by chunk with the
- * chunk's recorded time, as live data would arrive. `onFrame` gets each borrowed frame.
+ * chunk's recorded time, as live data would arrive. `onFrame` gets each borrowed frame and the
+ * link monitor, which has already counted it.
  */
 export function decodeCapture(
   capture: Capture,
   options: DecodeCaptureOptions,
-  onFrame: (frame: DecodedFrame) => void,
+  onFrame: (frame: DecodedFrame, link: LinkMonitor) => void,
 ): { decoder: SpektrumDecoder; link: LinkMonitor } {
   const { port = 0, ...decoderOptions } = options;
   const decoder = new SpektrumDecoder(decoderOptions);
@@ -29,7 +30,7 @@ export function decodeCapture(
   const drain = (): void => {
     for (let f = decoder.next(); f !== undefined; f = decoder.next()) {
       link.frame(f);
-      onFrame(f);
+      onFrame(f, link);
     }
   };
   for (const chunk of captureChunks(capture, port)) {
@@ -88,7 +89,7 @@ export function summarizeCapture(capture: Capture, options: DecodeCaptureOptions
     lastUs = f.timeUs;
     for (let i = 0; i < f.count; i++) {
       const id = f.ids[i] as number;
-      const us = servoToMicros(f.positions[i] as number, id >= XPLUS_FIRST ? 2048 : f.resolution);
+      const us = servoToMicros(f.positions[i] as number, channelResolution(id, f.resolution));
       frames[id] = (frames[id] as number) + 1;
       if (us < (min[id] as number)) min[id] = us;
       if (us > (max[id] as number)) max[id] = us;

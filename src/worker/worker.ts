@@ -5,7 +5,7 @@
  * capture being replayed. A source's id is its port number in recordings.
  */
 /// <reference lib="webworker" />
-import { CaptureFormatError, LinkMonitor, USB_CHUNK_JITTER_US, decodeCapture, readCapture, systemInfo, type Capture } from '../decoder/index.js';
+import { CaptureFormatError, USB_CHUNK_JITTER_US, decodeCapture, readCapture, systemInfo, type Capture } from '../decoder/index.js';
 import { Engine } from './engine.js';
 import { runBind } from './bind.js';
 import { REMOTE_LABELS, type BindProgress, type FromWorker, type Overview, type PortIdentity, type SourceKind, type SourceStatus, type ToWorker } from './protocol.js';
@@ -365,12 +365,13 @@ function overviewOf(capture: Capture, ports: readonly number[]): Overview {
   const lost: number[] = [];
   const failsafe: Overview['failsafe'] = [];
   let first = NaN;
-  const jitterUs = replayJitter(capture);
   for (const port of ports) {
-    const link = new LinkMonitor({ jitterUs });
-    decodeCapture(capture, { resolution, port }, (f) => {
-      const missed = link.stats.missedFrames;
-      link.frame(f);
+    // decodeCapture's link monitor has counted each frame before we see it: remember its
+    // missed-frame count from the frame before.
+    let missed = 0;
+    const { link } = decodeCapture(capture, { resolution, port }, (f, monitor) => {
+      const before = missed;
+      missed = monitor.stats.missedFrames;
       if (!Number.isFinite(f.timeUs)) return;
       if (Number.isNaN(first)) first = Math.floor(f.timeUs / BIN_US) * BIN_US;
       const bin = Math.max(0, Math.floor((f.timeUs - first) / BIN_US));
@@ -380,7 +381,7 @@ function overviewOf(capture: Capture, ports: readonly number[]): Overview {
         lost.push(0);
       }
       fades[bin] = (fades[bin] as number) + f.fadesDelta;
-      lost[bin] = (lost[bin] as number) + link.stats.missedFrames - missed;
+      lost[bin] = (lost[bin] as number) + missed - before;
     });
     for (const e of link.episodes) if (e.kind === 'failsafe') failsafe.push({ startUs: e.startUs, endUs: e.endUs ?? e.startUs });
   }

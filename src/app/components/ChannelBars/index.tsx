@@ -5,7 +5,7 @@
  * stops arriving greys out and shows its age.
  */
 import { useEffect, useRef } from 'preact/hooks';
-import { channelName, PULSE_MAX_US, PULSE_MIN_US, servoToMicros, servoToPercent, XPLUS_FIRST } from '../../../decoder/index.js';
+import { channelName, channelResolution, PULSE_MAX_US, PULSE_MIN_US, servoToMicros, servoToPercent } from '../../../decoder/index.js';
 import { onFrame } from '../../frame-loop.js';
 import { current } from '../../store.js';
 import './style.css';
@@ -41,7 +41,7 @@ export function ChannelBars({ ids, label }: { ids: number[]; label: string }) {
       ids.forEach((id, i) => {
         const row = rows[i] as Row;
         const seen = live.seenUs[id] as number;
-        const resolution = id >= XPLUS_FIRST ? 2048 : (live.resolution ?? 2048);
+        const resolution = channelResolution(id, live.resolution ?? 2048);
         const pos = live.positions[id] as number;
         const never = Number.isNaN(seen);
         // Seen in data without times (+Infinity): shown, never stale.
