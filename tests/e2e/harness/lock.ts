@@ -6,7 +6,8 @@ import { join } from 'node:path';
 
 export const LOCK_DIR = '/tmp/satscope-e2e-locks';
 
-function alive(pid: number): boolean {
+/** Whether a process with this id exists (EPERM: it does, owned by someone else). */
+export function alive(pid: number): boolean {
   try {
     process.kill(pid, 0);
     return true;

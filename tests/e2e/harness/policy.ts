@@ -6,7 +6,7 @@
 // owners (pid + origin); owners whose process is gone are dropped on every rewrite.
 import { existsSync, mkdirSync, readdirSync, readFileSync, rmSync, writeFileSync, renameSync } from 'node:fs';
 import { join } from 'node:path';
-import { acquireLock, LOCK_DIR } from './lock.js';
+import { acquireLock, alive, LOCK_DIR } from './lock.js';
 import { ensureReaper } from './reaper.js';
 
 export const POLICY_DIR = '/etc/chromium/policies/managed';
@@ -21,14 +21,6 @@ export interface SerialPolicy {
   remove(): Promise<void>;
 }
 
-function alive(pid: number): boolean {
-  try {
-    process.kill(pid, 0);
-    return true;
-  } catch (e) {
-    return (e as NodeJS.ErrnoException).code === 'EPERM';
-  }
-}
 
 /** Rewrite the policy file from the live owners; delete it when there are none. Sync, no lock. */
 function rewrite(): string[] {
