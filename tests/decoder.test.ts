@@ -108,11 +108,13 @@ describe('internal remote frames', () => {
 
   it('falls back to fades when byte 0 turns positive (RSSI is never positive)', () => {
     const frames: Uint8Array[] = [];
-    for (let i = 0; i < 8; i++) frames.push(dsmxPair(0, 0xb2, i)[i % 2]!.map((b, k) => (k === 0 ? (i < 4 ? 0xc0 + i : i) : b)));
+    // RSSI that wanders (a fall says RSSI), then small positive values: a fade count after all.
+    const b0 = [0xc3, 0xc1, 0xc2, 0xc0, 4, 5, 6, 7];
+    for (let i = 0; i < 8; i++) frames.push(dsmxPair(0, 0xb2, i)[i % 2]!.map((b, k) => (k === 0 ? b0[i]! : b)));
     const decoder = new SpektrumDecoder();
     const out = decodeAll(join(frames), decoder);
     expect(out).toHaveLength(8);
-    expect(out[0]!.rssi).toBe(-64);
+    expect(out[0]!.rssi).toBe(-61);
     expect(out[4]!.fades).toBe(4);
     expect(decoder.format.headerMode).toBe('fades');
   });
@@ -277,15 +279,17 @@ describe('finding frames without a sync byte', () => {
     expect(s.discardedBytes).toBe(5);
   });
 
-  it('emits a frame with a known layout as soon as its 16 bytes are in', () => {
+  it('holds a frame until the next frame starts where it ends, then emits it', () => {
     const decoder = new SpektrumDecoder();
     const stream = dsmxStream(8);
     decoder.push(stream.subarray(0, 224));
     let n = 0;
     while (decoder.next()) n++;
-    decoder.push(stream.subarray(224, 240));
-    expect(decoder.next()?.offset).toBe(224);
-    expect(n).toBe(14);
+    // Frames 0…12 are confirmed; frame 13 (208…223) waits for the next frame's header.
+    expect(n).toBe(13);
+    decoder.push(stream.subarray(224, 226));
+    expect(decoder.next()?.offset).toBe(208);
+    expect(decoder.next()).toBeUndefined();
   });
 
   it('reuses one frame object (a borrowed view) for every frame', () => {

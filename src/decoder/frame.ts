@@ -33,15 +33,15 @@ export function isVtxFrame(b: Uint8Array, o: number): boolean {
 /**
  * The frame's slot layout under `resolution`: a small integer naming which channel ID each
  * slot holds (X-Plus, empty and VTX slots as codes of their own) plus the first slot's phase
- * bit, or `INVALID` when a slot holds an impossible ID, an ID repeats, or no slot carries a
- * channel. Frames of one transmitter repeat a few layouts, so a known layout is strong evidence
+ * bit, or `INVALID` when a slot holds an impossible ID or an ID repeats. A frame of seven
+ * empty slots is valid: a receiver sends it, and reading it as anything else (its next frame's
+ * header as a slot) invents a channel. Frames of one transmitter repeat a few layouts, so a known layout is strong evidence
  * that the decoder is aligned.
  */
 export function slotLayout(b: Uint8Array, o: number, resolution: Resolution): number {
   const vtx = isVtxFrame(b, o);
   const slots = vtx ? SLOTS_PER_FRAME - 2 : SLOTS_PER_FRAME;
   let seen = 0;
-  let channels = 0;
   let layout = 0;
   for (let i = 0; i < slots; i++) {
     const word = ((b[o + 2 + 2 * i] as number) << 8) | (b[o + 3 + 2 * i] as number);
@@ -71,11 +71,9 @@ export function slotLayout(b: Uint8Array, o: number, resolution: Resolution): nu
     const bit = 1 << channel;
     if ((seen & bit) !== 0) return INVALID;
     seen |= bit;
-    channels++;
     layout |= code << (CODE_BITS * i);
   }
   if (vtx) layout |= (CODE_VTX << (CODE_BITS * 5)) | (CODE_VTX << (CODE_BITS * 6));
-  else if (channels === 0) return INVALID;
   if (((b[o + 2] as number) & 0x80) !== 0) layout |= LAYOUT_PHASE_BIT;
   return layout;
 }

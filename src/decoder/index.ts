@@ -7,7 +7,7 @@ export { LinkMonitor, type LinkEpisode, type LinkOptions, type LinkState, type L
 export { copyFrame, type ChannelValue, type FrameSnapshot } from './snapshot.js';
 export { decodeStream, type TimedChunk } from './stream.js';
 export type {
-  DecodedFrame, DecoderEvent, DecoderStats, FormatInfo, HeaderMode, RemoteKind, ResolutionReason, VtxControl,
+  DecodedFrame, DecoderEvent, DecoderStats, FormatInfo, HeaderMode, HeaderReading, RemoteKind, ResolutionReason, VtxControl,
 } from './types.js';
 export {
   BAUD_RATE, BYTE_TIME_US, CHANNEL_COUNT, CHANNEL_NAMES, channelResolution, EMPTY_SLOT, FAILSAFE_TIMEOUT_US, FRAME_SIZE,

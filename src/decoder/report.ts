@@ -14,7 +14,7 @@ import { captureChunks, capturePorts } from './capture/index.js';
 import type { LinkEpisode } from './link.js';
 import { BYTE_TIME_US, CHANNEL_COUNT, channelResolution, FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US, XPLUS_FIRST, channelName, servoToMicros, servoToPercent, systemInfo, type Resolution, USB_CHUNK_JITTER_US } from './spec.js';
 import { decodeCapture } from './summary.js';
-import type { HeaderMode, RemoteKind, ResolutionReason } from './types.js';
+import type { HeaderReading, RemoteKind, ResolutionReason } from './types.js';
 
 // ---------------------------------------------------------------------------------------------
 // Thresholds
@@ -253,7 +253,7 @@ export interface RemoteReport {
   system: { byte: number | null; name: string | null; valid: boolean };
   remote: RemoteKind | null;
   /** What byte 0 carries: fades or SPM4649T RSSI. */
-  headerMode: HeaderMode;
+  headerMode: HeaderReading;
   /** The resolution used, why (the decoder's reason code) and a sentence saying so. */
   resolution: { value: Resolution | null; reason: ResolutionReason; explanation: string };
   firstFrameUs: number | null;

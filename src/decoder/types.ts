@@ -6,6 +6,13 @@ export type RemoteKind = 'internal' | 'external';
 export type HeaderMode = 'fades' | 'rssi';
 
 /**
+ * How the decoder reads byte 0 of the remote it is locked on: a header mode, or 'unknown' while
+ * an internal remote's byte 0 has stayed ≥ 0x80 without falling (fades above 127 and SPM4649T
+ * RSSI look alike until one rises past 255 or the other falls).
+ */
+export type HeaderReading = HeaderMode | 'unknown';
+
+/**
  * Spektrum VTX control carried in the last two slots (bytes 12–15) instead of channels.
  * Fields follow the layout PX4 and Betaflight read.
  */
@@ -91,9 +98,17 @@ export interface FormatInfo {
   /** A sentence a person can read: what was decided from what. */
   explanation: string;
   remote: RemoteKind | null;
-  /** The system byte the internal remote sends, if valid. */
+  /** The system byte the internal remote sends (valid or not; see `systemValid`), `null` for an external remote. */
   system: number | null;
-  headerMode: HeaderMode;
+  /** Whether `system` is one of the four values of §8.3 (others are ignored: the resolution then comes from the channel IDs). */
+  systemValid: boolean;
+  /** What byte 0 carries; 'unknown' while the evidence cannot tell fades from RSSI (frames then carry neither). */
+  headerMode: HeaderReading;
+  /**
+   * Set while the resolution is forced and no frame fits it, but frames fit this other
+   * resolution: nothing is decoded, and that is a setting, not link loss.
+   */
+  forcedMismatch: Resolution | null;
 }
 
 /** Counters. Every byte pushed ends up in exactly one of `frameBytes`, `discardedBytes` or `pendingBytes`. */
@@ -113,6 +128,8 @@ export interface DecoderStats {
   emptySlots: number;
   /** Frames that carried VTX control. */
   vtxFrames: number;
+  /** Fade counts that jumped in a way the decoder could not attribute to the receiver (not counted as fades). */
+  fadeJumps: number;
 }
 
 /** Something the decoder did that an inspector or log may want to show. */
@@ -120,4 +137,9 @@ export type DecoderEvent =
   | { type: 'locked'; offset: number; format: FormatInfo }
   | { type: 'discarded'; offset: number; length: number; reason: 'before-lock' | 'noise' | 'truncated-frame' | 'end-of-stream' }
   | { type: 'resync'; offset: number }
-  | { type: 'format-changed'; offset: number; format: FormatInfo };
+  | { type: 'format-changed'; offset: number; format: FormatInfo }
+  /**
+   * The fade count jumped across a break in the stream from `from` to `to`. `counted`: it is the
+   * same remote's own count going on (it is in `fadesDelta`); otherwise it counts nothing.
+   */
+  | { type: 'fade-jump'; offset: number; from: number; to: number; counted: boolean };
