@@ -346,7 +346,7 @@ export class SpektrumDecoder {
       // The frame at o does not continue the stream (or the next one does not continue it).
       const q = this.#search(o + 1, o + MAX_RESYNC_BYTES);
       if (q === NEED_MORE) return undefined;
-      if (fits && this.#knownLayout(layout) && (q === NOT_FOUND || q >= o + FRAME_SIZE)) {
+      if (fits && this.#knownLayout(layout) && (q === NOT_FOUND || q >= o + FRAME_SIZE) && this.#aloneOk(o)) {
         // This frame is whole; the damage is in what follows it.
         return this.#emit(o, layout);
       }
@@ -403,9 +403,21 @@ export class SpektrumDecoder {
         return pending === NOT_FOUND ? q : pending;
       }
       if (slotLayout(buf, q + FRAME_SIZE, resolution) !== INVALID && this.#follows(q, q + FRAME_SIZE)) return q;
-      if (pending === NOT_FOUND) pending = q;
+      if (pending === NOT_FOUND && this.#aloneOk(q)) pending = q;
     }
     return NOT_FOUND;
+  }
+
+  /**
+   * Whether the frame at `o`, which continues the last frame but is not continued by the next,
+   * may stand alone: the next frame must be damaged (invalid) or start something new. A valid
+   * next frame that continues the last frame says the header at `o` is the foreign one (bytes
+   * lost across a frame boundary: one frame's last byte read as the next one's fade count).
+   */
+  #aloneOk(o: number): boolean {
+    const next = o + FRAME_SIZE;
+    if (next + FRAME_SIZE > this.#tail || !this.#haveLast) return true;
+    return slotLayout(this.#buf, next, this.#resolution as Resolution) === INVALID || !this.#fitsLast(next);
   }
 
   /** Discards the bytes from `o` up to `q`, where frames continue. */
