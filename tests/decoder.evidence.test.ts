@@ -79,13 +79,13 @@ describe('fade counts', () => {
   });
 
   it('reports a fade count that falls as a jump and counts nothing', () => {
-    const before = Array.from({ length: 12 }, (_, i) => external(i, 200));
+    const before = Array.from({ length: 12 }, (_, i) => external(i, 500));
     const after = Array.from({ length: 12 }, (_, i) => external(12 + i, 3));
     const { frames, decoder, events } = decodeAll(join([...before, ...after]));
     expect(frames).toHaveLength(24);
     expect(frames.reduce((s, f) => s + f.fadesDelta, 0)).toBe(0);
     expect(decoder.stats.fadeJumps).toBe(1);
-    expect(events.filter((e) => e.type === 'fade-jump')).toEqual([{ type: 'fade-jump', offset: 192, from: 200, to: 3, counted: false }]);
+    expect(events.filter((e) => e.type === 'fade-jump')).toEqual([{ type: 'fade-jump', offset: 192, from: 500, to: 3, counted: false }]);
   });
 });
 
@@ -112,12 +112,26 @@ describe('remote kind and system byte', () => {
     expect(decoder.format.resolutionReason).toBe('system-byte');
   });
 
-  it('reads 03 55 as 3 fades under an ignored system byte, never as 853 fades', () => {
-    const { frames, decoder } = decodeAll(join(Array.from({ length: 12 }, (_, i) => internal(i, 3, 0x55))));
-    expect(frames.map((f) => [f.remote, f.fades])).toEqual(Array(12).fill(['internal', 3]));
+  it('reads 03 55 after B2 frames as 3 fades under an ignored system byte, never as 853 fades', () => {
+    const frames = [...Array.from({ length: 6 }, (_, i) => internal(i, 3)), ...Array.from({ length: 12 }, (_, i) => internal(6 + i, 3, 0x55))];
+    const { frames: out, decoder } = decodeAll(join(frames));
+    expect(out.map((f) => [f.remote, f.fades])).toEqual(Array(18).fill(['internal', 3]));
     expect(decoder.format.systemValid).toBe(false);
     expect(decoder.format.resolutionReason).toBe('channel-ids');
     expect(decoder.format.explanation).toMatch(/0x55 is none of the four in §8\.3: ignored/);
+  });
+
+  it('after an internal remote, reads an external count above 255 as an ignored system byte until the count moves', () => {
+    const frames = [...Array.from({ length: 8 }, (_, i) => internal(i, 3)), ...Array.from({ length: 16 }, (_, i) => external(8 + i, 300 + (i >> 3)))];
+    const { frames: out } = decodeAll(join(frames));
+    expect(out.slice(8, 16).every((f) => f.remote === 'internal' && f.system === 300 % 256 && f.fades === 1)).toBe(true);
+    // The count moves at frame 16 (byte 1 changes): from there on it is the external remote it is.
+    expect(out.slice(-6).map((f) => [f.remote, f.fades])).toEqual(Array(6).fill(['external', 301]));
+  });
+
+  it('reads an external fade count above 255 as a count, though its low byte stays still between fades', () => {
+    const { frames } = decodeAll(join(Array.from({ length: 12 }, (_, i) => external(i, 300 + (i >> 2)))));
+    expect(frames.map((f) => [f.remote, f.fades])).toEqual(Array.from({ length: 12 }, (_, i) => ['external', 300 + (i >> 2)]));
   });
 });
 

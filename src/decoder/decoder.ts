@@ -12,10 +12,10 @@
  *   Contiguous channel sets, layouts that recur every other frame and a system byte that agrees
  *   with the resolution score higher. The winning chain is emitted as it stands.
  * - Locked, a frame is emitted when it continues the last one (same model, fade count risen by
- *   less than FADE_STEP), its slot layout is one the transmitter has used, and the next frame's
- *   header continues it: at most one frame period of latency. A frame whose slot layout is new
- *   needs the whole next frame, and must not overlap a frame that continues the stream (the
- *   front of one frame glued to the back of the next after lost bytes reads as a new layout).
+ *   less than FADE_STEP) and the whole next frame is valid and continues it: one frame period
+ *   of latency. A frame whose slot layout is new must also not overlap a frame that continues
+ *   the stream (the front of one frame glued to the back of the next after lost bytes reads as
+ *   a new layout).
  * - A frame that fails starts a search for the nearest offset where a known layout continues the
  *   stream; what lies between is discarded and counted. Where nothing continues (a rebind, a
  *   system byte that changed, a fade count that jumped, another satellite) it acquires afresh.
@@ -43,10 +43,10 @@ export interface DecoderOptions {
   onEvent?: (event: DecoderEvent) => void;
 }
 
-/** §8.3, §8.4: the two header bytes (system and fades, or a UINT16 fade count). */
-const HEADER_SIZE = 2;
 /** Frames looked at before a lock. */
 const ACQUIRE_FRAMES = 4;
+/** Fewest of them that must chain for a lock: two frames that happen to parse are common. */
+const MIN_CHAIN = 3;
 /**
  * Start offsets compared before locking. A damaged frame can hide the real alignment's first
  * start while a shifted reading that happens to parse starts earlier; the real start lies at
@@ -65,10 +65,17 @@ const ACQUIRE_COMMIT = 2 * FRAME_SIZE;
 const HEADER_EVIDENCE_FRAMES = 8;
 /**
  * The largest rise of a fade counter between two consecutive frames that continues the chain
- * (≈ 0.35 s of lost frames at 11 ms). A larger rise, or any fall that is not a wrap, breaks the
+ * (≈ 90 ms of lost frames at 11 ms; an external count that lands on a §8.3 system byte, 0x12
+ * say, is then more likely an internal remote taking over). A larger rise, or any fall that is not a wrap, breaks the
  * chain: the decoder acquires again and reports the jump (`fade-jump`).
  */
-const FADE_STEP = 32;
+const FADE_STEP = 8;
+/**
+ * The rise a fade count may take between the frames of a chain that acquisition confirms (and
+ * emits as it stands): counts rarely move from one frame to the next, while a frame glued from
+ * two (a foreign byte read as its fade count) moves them anywhere.
+ */
+const ACQUIRE_FADE_STEP = 3;
 /** How far a locked decoder searches for a frame that continues the stream before it acquires afresh. */
 const MAX_RESYNC_BYTES = 8 * FRAME_SIZE;
 /** Slot layouts remembered (a transmitter uses two to four). */
@@ -93,17 +100,19 @@ function plausibleRssi(byte: number): boolean {
 }
 
 /** Whether byte 0 of an internal remote can go from `prev` to `next` between consecutive frames. */
-function byte0Follows(prev: number, next: number, mode: number): boolean {
+function byte0Follows(prev: number, next: number, mode: number, step = FADE_STEP): boolean {
   if (mode === B0_RSSI_FORCED) return true;
-  const rise = ((next - prev) & 0xff) < FADE_STEP;
+  // Acquisition's tight step allows no wrap: 0xFF, an empty slot's byte, read as a fade count
+  // would otherwise "wrap" to the next frame's 0.
+  const rise = step === ACQUIRE_FADE_STEP ? next >= prev && next - prev < step : ((next - prev) & 0xff) < step;
   if (mode === B0_FADES) return rise;
   if (mode === B0_RSSI) return plausibleRssi(next);
   return rise || (plausibleRssi(prev) && plausibleRssi(next));
 }
 
 /** Whether an external remote's UINT16 fade count can go from `prev` to `next` between consecutive frames. */
-function countFollows(prev: number, next: number): boolean {
-  return ((next - prev) & 0xffff) < FADE_STEP;
+function countFollows(prev: number, next: number, step = FADE_STEP): boolean {
+  return step === ACQUIRE_FADE_STEP ? next >= prev && next - prev < step : ((next - prev) & 0xffff) < step;
 }
 
 export class SpektrumDecoder {
@@ -149,7 +158,11 @@ export class SpektrumDecoder {
   #haveLast = false;
   /** Whether a fade jump at the first frame after a lock is the receiver's own count (same remote, known layouts). */
   #jumpTrusted = false;
+  /** The layout of the frame at stream offset #nextAt, read while confirming the one before it. */
+  #nextAt = -1;
+  #nextLayout = INVALID;
   #layouts = new Int32Array(LAYOUT_MEMORY);
+
   #layoutCount = 0;
   #layoutNext = 0;
 
@@ -164,6 +177,9 @@ export class SpektrumDecoder {
   #candInternal = false;
   #candSystem = 0;
   #candB0 = B0_FADES;
+  #candFrames = 0;
+  /** Index in the chain of a frame with a damaged header, skipped over (not confirmed), or -1. */
+  #candSkipped = -1;
   /** Who fixed the resolution, when it is fixed. */
   #fixedBy: 'user' | 'internal-remote' = 'user';
 
@@ -266,6 +282,7 @@ export class SpektrumDecoder {
     this.#ended = false;
     this.#locked = this.#everLocked = false;
     this.#confirmedUntil = 0;
+    this.#nextAt = -1;
     this.#resolution = null;
     this.#reason = 'unknown';
     this.#remote = this.#system = null;
@@ -318,36 +335,52 @@ export class SpektrumDecoder {
         return undefined;
       }
       const resolution = this.#resolution as Resolution;
-      const layout = slotLayout(this.#buf, o, resolution);
+      const at = this.#base + o;
+      const layout = at === this.#nextAt ? this.#nextLayout : slotLayout(this.#buf, o, resolution);
       // Frames acquisition confirmed go out as they stand.
-      if (this.#base + o < this.#confirmedUntil && layout !== INVALID) return this.#emit(o, layout);
+      if (at < this.#confirmedUntil && layout !== INVALID) return this.#emit(o, layout);
       const fits = layout !== INVALID && this.#fitsLast(o);
       if (fits) {
-        const known = this.#knownLayout(layout);
-        // A known layout needs the next frame's header to continue it; a new one the whole next frame.
-        if (avail < (known ? FRAME_SIZE + HEADER_SIZE : 2 * FRAME_SIZE)) {
+        // The whole next frame must be in: a header alone is too weak (`00 00` read one byte
+        // late is `00 0c`, a count that rose by 12).
+        if (avail < 2 * FRAME_SIZE) {
           if (!this.#ended) return undefined;
-          if (known) return this.#emit(o, layout);
+          // The stream's last frame: whole when the stream ends with it, or when what is left
+          // after it starts with a header that continues it (a truncated last frame).
+          if (this.#knownLayout(layout) && (avail === FRAME_SIZE || (avail >= FRAME_SIZE + 2 && this.#standsAlone(o, layout, o + FRAME_SIZE)))) {
+            return this.#emit(o, layout);
+          }
           this.#discard(o, avail, 'end-of-stream');
           return undefined;
         }
-        if (this.#follows(o, o + FRAME_SIZE)) {
-          if (known) return this.#emit(o, layout);
-          if (slotLayout(this.#buf, o + FRAME_SIZE, resolution) !== INVALID) {
-            // A new layout: make sure no frame that continues the stream starts inside this one.
-            const q = this.#search(o + 1, o + FRAME_SIZE - 1);
-            if (q === NEED_MORE) return undefined;
-            if (q === NOT_FOUND) return this.#emit(o, layout);
-            this.#resync(o, q);
-            continue;
-          }
+        const next = slotLayout(this.#buf, o + FRAME_SIZE, resolution);
+        this.#nextAt = at + FRAME_SIZE;
+        this.#nextLayout = next;
+        if (next !== INVALID && this.#follows(o, o + FRAME_SIZE)) {
+          if (this.#knownLayout(layout)) return this.#emit(o, layout);
+          // A new layout: make sure no frame that continues the stream starts inside this one.
+          const q = this.#search(o + 1, o + FRAME_SIZE - 1);
+          if (q === NEED_MORE) return undefined;
+          if (q === NOT_FOUND) return this.#emit(o, layout);
+          this.#resync(o, q);
+          continue;
+        }
+      }
+      if (!fits && layout !== INVALID && this.#countJumped(o, layout)) {
+        // The same remote goes on after lost frames (its fade count jumped): no frame that
+        // continues the old count starts inside this one.
+        const q = this.#search(o + 1, o + FRAME_SIZE - 1);
+        if (q === NEED_MORE) return undefined;
+        if (q === NOT_FOUND) {
+          this.#jumpTrusted = true;
+          return this.#emit(o, layout);
         }
       }
       // The frame at o does not continue the stream (or the next one does not continue it).
       const q = this.#search(o + 1, o + MAX_RESYNC_BYTES);
       if (q === NEED_MORE) return undefined;
-      if (fits && this.#knownLayout(layout) && (q === NOT_FOUND || q >= o + FRAME_SIZE) && this.#aloneOk(o)) {
-        // This frame is whole; the damage is in what follows it.
+      if (fits && (q === NOT_FOUND ? this.#lastOfItsKind(o, layout) : this.#standsAlone(o, layout, q))) {
+        // This frame is whole: what follows it up to q is noise, or something new starts after it.
         return this.#emit(o, layout);
       }
       if (q !== NOT_FOUND) {
@@ -384,40 +417,78 @@ export class SpektrumDecoder {
   }
 
   /**
+   * Whether the frame at `o` is the same internal remote going on with a fade count that jumped:
+   * a known layout, its own system byte, and a whole next frame that continues it.
+   */
+  #countJumped(o: number, layout: number): boolean {
+    const buf = this.#buf;
+    // An external count has no system byte to vouch for it: a jump there may be an internal
+    // remote taking over (`00 00` then `00 B2`), which acquisition decides.
+    if (this.#remote !== 'internal' || !this.#knownLayout(layout) || o + 2 * FRAME_SIZE > this.#tail) return false;
+    if (buf[o + 1] !== this.#system || (this.#b0Mode === B0_RSSI && !plausibleRssi(buf[o] as number))) return false;
+    return slotLayout(buf, o + FRAME_SIZE, this.#resolution as Resolution) !== INVALID && this.#follows(o, o + FRAME_SIZE);
+  }
+
+  /**
    * The nearest offset in [from, to] where frames continue: a frame with a known layout that
-   * continues the stream, confirmed by the frame after it, or, when that next frame is damaged,
-   * one that no confirmed frame overlaps. NOT_FOUND, or NEED_MORE when the answer depends on
-   * bytes that have not arrived.
+   * continues the stream, confirmed by the frame after it; or, before that one, a frame that
+   * stands alone (see #standsAlone). NOT_FOUND, or NEED_MORE when the answer depends on bytes
+   * that have not arrived.
    */
   #search(from: number, to: number): number {
     const resolution = this.#resolution as Resolution;
     const buf = this.#buf;
-    let pending = NOT_FOUND;
-    for (let q = from; q <= to || pending !== NOT_FOUND; q++) {
-      if (pending !== NOT_FOUND && q >= pending + FRAME_SIZE) return pending;
-      if (q + FRAME_SIZE > this.#tail) return this.#ended ? pending : NEED_MORE;
+    let alone = NOT_FOUND;
+    let aloneLayout = INVALID;
+    for (let q = from; q <= to; q++) {
+      if (q + 2 * FRAME_SIZE > this.#tail) return this.#ended ? NOT_FOUND : NEED_MORE;
       const layout = slotLayout(buf, q, resolution);
       if (layout === INVALID || !this.#fitsLast(q) || !this.#knownLayout(layout)) continue;
-      if (q + 2 * FRAME_SIZE > this.#tail) {
-        if (!this.#ended) return NEED_MORE;
-        return pending === NOT_FOUND ? q : pending;
+      if (slotLayout(buf, q + FRAME_SIZE, resolution) !== INVALID && this.#follows(q, q + FRAME_SIZE)) {
+        return alone !== NOT_FOUND && this.#standsAlone(alone, aloneLayout, q) ? alone : q;
       }
-      if (slotLayout(buf, q + FRAME_SIZE, resolution) !== INVALID && this.#follows(q, q + FRAME_SIZE)) return q;
-      if (pending === NOT_FOUND && this.#aloneOk(q)) pending = q;
+      if (alone === NOT_FOUND) {
+        alone = q;
+        aloneLayout = layout;
+      }
     }
     return NOT_FOUND;
   }
 
   /**
-   * Whether the frame at `o`, which continues the last frame but is not continued by the next,
-   * may stand alone: the next frame must be damaged (invalid) or start something new. A valid
-   * next frame that continues the last frame says the header at `o` is the foreign one (bytes
-   * lost across a frame boundary: one frame's last byte read as the next one's fade count).
+   * Whether the frame at `o`, which continues the last frame but is not continued by a valid next
+   * frame, is whole, with frames going on at `q`. Bytes lost or added inside `o` can leave a
+   * frame that reads as whole (its front glued to another's back, a stray byte in its last
+   * slot), and no rule on content tells that from noise after a whole frame; so it stands alone
+   * only when the next frame's header sits where `o` ends and continues it (that frame is the
+   * truncated one), and only an internal remote's system byte and fade byte are strong enough
+   * to say so. Otherwise it is dropped with the damage (the frame beside damage may go).
    */
-  #aloneOk(o: number): boolean {
-    const next = o + FRAME_SIZE;
-    if (next + FRAME_SIZE > this.#tail || !this.#haveLast) return true;
-    return slotLayout(this.#buf, next, this.#resolution as Resolution) === INVALID || !this.#fitsLast(next);
+  #standsAlone(o: number, layout: number, q: number): boolean {
+    if (q < o + FRAME_SIZE || !this.#knownLayout(layout)) return false;
+    const buf = this.#buf;
+    const n = o + FRAME_SIZE;
+    // An external count (often `00 00`) is too weak a header to stand on: zero bytes abound in slots.
+    return this.#remote === 'internal' && buf[n + 1] === this.#system && byte0Follows(buf[o] as number, buf[n] as number, this.#b0Mode);
+  }
+
+  /**
+   * Whether the frame at `o` may be the last of the stream's current kind (nothing within reach
+   * continues it): its layout is known and a new kind of stream starts right where it ends
+   * (two valid frames at any resolution whose headers continue each other), so that nothing
+   * was lost inside it.
+   */
+  #lastOfItsKind(o: number, layout: number): boolean {
+    if (!this.#knownLayout(layout)) return false;
+    const buf = this.#buf;
+    const a = o + FRAME_SIZE;
+    const b = a + FRAME_SIZE;
+    if (b + FRAME_SIZE > this.#tail) return false;
+    if (this.#haveLast && slotLayout(buf, a, this.#resolution as Resolution) !== INVALID && this.#fitsLast(a)) return false;
+    const valid = (f: number) => slotLayout(buf, f, 2048) !== INVALID || slotLayout(buf, f, 1024) !== INVALID;
+    if (!valid(a) || !valid(b)) return false;
+    return buf[a + 1] === buf[b + 1] ||
+      countFollows(((buf[a] as number) << 8) | (buf[a + 1] as number), ((buf[b] as number) << 8) | (buf[b + 1] as number));
   }
 
   /** Discards the bytes from `o` up to `q`, where frames continue. */
@@ -431,6 +502,7 @@ export class SpektrumDecoder {
   #unlock(): void {
     this.#locked = false;
     this.#confirmedUntil = 0;
+    this.#nextAt = -1;
   }
 
   #knownLayout(layout: number): boolean {
@@ -554,23 +626,33 @@ export class SpektrumDecoder {
       this.#discard(p, Math.min(FRAME_SIZE, avail), lost);
       return true;
     }
-    const o = p + best.shift;
+    let o = p + best.shift;
     const resolution = best.resolution;
     // Score again to leave the winner's header reading in the scratch fields.
-    const frames = Math.min(ACQUIRE_FRAMES, Math.floor((avail - best.shift) / FRAME_SIZE));
-    this.#score(o, resolution, frames);
+    this.#score(o, resolution, Math.min(ACQUIRE_FRAMES, Math.floor((avail - best.shift) / FRAME_SIZE)));
+    let frames = this.#candFrames;
+    let skipped = this.#candSkipped;
     const internal = this.#candInternal;
     const system = this.#candSystem;
+    // A start that scored best can be a frame late (its chain's layouts recur better): take in
+    // the frames before it that the chain continues from.
+    while (o - FRAME_SIZE >= p && this.#chainsInto(o - FRAME_SIZE, o, resolution, internal, system)) {
+      o -= FRAME_SIZE;
+      frames++;
+      if (skipped >= 0) skipped++;
+    }
+    const sameRemote = this.#haveLast && this.#remote === (internal ? 'internal' : 'external') &&
+      (internal ? this.#system === system : true) && this.#resolution === resolution;
     let b0Mode = this.#candB0;
+    // The same remote going on keeps what its byte 0 was shown to be, if byte 0 goes on too.
+    if (internal && b0Mode === B0_UNKNOWN && sameRemote && byte0Follows(this.#last0, this.#buf[o] as number, this.#b0Mode)) b0Mode = this.#b0Mode;
     if (internal && b0Mode === B0_UNKNOWN) {
       // Byte 0 has only been a plausible RSSI and never fallen: read further along the chain before deciding.
       const evidence = this.#byte0Evidence(o, resolution, system);
       if (evidence === NEED_MORE) return false;
       b0Mode = evidence;
     }
-    if (best.shift > 0) this.#discard(p, best.shift, lost);
-    const sameRemote = this.#haveLast && this.#remote === (internal ? 'internal' : 'external') &&
-      (internal ? this.#system === system : true) && this.#resolution === resolution;
+    if (o > p) this.#discard(p, o - p, lost);
     if (this.#resolution !== resolution) this.#layoutCount = 0;
     // A count that jumped across the break is the receiver's own when the same remote goes on
     // with layouts it used before (a shifted reading of the stream makes layouts of its own).
@@ -579,9 +661,13 @@ export class SpektrumDecoder {
     const changed = this.#everLocked && (this.#remote !== (internal ? 'internal' : 'external') || this.#system !== (internal ? system : null) ||
       this.#resolution !== resolution);
     this.#locked = true;
+    this.#nextAt = -1;
     this.#everLocked = true;
     this.#forcedMismatch = null;
-    this.#confirmedUntil = this.#base + o + frames * FRAME_SIZE;
+    // Each frame of the chain is confirmed by the one after it; the last waits for its own next
+    // (or the stream's end) like any other, and so does a frame with a damaged header.
+    const confirmed = skipped >= 0 ? skipped : frames - (this.#ended && o + frames * FRAME_SIZE >= this.#tail - FRAME_SIZE ? 0 : 1);
+    this.#confirmedUntil = this.#base + o + confirmed * FRAME_SIZE;
     this.#resolution = resolution;
     this.#remote = internal ? 'internal' : 'external';
     this.#system = internal ? system : null;
@@ -590,6 +676,17 @@ export class SpektrumDecoder {
     this.#event({ type: 'locked', offset: this.#base + o, format: this.format });
     if (changed) this.#event({ type: 'format-changed', offset: this.#base + o, format: this.format });
     return true;
+  }
+
+  /** Whether the frame at `a` is valid and its header continues into frame `b`'s as acquisition chains them. */
+  #chainsInto(a: number, b: number, resolution: Resolution, internal: boolean, system: number): boolean {
+    const buf = this.#buf;
+    if (slotLayout(buf, a, resolution) === INVALID) return false;
+    if (internal) {
+      const mode = this.#options.headerMode === 'rssi' ? B0_RSSI_FORCED : this.#options.headerMode === 'fades' ? B0_FADES : B0_UNKNOWN;
+      return buf[a + 1] === system && buf[b + 1] === system && byte0Follows(buf[a] as number, buf[b] as number, mode, ACQUIRE_FADE_STEP);
+    }
+    return countFollows(((buf[a] as number) << 8) | (buf[a + 1] as number), ((buf[b] as number) << 8) | (buf[b + 1] as number), ACQUIRE_FADE_STEP);
   }
 
   /** The best-scoring start among the next ACQUIRE_SHIFTS offsets, at one resolution or (0) both. */
@@ -630,7 +727,7 @@ export class SpektrumDecoder {
       const f = o + k * FRAME_SIZE;
       if (f + FRAME_SIZE > this.#tail) return this.#ended ? B0_UNKNOWN : NEED_MORE;
       const b0 = buf[f] as number;
-      if (buf[f + 1] !== system || slotLayout(buf, f, resolution) === INVALID || !byte0Follows(prev, b0, B0_UNKNOWN)) return B0_UNKNOWN;
+      if (buf[f + 1] !== system || slotLayout(buf, f, resolution) === INVALID || !byte0Follows(prev, b0, B0_UNKNOWN, ACQUIRE_FADE_STEP)) return B0_UNKNOWN;
       if (!plausibleRssi(b0)) return B0_FADES;
       if (b0 < prev) return B0_RSSI;
       prev = b0;
@@ -639,72 +736,111 @@ export class SpektrumDecoder {
   }
 
   /**
-   * How well `frames` frames at `o` read as consecutive frames of one remote at `resolution`;
-   * -1 when any frame is invalid or the headers do not form one remote's chain. Leaves the
-   * header reading in #candInternal / #candSystem / #candB0.
+   * How well the frames at `o` (up to `frames`) read as consecutive frames of one remote at
+   * `resolution`; -1 when fewer than MIN_CHAIN do. The chain ends at the first invalid frame or header
+   * that does not continue it (a damaged frame ahead shortens it, and a shorter chain scores
+   * less). Leaves the reading in #candInternal / #candSystem / #candB0 and its length in
+   * #candFrames.
    */
   #score(o: number, resolution: Resolution, frames: number): number {
     const buf = this.#buf;
     const { remote, headerMode } = this.#options;
     const s = buf[o + 1] as number;
-    const first0 = buf[o] as number;
     const forcedB0 = headerMode === 'rssi' ? B0_RSSI_FORCED : headerMode === 'fades' ? B0_FADES : B0_UNKNOWN;
-    let internal = remote !== 'external';
-    let external = remote !== 'internal';
-    let positive = !plausibleRssi(first0);
+    // How far each header reading carries the chain.
+    let chainI = remote === 'external' ? 0 : frames;
+    let chainE = remote === 'internal' ? 0 : frames;
+    let zeroByte0 = false;
+    const info = systemInfo(s);
+    // Under a §8.3 system byte, one frame inside the chain may have a damaged header (a flipped
+    // bit): it is skipped over, not confirmed, and costs score.
+    let damaged = -1;
+    let good = o;
+    for (let k = 0; k < frames; k++) {
+      const f = o + k * FRAME_SIZE;
+      if (buf[f] === 0) zeroByte0 = true;
+      if (slotLayout(buf, f, resolution) === INVALID) {
+        chainI = Math.min(chainI, k);
+        chainE = Math.min(chainE, k);
+        break;
+      }
+      if (k === 0) continue;
+      const p = f - FRAME_SIZE;
+      if (chainI > k) {
+        if (buf[f + 1] === s && byte0Follows(buf[good] as number, buf[f] as number, forcedB0, ACQUIRE_FADE_STEP)) good = f;
+        else if (damaged < 0 && info !== undefined && k < frames - 1) damaged = k;
+        else chainI = k;
+      }
+      if (chainE > k && !countFollows(((buf[p] as number) << 8) | (buf[p + 1] as number), ((buf[f] as number) << 8) | (buf[f + 1] as number), ACQUIRE_FADE_STEP)) chainE = k;
+      if (chainI <= k && chainE <= k) break;
+    }
+    // A skipped frame counts only when good frames follow it.
+    if (damaged >= 0 && chainI <= damaged + 1) chainI = Math.min(chainI, damaged);
+    // Both readings hold as far: §8.3 names four system bytes. Any other byte 1 is an external
+    // fade count (one above 255 keeps byte 1 still between fades), unless this stream's remote
+    // was internal and byte 0 is never zero (`03 55`): then it is a system byte to ignore
+    // (§8.3). `00 xx` is a count below 256, the header of an external remote (or a clone).
+    // A header that continues the last one as a rising count is that count moving, though.
+    const countGoesOn = this.#haveLast && countFollows((this.#last0 << 8) | this.#last1, ((buf[o] as number) << 8) | s) &&
+      ((buf[o] as number) << 8 | s) !== ((this.#last0 << 8) | this.#last1);
+    const preferInternal = remote === 'internal' || info !== undefined || (s !== 0 && !zeroByte0 && !countGoesOn && this.#remote === 'internal');
+    const internal = chainI > chainE || (chainI === chainE && preferInternal);
+    const length = internal ? chainI : chainE;
+    const skipped = internal && damaged >= 0 && damaged < length ? damaged : -1;
+    // Where the stream ends too: fewer frames are no evidence (its last frames may go). An
+    // unlisted system byte (read as one only after an internal remote) needs a full window.
+    if (length < (internal && info === undefined ? ACQUIRE_FRAMES : MIN_CHAIN)) return -1;
+    if (internal && info !== undefined && info.resolution !== resolution && this.#options.resolution === 'auto') {
+      // Contradict a §8.3 system byte only where its resolution cannot read the frames.
+      let readable = 0;
+      for (let k = 0; k < length; k++) if (slotLayout(buf, o + k * FRAME_SIZE, info.resolution) !== INVALID) readable++;
+      if (readable === length) return -1;
+    }
+    let positive = false;
     let fell = false;
     let channels = 0;
     let zeroWords = 0;
     let recurring = 0;
     let layout1 = INVALID;
     let layout2 = INVALID;
-    let prev0 = first0;
-    let prevWord = (first0 << 8) | s;
-    let zeroByte0 = first0 === 0;
-    for (let k = 0; k < frames; k++) {
+    // Slots whose low byte is the same §8.3 system byte in every frame: an internal remote's
+    // header read as a slot (the stream read two bytes late, say).
+    let headerSlots = 0x7f;
+    let headerByte = -1;
+    for (let k = 0; k < length; k++) {
       const f = o + k * FRAME_SIZE;
       const layout = slotLayout(buf, f, resolution);
-      if (layout === INVALID) return -1;
-      if (k > 0) {
-        const b0 = buf[f] as number;
-        const word = (b0 << 8) | (buf[f + 1] as number);
-        if (internal && (buf[f + 1] !== s || !byte0Follows(prev0, b0, forcedB0))) internal = false;
-        if (external && !countFollows(prevWord, word)) external = false;
-        if (!internal && !external) return -1;
-        if (b0 === 0) zeroByte0 = true;
-        if (!plausibleRssi(b0)) positive = true;
-        else if (prev0 >= 0x80 && b0 < prev0) fell = true;
-        prev0 = b0;
-        prevWord = word;
-      }
+      const b0 = buf[f] as number;
+      if (!plausibleRssi(b0)) positive = true;
+      else if (k > 0 && b0 < (buf[f - FRAME_SIZE] as number)) fell = true;
       if (layout === layout2) recurring++;
       layout2 = layout1;
       layout1 = layout;
       channels |= layoutChannels(layout);
       zeroWords += countZeroWords(buf, f);
+      for (let i = 0; i < 7; i++) {
+        const low = buf[f + 3 + 2 * i] as number;
+        if (systemInfo(low) === undefined || (headerByte >= 0 && low !== headerByte)) headerSlots &= ~(1 << i);
+        else if ((headerSlots & (1 << i)) !== 0) headerByte = low;
+      }
     }
-    const info = systemInfo(s);
-    if (internal && external) {
-      // Both readings hold. §8.3 names four system bytes; a count below 256 (`00 xx`, the
-      // external and clone header) is external; an unlisted byte 1 over a byte 0 that is never
-      // zero is a system byte to ignore, as is any byte 1 an internal remote of this stream sent.
-      internal = remote === 'internal' || info !== undefined ||
-        (s !== 0 && (!zeroByte0 || (this.#remote === 'internal' && this.#system === s)));
-    }
-    let score = 10 * frames + recurring - zeroWords;
+    let score = 10 * length + recurring - zeroWords - (skipped >= 0 ? 5 : 0);
     if (internal) {
-      // Only a system byte of §8.3 is evidence of an internal remote.
-      if (info !== undefined) score += 4;
+      // A §8.3 system byte in every frame is strong evidence of an internal remote.
+      if (info !== undefined) score += 8;
       if (info?.resolution === resolution) score += 2;
-    } else if (prevWord < 256) {
+    } else if (((buf[o] as number) << 8 | s) < 256) {
       score += 1;
     }
+    if (length > 1 && headerSlots !== 0) score -= 6;
     // A header of 0xFFFF is an empty slot's filler more often than a fade count at its limit.
-    if (((first0 << 8) | s) === 0xffff) score -= 3;
+    if (((buf[o] as number) << 8 | s) === 0xffff) score -= 3;
     // Transmitters send channels 0…N-1: a contiguous set is the signature of the right reading.
     if ((channels & (channels + 1)) === 0) score += 2;
     this.#candInternal = internal;
     this.#candSystem = s;
+    this.#candFrames = length;
+    this.#candSkipped = skipped;
     this.#candB0 = forcedB0 !== B0_UNKNOWN ? forcedB0 : positive ? B0_FADES : fell ? B0_RSSI : B0_UNKNOWN;
     return score;
   }
