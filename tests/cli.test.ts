@@ -126,6 +126,9 @@ describe('satscope decode', () => {
     expect(r.code).toBe(0);
     expect(r.err).toMatch(/damaged-header\.sscap: damaged header: its metadata length \(\d+, not \d+\) is wrong; repaired/);
     expect(r.out).toBe(satscope('decode', join(dir, 'run.sscap')).out);
+    const info = satscope('info', join(dir, 'damaged-header.sscap'));
+    expect(info.code).toBe(0);
+    expect(info.out).toMatch(/File issues\s+1 \(bad-header: what was damaged or skipped is listed above\)/);
   });
 
   it('says which ports have data when the port asked for has none', () => {

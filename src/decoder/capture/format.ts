@@ -148,9 +148,10 @@ export interface ParsedCapture extends Capture {
 }
 
 /**
- * Thrown when a file is not a capture at all (wrong signature, unreadable header, a text file
- * that is not a Saleae export, an empty file). Damage inside a capture never throws: it is
- * reported in `Capture.issues`.
+ * Thrown when a file is not a capture at all (wrong signature, a text file that is not a Saleae
+ * export, an empty file), is a .sscap of an unsupported version, or holds nothing to recover
+ * (it ends inside its header). Damage inside a capture, its header included, never throws: it
+ * is reported in `Capture.issues`.
  */
 export class CaptureFormatError extends Error {
   override readonly name = 'CaptureFormatError';
