@@ -383,6 +383,22 @@ describe('.sscap damage recovery', () => {
     expect(parsed.issues[0]?.message).toMatch(new RegExp(`records start at offset ${headerLength}`));
   });
 
+  it('keeps the metadata when both the metadata length and the first record are damaged', () => {
+    const { file, starts, headerLength } = smallCapture();
+    const damaged = file.slice();
+    damaged[13]! ^= 0x10; // the metadata length, off by 4096
+    damaged[(starts[0] as number) + 17]! ^= 0x01; // the first record ("port opened")
+    const parsed = parseCapture(damaged);
+    expect(parsed.meta).toEqual(parseCapture(file).meta);
+    expect(parsed.headerLength).toBe(headerLength);
+    expect(chunksOf(parsed)).toEqual(chunksOf(parseCapture(file)));
+    expect(parsed.events.map((e) => e.text)).toEqual(['device lost']);
+    expect(parsed.issues.map((i) => [i.kind, i.offset, i.length])).toEqual([
+      ['bad-header', 0, headerLength],
+      ['bad-checksum', starts[0], (starts[1] as number) - (starts[0] as number)],
+    ]);
+  });
+
   it('reads a version field damaged by one bit as version 1 and reports it', () => {
     const { file } = smallCapture();
     const damaged = file.slice();
@@ -485,9 +501,18 @@ describe('.sscap header errors', () => {
     expect(parsed.issues.map((i) => i.kind)).toEqual(['bad-header']);
   });
 
-  it('refuses a header that announces more than 1 MiB of metadata when no record follows', () => {
-    const file = encodeCapture({}, []);
+  it('repairs the metadata length of a capture without records from where its metadata ends', () => {
+    const file = encodeCapture({ note: 'nothing recorded' }, []);
     new DataView(file.buffer).setUint32(12, 0x7fffffff, true);
+    const parsed = parseCapture(file);
+    expect(parsed.meta).toEqual({ note: 'nothing recorded' });
+    expect(parsed.issues.map((i) => [i.kind, i.offset, i.length])).toEqual([['bad-header', 0, file.length]]);
+  });
+
+  it('refuses a header with an impossible metadata length and damaged metadata when no record follows', () => {
+    const file = encodeCapture({ note: 'nothing recorded' }, []);
+    new DataView(file.buffer).setUint32(12, 0x7fffffff, true);
+    file[20]! ^= 0x01;
     expectFormatError(() => parseCapture(file), /damaged SatScope capture header.*no intact record/);
   });
 

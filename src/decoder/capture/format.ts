@@ -770,7 +770,7 @@ function readHeader(bytes: Uint8Array, view: DataView, probe: RecordProbe, issue
   const first = probe.firstIntact(MIN_HEADER_SIZE);
   // Damage confined to the fixed fields (signature, version, flags, metadata length) is repaired:
   // with the values a version-1 writer puts there, the header CRC matches again.
-  for (const end of [first, stated]) {
+  for (const end of headerEnds(bytes, first, stated)) {
     if (end < MIN_HEADER_SIZE || end > n || !repairedHeaderMatches(bytes, view, end)) continue;
     const damaged = damagedFixedFields(bytes, view, end);
     issues.push({
@@ -807,6 +807,27 @@ function readHeader(bytes: Uint8Array, view: DataView, probe: RecordProbe, issue
   const meta = cleanMeta(parsed, problems);
   if (problems.length > 0) pushBadMeta(issues, headerLength, problems);
   return { meta, version: CAPTURE_FORMAT_VERSION, headerLength };
+}
+
+/** Closing braces tried as the end of the metadata when neither the stated length nor the first record fits. */
+const MAX_BRACE_TRIES = 16;
+const CLOSE_BRACE = 0x7d;
+
+/**
+ * Where the header may end, most likely first: where the first intact record starts, where the
+ * metadata length says; then (the length and the first record both damaged) just after each of
+ * the last few '}' before the first intact record, since the metadata is a JSON object and its
+ * CRC follows it.
+ */
+function* headerEnds(bytes: Uint8Array, first: number, stated: number): Generator<number, void, undefined> {
+  yield first;
+  if (stated !== first) yield stated;
+  const limit = Math.min(first >= 0 ? first : bytes.length, MIN_HEADER_SIZE + MAX_META_BYTES);
+  let q = bytes.lastIndexOf(CLOSE_BRACE, limit - CRC_SIZE - 1);
+  for (let tries = 0; q >= HEADER_FIXED_SIZE && tries < MAX_BRACE_TRIES; tries++, q = bytes.lastIndexOf(CLOSE_BRACE, q - 1)) {
+    const end = q + 1 + CRC_SIZE;
+    if (end !== first && end !== stated) yield end;
+  }
 }
 
 function notCapture(bytes: Uint8Array): CaptureFormatError {
