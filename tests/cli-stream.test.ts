@@ -4,7 +4,7 @@
  * it cleanly. Runs dist/cli/main.js: needs `npm run build:lib` first (`npm test` does it).
  */
 import { spawn, spawnSync } from 'node:child_process';
-import { mkdtempSync, rmSync, writeFileSync } from 'node:fs';
+import { closeSync, existsSync, mkdtempSync, openSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
 import { pathToFileURL } from 'node:url';
@@ -70,6 +70,19 @@ describe('satscope decode into a pipe', () => {
     expect(peak).toBeLessThan(160 * 1024);
     expect(err.replace(/\s*peak-rss-kb \d+\s*/, '')).toBe('');
   }, 60_000);
+
+  it.skipIf(!existsSync('/dev/full'))('says the output could not be written, with exit code 1, when the disk is full', () => {
+    const full = openSync('/dev/full', 'w');
+    try {
+      for (const command of ['decode', 'info']) {
+        const r = spawnSync(process.execPath, [cli, command, big], { stdio: ['ignore', full, 'pipe'], encoding: 'utf8' });
+        expect(r.status, command).toBe(1);
+        expect(r.stderr, command).toBe('satscope: cannot write the output: ENOSPC\n');
+      }
+    } finally {
+      closeSync(full);
+    }
+  });
 
   it('ends cleanly, with exit code 0 and no message, when the reader stops early (| head)', () => {
     const r = spawnSync('sh', ['-c', `("${process.execPath}" "${join(dir, 'peak.mjs')}" decode "${big}" 2>"${dir}/err"; echo $? >"${dir}/rc") | head -n 3; cat "${dir}/rc" "${dir}/err"`], { encoding: 'utf8' });

@@ -70,9 +70,17 @@ export class TextOutput {
     });
   }
 
-  /** Writes what is gathered and waits until the stream has taken it. */
+  /**
+   * Writes what is gathered and waits until the stream has written it, so that a failed last
+   * write (a file on a full disk fails after `write()` returned) is known before exiting.
+   */
   async end(): Promise<void> {
-    this.#flush();
+    const block = this.#parts.join('');
+    this.#parts = [];
+    this.#size = 0;
+    if (this.stopped) return;
+    // The callback runs once the block (and everything before it) is written, or on an error.
+    await new Promise<void>((resolve) => this.#stream.write(block, () => resolve()));
     await this.ready();
   }
 
