@@ -3,8 +3,8 @@
  * The `satscope` command: decode, summarise and report on captures from scripts. A thin shell
  * over the library: read the file, hand it to `readCapture`, then to the decoder,
  * `summarizeCapture` or `healthReport`, print. Output streams with backpressure (output.ts).
- * Exit codes: 0 ok (also when the reader stops early), 1 the file could not be decoded, 2 bad
- * usage or unreadable file.
+ * Exit codes: 0 ok (also when the reader stops early), 1 the file could not be decoded or the
+ * output not written, 2 bad usage or unreadable file.
  */
 import { readFileSync, writeFileSync } from 'node:fs';
 import { basename } from 'node:path';
@@ -31,7 +31,8 @@ per minute, lost frames, holds, failsafe episodes, frame-period jitter, channels
 graphs) as one self-contained HTML page on stdout, or in the file --out names (then the findings
 go to stdout); --json gives the same report as JSON.
 Exit codes: 0 done (also when the reader of the output stops early, as head does), 1 the file
-holds no frames (on that port) or is not a capture, 2 bad usage or a file that cannot be read.`;
+holds no frames (on that port) or is not a capture, or the output could not be written (a full
+disk), 2 bad usage or a file that cannot be read.`;
 
 function load(file: string): Capture {
   let bytes: Uint8Array;
