@@ -5,7 +5,7 @@
 import { existsSync, readFileSync } from 'node:fs';
 import { fileURLToPath } from 'node:url';
 import { describe, expect, it } from 'vitest';
-import { CaptureWriter, captureChunks, parseCapture, readCapture } from '../src/decoder/capture/index.js';
+import { CaptureFormatError, CaptureWriter, captureChunks, parseCapture, readCapture } from '../src/decoder/capture/index.js';
 import type { Capture, ParsedCapture } from '../src/decoder/capture/index.js';
 // A test hook, not part of the package: what the reader did, counted.
 import { parseCaptureCounting } from '../src/decoder/capture/format.js';
@@ -92,6 +92,49 @@ describe.each(sources)('a .sscap of %s with one bit of its header flipped', (_, 
     expect(metaKept).toBeGreaterThanOrEqual(160);
   });
 
+  it('keeps every untouched record whatever bytes are damaged, header and records alike', () => {
+    // Where each record starts and ends, from the intact file: the event, then one per data chunk.
+    const ends: number[] = [];
+    const starts: number[] = [];
+    for (let p = whole.headerLength; p < file.length; ) {
+      starts.push(p);
+      p += 20 + new DataView(file.buffer, file.byteOffset).getUint32(p + 4, true);
+      ends.push(p);
+    }
+    let random = 12345;
+    const next = (n: number): number => {
+      random = (Math.imul(random, 1103515245) + 12345) >>> 0;
+      return (random >>> 8) % n;
+    };
+    let refused = 0;
+    for (let run = 0; run < 400; run++) {
+      const damaged = file.slice();
+      // Half the runs replace a header byte (the signature included), all replace a few bytes anywhere.
+      if (run % 2 === 0) damaged[next(whole.headerLength)] = next(256);
+      for (let k = next(4); k > 0; k--) damaged[next(file.length)] = next(256);
+      // Data records left untouched (the event record is the first one).
+      const untouched = new Set<number>();
+      for (let r = 1; r < starts.length; r++) {
+        if (damaged.subarray(starts[r], ends[r]).every((b, i) => b === file[starts[r]! + i])) untouched.add(whole.chunkTimesUs[r - 1]!);
+      }
+      let parsed: ParsedCapture;
+      try {
+        parsed = parseCapture(damaged);
+      } catch (error) {
+        // Allowed only when the signature is beyond repair and nothing else proves a capture.
+        expect(error, `run ${run}`).toBeInstanceOf(CaptureFormatError);
+        expect(signatureBitErrors(damaged), `run ${run}`).toBeGreaterThan(2);
+        refused++;
+        continue;
+      }
+      const recovered = new Set(parsed.chunkTimesUs);
+      for (const t of untouched) expect(recovered.has(t), `run ${run}: the record at ${t} µs`).toBe(true);
+      if (damaged.subarray(0, whole.headerLength).some((b, i) => b !== file[i])) expect(parsed.issues.some((i) => i.kind === 'bad-header'), `run ${run}`).toBe(true);
+    }
+    // A signature beyond repair alone is recovered too (the header CRC or the first record proves the file).
+    expect(refused).toBe(0);
+  });
+
   it('also recognises the file by its content when a bit of its signature is flipped', () => {
     for (let bit = 0; bit < 64; bit++) {
       const damaged = file.slice();
@@ -102,6 +145,14 @@ describe.each(sources)('a .sscap of %s with one bit of its header flipped', (_, 
     }
   });
 });
+
+const SIGNATURE = [0x89, 0x53, 0x53, 0x43, 0x41, 0x50, 0x0d, 0x0a];
+
+function signatureBitErrors(bytes: Uint8Array): number {
+  let errors = 0;
+  for (let i = 0; i < 8; i++) for (let x = (bytes[i]! ^ SIGNATURE[i]!) & 0xff; x !== 0; x &= x - 1) errors++;
+  return errors;
+}
 
 // ---------------------------------------------------------------------------------------------
 // Linear time on crafted input

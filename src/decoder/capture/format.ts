@@ -745,8 +745,9 @@ function readHeader(bytes: Uint8Array, view: DataView, probe: RecordProbe, issue
     }
     throw notCapture(bytes);
   }
-  if (!looksLikeCaptureMagic(bytes)) throw notCapture(bytes);
+  const magicOk = looksLikeCaptureMagic(bytes);
   if (n < HEADER_FIXED_SIZE) {
+    if (!magicOk) throw notCapture(bytes);
     throw new CaptureFormatError(`truncated SatScope capture: the file ends inside its header (${n} of at least ${MIN_HEADER_SIZE} bytes)`);
   }
   const version = view.getUint16(OFF_VERSION, true);
@@ -754,6 +755,12 @@ function readHeader(bytes: Uint8Array, view: DataView, probe: RecordProbe, issue
   // The header's length as stated, when it is possible at all.
   const stated = metaLength <= MAX_META_BYTES ? HEADER_FIXED_SIZE + metaLength + CRC_SIZE : -1;
   const statedFits = stated >= 0 && stated <= n;
+  // A signature beyond repair is still a capture's when the rest proves it (odds of 2^-32 by
+  // chance): the header CRC matches with the signature restored, or an intact record starts
+  // where the header says it ends.
+  if (!magicOk && !(statedFits && (repairedHeaderMatches(bytes, view, stated) || (stated < n && probe.at(stated) > 0)))) {
+    throw notCapture(bytes);
+  }
   if (statedFits && crc32(bytes, 0, stated - CRC_SIZE) === view.getUint32(stated - CRC_SIZE, true)) {
     if (version !== CAPTURE_FORMAT_VERSION) {
       // An intact header of another version: a format this reader does not know, not damage.
@@ -916,8 +923,9 @@ function readMeta(bytes: Uint8Array, start: number, end: number, issues: Capture
  * whatever the bytes are.
  *
  * @throws {CaptureFormatError} only when the file is not a SatScope capture (its signature is
- *   wrong in more than two bits), is a capture of an unsupported version (an intact header of
- *   another version), or holds nothing to recover (it ends inside its header).
+ *   wrong in more than two bits and neither the header CRC nor a record proves it a capture), is
+ *   a capture of an unsupported version (an intact header of another version), or holds nothing
+ *   to recover (it ends inside its header).
  * @throws {TypeError} when `bytes` is not a Uint8Array.
  */
 export function parseCapture(bytes: Uint8Array): ParsedCapture {
