@@ -154,10 +154,10 @@ describe('satscope decode', () => {
 
   it('refuses options a command does not take, missing and repeated values, with exit code 2', () => {
     const cases: [string[], RegExp][] = [
-      [['info', 'x', '--format', 'csv'], /info prints a summary; --format \(jsonl or csv\) is for decode/],
-      [['decode', 'x', '--json'], /--json is for info and report/],
+      [['info', 'x', '--format', 'csv'], /unknown option '--format' for info: info prints a summary; --format \(jsonl or csv\) is for decode/],
+      [['decode', 'x', '--json'], /unknown option '--json' for decode: .*--json is for info and report/],
       [['report', 'x', '--port', '1'], /report covers every port/],
-      [['decode', 'x', '--out', 'y'], /decode does not take --out \(it takes --format, --resolution, --port\)/],
+      [['decode', 'x', '--out', 'y'], /unknown option '--out' for decode \(decode takes --format, --resolution, --port\)/],
       [['decode', 'x', '--frobnicate'], /unknown option '--frobnicate'/],
       [['decode', 'x', '--format'], /--format needs a value/],
       [['decode', 'x', '--format', '--port', '1'], /--format needs a value, not the option '--port'/],

@@ -78,7 +78,8 @@ export function parseCommandLine(argv: readonly string[]): Args | 'help' | 'vers
     if (!isOption(t.name)) throw new UsageError(`unknown option '${t.rawName}'`);
     if (!allowed.includes(t.name)) {
       const takes = allowed.map((o) => `--${o}`).join(', ');
-      throw new UsageError(HINTS[`${command} ${t.name}`] ?? `${command} does not take ${t.rawName} (it takes ${takes})`);
+      const hint = HINTS[`${command} ${t.name}`];
+      throw new UsageError(`unknown option '${t.rawName}' for ${command}${hint ? `: ${hint}` : ` (${command} takes ${takes})`}`);
     }
     if (seen.has(t.name)) throw new UsageError(`${t.rawName} is given more than once`);
     seen.add(t.name);
