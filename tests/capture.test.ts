@@ -334,15 +334,90 @@ describe('.sscap damage recovery', () => {
   });
 
   it('keeps reading past a damaged header checksum when the metadata still parses', () => {
-    const { file } = smallCapture();
+    const { file, headerLength } = smallCapture();
     const damaged = file.slice();
     const at = new TextDecoder().decode(damaged).indexOf('demo');
     damaged[at] = 'D'.charCodeAt(0);
     const parsed = parseCapture(damaged);
     expect(parsed.meta.source).toBe('Demo');
     expect(parsed.issues).toHaveLength(1);
-    expect(parsed.issues[0]).toMatchObject({ kind: 'bad-checksum', offset: 0 });
+    expect(parsed.issues[0]).toMatchObject({ kind: 'bad-header', offset: 0, length: headerLength });
+    expect(parsed.issues[0]?.message).toMatch(/metadata may be wrong/);
     expect(chunksOf(parsed)).toEqual(chunksOf(parseCapture(file)));
+  });
+
+  it('repairs a damaged metadata length from where the records start, and keeps the metadata', () => {
+    const { file, headerLength } = smallCapture();
+    for (const bit of [0, 3, 9, 20, 31]) {
+      const damaged = file.slice();
+      damaged[12 + (bit >> 3)]! ^= 1 << (bit & 7);
+      const parsed = parseCapture(damaged);
+      expect(parsed.meta, `bit ${bit}`).toEqual(parseCapture(file).meta);
+      expect(chunksOf(parsed), `bit ${bit}`).toEqual(chunksOf(parseCapture(file)));
+      expect(parsed.headerLength).toBe(headerLength);
+      expect(parsed.issues.map((i) => [i.kind, i.offset, i.length]), `bit ${bit}`).toEqual([['bad-header', 0, headerLength]]);
+      expect(parsed.issues[0]?.message).toMatch(/metadata length \(\d+, not \d+\) is wrong; repaired/);
+    }
+  });
+
+  it('loses only the metadata when it no longer reads as JSON, and says so', () => {
+    const { file, headerLength } = smallCapture();
+    const damaged = file.slice();
+    damaged[16] = 0x7e; // '{' → '~'
+    const parsed = parseCapture(damaged);
+    expect(parsed.meta).toEqual({});
+    expect(chunksOf(parsed)).toEqual(chunksOf(parseCapture(file)));
+    expect(parsed.events).toEqual(parseCapture(file).events);
+    expect(parsed.issues.map((i) => [i.kind, i.offset, i.length])).toEqual([['bad-header', 0, headerLength]]);
+    expect(parsed.issues[0]?.message).toMatch(/metadata cannot be read/);
+  });
+
+  it('finds the records after a header whose length and metadata are both damaged', () => {
+    const { file, headerLength } = smallCapture();
+    const damaged = file.slice();
+    new DataView(damaged.buffer).setUint32(12, 0x7fffffff, true);
+    damaged[20]! ^= 0x01;
+    const parsed = parseCapture(damaged);
+    expect(chunksOf(parsed)).toEqual(chunksOf(parseCapture(file)));
+    expect(parsed.issues.map((i) => [i.kind, i.offset, i.length])).toEqual([['bad-header', 0, headerLength]]);
+    expect(parsed.issues[0]?.message).toMatch(new RegExp(`records start at offset ${headerLength}`));
+  });
+
+  it('keeps the metadata when both the metadata length and the first record are damaged', () => {
+    const { file, starts, headerLength } = smallCapture();
+    const damaged = file.slice();
+    damaged[13]! ^= 0x10; // the metadata length, off by 4096
+    damaged[(starts[0] as number) + 17]! ^= 0x01; // the first record ("port opened")
+    const parsed = parseCapture(damaged);
+    expect(parsed.meta).toEqual(parseCapture(file).meta);
+    expect(parsed.headerLength).toBe(headerLength);
+    expect(chunksOf(parsed)).toEqual(chunksOf(parseCapture(file)));
+    expect(parsed.events.map((e) => e.text)).toEqual(['device lost']);
+    expect(parsed.issues.map((i) => [i.kind, i.offset, i.length])).toEqual([
+      ['bad-header', 0, headerLength],
+      ['bad-checksum', starts[0], (starts[1] as number) - (starts[0] as number)],
+    ]);
+  });
+
+  it('reads a version field damaged by one bit as version 1 and reports it', () => {
+    const { file } = smallCapture();
+    const damaged = file.slice();
+    damaged[8]! ^= 0x02; // version 1 → 3, and the header CRC no longer matches
+    const parsed = parseCapture(damaged);
+    expect(parsed.version).toBe(1);
+    expect(chunksOf(parsed)).toEqual(chunksOf(parseCapture(file)));
+    expect(parsed.issues[0]?.message).toMatch(/version \(3\) is wrong; repaired/);
+  });
+
+  it('reads a capture whose signature has a flipped bit, even when it must be recognised by content', () => {
+    const { file } = smallCapture();
+    const damaged = file.slice();
+    damaged[0]! ^= 0x80; // 0x89 → 0x09: no longer a high-bit first byte
+    for (const capture of [parseCapture(damaged), readCapture(damaged), readCapture(damaged, 'capture.bin')]) {
+      expect(capture.kind).toBe('sscap');
+      expect(chunksOf(capture)).toEqual(chunksOf(parseCapture(file)));
+      expect(capture.issues[0]?.message).toMatch(/signature is wrong; repaired/);
+    }
   });
 
   it('recovers exactly the untouched records under random damage, and accounts for every other byte', () => {
@@ -408,22 +483,53 @@ describe('.sscap header errors', () => {
     expectFormatError(() => parseCapture(new Uint8Array(0)), /empty/);
   });
 
-  it('refuses a newer format version with a message naming both versions', () => {
-    const file = encodeCapture(META, []);
-    new DataView(file.buffer).setUint16(8, 2, true);
+  it('refuses a newer format version (an intact header) with a message naming both versions', () => {
+    const file = encodeCapture(META, [{ type: 'data', bytes: FRAME, timeUs: 0 }]);
+    const view = new DataView(file.buffer);
+    const crcAt = 16 + view.getUint32(12, true);
+    view.setUint16(8, 2, true);
+    view.setUint32(crcAt, crc32(file, 0, crcAt), true);
     expectFormatError(() => parseCapture(file), /version 2.*version 1/);
   });
 
-  it('refuses metadata that is not JSON', () => {
+  it('keeps a capture without records whose metadata is not JSON, reporting the header', () => {
     const file = encodeCapture({ note: 'x' }, []);
     file[16] = 0x7e; // '{' → '~'
-    expectFormatError(() => parseCapture(file), /metadata is not valid JSON/);
+    const parsed = parseCapture(file);
+    expect(parsed.meta).toEqual({});
+    expect(parsed.chunkEnds).toHaveLength(0);
+    expect(parsed.issues.map((i) => i.kind)).toEqual(['bad-header']);
   });
 
-  it('refuses a header that announces more than 1 MiB of metadata', () => {
-    const file = encodeCapture({}, []);
+  it('repairs the metadata length of a capture without records from where its metadata ends', () => {
+    const file = encodeCapture({ note: 'nothing recorded' }, []);
     new DataView(file.buffer).setUint32(12, 0x7fffffff, true);
-    expectFormatError(() => parseCapture(file), /damaged SatScope capture header/);
+    const parsed = parseCapture(file);
+    expect(parsed.meta).toEqual({ note: 'nothing recorded' });
+    expect(parsed.issues.map((i) => [i.kind, i.offset, i.length])).toEqual([['bad-header', 0, file.length]]);
+  });
+
+  it('refuses a header with an impossible metadata length and damaged metadata when no record follows', () => {
+    const file = encodeCapture({ note: 'nothing recorded' }, []);
+    new DataView(file.buffer).setUint32(12, 0x7fffffff, true);
+    file[20]! ^= 0x01;
+    expectFormatError(() => parseCapture(file), /damaged SatScope capture header.*no intact record/);
+  });
+
+  it('reports metadata that is not a JSON object under an intact CRC, and keeps the records', () => {
+    // A foreign writer's header: valid CRC, but the metadata is a JSON array.
+    const json = ascii('[1,2]');
+    const header = new Uint8Array(16 + json.length + 4);
+    const view = new DataView(header.buffer);
+    header.set([0x89, 0x53, 0x53, 0x43, 0x41, 0x50, 0x0d, 0x0a]);
+    view.setUint16(8, 1, true);
+    view.setUint32(12, json.length, true);
+    header.set(json, 16);
+    view.setUint32(16 + json.length, crc32(header, 0, 16 + json.length), true);
+    const parsed = parseCapture(concat(header, new CaptureWriter().data(FRAME, 1)));
+    expect(parsed.meta).toEqual({});
+    expect(parsed.issues.map((i) => [i.kind, i.offset, i.length])).toEqual([['bad-meta', 16, json.length]]);
+    expect(chunksOf(parsed)).toEqual([{ bytes: [...FRAME], timeUs: 1, port: 0 }]);
   });
 });
 

@@ -3,11 +3,11 @@
  * made from the simulator. Needs `npm run build:lib` first (`npm test` does it).
  */
 import { spawnSync } from 'node:child_process';
-import { mkdtempSync, rmSync, writeFileSync } from 'node:fs';
+import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
-import { CaptureWriter } from '../src/decoder/index.js';
+import { CaptureWriter, readCapture, summarizeCapture } from '../src/decoder/index.js';
 import { preset, simulate } from '../src/simulator/index.js';
 import { concatBytes } from './bytes.js';
 
@@ -40,6 +40,14 @@ beforeAll(() => {
   writeFileSync(join(dir, 'run.bin'), sim.bytes);
   const csv = ['Time [s],Value,Parity Error,Framing Error', ...Array.from(sim.bytes, (b, i) => `${(sim.timesUs[i]! / 1e6).toFixed(9)},0x${b.toString(16).toUpperCase().padStart(2, '0')},,`)];
   writeFileSync(join(dir, 'run.csv'), csv.join('\n'));
+  // The same bytes with one bit of the header's metadata length flipped.
+  const damaged = file.slice();
+  damaged[13]! ^= 0x04;
+  writeFileSync(join(dir, 'damaged-header.sscap'), damaged);
+  // Two satellites on ports 1 and 2, none on port 0.
+  const two = new CaptureWriter({ source: 'test' });
+  writeFileSync(join(dir, 'two.sscap'), concatBytes([two.header(), two.data(sim.bytes, NaN, 1), two.data(sim.bytes.subarray(0, 800), NaN, 2)]));
+  writeFileSync(join(dir, '-dash.bin'), sim.bytes);
   writeFileSync(join(dir, 'notes.txt'), 'these are my notes\nnot a capture\n');
   writeFileSync(join(dir, 'empty.bin'), new Uint8Array(0));
   writeFileSync(join(dir, 'noise.bin'), Uint8Array.from({ length: 500 }, (_, i) => (i * 37 + 11) & 0xff));
@@ -113,6 +121,64 @@ describe('satscope decode', () => {
     expect(noise.err).toMatch(/no Spektrum frames found in 500 bytes/);
   });
 
+  it('keeps every frame of a capture whose header is damaged, and says what was damaged', () => {
+    const r = satscope('decode', join(dir, 'damaged-header.sscap'));
+    expect(r.code).toBe(0);
+    expect(r.err).toMatch(/damaged-header\.sscap: damaged header: its metadata length \(\d+, not \d+\) is wrong; repaired/);
+    expect(r.out).toBe(satscope('decode', join(dir, 'run.sscap')).out);
+    const info = satscope('info', join(dir, 'damaged-header.sscap'));
+    expect(info.code).toBe(0);
+    expect(info.out).toMatch(/File issues\s+1 \(bad-header: what was damaged or skipped is listed above\)/);
+  });
+
+  it('says which ports have data when the port asked for has none', () => {
+    const one = satscope('decode', join(dir, 'run.sscap'), '--port', '3');
+    expect(one.code).toBe(1);
+    expect(one.err).toMatch(/run\.sscap: port 3 has no data; this capture has data on port 0\n/);
+    expect(one.out).toBe('');
+    const two = satscope('info', join(dir, 'two.sscap'));
+    expect(two.code).toBe(1);
+    expect(two.err).toMatch(/port 0 has no data; this capture has data on ports 1, 2 \(choose one with --port 1\)/);
+    const chosen = satscope('decode', join(dir, 'two.sscap'), '--port', '1');
+    expect(chosen.code).toBe(0);
+    expect(chosen.out.trim().split('\n')).toHaveLength(intact.length);
+  });
+
+  it('takes FILE after --, also a FILE whose name starts with -', () => {
+    const plain = satscope('decode', join(dir, 'run.bin')).out;
+    expect(satscope('decode', '--', join(dir, 'run.bin'))).toMatchObject({ code: 0, out: plain });
+    const dashed = spawnSync(process.execPath, [cli, 'decode', '--format', 'csv', '--', '-dash.bin'], { cwd: dir, encoding: 'utf8' });
+    expect(dashed.status).toBe(0);
+    expect(dashed.stdout.trim().split('\n')).toHaveLength(intact.length + 1);
+  });
+
+  it('refuses options a command does not take, missing and repeated values, with exit code 2', () => {
+    const cases: [string[], RegExp][] = [
+      [['info', 'x', '--format', 'csv'], /unknown option '--format' for info: info prints a summary; --format \(jsonl or csv\) is for decode/],
+      [['decode', 'x', '--json'], /unknown option '--json' for decode: .*--json is for info and report/],
+      [['report', 'x', '--port', '1'], /report covers every port/],
+      [['decode', 'x', '--out', 'y'], /unknown option '--out' for decode \(decode takes --format, --resolution, --port\)/],
+      [['decode', 'x', '--frobnicate'], /unknown option '--frobnicate'/],
+      [['decode', 'x', '--format'], /--format needs a value/],
+      [['decode', 'x', '--format', '--port', '1'], /--format needs a value, not the option '--port'/],
+      [['decode', 'x', '--format', 'csv', '--format', 'jsonl'], /--format is given more than once/],
+      [['info', 'x', '--json=yes'], /--json takes no value/],
+      [['decode', 'x', '--port', '256'], /--port must be an integer 0–255, not '256'/],
+      [['decode', 'x', '--port', '1.5'], /--port must be an integer 0–255/],
+      [['decode', 'x', '--resolution', '4096'], /--resolution must be auto, 1024 or 2048/],
+      [['decode', 'x', 'y'], /unexpected argument 'y' \(decode takes one FILE\)/],
+      [['info', '--', 'x', '--json'], /unexpected argument '--json'/],
+      [[], /no command given/],
+    ];
+    for (const [args, message] of cases) {
+      const r = satscope(...args);
+      expect(r.code, args.join(' ')).toBe(2);
+      expect(r.err, args.join(' ')).toMatch(message);
+      expect(r.err, args.join(' ')).toMatch(/Usage:/);
+      expect(r.out, args.join(' ')).toBe('');
+    }
+  });
+
   it('explains bad usage', () => {
     expect(satscope('decode').err).toMatch(/no FILE given/);
     expect(satscope('decode', 'x', '--format', 'xml').err).toMatch(/--format must be jsonl or csv/);
@@ -137,10 +203,18 @@ describe('satscope info', () => {
     expect(r.out).toMatch(/ 0 Throttle/);
   });
 
-  it('prints the summary as JSON with --json', () => {
-    const s = JSON.parse(satscope('info', join(dir, 'run.sscap'), '--json').out);
-    expect(s.kind).toBe('sscap');
+  it('prints the summary as JSON with --json: the library\'s summary, and the figures the text shows', () => {
+    const r = satscope('info', join(dir, 'run.csv'), '--json');
+    expect(r.code).toBe(0);
+    const s = JSON.parse(r.out);
+    expect(s.kind).toBe('saleae-csv');
     expect(s.decoder.frames).toBe(intact.length);
     expect(s.format.resolution).toBe(2048);
+    const file = join(dir, 'run.csv');
+    expect(s).toEqual(JSON.parse(JSON.stringify(summarizeCapture(readCapture(readFileSync(file), file)))));
+    const text = satscope('info', file).out;
+    expect(text).toMatch(new RegExp(`Frames\\s+${s.decoder.frames} \\(${s.decoder.discardedBytes} bytes discarded`));
+    expect(text).toMatch(new RegExp(`Failsafe\\s+${s.link.holds} holds, ${s.link.failsafes} failsafes`));
+    expect(text).toMatch(new RegExp(`Gaps\\s+${s.link.missedFrames} missed frames`));
   });
 });

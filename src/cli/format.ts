@@ -75,7 +75,10 @@ export function formatSummary(s: CaptureSummary, name: string): string {
   } else {
     add('Timing', 'none in this file: no frame period, gaps or failsafe episodes');
   }
-  if (s.issues.length > 0) add('File issues', `${s.issues.length} (damaged records skipped; see above)`);
+  if (s.issues.length > 0) {
+    const kinds = [...new Set(s.issues.map((i) => i.kind))].join(', ');
+    add('File issues', `${s.issues.length} (${kinds}: what was damaged or skipped is listed above)`);
+  }
   return lines.join('\n');
 }
 

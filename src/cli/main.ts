@@ -1,16 +1,20 @@
 #!/usr/bin/env node
 /**
  * The `satscope` command: decode, summarise and report on captures from scripts. A thin shell
- * over the library: read the file, hand it to `readCapture`, `decodeCapture`,
- * `summarizeCapture` or `healthReport`, print. Exit codes: 0 ok, 1 the file could not be decoded, 2 bad usage or unreadable file.
+ * over the library: read the file, hand it to `readCapture`, then to the decoder,
+ * `summarizeCapture` or `healthReport`, print. Output streams with backpressure (output.ts).
+ * Exit codes: 0 ok (also when the reader stops early), 1 the file could not be decoded or the
+ * output not written, 2 bad usage or unreadable file.
  */
 import { readFileSync, writeFileSync } from 'node:fs';
 import { basename } from 'node:path';
-import { CaptureFormatError, readCapture, type Capture } from '../decoder/capture/index.js';
+import { CaptureFormatError, captureChunks, capturePorts, readCapture, type Capture, type CaptureChunk } from '../decoder/capture/index.js';
+import { SpektrumDecoder } from '../decoder/decoder.js';
 import { healthReport, reportHtml } from '../decoder/report.js';
-import { decodeCapture, summarizeCapture, type DecodeCaptureOptions } from '../decoder/summary.js';
-import type { DecodedFrame } from '../decoder/types.js';
+import { summarizeCapture } from '../decoder/summary.js';
+import { parseCommandLine, UsageError, type Args } from './args.js';
 import { formatJsonLine, formatCsvHeader, formatCsvLine, formatReportVerdict, formatSummary } from './format.js';
+import { TextOutput } from './output.js';
 
 const USAGE = `Usage:
   satscope decode FILE [--format jsonl|csv] [--resolution auto|1024|2048] [--port N]
@@ -18,92 +22,17 @@ const USAGE = `Usage:
   satscope report FILE [--out REPORT.html] [--json] [--resolution auto|1024|2048]
   satscope --help | --version
 
-FILE is a SatScope capture (.sscap), a raw byte dump (.bin) or a Saleae async-serial CSV export.
-decode prints one line per frame; info prints a summary (system, remote, resolution and why,
-frames, channels, fades, frame period, gaps, failsafe episodes). report makes a link-health
-report of every port (fades per minute, lost frames, holds, failsafe episodes, frame-period
-jitter, channels, glitches, with graphs) as one self-contained HTML page on stdout, or in the
-file --out names (then the findings go to stdout); --json gives the same report as JSON.`;
-
-class UsageError extends Error {}
-
-type Command = 'decode' | 'info' | 'report';
-
-interface Args {
-  command: Command;
-  file: string;
-  format: 'jsonl' | 'csv';
-  resolution: 'auto' | 1024 | 2048;
-  port: number;
-  json: boolean;
-  /** report: the file to write instead of stdout. */
-  out: string | null;
-}
-
-const COMMANDS: readonly string[] = ['decode', 'info', 'report'];
-const isCommand = (c: string | undefined): c is Command => c !== undefined && COMMANDS.includes(c);
-
-function parseArgs(argv: string[]): Args | 'help' | 'version' {
-  if (argv.includes('--help') || argv.includes('-h')) return 'help';
-  if (argv.includes('--version')) return 'version';
-  const [command, ...rest] = argv;
-  if (!isCommand(command)) throw new UsageError(command === undefined ? 'no command given' : `unknown command '${command}'`);
-  const args: Args = { command, file: '', format: 'jsonl', resolution: 'auto', port: 0, json: false, out: null };
-  for (let i = 0; i < rest.length; i++) {
-    const arg = rest[i] as string;
-    const value = (): string => {
-      const v = rest[++i];
-      if (v === undefined) throw new UsageError(`${arg} needs a value`);
-      return v;
-    };
-    if (arg === '--format' && command !== 'report') {
-      const v = value();
-      if (v !== 'jsonl' && v !== 'csv') throw new UsageError(`--format must be jsonl or csv, not '${v}'`);
-      args.format = v;
-    } else if (arg === '--resolution') {
-      const v = value();
-      if (v === 'auto') args.resolution = 'auto';
-      else if (v === '1024' || v === '2048') args.resolution = Number(v) as 1024 | 2048;
-      else throw new UsageError(`--resolution must be auto, 1024 or 2048, not '${v}'`);
-    } else if (arg === '--port' && command === 'report') {
-      throw new UsageError('report covers every port of the capture; --port is for decode and info');
-    } else if (arg === '--port') {
-      const v = Number(value());
-      if (!Number.isInteger(v) || v < 0 || v > 255) throw new UsageError('--port must be an integer 0–255');
-      args.port = v;
-    } else if (arg === '--json' && command !== 'decode') {
-      args.json = true;
-    } else if (arg === '--out' && command === 'report') {
-      args.out = value();
-      if (args.out === '') throw new UsageError('--out needs a file name');
-    } else if (arg.startsWith('-')) {
-      throw new UsageError(`unknown option '${arg}'`);
-    } else if (args.file === '') {
-      args.file = arg;
-    } else {
-      throw new UsageError(`unexpected argument '${arg}'`);
-    }
-  }
-  if (args.file === '') throw new UsageError('no FILE given');
-  return args;
-}
-
-/** Collects output and writes it in large blocks: one write per line would dominate the run time. */
-class Output {
-  #parts: string[] = [];
-  #size = 0;
-  line(text: string): void {
-    this.#parts.push(text, '\n');
-    this.#size += text.length + 1;
-    if (this.#size > 1 << 16) this.flush();
-  }
-  flush(): void {
-    if (this.#parts.length === 0) return;
-    process.stdout.write(this.#parts.join(''));
-    this.#parts = [];
-    this.#size = 0;
-  }
-}
+FILE is a SatScope capture (.sscap), a raw byte dump (.bin) or a Saleae async-serial CSV export
+(after --, a FILE may start with -). decode prints one line per frame as it decodes; info prints
+a summary (system, remote, resolution and why, frames, channels, fades, frame period, gaps,
+failsafe episodes), or with --json the same summary as JSON. --port picks the serial port of a
+capture that holds several (default 0). report makes a link-health report of every port (fades
+per minute, lost frames, holds, failsafe episodes, frame-period jitter, channels, glitches, with
+graphs) as one self-contained HTML page on stdout, or in the file --out names (then the findings
+go to stdout); --json gives the same report as JSON.
+Exit codes: 0 done (also when the reader of the output stops early, as head does), 1 the file
+holds no frames (on that port) or is not a capture, or the output could not be written (a full
+disk), 2 bad usage or a file that cannot be read.`;
 
 function load(file: string): Capture {
   let bytes: Uint8Array;
@@ -119,23 +48,24 @@ function load(file: string): Capture {
   return capture;
 }
 
-function main(argv: string[]): number {
-  let args: ReturnType<typeof parseArgs>;
+async function main(argv: string[]): Promise<number> {
+  let args: ReturnType<typeof parseCommandLine>;
   try {
-    args = parseArgs(argv);
+    args = parseCommandLine(argv);
   } catch (error) {
     if (!(error instanceof UsageError)) throw error;
     process.stderr.write(`satscope: ${error.message}\n\n${USAGE}\n`);
     return 2;
   }
+  const out = new TextOutput(process.stdout);
   if (args === 'help') {
-    process.stdout.write(`${USAGE}\n`);
-    return 0;
+    out.text(`${USAGE}\n`);
+    return finish(out, 0);
   }
   if (args === 'version') {
     const pkg = JSON.parse(readFileSync(new URL('../../package.json', import.meta.url), 'utf8')) as { version: string };
-    process.stdout.write(`${pkg.version}\n`);
-    return 0;
+    out.text(`${pkg.version}\n`);
+    return finish(out, 0);
   }
   let capture: Capture;
   try {
@@ -151,21 +81,82 @@ function main(argv: string[]): number {
     }
     throw error;
   }
-  if (args.command === 'report') return report(capture, args);
-  const options: DecodeCaptureOptions = { resolution: args.resolution, port: args.port };
-  if (args.command === 'info') {
-    const summary = summarizeCapture(capture, options);
-    process.stdout.write(args.json ? `${JSON.stringify(summary, null, 2)}\n` : `${formatSummary(summary, basename(args.file))}\n`);
-    return summary.decoder.frames > 0 ? 0 : 1;
+  if (args.command === 'report') return report(capture, args, out);
+  const port = args.port ?? 0;
+  const noData = portProblem(capture, args.port);
+  if (noData !== null) {
+    process.stderr.write(`satscope: ${args.file}: ${noData}\n`);
+    return 1;
   }
-  const out = new Output();
-  if (args.format === 'csv') out.line(formatCsvHeader());
-  const write = args.format === 'csv' ? formatCsvLine : formatJsonLine;
-  const { decoder } = decodeCapture(capture, options, (f: DecodedFrame) => out.line(write(f)));
-  out.flush();
+  if (args.command === 'info') {
+    const summary = summarizeCapture(capture, { resolution: args.resolution, port });
+    out.text(args.json ? `${JSON.stringify(summary, null, 2)}\n` : `${formatSummary(summary, basename(args.file))}\n`);
+    return finish(out, summary.decoder.frames > 0 ? 0 : 1);
+  }
+  return decode(capture, args, port, out);
+}
+
+/** Why the port asked for (or port 0) cannot be decoded, naming the ports that have data; null when it can. */
+function portProblem(capture: Capture, asked: number | null): string | null {
+  const ports = capturePorts(capture);
+  const port = asked ?? 0;
+  if (ports.includes(port)) return null;
+  if (ports.length === 0) return 'the capture holds no data (no data records on any port)';
+  const list = ports.length === 1 ? `port ${ports[0]}` : `ports ${ports.join(', ')}`;
+  return `port ${port} has no data; this capture has data on ${list}${asked === null ? ` (choose one with --port ${ports[0]})` : ''}`;
+}
+
+/** Largest piece of a chunk pushed at once, so the decoder never holds a whole raw file. */
+const PUSH_BYTES = 1 << 16;
+
+/**
+ * The pieces of a chunk to push. The decoder gives the same frames however bytes are split, so
+ * a long chunk is cut into pieces, except one with a single chunk time: that time belongs to its
+ * last byte, and splitting would stamp earlier bytes with it (the .sscap format bounds those
+ * chunks to 16 MiB anyway).
+ */
+function* pieces(chunk: CaptureChunk): Generator<{ bytes: Uint8Array; time: number | Float64Array | undefined }> {
+  const { bytes, time } = chunk;
+  if (typeof time === 'number' || bytes.length <= PUSH_BYTES) {
+    yield { bytes, time };
+    return;
+  }
+  for (let at = 0; at < bytes.length; at += PUSH_BYTES) {
+    const end = Math.min(at + PUSH_BYTES, bytes.length);
+    yield { bytes: bytes.subarray(at, end), time: time?.subarray(at, end) };
+  }
+}
+
+/**
+ * `satscope decode`: one line per frame, written as it is decoded. Nothing grows with the
+ * capture: the decoder gets the bytes a piece at a time, each frame is formatted and handed to
+ * the output at once, and decoding waits whenever the reader of stdout is behind.
+ */
+async function decode(capture: Capture, args: Args, port: number, out: TextOutput): Promise<number> {
+  const decoder = new SpektrumDecoder({ resolution: args.resolution });
+  const format = args.format === 'csv' ? formatCsvLine : formatJsonLine;
+  if (args.format === 'csv' && out.line(formatCsvHeader())) await out.ready();
+  const drain = async (): Promise<void> => {
+    for (let f = decoder.next(); f !== undefined; f = decoder.next()) {
+      // The frame is borrowed: it is formatted before anything else touches the decoder.
+      if (out.line(format(f))) await out.ready();
+      if (out.stopped) return;
+    }
+  };
+  for (const chunk of captureChunks(capture, port)) {
+    for (const piece of pieces(chunk)) {
+      decoder.push(piece.bytes, piece.time);
+      await drain();
+      if (out.stopped) return finish(out, 0);
+    }
+  }
+  decoder.end();
+  await drain();
+  await out.end();
+  if (out.stopped) return finish(out, 0);
   const s = decoder.stats;
   if (s.frames === 0) {
-    process.stderr.write(`satscope: ${args.file}: no Spektrum frames found in ${s.bytes} bytes (is this the satellite's DATA line at 115200 baud?)\n`);
+    process.stderr.write(`satscope: ${args.file}: no Spektrum frames found in ${s.bytes} bytes on port ${port} (is this the satellite's DATA line at 115200 baud?)\n`);
     return 1;
   }
   if (s.discardedBytes > 0) {
@@ -174,8 +165,21 @@ function main(argv: string[]): number {
   return 0;
 }
 
+/**
+ * The exit code once the output is written: `code`, or 1 when writing failed. A reader that
+ * stopped early (`| head`) is a normal end and keeps `code`.
+ */
+async function finish(out: TextOutput, code: number): Promise<number> {
+  await out.end();
+  if (out.error !== null) {
+    process.stderr.write(`satscope: cannot write the output: ${out.error.code ?? out.error.message}\n`);
+    return 1;
+  }
+  return code;
+}
+
 /** `satscope report`: the health report of every port, as HTML or JSON, to stdout or --out. */
-function report(capture: Capture, args: Args): number {
+function report(capture: Capture, args: Args, out: TextOutput): Promise<number> {
   const name = basename(args.file);
   const r = healthReport(capture, { resolution: args.resolution, name });
   const text = args.json ? `${JSON.stringify(r, null, 2)}\n` : reportHtml(r);
@@ -186,23 +190,18 @@ function report(capture: Capture, args: Args): number {
       const code = (error as NodeJS.ErrnoException).code;
       const why = code === 'ENOENT' ? 'no such directory' : code === 'EISDIR' ? 'it is a directory' : code === 'EACCES' ? 'permission denied' : String(error);
       process.stderr.write(`satscope: cannot write ${args.out}: ${why}\n`);
-      return 2;
+      return Promise.resolve(2);
     }
-    process.stdout.write(`${formatReportVerdict(r, args.out)}\n`);
+    out.text(`${formatReportVerdict(r, args.out)}\n`);
   } else {
-    process.stdout.write(text);
+    out.text(text);
   }
   const frames = r.remotes.reduce((n, x) => n + x.frames, 0);
   if (frames === 0) {
     process.stderr.write(`satscope: ${args.file}: no Spektrum frames found in ${r.source.bytes} bytes (is this the satellite's DATA line at 115200 baud?)\n`);
-    return 1;
+    return finish(out, 1);
   }
-  return 0;
+  return finish(out, 0);
 }
 
-// A reader that stops early (`| head`) closes the pipe: that is not an error.
-process.stdout.on('error', (error: NodeJS.ErrnoException) => {
-  if (error.code === 'EPIPE') process.exit(0);
-  throw error;
-});
-process.exitCode = main(process.argv.slice(2));
+process.exitCode = await main(process.argv.slice(2));

@@ -6,7 +6,7 @@
 
 import {
   CaptureFormatError,
-  hasCaptureMagic,
+  looksLikeCaptureMagic,
   isCaptureMagicPrefix,
   parseCapture,
   CAPTURE_FILE_EXTENSION,
@@ -542,13 +542,13 @@ function hasExtension(fileName: string | undefined, ext: string): boolean {
 /**
  * Reads any supported capture file, deciding by content (the name is only a hint):
  *
- * 1. the .sscap signature (or a `.sscap` name) → `parseCapture`;
+ * 1. the .sscap signature, even with up to two bits flipped (or a `.sscap` name) → `parseCapture`;
  * 2. text whose first line is a Saleae async-serial header → `importSaleaeCsv`;
  * 3. a `.bin` name, or content that is not text → `importRaw`;
  * 4. any other text (JSON, a README…) → `CaptureFormatError`.
  *
- * @throws {CaptureFormatError} for an empty file, a damaged .sscap header, or text that is not
- *   a Saleae async-serial CSV.
+ * @throws {CaptureFormatError} for an empty file, a .sscap with nothing to recover (see
+ *   `parseCapture`), or text that is not a Saleae async-serial CSV.
  * @throws {TypeError} when `bytes` is not a Uint8Array.
  */
 export function readCapture(bytes: Uint8Array, fileName?: string): Capture {
@@ -557,7 +557,7 @@ export function readCapture(bytes: Uint8Array, fileName?: string): Capture {
   if (bytes.length === 0) throw new CaptureFormatError(`empty file${named}: there is nothing to decode`);
   const isBin = hasExtension(fileName, '.bin');
   // A file shorter than the signature that matches its start is a cut-off .sscap, unless named .bin.
-  if (hasCaptureMagic(bytes) || (!isBin && isCaptureMagicPrefix(bytes)) || hasExtension(fileName, CAPTURE_FILE_EXTENSION)) {
+  if (looksLikeCaptureMagic(bytes) || (!isBin && isCaptureMagicPrefix(bytes)) || hasExtension(fileName, CAPTURE_FILE_EXTENSION)) {
     return parseCapture(bytes);
   }
   const text = looksLikeText(bytes);
