@@ -112,6 +112,8 @@ const RESTART_MIN_GAP_US = 100_000;
 /** Seconds with fades on two remotes or more, out of the seconds with fades on any, above which they fade together. */
 const TOGETHER_RATIO = 0.6;
 const TOGETHER_MIN_SECONDS = 3;
+/** Fades in the last 10 s before a fade rate is judged. */
+const MIN_FADES = 5;
 /** Frames a remote must have sent before its format counts for setup findings. */
 const SETUP_MIN_FRAMES = 20;
 /** Guess decisions before predicting ArduPilot's or PX4's outcome. */
@@ -198,6 +200,8 @@ interface PortState {
   frames: number;
   guess: StackGuess;
   px4Rejected: number;
+  /** Frames whose system byte demands the other reading than the data's: PX4 resets its guess on each. */
+  px4Conflicts: number;
   xplusMask: number;
   xplusFirstUs: number;
   vtxFrames: number;
@@ -266,7 +270,7 @@ export class Doctor {
         burst: new BurstClock(),
         confirmed: null,
         probePackets: { ibus: 0, 'srxl-v1': 0, srxl2: 0, crsf: 0, sbus: 0 },
-        frames: 0, guess: new StackGuess(), px4Rejected: 0, xplusMask: 0, xplusFirstUs: NaN, vtxFrames: 0, vtxFirstUs: NaN,
+        frames: 0, guess: new StackGuess(), px4Rejected: 0, px4Conflicts: 0, xplusMask: 0, xplusFirstUs: NaN, vtxFrames: 0, vtxFirstUs: NaN,
         prevFades: null, prevFrameUs: NaN, prevMissed: 0, first: null, changes: [], restarts: [], rssiFrames: 0,
       };
       p = state;
@@ -369,7 +373,9 @@ export class Doctor {
     p.frames++;
     p.bins.add(M_FRAME_BYTES, t, FRAME_SIZE);
     p.guess.frame(f.words);
-    if (!px4AcceptsSystemByte(f.bytes[1] as number)) p.px4Rejected++;
+    const byte1 = f.bytes[1] as number;
+    if (!px4AcceptsSystemByte(byte1)) p.px4Rejected++;
+    else if ((byte1 === 0x01) !== (f.resolution === 1024)) p.px4Conflicts++;
     for (let i = 0; i < f.count; i++) {
       const id = f.ids[i] as number;
       if (id >= 12) {
@@ -690,7 +696,7 @@ export class Doctor {
     const want = resolution === 2048 ? 11 : 10;
     const apBad = decisions >= GUESS_MIN_DECISIONS && g.ardupilot[want] < decisions / 2;
     const px4Decisions = g.px4[10] + g.px4[11] + g.px4.none;
-    const px4Bad = (px4Decisions >= GUESS_MIN_DECISIONS && g.px4[want] < px4Decisions / 2) || p.px4Rejected > p.frames / 2;
+    const px4Bad = (px4Decisions >= GUESS_MIN_DECISIONS && g.px4[want] < px4Decisions / 2) || p.px4Rejected > p.frames / 2 || p.px4Conflicts > p.frames / 2;
     if (apBad || px4Bad) {
       add({
         code: 'autopilot-detection', ports: [p.port], severity: 'warning', confidence: 'likely',
@@ -715,7 +721,9 @@ export class Doctor {
     const failsafes = episodes.filter((e) => e.kind === 'failsafe');
     const holds = episodes.filter((e) => e.kind === 'hold' && !failsafes.some((f) => f.lastFrameUs === e.lastFrameUs));
     const fadesPerMin = s.fadeRate * 60;
-    const fadeHigh = format.headerMode === 'fades' && fadesPerMin > REPORT_THRESHOLDS.fadeRateHighPerMin;
+    // A rate needs a few fades behind it: one corrupted header is not a weak link.
+    const recentFades = p.bins.sum(M_FADES, Math.floor(now / 1e6) - 9, Math.floor(now / 1e6));
+    const fadeHigh = format.headerMode === 'fades' && fadesPerMin > REPORT_THRESHOLDS.fadeRateHighPerMin && recentFades >= MIN_FADES;
     const rssiLow = Number.isFinite(s.minRssi) && s.minRssi < REPORT_THRESHOLDS.rssiLowDbm;
     if (failsafes.length > 0 || holds.length > 0 || fadeHigh || rssiLow) {
       const evidence: Evidence[] = [];
@@ -793,6 +801,7 @@ export class Doctor {
     };
     let px4 = say(g.px4, 'PX4');
     if (p.px4Rejected > 0) px4 += ` It drops frames whose byte 1 is not a system value: ${p.px4Rejected} of ${p.frames}.`;
+    if (p.px4Conflicts > 0) px4 += ` Byte 1 names the other resolution than the channel IDs show in ${p.px4Conflicts} of ${p.frames} frames: PX4 starts its guess over on each, so it never outputs.`;
     return { ardupilot: say(g.ardupilot, 'ArduPilot'), px4 };
   }
 
