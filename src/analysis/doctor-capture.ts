@@ -13,7 +13,7 @@ import { Doctor, type DoctorCode, type DoctorFinding, type Severity } from './do
 export interface DoctorCaptureOptions {
   /** Resolution override for every port's decoder. Default 'auto'. */
   resolution?: 'auto' | Resolution;
-  /** How often the findings are taken for the timeline, µs of capture time. Default 1 s. */
+  /** How often the findings are taken for the timeline, µs of capture time. Default 250 ms. */
   stepUs?: number;
 }
 
@@ -33,7 +33,7 @@ export interface DoctorReport {
   format: 'satscope-doctor';
   version: 1;
   source: { kind: CaptureKind; timing: CaptureTiming; ports: number[]; bytes: number; startUs: number | null; endUs: number | null };
-  /** The findings at the end of the capture, worst first (times on the capture's clock). */
+  /** The findings at the end of the capture, worst first (times on the capture's clock; sentences count from `source.startUs`). */
   findings: DoctorFinding[];
   /** Every finding seen along the way, with when it held, in order of appearance. */
   timeline: DoctorTimelineEntry[];
@@ -64,22 +64,12 @@ const SLICE_BYTES = 256;
  * timeline of findings along the way. Never throws on the capture's content.
  */
 export function doctorCapture(capture: Capture, options: DoctorCaptureOptions = {}): DoctorReport {
-  const step = options.stepUs ?? 1_000_000;
+  const step = options.stepUs ?? 250_000;
   if (!(step > 0)) throw new TypeError(`stepUs must be positive, not ${step}`);
   const timed = capture.timing !== 'none';
-  const doctor = new Doctor({ timing: capture.timing === 'per-byte' ? 'per-byte' : 'per-chunk', memoryUs: Infinity });
   const ports = new Set(capturePorts(capture));
   for (const e of capture.events) ports.add(e.port);
   const sorted = [...ports].sort((a, b) => a - b);
-  const names = capture.meta.ports;
-  const sources = new Map<number, { decoder: SpektrumDecoder; link: LinkMonitor }>();
-  for (const port of sorted) {
-    const decoder = new SpektrumDecoder({ resolution: options.resolution ?? 'auto' });
-    const link = new LinkMonitor({ jitterUs: capture.timing === 'per-chunk' ? USB_CHUNK_JITTER_US : 0 });
-    sources.set(port, { decoder, link });
-    const label = names?.[port]?.name;
-    doctor.attach(port, { decoder, link, label: typeof label === 'string' && label !== '' ? label : `Port ${port}` });
-  }
 
   // Everything in arrival order: data pieces and events.
   const pieces: Piece[] = [];
@@ -112,6 +102,20 @@ export function doctorCapture(capture: Capture, options: DoctorCaptureOptions = 
   pushEvents(Infinity);
   // Per-byte captures hold one chunk per port: put the ports' slices back in time order.
   if (capture.timing === 'per-byte') pieces.sort((a, b) => (Number.isFinite(a.timeUs) && Number.isFinite(b.timeUs) ? a.timeUs - b.timeUs : 0) || a.order - b.order);
+
+  // Time zero of the evidence sentences: the capture's first time, as in the health report.
+  let origin = Infinity;
+  for (const piece of pieces) if (piece.timeUs < origin) origin = piece.timeUs;
+  const doctor = new Doctor({ timing: capture.timing === 'per-byte' ? 'per-byte' : 'per-chunk', memoryUs: Infinity, originUs: Number.isFinite(origin) ? origin : 0 });
+  const names = capture.meta.ports;
+  const sources = new Map<number, { decoder: SpektrumDecoder; link: LinkMonitor }>();
+  for (const port of sorted) {
+    const decoder = new SpektrumDecoder({ resolution: options.resolution ?? 'auto' });
+    const link = new LinkMonitor({ jitterUs: capture.timing === 'per-chunk' ? USB_CHUNK_JITTER_US : 0 });
+    sources.set(port, { decoder, link });
+    const label = names?.[port]?.name;
+    doctor.attach(port, { decoder, link, label: typeof label === 'string' && label !== '' ? label : `Port ${port}` });
+  }
 
   const timeline: DoctorTimelineEntry[] = [];
   const open = new Map<string, DoctorTimelineEntry>();
@@ -186,10 +190,12 @@ export function doctorCapture(capture: Capture, options: DoctorCaptureOptions = 
   const end = Number.isFinite(now) ? now : 0;
   for (const s of sources.values()) s.link.update(end);
   const findings = sample(end);
+  // Times are real when the capture has timing, or holds only events (which always have times).
+  const real = timed || bytes === 0;
   return {
     format: 'satscope-doctor',
     version: 1,
-    source: { kind: capture.kind, timing: capture.timing, ports: sorted, bytes, startUs: Number.isFinite(start) && timed ? start : null, endUs: Number.isFinite(now) && timed ? now : null },
+    source: { kind: capture.kind, timing: capture.timing, ports: sorted, bytes, startUs: Number.isFinite(origin) && real ? origin : null, endUs: Number.isFinite(now) && real ? now : null },
     findings,
     timeline,
   };

@@ -87,6 +87,12 @@ export interface DoctorOptions {
   timing?: 'per-byte' | 'per-chunk';
   /** How far back link findings (holds, failsafes, fades, restarts, rebinds) look, µs. Default 60 s; a whole capture: Infinity. */
   memoryUs?: number;
+  /**
+   * Time zero for the times written in the evidence sentences ("at 12.3 s"), µs on the
+   * caller's clock: the session's start, or a capture's first time. Default 0. `Evidence.timeUs`
+   * stays on the caller's clock.
+   */
+  originUs?: number;
 }
 
 /** What a port's source gives the doctor to read. */
@@ -218,7 +224,8 @@ interface PortState {
 const SEVERITY_ORDER: Record<Severity, number> = { problem: 0, warning: 1, info: 2 };
 const CONFIDENCE_ORDER: Record<Confidence, number> = { certain: 0, likely: 1, possible: 2 };
 
-const sec = (us: number): string => `${(us / 1e6).toFixed(1)} s`;
+/** "2.4 s" */
+const dur = (us: number): string => `${(us / 1e6).toFixed(1)} s`;
 const plural = (n: number, one: string, many = `${one}s`): string => `${n} ${n === 1 ? one : many}`;
 
 /** Advice from spec §5 for a weak link. */
@@ -247,6 +254,7 @@ export class Doctor {
   readonly #precise: boolean;
   readonly #memoryUs: number;
   readonly #since = new Map<string, number>();
+  readonly #originUs: number;
 
   /** @throws {TypeError} on an option out of range. */
   constructor(options: DoctorOptions = {}) {
@@ -254,8 +262,16 @@ export class Doctor {
     if (timing !== 'per-byte' && timing !== 'per-chunk') throw new TypeError(`timing must be 'per-byte' or 'per-chunk', not ${String(timing)}`);
     const memory = options.memoryUs ?? 60_000_000;
     if (!(memory > 0)) throw new TypeError(`memoryUs must be positive, not ${memory}`);
+    const origin = options.originUs ?? 0;
+    if (!Number.isFinite(origin)) throw new TypeError(`originUs must be a finite number, not ${origin}`);
     this.#precise = timing === 'per-byte';
     this.#memoryUs = memory;
+    this.#originUs = origin;
+  }
+
+  /** A time in a sentence, from the origin. Durations use `dur`. */
+  #at(us: number): string {
+    return dur(us - this.#originUs);
   }
 
   #port(port: number): PortState {
@@ -457,7 +473,7 @@ export class Doctor {
       code: 'nothing-arrives', ports: [p.port], severity: 'problem',
       confidence: silent >= NOTHING_CERTAIN_US ? 'certain' : 'likely',
       title: `${p.label}: nothing arrives`,
-      evidence: [{ text: `No byte and no line error in ${sec(silent)} since the port opened at ${p.baudRate} baud; a satellite with a link sends a frame every 11 or 22 ms, and nothing at all without one (spec §7.1).`, timeUs: p.openUs }],
+      evidence: [{ text: `No byte and no line error in ${dur(silent)} since the port opened at ${p.baudRate} baud; a satellite with a link sends a frame every 11 or 22 ms, and nothing at all without one (spec §7.1).`, timeUs: p.openUs }],
       todo: NOTHING_TODO,
       settings: [], confirm: null, sinceUs: p.openUs + NOTHING_AFTER_US,
     });
@@ -668,7 +684,7 @@ export class Doctor {
       add({
         code: 'xplus-channels', ports: [p.port], severity: 'warning', confidence: 'certain',
         title: `${p.label}: X-Plus channels ${names.join(', ')} are sent; flight controllers drop or mix them`,
-        evidence: [{ text: `X-Plus channels (ID 12 with a sub-ID, spec §8.6) seen since ${sec(p.xplusFirstUs)}.`, timeUs: p.xplusFirstUs }],
+        evidence: [{ text: `X-Plus channels (ID 12 with a sub-ID, spec §8.6) seen since ${this.#at(p.xplusFirstUs)}.`, timeUs: p.xplusFirstUs }],
         todo: [
           'Betaflight and iNav read channel IDs 0–11 only (SPEKTRUM_MAX_SUPPORTED_CHANNEL_COUNT 12): X-Plus channels are dropped.',
           'ArduPilot reads ID 12 as one channel whatever the sub-ID, so every X-Plus channel lands on the same input; PX4 maps X+5…X+8 onto X+1…X+4 (its phase test never fires).',
@@ -682,7 +698,7 @@ export class Doctor {
       add({
         code: 'vtx-frames', ports: [p.port], severity: 'info', confidence: 'certain',
         title: `${p.label}: the transmitter sends VTX control in the channel slots`,
-        evidence: [{ text: `${plural(p.vtxFrames, 'frame')} carried Spektrum VTX control in bytes 12–15 (0xE… 0xE…), first at ${sec(p.vtxFirstUs)}.`, timeUs: p.vtxFirstUs }],
+        evidence: [{ text: `${plural(p.vtxFrames, 'frame')} carried Spektrum VTX control in bytes 12–15 (0xE… 0xE…), first at ${this.#at(p.vtxFirstUs)}.`, timeUs: p.vtxFirstUs }],
         todo: [
           'Betaflight builds with USE_SPEKTRUM_VTX_CONTROL take these out and set the VTX; a stack or build without it reads the two words as channel 12 (X-Plus) data, and ArduPilot/PX4 channel-ID guesses may reset while they come.',
           'Turn VTX control off in the transmitter if the flight controller does not use it.',
@@ -727,10 +743,10 @@ export class Doctor {
     const rssiLow = Number.isFinite(s.minRssi) && s.minRssi < REPORT_THRESHOLDS.rssiLowDbm;
     if (failsafes.length > 0 || holds.length > 0 || fadeHigh || rssiLow) {
       const evidence: Evidence[] = [];
-      for (const e of failsafes.slice(-5)) evidence.push({ text: `Failsafe: no frame for over 1 s after ${sec(e.lastFrameUs)}${e.endUs === null ? ', still now' : `, back at ${sec(e.endUs)}`} (spec §7.1).`, timeUs: e.startUs });
+      for (const e of failsafes.slice(-5)) evidence.push({ text: `Failsafe: no frame for over 1 s after ${this.#at(e.lastFrameUs)}${e.endUs === null ? ', still now' : `, back at ${this.#at(e.endUs)}`} (spec §7.1).`, timeUs: e.startUs });
       if (holds.length > 0) {
         const last = holds[holds.length - 1] as (typeof holds)[number];
-        evidence.push({ text: `${plural(holds.length, 'hold')} (frames stopped, last values held, recovered), the last at ${sec(last.startUs)}.`, timeUs: last.startUs });
+        evidence.push({ text: `${plural(holds.length, 'hold')} (frames stopped, last values held, recovered), the last at ${this.#at(last.startUs)}.`, timeUs: last.startUs });
       }
       if (fadeHigh) evidence.push({ text: `Fade rate ${fadesPerMin.toFixed(0)} a minute over the last ~500 frames (over ${REPORT_THRESHOLDS.fadeRateHighPerMin} a minute is high).`, timeUs: null });
       if (rssiLow) evidence.push({ text: `RSSI down to ${s.minRssi} dBm (below ${REPORT_THRESHOLDS.rssiLowDbm} dBm leaves little margin).`, timeUs: null });
@@ -752,7 +768,7 @@ export class Doctor {
       add({
         code: 'rebind', ports: [p.port], severity: 'warning', confidence: 'certain',
         title: `${p.label}: the receiver changed mode mid-session (a rebind?)`,
-        evidence: [{ text: `From ${name(c.from)} to ${name(c.to)} at ${sec(c.timeUs)}.`, timeUs: c.timeUs }],
+        evidence: [{ text: `From ${name(c.from)} to ${name(c.to)} at ${this.#at(c.timeUs)}.`, timeUs: c.timeUs }],
         todo: [
           'A satellite changes mode only when it is bound again: check that the flight controller does not send bind pulses at every power-up (Betaflight/iNav: spektrum_sat_bind back to 0, or spektrum_sat_bind_autoreset on).',
           `Set the flight controller for the new mode: ${c.to.resolution === 2048 ? 'SPEK2048' : 'SPEK1024'}.`,
@@ -766,7 +782,7 @@ export class Doctor {
       add({
         code: 'receiver-restart', ports: [p.port], severity: 'warning', confidence: 'likely',
         title: `${p.label}: the receiver restarted (power dip?)`,
-        evidence: [{ text: `${plural(restarts.length, 'restart')}: the fade counter went from ${r.from} back to ${r.to} after ${sec(r.gapUs)} without frames, at ${sec(r.timeUs)}; a counter only starts again from 0 at power-up.`, timeUs: r.timeUs }],
+        evidence: [{ text: `${plural(restarts.length, 'restart')}: the fade counter went from ${r.from} back to ${r.to} after ${dur(r.gapUs)} without frames, at ${this.#at(r.timeUs)}; a counter only starts again from 0 at power-up.`, timeUs: r.timeUs }],
         todo: [
           'Check the 3.3 V supply (orange) under load: a brown-out restarts the satellite; power it from a regulator that does not sag when motors or servos draw current.',
           'Check the connector and wires for an intermittent contact.',
@@ -875,7 +891,7 @@ export class Doctor {
       add({
         code: 'fades-together', ports: all, severity: 'warning', confidence: 'likely',
         title: 'The remotes fade together',
-        evidence: [{ text: `In ${together} of the ${any} seconds with fades or lost frames, two remotes or more lost frames in the same second (first at ${sec(firstTogether)}).`, timeUs: firstTogether }],
+        evidence: [{ text: `In ${together} of the ${any} seconds with fades or lost frames, two remotes or more lost frames in the same second (first at ${this.#at(firstTogether)}).`, timeUs: firstTogether }],
         todo: [
           'A cause common to all remotes, not one remote\'s placement: the transmitter (range, antenna orientation, battery), or something on board that blankets every receiver (a VTX antenna next to them, ESC or motor noise).',
           'A power dip also stops every remote at once: check the 3.3 V supply they share.',
