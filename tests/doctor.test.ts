@@ -209,11 +209,44 @@ describe('bytes that are not a satellite stream', () => {
     expect(codes(after)).not.toContain('wrong-speed');
   });
 
+  it('says clean bytes at 115200 that are no known protocol (here GPS sentences) are not a satellite, after giving a decoder time to lock', () => {
+    const s = new Session();
+    const sentence = new TextEncoder().encode('$GPGGA,123519,4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,*47\r\n');
+    const n = 30;
+    const bytes = new Uint8Array(sentence.length * n);
+    const timesUs = new Float64Array(bytes.length);
+    for (let k = 0; k < n; k++) {
+      bytes.set(sentence, k * sentence.length);
+      for (let j = 0; j < sentence.length; j++) timesUs[k * sentence.length + j] = 1000 + k * 100_000 + j * 86.8;
+    }
+    s.feed(0, { bytes, timesUs });
+    expect(codes(s.findings(1 * SECOND))).not.toContain('unknown-stream');
+    expect(find(s.findings(3 * SECOND), 'unknown-stream').title).toMatch(/clean bytes at 115200, but not Spektrum frames/);
+  });
+
   it('calls a line of random levels noise and asks for a ground', () => {
     const s = new Session();
     s.feed(0, uartReceive(noiseSignal({ durationUs: 3 * SECOND })));
     const f = find(s.findings(3 * SECOND), 'noise');
     expect(f.todo[0]).toMatch(/GND/);
+  });
+
+  it('never takes a satellite for something else, from its first bytes on, even on a damaged line', () => {
+    for (const name of ['dsmx-11ms-2048-internal', 'dsm2-22ms-1024-external', 'clone-zero-header', 'damaged-line', 'dropouts-and-damage', 'rssi-spm4649t']) {
+      const s = new Session();
+      s.doctor.open(0, 0);
+      const sim = satellite(preset(name), 3 * SECOND, 20_000);
+      for (let t = 50_000; t <= 3 * SECOND; t += 50_000) {
+        let end = 0;
+        while (end < sim.bytes.length && sim.timesUs[end]! < t) end++;
+        const fed = t - 50_000;
+        let start = 0;
+        while (start < sim.bytes.length && sim.timesUs[start]! < fed) start++;
+        s.feed(0, { bytes: sim.bytes.subarray(start, end), timesUs: sim.timesUs.subarray(start, end) });
+        const wrong = s.findings(t).filter((f) => ['inverted-line', 'srxl-v1', 'srxl2', 'ibus', 'sbus', 'crsf', 'wrong-speed', 'noise', 'unknown-stream', 'nothing-arrives'].includes(f.code));
+        expect(wrong.map((f) => `${name} at ${t}: ${f.code}`)).toEqual([]);
+      }
+    }
   });
 
   it('clears a line finding once the satellite\'s own frames have filled the window', () => {
@@ -343,6 +376,16 @@ describe('a weak link', () => {
     expect(f.todo[0]).toMatch(/common to all remotes/);
   });
 
+  it('does not say remotes fade together when one also fades often on its own', () => {
+    const s = new Session();
+    const shared = [1, 3, 5].map((at) => ({ atUs: at * SECOND, durationUs: 0.1 * SECOND }));
+    const alone = [0.5, 1.6, 2.2, 2.6, 3.6, 4.2, 4.6, 5.6, 6.2, 6.6, 7.2].map((at) => ({ atUs: at * SECOND, durationUs: 0.1 * SECOND }));
+    s.feed(0, satellite({ ...preset('dsmx-11ms-2048-internal'), dropouts: [...shared, ...alone], fades: { lossRate: 0, randomRate: 0 } }, 8 * SECOND));
+    s.feed(1, satellite({ ...preset('dsmx-11ms-2048-external'), dropouts: shared, fades: { lossRate: 0, randomRate: 0 } }, 8 * SECOND));
+    expect(codes(s.findings(8 * SECOND))).not.toContain('fades-together');
+    expect(find(s.findings(8 * SECOND), 'weakest-remote').ports).toEqual([0]);
+  });
+
   it('does not say remotes fade together when they fade at different times', () => {
     const s = new Session();
     s.feed(0, satellite({ ...preset('dsmx-11ms-2048-internal'), dropouts: [1, 3, 5].map((at) => ({ atUs: at * SECOND, durationUs: 0.1 * SECOND })), fades: { lossRate: 0, randomRate: 0 } }, 8 * SECOND));
@@ -398,8 +441,11 @@ describe('a wrong setup', () => {
 
   it('does not take a fade counter that wraps during a dropout for a restart', () => {
     const s = new Session({ timing: 'per-byte' });
-    s.feed(0, satellite({ ...preset('dsmx-11ms-2048-internal'), fades: { start: 200, lossRate: 0 }, dropouts: [{ atUs: 1 * SECOND, durationUs: 0.9 * SECOND }] }, 3 * SECOND));
-    expect(codes(s.findings(3 * SECOND))).not.toContain('receiver-restart');
+    // 120 + ~164 missed frames: the 8-bit counter wraps to ~28 while nothing is sent.
+    s.feed(0, satellite({ ...preset('dsmx-11ms-2048-internal'), fades: { start: 120, lossRate: 0, randomRate: 0 }, dropouts: [{ atUs: 1 * SECOND, durationUs: 1.8 * SECOND }] }, 4 * SECOND));
+    const last = s.ports.get(0)!.decoder;
+    expect(last.format.headerMode).toBe('fades');
+    expect(codes(s.findings(4 * SECOND))).not.toContain('receiver-restart');
   });
 
   it('explains an SPM4649T\'s RSSI byte', () => {

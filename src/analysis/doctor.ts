@@ -118,6 +118,8 @@ const RESTART_MIN_GAP_US = 100_000;
 /** Seconds with fades on two remotes or more, out of the seconds with fades on any, above which they fade together. */
 const TOGETHER_RATIO = 0.6;
 const TOGETHER_MIN_SECONDS = 3;
+/** Clean bytes that decode as nothing are judged only after this long (a satellite locks within a few frames). */
+const UNKNOWN_AFTER_US = 1_500_000;
 /** Fades in the last 10 s before a fade rate is judged. */
 const MIN_FADES = 5;
 /** Frames a remote must have sent before its format counts for setup findings. */
@@ -609,6 +611,8 @@ export class Doctor {
         });
         return;
       case 'unknown-115200':
+        // A satellite's first frames wait for the decoder's evidence: give it time to lock.
+        if (now - p.firstActivityUs < UNKNOWN_AFTER_US || p.source?.decoder.format.locked === true) return;
         add({
           code: 'unknown-stream', ports: [p.port], severity: 'warning', confidence: 'possible',
           title: `${p.label}: clean bytes at 115200, but not Spektrum frames`,
