@@ -3,9 +3,11 @@
  * model, fed as a USB adapter would deliver it (chunks of ~16 ms stamped at their end) or with
  * per-byte times, and the finding's appearance and clearing.
  */
+import { existsSync, readFileSync } from 'node:fs';
+import { join, resolve } from 'node:path';
 import { describe, expect, it } from 'vitest';
 import { Doctor, doctorCapture, type DoctorFinding, type DoctorOptions } from '../src/analysis/index.js';
-import { CaptureWriter, LinkMonitor, readCapture, SpektrumDecoder, USB_CHUNK_JITTER_US } from '../src/decoder/index.js';
+import { CaptureWriter, importSaleaeCsv, LinkMonitor, readCapture, SpektrumDecoder, USB_CHUNK_JITTER_US } from '../src/decoder/index.js';
 import {
   crsfStream, ibusStream, noiseSignal, preset, receiveAs, sbusStream, simulate, spektrumTransmission, srxl2Stream, srxlV1Stream, uartReceive,
   type Scenario, type UartResult,
@@ -290,14 +292,14 @@ describe('a satellite stream the flight controller will read wrong', () => {
     expect(find(s.findings(3 * SECOND), 'bind-mode').todo[0]).toMatch(/external: 10 pulses.*spektrum_sat_bind = 10/);
   });
 
-  it('warns when the system byte says 2048 but the data is 1024, and that PX4 will not read it', () => {
+  it('warns when the system byte says 2048 but the data is 1024, and asks for SPEK1024', () => {
     const s = new Session();
     s.feed(0, satellite(preset('lying-b2-with-1024-data'), 3 * SECOND));
     const fs = s.findings(3 * SECOND);
     const f = find(fs, 'system-byte-contradicted');
     expect(f.todo[0]).toMatch(/SPEK1024/);
-    expect(f.todo[1]).toMatch(/PX4/);
-    expect(find(fs, 'autopilot-detection').title).toMatch(/PX4/);
+    expect(f.todo[1]).toMatch(/ArduPilot and PX4 ignore the system byte/);
+    expect(settingLines(find(fs, 'fc-settings'), 'Betaflight')).toContain('set serialrx_provider = SPEK1024');
   });
 
   it('warns that X-Plus channels are dropped or mixed by the flight stacks', () => {
@@ -314,23 +316,22 @@ describe('a satellite stream the flight controller will read wrong', () => {
     expect(find(s.findings(3 * SECOND), 'vtx-frames').evidence[0]!.text).toMatch(/bytes 12–15/);
   });
 
-  it('predicts that ArduPilot\'s and PX4\'s channel-ID guess never settles on 12 channels, and does on 10', () => {
-    const twelve = new Session();
-    twelve.feed(0, satellite(preset('empty-slots-12ch'), 3 * SECOND));
-    const f = find(twelve.findings(3 * SECOND), 'autopilot-detection');
-    expect(f.evidence[0]!.text).toMatch(/11-bit: 0–11/);
-    expect(f.evidence[1]!.text).toMatch(/ArduPilot: its 10\/11-bit guess never settles/);
-    const ten = new Session();
-    ten.feed(0, satellite(preset('dsmx-11ms-2048-internal'), 3 * SECOND));
-    expect(codes(ten.findings(3 * SECOND))).not.toContain('autopilot-detection');
+  it('predicts that ArduPilot\'s guess never settles on 1024 frames of 10 channels, whose 11-bit reading also looks right', () => {
+    const s = new Session();
+    s.feed(0, satellite({ ...preset('dsm2-22ms-1024-internal'), channels: 10 }, 3 * SECOND));
+    const f = find(s.findings(3 * SECOND), 'autopilot-detection');
+    expect(f.evidence[0]!.text).toMatch(/as 11-bit: 0–4; as 10-bit: 0–9/);
+    expect(f.evidence[1]!.text).toMatch(/never settles/);
   });
 
-  it('says PX4 drops an external remote\'s frames (no system byte)', () => {
-    const s = new Session();
-    s.feed(0, satellite(preset('dsmx-11ms-2048-external'), 3 * SECOND));
-    const f = find(s.findings(3 * SECOND), 'autopilot-detection');
-    expect(f.title).toMatch(/PX4/);
-    expect(f.todo.join(' ')).toMatch(/internal \("A"\) remote to PX4/);
+  it('predicts that ArduPilot settles on 11-bit for 2048 streams of 10 and 12 channels, with X-Plus and VTX', () => {
+    for (const name of ['dsmx-11ms-2048-internal', 'empty-slots-12ch', 'xplus-dx9', 'vtx', 'dsmx-11ms-2048-external']) {
+      const s = new Session();
+      s.feed(0, satellite(preset(name), 3 * SECOND));
+      const fs = s.findings(3 * SECOND);
+      expect(codes(fs)).not.toContain('autopilot-detection');
+      expect(find(fs, 'fc-settings').settings.find((x) => x.stack === 'ArduPilot')!.note).toMatch(/settles on 11-bit/);
+    }
   });
 });
 
@@ -488,5 +489,26 @@ describe('doctorCapture', () => {
     }
     const r = doctorCapture(readCapture(concatBytes(parts), 'sbus.sscap'));
     expect(r.findings.map((f) => f.code)).toContain('sbus');
+  });
+});
+
+const px4 = resolve(import.meta.dirname, '../../shared/captures/px4');
+describe.skipIf(!existsSync(px4))('the real PX4 captures', () => {
+  it('find only what is true of them: the settings, and X-Plus on the DX9 ones; no weak link, nothing foreign', () => {
+    const expected: Record<string, string[]> = {
+      'dsm_x_data.txt': ['fc-settings'],
+      'dsm_x_dx9_data.txt': ['xplus-channels', 'fc-settings'],
+      'dsm_x_dx9_px4_binding_data.txt': ['xplus-channels', 'fc-settings'],
+    };
+    for (const [name, want] of Object.entries(expected)) {
+      const capture = importSaleaeCsv(new Uint8Array(readFileSync(join(px4, name))));
+      const r = doctorCapture(capture);
+      expect([name, ...r.timeline.map((e) => e.code)]).toEqual([name, ...want]);
+      // The same bytes as a USB adapter delivers them: 16 ms chunks stamped at their end.
+      const s = new Session();
+      s.feed(0, { bytes: capture.bytes, timesUs: capture.byteTimesUs! });
+      const end = capture.byteTimesUs![capture.byteTimesUs!.length - 1]!;
+      expect([name, ...s.findings(end).map((f) => f.code)]).toEqual([name, ...want]);
+    }
   });
 });

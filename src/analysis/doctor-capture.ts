@@ -50,7 +50,10 @@ interface Piece {
   kind: 'data' | 'event';
   port: number;
   order: number;
+  /** The time of its last byte (data) or the event's time. */
   timeUs: number;
+  /** The earliest time anything in it can carry: its first byte's (estimated for a chunk). */
+  firstUs: number;
   bytes?: Uint8Array;
   time?: number | Float64Array;
   text?: string;
@@ -80,7 +83,7 @@ export function doctorCapture(capture: Capture, options: DoctorCaptureOptions = 
   const pushEvents = (upTo: number): void => {
     while (events < evs.length && (evs[events] as (typeof evs)[number]).chunkIndex <= upTo) {
       const e = evs[events++] as (typeof evs)[number];
-      pieces.push({ kind: 'event', port: e.port, order: order++, timeUs: e.timeUs, text: e.text });
+      pieces.push({ kind: 'event', port: e.port, order: order++, timeUs: e.timeUs, firstUs: e.timeUs, text: e.text });
     }
   };
   let bytes = 0;
@@ -90,13 +93,15 @@ export function doctorCapture(capture: Capture, options: DoctorCaptureOptions = 
     if (chunk.byteTimesUs !== undefined) {
       for (let s = 0; s < chunk.bytes.length; s += SLICE_BYTES) {
         const times = chunk.byteTimesUs.subarray(s, s + SLICE_BYTES);
-        pieces.push({ kind: 'data', port: chunk.port, order: order++, timeUs: times[times.length - 1] as number, bytes: chunk.bytes.subarray(s, s + SLICE_BYTES), time: times });
+        pieces.push({ kind: 'data', port: chunk.port, order: order++, timeUs: times[times.length - 1] as number, firstUs: times[0] as number, bytes: chunk.bytes.subarray(s, s + SLICE_BYTES), time: times });
       }
     } else {
       // Untimed: as if the bytes came back to back at 115200.
       offset += chunk.bytes.length;
       const t = timed ? chunk.timeUs : offset * BYTE_TIME_US;
-      pieces.push({ kind: 'data', port: chunk.port, order: order++, timeUs: t, bytes: chunk.bytes, time: timed ? chunk.time : t });
+      // A decoder dates a chunk's frames back from its arrival at 115200: none is earlier than this.
+      const first = t - (chunk.bytes.length - 1) * BYTE_TIME_US;
+      pieces.push({ kind: 'data', port: chunk.port, order: order++, timeUs: t, firstUs: first, bytes: chunk.bytes, time: timed ? chunk.time : t });
     }
   }
   pushEvents(Infinity);
@@ -105,7 +110,7 @@ export function doctorCapture(capture: Capture, options: DoctorCaptureOptions = 
 
   // Time zero of the evidence sentences: the capture's first time, as in the health report.
   let origin = Infinity;
-  for (const piece of pieces) if (piece.timeUs < origin) origin = piece.timeUs;
+  for (const piece of pieces) if (piece.firstUs < origin) origin = piece.firstUs;
   const doctor = new Doctor({ timing: capture.timing === 'per-byte' ? 'per-byte' : 'per-chunk', memoryUs: Infinity, originUs: Number.isFinite(origin) ? origin : 0 });
   const names = capture.meta.ports;
   const sources = new Map<number, { decoder: SpektrumDecoder; link: LinkMonitor }>();
@@ -152,9 +157,11 @@ export function doctorCapture(capture: Capture, options: DoctorCaptureOptions = 
     if (Number.isFinite(t)) {
       if (Number.isNaN(start)) {
         start = t;
-        nextSample = Math.floor(t / step) * step + step;
+        nextSample = Math.floor(piece.firstUs / step) * step + step;
       }
-      while (t >= nextSample) {
+      // Take the findings at each step this piece starts after: everything before it has been
+      // fed, so no link monitor is advanced past a frame it has not seen yet.
+      while (piece.firstUs >= nextSample) {
         for (const s of sources.values()) s.link.update(nextSample);
         sample(nextSample);
         nextSample += step;

@@ -12,7 +12,9 @@ export type PacketKind = (typeof PACKET_KINDS)[number];
 
 /** IBUS: 0x20 0x40, 32 bytes, checksum 0xFFFF − sum of the first 30, little-endian. */
 const IBUS_LENGTH = 32;
-/** SRXL v1 (0xA5) and SRXL2 (0xA6): byte 2 is the whole packet's length, ≤ 80 (SRXL_MAX_BUFFER_SIZE). */
+/** SRXL v1 (0xA5, Spektrum AR7700 and others): 18 bytes, CRC-16/XMODEM over the first 16 (ArduPilot's SRXL_FRAMELEN_V5). */
+const SRXL_V1_LENGTH = 18;
+/** SRXL2 (0xA6): byte 2 is the whole packet's length, ≤ 80 (SRXL_MAX_BUFFER_SIZE). */
 const SRXL_MAX_LENGTH = 80;
 const SRXL_MIN_LENGTH = 5;
 /** CRSF: sync, length (type + payload + CRC, 2…62), type, payload, CRC-8/DVB-S2. */
@@ -89,7 +91,14 @@ export class PacketScanner {
         const kind = this.#pendingKind[p] as number;
         const lengthAt = at + (kind === 2 ? 1 : 2);
         let keep = true;
-        if (k === lengthAt) {
+        if (kind === 0) {
+          // SRXL v1 has no length byte: a fixed 18 bytes.
+          if (k === at + SRXL_V1_LENGTH - 1) {
+            keep = false;
+            const crc = ((ring[(k - 1) & mask] as number) << 8) | (ring[k & mask] as number);
+            if (crc16Xmodem(ring, at, SRXL_V1_LENGTH - 2) === crc) this.onPacket('srxl-v1', k);
+          }
+        } else if (k === lengthAt) {
           const length = ring[k & mask] as number;
           keep = kind === 2 ? length >= 2 && length <= CRSF_MAX_LENGTH : length >= SRXL_MIN_LENGTH && length <= SRXL_MAX_LENGTH;
         } else if (k > lengthAt) {
@@ -102,8 +111,8 @@ export class PacketScanner {
             } else {
               const crc = ((ring[(k - 1) & mask] as number) << 8) | (ring[k & mask] as number);
               if (crc16Xmodem(ring, at, total - 2) === crc) {
-                if (kind === 1) this.lastSrxl2Type = ring[(at + 1) & mask] as number;
-                this.onPacket(kind === 0 ? 'srxl-v1' : 'srxl2', k);
+                this.lastSrxl2Type = ring[(at + 1) & mask] as number;
+                this.onPacket('srxl2', k);
               }
             }
           }

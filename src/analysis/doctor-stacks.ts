@@ -41,8 +41,10 @@ export type ForeignProtocol = 'srxl-v1' | 'srxl2' | 'ibus' | 'sbus' | 'crsf';
 
 /** The provider to select for a protocol in each stack: `null` where the stack has none. */
 export const PROTOCOL_SETTINGS: Readonly<Record<ForeignProtocol, { name: string; betaflight: string | null; inav: string | null; ardupilot: boolean; px4: boolean }>> = {
-  // Betaflight "SRXL"; iNav's serial_rx table has no SRXL v1. ArduPilot has an SRXL decoder
-  // (AP_RCProtocol_SRXL.cpp); PX4's rc_input list has none.
+  // Betaflight "SRXL": its Spektrum reader (src/main/rx/spektrum.c) takes the 16 bytes after a
+  // gap, and bytes 2–15 of an 0xA5 SRXL frame are the same seven channel words; iNav's serial_rx
+  // table has no SRXL. ArduPilot reads 0xA5 frames ("Spk AR7700 etc.", SRXL_HEADER_V5 in
+  // AP_RCProtocol_SRXL.h); PX4's rc_input list has none.
   'srxl-v1': { name: 'Spektrum SRXL (v1)', betaflight: 'SRXL', inav: null, ardupilot: true, px4: false },
   'srxl2': { name: 'Spektrum SRXL2', betaflight: 'SRXL2', inav: 'SRXL2', ardupilot: true, px4: false },
   'ibus': { name: 'FlySky IBUS', betaflight: 'IBUS', inav: 'IBUS', ardupilot: true, px4: false },
@@ -103,68 +105,68 @@ export function satelliteSettings(s: StreamFacts): StackSetting[] {
 }
 
 // ---------------------------------------------------------------------------------------------
-// The 10/11-bit guess ArduPilot and PX4 make
+// ArduPilot's 10/11-bit guess
 // ---------------------------------------------------------------------------------------------
 
 /**
- * ArduPilot (AP_RCProtocol_DSM.cpp `dsm_guess_format`) and PX4 (dsm.cpp `dsm_guess_format`)
- * do not trust the system byte for the resolution: they decode every slot of a few frames both
- * as 10-bit (channel = word >> 10 & 0xF) and as 11-bit (word >> 11 & 0xF; PX4 adds the X-Plus
- * sub-ID), OR the channel numbers into a bit set each, and accept a reading only when its set is
- * one of these: 6, 7, 8, 9, 10, 13 or 14 channels from 0 up. Anything else resets the guess.
+ * ArduPilot does not trust the system byte for the resolution ("The encoding of the first two
+ * bytes is uncertain, so we're going to ignore them"): it decodes the slots of 6 frames both as
+ * 10-bit and as 11-bit (channel = word >> 10 or >> 11, & 0xF; 0xFFFF skipped; the last two
+ * slots of a VTX frame skipped) and keeps the reading whose channel set is 0…n−1 for some
+ * n = 5…16 when the other's is not; otherwise it starts over. Replayed here as written in
+ * libraries/AP_RCProtocol/AP_RCProtocol_DSM.cpp at commit 814bbe4f (`dsm_guess_format`).
+ *
+ * PX4 also guesses from the channel IDs (src/lib/rc/dsm.cpp), but its rule has changed across
+ * releases (masks, then channel-count statistics) in ways the versions read for this module do
+ * not settle, so it is not replayed; the doctor says only what PX4's own tests pin down.
  */
-export const GUESS_MASKS: readonly number[] = [0x3f, 0x7f, 0xff, 0x1ff, 0x3ff, 0x1fff, 0x3fff];
+export const ARDUPILOT_GUESS_FRAMES = 6;
+const VTX_MASK = 0xf000f000;
+const VTX_MARKER = 0xe000e000;
 
-/** Which reading a guess over some frames settles on. */
-export type GuessOutcome = 10 | 11 | 'none';
+export interface GuessTally {
+  10: number;
+  11: number;
+  none: number;
+}
 
-/**
- * Replays both stacks' guess over the frames a remote sends. ArduPilot decides after 6 frames
- * (`samples++ < 5`), PX4 after 5 (`samples < 5` after the increment); both start over when no
- * reading or both match. The last outcome of each, and how often each settled, are kept.
- */
-export class StackGuess {
-  #cs10 = 0;
-  #cs11 = 0;
-  #cs11px4 = 0;
-  #samples = 0;
-  /** Decisions made so far, by outcome, per stack. */
-  readonly ardupilot = { 10: 0, 11: 0, none: 0 };
-  readonly px4 = { 10: 0, 11: 0, none: 0 };
-  /** Channel sets of the last decision window, for the evidence. */
+/** 0…n−1 with min ≤ n ≤ max: n, else 0. */
+function contiguous(mask: number, min: number, max: number): number {
+  let n = 0;
+  while (n < 32 && ((mask >>> n) & 1) === 1) n++;
+  if (n < min || n > max) return 0;
+  return mask >>> n === 0 ? n : 0;
+}
+
+/** Replays ArduPilot's guess over a remote's frames, window after window, and counts the outcomes. */
+export class ArduPilotGuess {
+  readonly outcomes: GuessTally = { 10: 0, 11: 0, none: 0 };
+  /** Channel sets of the last window, for the evidence. */
   last10 = 0;
   last11 = 0;
+  #cs10 = 0;
+  #cs11 = 0;
+  #samples = 0;
 
-  /** One frame's seven raw slot words. */
-  frame(words: ArrayLike<number>): void {
-    for (let i = 0; i < 7; i++) {
-      const raw = words[i] as number;
+  /** One frame's 16 bytes. */
+  frame(b: ArrayLike<number>): void {
+    const vtx = (((((b[12] as number) << 24) | ((b[13] as number) << 16) | ((b[14] as number) << 8) | (b[15] as number)) & VTX_MASK) >>> 0) === VTX_MARKER && ((b[2] as number) & 0x80) === 0;
+    const slots = vtx ? 5 : 7;
+    for (let i = 0; i < slots; i++) {
+      const raw = ((b[2 + 2 * i] as number) << 8) | (b[3 + 2 * i] as number);
       if (raw === 0xffff) continue;
       this.#cs10 |= 1 << ((raw >> 10) & 0xf);
-      const c11 = (raw >> 11) & 0xf;
-      this.#cs11 |= 1 << c11;
-      // PX4 decodes X-Plus in its 11-bit reading: channel 12 + sub-ID (bits 9–10).
-      this.#cs11px4 |= 1 << (c11 === 12 ? 12 + ((raw >> 9) & 3) : c11);
+      this.#cs11 |= 1 << ((raw >> 11) & 0xf);
     }
-    this.#samples++;
-    if (this.#samples === 5) this.#decide(this.px4, this.#cs10, this.#cs11px4);
-    if (this.#samples === 6) {
-      this.#decide(this.ardupilot, this.#cs10, this.#cs11);
-      this.last10 = this.#cs10;
-      this.last11 = this.#cs11;
-      this.#cs10 = 0;
-      this.#cs11 = 0;
-      this.#cs11px4 = 0;
-      this.#samples = 0;
-    }
-  }
-
-  #decide(into: { 10: number; 11: number; none: number }, cs10: number, cs11: number): void {
-    const v10 = GUESS_MASKS.includes(cs10) ? 1 : 0;
-    const v11 = GUESS_MASKS.includes(cs11) ? 1 : 0;
-    if (v11 === 1 && v10 === 0) into[11]++;
-    else if (v10 === 1 && v11 === 0) into[10]++;
-    else into.none++;
+    if (this.#samples++ < ARDUPILOT_GUESS_FRAMES - 1) return;
+    const v10 = contiguous(this.#cs10, 5, 16) > 0;
+    const v11 = contiguous(this.#cs11, 5, 16) > 0;
+    this.outcomes[v11 && !v10 ? 11 : v10 && !v11 ? 10 : 'none']++;
+    this.last10 = this.#cs10;
+    this.last11 = this.#cs11;
+    this.#cs10 = 0;
+    this.#cs11 = 0;
+    this.#samples = 0;
   }
 }
 
@@ -179,13 +181,4 @@ export function channelSetText(mask: number): string {
     c = end;
   }
   return parts.join(', ') || 'none';
-}
-
-/**
- * PX4 (dsm.cpp `dsm_decode`) checks byte 1 of every frame against the system values it knows
- * (0x01 needs the 10-bit reading, 0x12/0xA2/0xB2 the 11-bit one; a mismatch resets its guess)
- * and drops any frame whose byte 1 is another value, such as an external remote's fade count.
- */
-export function px4AcceptsSystemByte(byte1: number): boolean {
-  return byte1 === 0x01 || byte1 === 0x12 || byte1 === 0xa2 || byte1 === 0xb2;
 }

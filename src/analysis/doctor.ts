@@ -18,7 +18,7 @@ import {
 } from '../decoder/index.js';
 import { BurstClock, classifyLine, PACKET_KINDS, PacketScanner, type LineVerdict, type PacketKind } from './doctor-line.js';
 import {
-  bindPulses, channelSetText, foreignSettings, PROTOCOL_SETTINGS, px4AcceptsSystemByte, satelliteSettings, StackGuess,
+  ArduPilotGuess, ARDUPILOT_GUESS_FRAMES, bindPulses, channelSetText, foreignSettings, PROTOCOL_SETTINGS, satelliteSettings,
   type ForeignProtocol, type StackSetting,
 } from './doctor-stacks.js';
 
@@ -206,10 +206,7 @@ interface PortState {
   probePackets: Record<PacketKind, number>;
   // Frames
   frames: number;
-  guess: StackGuess;
-  px4Rejected: number;
-  /** Frames whose system byte demands the other reading than the data's: PX4 resets its guess on each. */
-  px4Conflicts: number;
+  guess: ArduPilotGuess;
   xplusMask: number;
   xplusFirstUs: number;
   vtxFrames: number;
@@ -288,7 +285,7 @@ export class Doctor {
         burst: new BurstClock(),
         confirmed: null,
         probePackets: { ibus: 0, 'srxl-v1': 0, srxl2: 0, crsf: 0, sbus: 0 },
-        frames: 0, guess: new StackGuess(), px4Rejected: 0, px4Conflicts: 0, xplusMask: 0, xplusFirstUs: NaN, vtxFrames: 0, vtxFirstUs: NaN,
+        frames: 0, guess: new ArduPilotGuess(), xplusMask: 0, xplusFirstUs: NaN, vtxFrames: 0, vtxFirstUs: NaN,
         prevFades: null, prevFrameUs: NaN, prevMissed: 0, first: null, changes: [], restarts: [], rssiFrames: 0,
       };
       p = state;
@@ -390,10 +387,7 @@ export class Doctor {
     const t = f.timeUs;
     p.frames++;
     p.bins.add(M_FRAME_BYTES, t, FRAME_SIZE);
-    p.guess.frame(f.words);
-    const byte1 = f.bytes[1] as number;
-    if (!px4AcceptsSystemByte(byte1)) p.px4Rejected++;
-    else if ((byte1 === 0x01) !== (f.resolution === 1024)) p.px4Conflicts++;
+    p.guess.frame(f.bytes);
     for (let i = 0; i < f.count; i++) {
       const id = f.ids[i] as number;
       if (id >= 12) {
@@ -544,7 +538,7 @@ export class Doctor {
         const bytes = p.bins.sum(M_BYTES, fromS, toS);
         const what = v.protocol === 'ibus' ? '32-byte packets starting 0x20 0x40 with valid checksums'
           : v.protocol === 'srxl2' ? `packets starting 0xA6 with valid CRCs${p.scanner.lastSrxl2Type === 0xcd ? ' (channel data, 0xA6 0xCD)' : p.scanner.lastSrxl2Type === 0x21 ? ' (handshakes, 0xA6 0x21)' : ''}`
-          : 'packets starting 0xA5 with valid CRCs';
+          : '18-byte packets starting 0xA5 with valid CRCs';
         const extra = v.protocol === 'srxl2'
           ? ['SRXL2 (e.g. an SPM4651T) is a two-way, single-wire protocol: on the flight controller it goes to a UART\'s TX pin in half-duplex (Betaflight and iNav set that up for SRXL2).']
           : v.protocol === 'srxl-v1' ? ['SRXL v1 comes from a full Spektrum receiver\'s SRXL port, not from a satellite.'] : [];
@@ -675,7 +669,7 @@ export class Doctor {
         evidence: [{ text: format.explanation, timeUs: null }],
         todo: [
           `Set Betaflight/iNav to ${resolution === 2048 ? 'SPEK2048' : 'SPEK1024'}, what the data is, not what the system byte says.`,
-          'PX4 checks the system byte against its own channel-ID guess and starts over on every mismatch (dsm.cpp): it will not read this remote. ArduPilot guesses from the channel IDs only.',
+          'ArduPilot and PX4 ignore the system byte and guess the resolution from the channel IDs, so they are not misled by it; stacks or tools that trust byte 1 are.',
           'This is a clone or a misbehaving receiver: a genuine Spektrum remote sends a system byte that matches its data (spec §8.3).',
         ],
         settings: [], confirm: null,
@@ -691,7 +685,7 @@ export class Doctor {
         evidence: [{ text: `X-Plus channels (ID 12 with a sub-ID, spec §8.6) seen since ${this.#at(p.xplusFirstUs)}.`, timeUs: p.xplusFirstUs }],
         todo: [
           'Betaflight and iNav read channel IDs 0–11 only (SPEKTRUM_MAX_SUPPORTED_CHANNEL_COUNT 12): X-Plus channels are dropped.',
-          'ArduPilot reads ID 12 as one channel whatever the sub-ID, so every X-Plus channel lands on the same input; PX4 maps X+5…X+8 onto X+1…X+4 (its phase test never fires).',
+          'ArduPilot (AP_RCProtocol_DSM.cpp) takes every X-Plus word as channel 13, whatever its sub-ID, and reports 13 channels as 12. PX4 reads them as channels 13 and up (its tests expect 16 channels from a DX9 with X+1…X+4).',
           'Put functions the flight controller needs on channels 1–12, and turn X-Plus off in the transmitter if nothing uses it.',
         ],
         settings: [], confirm: null,
@@ -704,31 +698,27 @@ export class Doctor {
         title: `${p.label}: the transmitter sends VTX control in the channel slots`,
         evidence: [{ text: `${plural(p.vtxFrames, 'frame')} carried Spektrum VTX control in bytes 12–15 (0xE… 0xE…), first at ${this.#at(p.vtxFirstUs)}.`, timeUs: p.vtxFirstUs }],
         todo: [
-          'Betaflight builds with USE_SPEKTRUM_VTX_CONTROL take these out and set the VTX; a stack or build without it reads the two words as channel 12 (X-Plus) data, and ArduPilot/PX4 channel-ID guesses may reset while they come.',
+          'Betaflight (spektrum.c, with USE_SPEKTRUM_VTX_CONTROL) and ArduPilot (AP_RCProtocol_DSM.cpp) take these frames\' last two slots out of the channel data and set the VTX from them; a stack or build without Spektrum VTX support reads the two words as channel data.',
           'Turn VTX control off in the transmitter if the flight controller does not use it.',
         ],
         settings: [], confirm: null,
       });
     }
 
-    const g = p.guess;
-    const decisions = g.ardupilot[10] + g.ardupilot[11] + g.ardupilot.none;
+    const g = p.guess.outcomes;
+    const tries = g[10] + g[11] + g.none;
     const want = resolution === 2048 ? 11 : 10;
-    const apBad = decisions >= GUESS_MIN_DECISIONS && g.ardupilot[want] < decisions / 2;
-    const px4Decisions = g.px4[10] + g.px4[11] + g.px4.none;
-    const px4Bad = (px4Decisions >= GUESS_MIN_DECISIONS && g.px4[want] < px4Decisions / 2) || p.px4Rejected > p.frames / 2 || p.px4Conflicts > p.frames / 2;
-    if (apBad || px4Bad) {
+    if (tries >= GUESS_MIN_DECISIONS && g[want] < tries / 2) {
       add({
         code: 'autopilot-detection', ports: [p.port], severity: 'warning', confidence: 'likely',
-        title: `${p.label}: ${apBad && px4Bad ? 'ArduPilot and PX4' : apBad ? 'ArduPilot' : 'PX4'} will not read this stream by itself`,
+        title: `${p.label}: ArduPilot may not read this stream by itself`,
         evidence: [
-          { text: `Channel IDs in 6 frames read as 11-bit: ${channelSetText(g.last11)}; as 10-bit: ${channelSetText(g.last10)}. Their guess accepts only 6–10, 13 or 14 channels numbered from 0 (AP_RCProtocol_DSM.cpp, dsm.cpp).`, timeUs: null },
+          { text: `Channel IDs in ${ARDUPILOT_GUESS_FRAMES} frames read as 11-bit: ${channelSetText(p.guess.last11)}; as 10-bit: ${channelSetText(p.guess.last10)}.`, timeUs: null },
           { text: guessNote.ardupilot, timeUs: null },
-          { text: guessNote.px4, timeUs: null },
         ],
         todo: [
-          'Change the transmitter\'s channel count so the remote sends 6–10 channels (e.g. leave unused channels off), or turn X-Plus and VTX control off.',
-          ...(p.px4Rejected > p.frames / 2 ? ['PX4 reads an internal remote only (it needs a system byte in byte 1): connect the internal ("A") remote to PX4.'] : []),
+          'ArduPilot guesses 10- or 11-bit from the channel numbers, not from the system byte, and needs exactly one reading to give channels 0…n−1 (5 to 16 of them). Change the number of channels the transmitter sends, or bind in DSMX 11 ms (2048), which it tells apart easily.',
+          'Check the result on ArduPilot\'s radio calibration page: every stick must move one bar.',
         ],
         settings: [], confirm: null,
       });
@@ -808,21 +798,20 @@ export class Doctor {
     }
   }
 
-  /** What ArduPilot's and PX4's own guess made of this remote's frames, as sentences. */
+  /** What ArduPilot's guess makes of this remote's frames, and what is known of PX4, as sentences. */
   #guessNotes(p: PortState, resolution: Resolution): { ardupilot: string; px4: string } {
-    const g = p.guess;
+    const d = p.guess.outcomes;
     const want = resolution === 2048 ? 11 : 10;
-    const say = (d: { 10: number; 11: number; none: number }, name: string): string => {
-      const n = d[10] + d[11] + d.none;
-      if (n === 0) return `${name}: not enough frames yet to replay its 10/11-bit guess.`;
-      if (d[want] === n) return `${name}: detects it by itself; its guess settles on ${want}-bit (${resolution}), as it should.`;
-      if (d.none === n) return `${name}: its 10/11-bit guess never settles (${n} tries), so it outputs no channels.`;
-      return `${name}: its guess settled on ${want}-bit in ${d[want]} of ${n} tries${d[want === 11 ? 10 : 11] > 0 ? `, on the wrong ${want === 11 ? 10 : 11}-bit reading in ${d[want === 11 ? 10 : 11]}` : ''}.`;
-    };
-    let px4 = say(g.px4, 'PX4');
-    if (p.px4Rejected > 0) px4 += ` It drops frames whose byte 1 is not a system value: ${p.px4Rejected} of ${p.frames}.`;
-    if (p.px4Conflicts > 0) px4 += ` Byte 1 names the other resolution than the channel IDs show in ${p.px4Conflicts} of ${p.frames} frames: PX4 starts its guess over on each, so it never outputs.`;
-    return { ardupilot: say(g.ardupilot, 'ArduPilot'), px4 };
+    const other = want === 11 ? 10 : 11;
+    const n = d[10] + d[11] + d.none;
+    const where = 'AP_RCProtocol_DSM.cpp, replayed';
+    let ardupilot = n === 0 ? `Detects the DSM protocol by itself (${where}: not enough frames yet).`
+      : d[want] === n ? `Detects it by itself: its 10/11-bit guess settles on ${want}-bit (${resolution}) (${where}).`
+        : d.none === n ? `Its 10/11-bit guess never settles (${n} tries), so it would output no channels (${where}).`
+          : `Its 10/11-bit guess settled on ${want}-bit in ${d[want]} of ${n} tries${d[other] > 0 ? `, on the wrong ${other}-bit reading in ${d[other]}` : ''} (${where}).`;
+    if (p.xplusMask !== 0) ardupilot += ' It takes every X-Plus word as channel 13 whatever its sub-ID, and reports 13 channels as 12: X-Plus channels are not usable.';
+    const px4 = `rc_input detects DSM by itself and guesses the resolution from the channel IDs (src/lib/rc/dsm.cpp)${p.xplusMask !== 0 ? '; its tests expect X-Plus channels as channels 13 and up (rc_tests/RCTest.cpp, 16 channels from a DX9)' : ''}.`;
+    return { ardupilot, px4 };
   }
 
   /** Findings about several remotes together. */

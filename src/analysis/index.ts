@@ -9,7 +9,7 @@ export {
 } from './doctor.js';
 export { doctorCapture, type DoctorCaptureOptions, type DoctorReport, type DoctorTimelineEntry } from './doctor-capture.js';
 export {
-  bindPulses, channelSetText, foreignSettings, GUESS_MASKS, PROTOCOL_SETTINGS, satelliteSettings, StackGuess,
-  type FlightStack, type ForeignProtocol, type GuessOutcome, type StackSetting, type StreamFacts,
+  ArduPilotGuess, ARDUPILOT_GUESS_FRAMES, bindPulses, channelSetText, foreignSettings, PROTOCOL_SETTINGS, satelliteSettings,
+  type FlightStack, type ForeignProtocol, type GuessTally, type StackSetting, type StreamFacts,
 } from './doctor-stacks.js';
 export { classifyLine, PacketScanner, PACKET_KINDS, type LineCounts, type LineVerdict, type PacketKind } from './doctor-line.js';

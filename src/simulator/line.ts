@@ -352,23 +352,22 @@ export function spektrumTransmission(chunk: Pick<SimChunk, 'bytes' | 'timesUs'>,
 }
 
 /**
- * Spektrum SRXL (v1), as a Spektrum receiver with an SRXL port sends it at 115200 8N1:
- * 0xA5, a packet type, the packet length (header to CRC), a 16-byte remote-receiver frame
- * (internal layout, DSMX 11 ms, 2048), and a CRC-16/XMODEM, big-endian. Every 11 ms.
+ * Spektrum SRXL (v1), as a Spektrum receiver's SRXL port (e.g. AR7700) sends it at 115200 8N1,
+ * in the layout ArduPilot reads (AP_RCProtocol_SRXL, SRXL_HEADER_V5): 0xA5, a status byte
+ * (bit 1 set while the link holds), seven 2048-mode channel words big-endian, and a
+ * CRC-16/XMODEM of the first 16 bytes, big-endian: 18 bytes every 11 ms.
  */
 export function srxlV1Stream(options: StreamOptions): Transmission {
-  const LENGTH = 21;
+  const LENGTH = 18;
   return packetStream(UART_115200_8N1, options, 11_000, (i, rng) => {
     const p = new Uint8Array(LENGTH);
     p[0] = 0xa5;
-    p[1] = 0x12;
-    p[2] = LENGTH;
-    p[3] = 0; // fades
-    p[4] = 0xb2; // DSMX 11 ms
+    p[1] = 0x02;
     for (let s = 0; s < 7; s++) {
-      const word = ((s & 0x0f) << 11) | Math.round(stick(i, s, rng) * 2047);
-      p[5 + 2 * s] = word >> 8;
-      p[6 + 2 * s] = word & 0xff;
+      const id = (i & 1) * 7 + s < 12 ? (i & 1) * 7 + s : s;
+      const word = (id << 11) | Math.round(stick(i, id, rng) * 2047);
+      p[2 + 2 * s] = word >> 8;
+      p[3 + 2 * s] = word & 0xff;
     }
     const crc = crc16Xmodem(p, 0, LENGTH - 2);
     p[LENGTH - 2] = crc >> 8;
