@@ -286,6 +286,22 @@ describe('a satellite stream the flight controller will read wrong', () => {
     expect(bind.todo[0]).toMatch(/spektrum_sat_bind = 9/);
   });
 
+  it('names the bind pulses of the mode it is in now (DSM2 22 ms internal: 3)', () => {
+    const s = new Session();
+    s.feed(0, satellite(preset('dsm2-22ms-1024-internal'), 3 * SECOND));
+    expect(find(s.findings(3 * SECOND), 'fc-settings').settings.find((x) => x.stack === 'Betaflight')!.note).toMatch(/bound now as DSM2 22 ms 1024 internal \(3 pulses\)/);
+  });
+
+  it('suggests 11 ms for a DSMX 22 ms stream, as information: SPEK2048 already reads it right', () => {
+    const s = new Session();
+    s.feed(0, satellite(preset('dsmx-22ms-2048-internal'), 3 * SECOND));
+    const fs = s.findings(3 * SECOND);
+    const bind = find(fs, 'bind-mode');
+    expect(bind.severity).toBe('info');
+    expect(bind.evidence[0]!.text).toMatch(/A frame every 22\.0 ms/);
+    expect(find(fs, 'fc-settings').settings.find((x) => x.stack === 'Betaflight')!.note).toMatch(/DSMX 22 ms 2048 internal \(7 pulses\)/);
+  });
+
   it('gives the external bind number (10) for an external remote', () => {
     const s = new Session();
     s.feed(0, satellite(preset('dsm2-22ms-1024-external'), 3 * SECOND));
