@@ -42,6 +42,7 @@ beforeAll(() => {
   dir = mkdtempSync(join(tmpdir(), 'satscope-doctor-'));
   const ibus = receiveAs(ibusStream({ durationUs: 3 * SECOND, startUs: 50_000 }));
   writeFileSync(join(dir, 'ibus.sscap'), recording(ibus.bytes, ibus.timesUs));
+  writeFileSync(join(dir, 'ibus.bin'), ibus.bytes);
   const dsm2 = simulate({ ...preset('dsm2-22ms-1024-internal'), fades: { lossRate: 0, randomRate: 0 }, timing: { startUs: 50_000 } }, 3 * SECOND);
   writeFileSync(join(dir, 'dsm2.sscap'), recording(dsm2.bytes, dsm2.timesUs));
   const w = new CaptureWriter({ baudRate: 115200, source: 'test' });
@@ -59,6 +60,13 @@ describe('satscope doctor', () => {
     expect(r.out).toMatch(/PROBLEM {2}Port 0: this is FlySky IBUS, not a Spektrum satellite {2}\[certain, since 0:00\.\d\]/);
     expect(r.out).toMatch(/Betaflight: .*\n {6}set serialrx_provider = IBUS/);
     expect(r.err).toBe('');
+  });
+
+  it('names IBUS in a raw byte dump too (no times: as if the bytes came back to back)', () => {
+    const r = run(join(dir, 'ibus.bin'));
+    expect(r.code).toBe(1);
+    expect(r.out).toMatch(/^satscope doctor: ibus\.bin \(raw, none timing/);
+    expect(r.out).toMatch(/this is FlySky IBUS/);
   });
 
   it('gives the flight-controller lines for a DSM2 22 ms stream and exits 0 when nothing is a problem', () => {

@@ -226,6 +226,14 @@ describe('bytes that are not a satellite stream', () => {
     expect(find(s.findings(3 * SECOND), 'unknown-stream').title).toMatch(/clean bytes at 115200, but not Spektrum frames/);
   });
 
+  it('reports bytes lost to buffer overruns, and forgets them after the window', () => {
+    const s = new Session();
+    s.feed(0, satellite(preset('dsmx-11ms-2048-internal'), 2 * SECOND));
+    s.doctor.lineError(0, 'BufferOverrunError', 1.5 * SECOND);
+    expect(find(s.findings(2 * SECOND), 'overrun').evidence[0]!.text).toMatch(/1 buffer overrun/);
+    expect(codes(s.findings(5 * SECOND))).not.toContain('overrun');
+  });
+
   it('calls a line of random levels noise and asks for a ground', () => {
     const s = new Session();
     s.feed(0, uartReceive(noiseSignal({ durationUs: 3 * SECOND })));
@@ -355,7 +363,9 @@ describe('a weak link', () => {
   it('reports failsafes with their times, as a problem, and gives the spec §5 advice', () => {
     const s = new Session({ timing: 'per-byte' });
     s.feed(0, satellite(preset('dropouts-failsafe'), 3.2 * SECOND));
-    const f = find(s.findings(3.2 * SECOND), 'weak-link');
+    const fs = s.findings(3.2 * SECOND);
+    const f = find(fs, 'weak-link');
+    expect(fs[0]).toBe(f); // worst first
     expect(f.severity).toBe('problem');
     expect(f.evidence[0]!.text).toMatch(/Failsafe: no frame for over 1 s after 1\.\d s, back at 2\.5 s/);
     expect(f.todo.join(' ')).toMatch(/90°/);

@@ -435,7 +435,9 @@ export class Doctor {
   findings(nowUs: number): DoctorFinding[] {
     const out: DoctorFinding[] = [];
     const add = (f: Omit<DoctorFinding, 'sinceUs'> & { sinceUs?: number }): void => {
-      out.push({ ...f, sinceUs: f.sinceUs ?? nowUs });
+      // JSON-safe: a time that is not known is null, never NaN.
+      const evidence = f.evidence.map((e) => (e.timeUs === null || Number.isFinite(e.timeUs) ? e : { ...e, timeUs: null }));
+      out.push({ ...f, evidence, sinceUs: f.sinceUs !== undefined && Number.isFinite(f.sinceUs) ? f.sinceUs : nowUs });
     };
     const ports = [...this.#ports.values()].sort((a, b) => a.port - b.port);
     for (const p of ports) {
