@@ -393,6 +393,19 @@ describe('a weak link', () => {
     expect(f.ports).toEqual([1]);
   });
 
+  it('compares an SPM4649T (RSSI, no fades) with a fade-counting remote by lost frames only', () => {
+    const s = new Session({ timing: 'per-byte' });
+    s.port(0, 'A');
+    s.port(1, 'B');
+    // A: an RSSI receiver that loses frames now and then; B: counts many fades but loses nothing.
+    const drops = [1, 2, 3, 4, 5, 6, 7, 8].map((at) => ({ atUs: at * SECOND, durationUs: 0.1 * SECOND }));
+    s.feed(0, satellite({ ...preset('rssi-spm4649t'), fades: { lossRate: 0, randomRate: 0 }, dropouts: drops }, 10 * SECOND));
+    s.feed(1, satellite({ ...preset('dsmx-11ms-2048-external'), fades: { start: 0, lossRate: 0, randomRate: 0.05 } }, 10 * SECOND));
+    const f = find(s.findings(10 * SECOND), 'weakest-remote');
+    expect(f.title).toBe('A fades most');
+    expect(f.evidence.at(-1)!.text).toMatch(/frames lost only.*SPM4649T/);
+  });
+
   it('with two remotes that lose frames in the same seconds, says they fade together', () => {
     const s = new Session();
     const dropouts = [1, 2.5, 4, 5.5, 7].map((at) => ({ atUs: at * SECOND, durationUs: 0.1 * SECOND }));

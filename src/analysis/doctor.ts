@@ -857,15 +857,22 @@ export class Doctor {
     // Who fades most, and do they fade together (per second over the memory window).
     const toS = Math.floor(now / 1e6);
     const fromS = Math.max(toS - Math.min(BIN_COUNT - 1, Math.ceil(this.#memoryUs / 1e6)), -Infinity);
-    const lossOf = (p: PortState, s: number): number => p.bins.at(M_FADES, s) + p.bins.at(M_MISSED, s);
-    const totals = locked.map((p) => ({ p, loss: p.bins.sum(M_FADES, fromS, toS) + p.bins.sum(M_MISSED, fromS, toS) })).sort((a, b) => b.loss - a.loss);
+    // An SPM4649T counts no fades (byte 0 is RSSI): when one is among fade-counting remotes,
+    // compare them all by frames lost, the one measure they share.
+    const modes = new Set(locked.map((p) => (p.source as DoctorPortSource).decoder.format.headerMode));
+    const mixed = modes.size > 1;
+    const lossOf = (p: PortState, s: number): number => (mixed ? 0 : p.bins.at(M_FADES, s)) + p.bins.at(M_MISSED, s);
+    const totals = locked.map((p) => ({ p, loss: (mixed ? 0 : p.bins.sum(M_FADES, fromS, toS)) + p.bins.sum(M_MISSED, fromS, toS) })).sort((a, b) => b.loss - a.loss);
     const top = totals[0];
     const second = totals[1];
     if (top !== undefined && second !== undefined && top.loss >= 10 && top.loss >= 2 * Math.max(1, second.loss)) {
       add({
         code: 'weakest-remote', ports: [top.p.port], severity: 'warning', confidence: 'certain',
         title: `${top.p.label} fades most`,
-        evidence: totals.map((t) => ({ text: `${t.p.label}: ${plural(t.loss, 'fade or lost frame', 'fades and lost frames')} in the last ${Math.min(toS - fromS + 1, BIN_COUNT)} s.`, timeUs: null })),
+        evidence: [
+          ...totals.map((t) => ({ text: `${t.p.label}: ${mixed ? plural(t.loss, 'lost frame') : plural(t.loss, 'fade or lost frame', 'fades and lost frames')} in the last ${Math.min(toS - fromS + 1, BIN_COUNT)} s.`, timeUs: null })),
+          ...(mixed ? [{ text: 'Compared by frames lost only: one remote sends RSSI in byte 0 (SPM4649T) and counts no fades.', timeUs: null }] : []),
+        ],
         todo: [`Move or turn ${top.p.label}: 90° from the other remote, away from carbon and metal, with line of sight to the transmitter (spec §5).`],
         settings: [], confirm: null,
       });
