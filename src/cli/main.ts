@@ -16,6 +16,7 @@ const USAGE = `Usage:
   satscope decode FILE [--format jsonl|csv] [--resolution auto|1024|2048] [--port N]
   satscope info FILE [--resolution auto|1024|2048] [--port N] [--json]
   satscope report FILE [--out REPORT.html] [--json] [--resolution auto|1024|2048]
+  satscope doctor FILE [--json] [--resolution auto|1024|2048]   (satscope doctor --help)
   satscope --help | --version
 
 FILE is a SatScope capture (.sscap), a raw byte dump (.bin) or a Saleae async-serial CSV export.
@@ -205,4 +206,6 @@ process.stdout.on('error', (error: NodeJS.ErrnoException) => {
   if (error.code === 'EPIPE') process.exit(0);
   throw error;
 });
-process.exitCode = main(process.argv.slice(2));
+const argv = process.argv.slice(2);
+// `doctor` has its own file (src/cli/doctor.ts), loaded only when it is asked for.
+process.exitCode = argv[0] === 'doctor' ? (await import('./doctor.js')).doctorCommand(argv.slice(1)) : main(argv);
