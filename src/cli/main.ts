@@ -20,6 +20,7 @@ const USAGE = `Usage:
   satscope decode FILE [--format jsonl|csv] [--resolution auto|1024|2048] [--port N]
   satscope info FILE [--resolution auto|1024|2048] [--port N] [--json]
   satscope report FILE [--out REPORT.html] [--json] [--resolution auto|1024|2048]
+  satscope doctor FILE [--json] [--resolution auto|1024|2048]   (satscope doctor --help)
   satscope --help | --version
 
 FILE is a SatScope capture (.sscap), a raw byte dump (.bin) or a Saleae async-serial CSV export
@@ -204,4 +205,6 @@ function report(capture: Capture, args: Args, out: TextOutput): Promise<number> 
   return finish(out, 0);
 }
 
-process.exitCode = await main(process.argv.slice(2));
+const argv = process.argv.slice(2);
+// `doctor` has its own file (src/cli/doctor.ts), loaded only when it is asked for.
+process.exitCode = argv[0] === 'doctor' ? (await import('./doctor.js')).doctorCommand(argv.slice(1)) : await main(argv);

@@ -1,0 +1,276 @@
+/**
+ * What is on the line when it is not a satellite: packet recognisers for the RC protocols a
+ * user may have plugged in instead (run on the bytes as they arrive), and the rule that names
+ * a line from its read errors.
+ *
+ * Pure ECMAScript; nothing allocated per byte.
+ */
+
+/** Packets recognised by their own structure and checksum. */
+export const PACKET_KINDS = ['ibus', 'srxl-v1', 'srxl2', 'crsf', 'sbus'] as const;
+export type PacketKind = (typeof PACKET_KINDS)[number];
+
+/** IBUS: 0x20 0x40, 32 bytes, checksum 0xFFFF − sum of the first 30, little-endian. */
+const IBUS_LENGTH = 32;
+/** SRXL v1 (0xA5, Spektrum AR7700 and others): 18 bytes, CRC-16/XMODEM over the first 16 (ArduPilot's SRXL_FRAMELEN_V5). */
+const SRXL_V1_LENGTH = 18;
+/** SRXL2 (0xA6): byte 2 is the whole packet's length, ≤ 80 (SRXL_MAX_BUFFER_SIZE). */
+const SRXL_MAX_LENGTH = 80;
+const SRXL_MIN_LENGTH = 5;
+/** CRSF: sync, length (type + payload + CRC, 2…62), type, payload, CRC-8/DVB-S2. */
+const CRSF_MAX_LENGTH = 62;
+/** SBUS: 25 bytes, 0x0F … footer 0x00 (or an SBUS2 telemetry slot footer 0x04/0x14/0x24/0x34). */
+const SBUS_LENGTH = 25;
+const HISTORY = 128;
+const MAX_PENDING = 16;
+
+function crc16Xmodem(ring: Uint8Array, start: number, length: number): number {
+  let crc = 0;
+  for (let i = 0; i < length; i++) {
+    crc ^= (ring[(start + i) & (HISTORY - 1)] as number) << 8;
+    for (let b = 0; b < 8; b++) crc = crc & 0x8000 ? ((crc << 1) ^ 0x1021) & 0xffff : (crc << 1) & 0xffff;
+  }
+  return crc;
+}
+
+function crc8DvbS2(ring: Uint8Array, start: number, length: number): number {
+  let crc = 0;
+  for (let i = 0; i < length; i++) {
+    crc ^= ring[(start + i) & (HISTORY - 1)] as number;
+    for (let b = 0; b < 8; b++) crc = crc & 0x80 ? ((crc << 1) ^ 0xd5) & 0xff : (crc << 1) & 0xff;
+  }
+  return crc;
+}
+
+/**
+ * Finds IBUS, SRXL v1, SRXL2, CRSF and SBUS packets in a byte stream, fed in any chunking.
+ * Each packet is checked by its checksum (SBUS, which has none, by its header and footer and
+ * the next header 25 bytes on). `onPacket` is called once per packet with its kind and the
+ * stream index of its last byte.
+ */
+export class PacketScanner {
+  readonly #ring = new Uint8Array(HISTORY);
+  /** Stream index of the next byte. */
+  #n = 0;
+  /** Candidate starts: stream index, and kind code (0 SRXL v1, 1 SRXL2, 2 CRSF). */
+  readonly #pendingAt = new Float64Array(MAX_PENDING);
+  readonly #pendingKind = new Uint8Array(MAX_PENDING);
+  #pending = 0;
+  /** Last SRXL2 packet type seen (0x21 handshake, 0xCD control data…). */
+  lastSrxl2Type = -1;
+
+  constructor(readonly onPacket: (kind: PacketKind, endIndex: number) => void) {}
+
+  push(bytes: Uint8Array): void {
+    const ring = this.#ring;
+    const mask = HISTORY - 1;
+    for (let i = 0; i < bytes.length; i++) {
+      const b = bytes[i] as number;
+      const k = this.#n++;
+      ring[k & mask] = b;
+      // IBUS ends here?
+      if (k >= IBUS_LENGTH - 1) {
+        const s = k - (IBUS_LENGTH - 1);
+        if (ring[s & mask] === 0x20 && ring[(s + 1) & mask] === 0x40) {
+          let sum = 0;
+          for (let j = 0; j < IBUS_LENGTH - 2; j++) sum += ring[(s + j) & mask] as number;
+          const check = (ring[(k - 1) & mask] as number) | ((ring[k & mask] as number) << 8);
+          if (((0xffff - sum) & 0xffff) === check) this.onPacket('ibus', k);
+        }
+      }
+      // SBUS: a 0x0F 25 bytes back, a footer just before this byte, and this byte the next 0x0F.
+      if (b === 0x0f && k >= SBUS_LENGTH) {
+        const s = k - SBUS_LENGTH;
+        const footer = ring[(k - 1) & mask] as number;
+        if (ring[s & mask] === 0x0f && (footer === 0x00 || (footer & 0xcf) === 0x04)) this.onPacket('sbus', k - 1);
+      }
+      // Packets announced by a length byte: check the ones that end here.
+      let w = 0;
+      for (let p = 0; p < this.#pending; p++) {
+        const at = this.#pendingAt[p] as number;
+        const kind = this.#pendingKind[p] as number;
+        const lengthAt = at + (kind === 2 ? 1 : 2);
+        let keep = true;
+        if (kind === 0) {
+          // SRXL v1 has no length byte: a fixed 18 bytes.
+          if (k === at + SRXL_V1_LENGTH - 1) {
+            keep = false;
+            const crc = ((ring[(k - 1) & mask] as number) << 8) | (ring[k & mask] as number);
+            if (crc16Xmodem(ring, at, SRXL_V1_LENGTH - 2) === crc) this.onPacket('srxl-v1', k);
+          }
+        } else if (k === lengthAt) {
+          const length = ring[k & mask] as number;
+          keep = kind === 2 ? length >= 2 && length <= CRSF_MAX_LENGTH : length >= SRXL_MIN_LENGTH && length <= SRXL_MAX_LENGTH;
+        } else if (k > lengthAt) {
+          const length = ring[lengthAt & mask] as number;
+          const total = kind === 2 ? length + 2 : length;
+          if (k === at + total - 1) {
+            keep = false;
+            if (kind === 2) {
+              if (crc8DvbS2(ring, at + 2, total - 3) === ring[k & mask]) this.onPacket('crsf', k);
+            } else {
+              const crc = ((ring[(k - 1) & mask] as number) << 8) | (ring[k & mask] as number);
+              if (crc16Xmodem(ring, at, total - 2) === crc) {
+                this.lastSrxl2Type = ring[(at + 1) & mask] as number;
+                this.onPacket('srxl2', k);
+              }
+            }
+          }
+        }
+        if (keep && k - at < HISTORY - 1) {
+          this.#pendingAt[w] = at;
+          this.#pendingKind[w] = kind;
+          w++;
+        }
+      }
+      this.#pending = w;
+      const start = b === 0xa5 ? 0 : b === 0xa6 ? 1 : b === 0xc8 || b === 0xee || b === 0xea ? 2 : -1;
+      if (start >= 0) {
+        if (this.#pending === MAX_PENDING) {
+          this.#pendingAt.copyWithin(0, 1);
+          this.#pendingKind.copyWithin(0, 1);
+          this.#pending--;
+        }
+        this.#pendingAt[this.#pending] = k;
+        this.#pendingKind[this.#pending] = start;
+        this.#pending++;
+      }
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Naming a line from its read errors
+// ---------------------------------------------------------------------------------------------
+
+/** What arrived over a window, for `classifyLine`. */
+export interface LineCounts {
+  /** Seconds the window covers (with data or errors). */
+  seconds: number;
+  bytes: number;
+  /** Bytes inside decoded Spektrum frames. */
+  frameBytes: number;
+  /** Characters with a framing or parity error (some platforms report a framing error as ParityError). */
+  characterErrors: number;
+  breaks: number;
+  /** Packets recognised, by kind. */
+  packets: Readonly<Record<PacketKind, number>>;
+  /**
+   * With per-byte times only: the period of the bursts of activity, µs, when they repeat
+   * regularly; NaN when they do not or when times are per chunk.
+   */
+  burstPeriodUs: number;
+}
+
+export type LineVerdict =
+  | { kind: 'satellite' }
+  | { kind: 'too-little' }
+  | { kind: 'packets'; protocol: 'ibus' | 'srxl-v1' | 'srxl2'; count: number }
+  | { kind: 'inverted-satellite'; periodUs: number; breaksPerSecond: number; bytesPerBreak: number; confident: boolean }
+  | { kind: 'sbus'; periodUs: number; breaksPerSecond: number; bytesPerBreak: number; confident: boolean }
+  | { kind: 'idle-low'; breaksPerSecond: number; bytesPerBreak: number }
+  | { kind: 'crsf'; periodUs: number }
+  | { kind: 'other-speed'; errorRatio: number }
+  | { kind: 'noise'; breaksPerSecond: number; errorRatio: number }
+  | { kind: 'unknown-115200'; bytes: number };
+
+/** Bytes a window needs before the line is judged: about a dozen frames' worth. */
+export const LINE_MIN_BYTES = 64;
+/** Known packets before a protocol is named (each passed its checksum). */
+export const LINE_MIN_PACKETS = 3;
+/** Share of the bytes that decoded as Spektrum frames above which the line is a satellite. */
+export const SATELLITE_SHARE = 0.5;
+/** Share of characters with errors above which the line is not 115200 8N1. */
+export const ERROR_RATIO = 0.15;
+
+const near = (x: number, target: number, tolerance = 0.15): boolean => Math.abs(x - target) <= tolerance * target;
+/** CRSF packet rates: 50, 150, 250, 500 Hz (ExpressLRS and Crossfire modes). */
+const CRSF_PERIODS_US = [20_000, 6_667, 4_000, 2_000];
+
+/**
+ * Names what is on a line from one window of counts. The rules, first match wins:
+ *
+ * 1. Most bytes decoded as Spektrum frames: a satellite.
+ * 2. IBUS, SRXL2 or SRXL v1 packets with valid checksums: that protocol at 115200.
+ * 3. Break conditions repeating: the line idles low (inverted). A satellite's 16 bytes, seen
+ *    through an inverter at its own speed, come out as about 10 bytes and one break per frame;
+ *    SBUS's 25 bytes at 100000 8E2 as about 16 and one break per frame. Fewer than 3 bytes a
+ *    break is noise. The break rate is the packet rate (11 or 22 ms; SBUS 7 or 14 ms).
+ * 4. Character errors without breaks: a normal-polarity signal at another speed: CRSF when
+ *    bursts repeat at a CRSF packet rate (needs per-byte times), else "another speed".
+ * 5. Clean bytes that are nothing known.
+ */
+export function classifyLine(c: LineCounts): LineVerdict {
+  const chars = c.bytes + c.characterErrors;
+  if (c.frameBytes >= LINE_MIN_BYTES / 2 && c.frameBytes >= SATELLITE_SHARE * c.bytes) return { kind: 'satellite' };
+  for (const protocol of ['srxl2', 'ibus', 'srxl-v1'] as const) {
+    const count = c.packets[protocol];
+    if (count >= LINE_MIN_PACKETS) return { kind: 'packets', protocol, count };
+  }
+  if (chars + c.breaks < LINE_MIN_BYTES || !(c.seconds > 0)) return { kind: 'too-little' };
+  const errorRatio = c.characterErrors / Math.max(1, chars);
+  if (c.breaks >= 3) {
+    const breaksPerSecond = c.breaks / c.seconds;
+    const bytesPerBreak = c.bytes / c.breaks;
+    const periodUs = 1e6 / breaksPerSecond;
+    if (bytesPerBreak < 3) return { kind: 'noise', breaksPerSecond, errorRatio };
+    if (bytesPerBreak >= 13) {
+      return { kind: 'sbus', periodUs, breaksPerSecond, bytesPerBreak, confident: near(periodUs, 14_000) || near(periodUs, 7_000) || near(periodUs, 9_000, 0.08) || near(periodUs, 10_000, 0.08) };
+    }
+    if (bytesPerBreak >= 6) {
+      return { kind: 'inverted-satellite', periodUs, breaksPerSecond, bytesPerBreak, confident: near(periodUs, 11_000) || near(periodUs, 22_000) };
+    }
+    return { kind: 'idle-low', breaksPerSecond, bytesPerBreak };
+  }
+  if (errorRatio >= ERROR_RATIO) {
+    if (Number.isFinite(c.burstPeriodUs) && CRSF_PERIODS_US.some((p) => near(c.burstPeriodUs, p, 0.05))) return { kind: 'crsf', periodUs: c.burstPeriodUs };
+    return { kind: 'other-speed', errorRatio };
+  }
+  return { kind: 'unknown-115200', bytes: c.bytes };
+}
+
+/**
+ * Burst timing from per-byte (or per-error) times: a burst starts after a quiet gap of
+ * `gapUs`; the period is the median interval between burst starts when at least 70 % of the
+ * intervals lie within 10 % of it. Keeps the last 64 burst starts.
+ */
+export class BurstClock {
+  readonly #starts = new Float64Array(64);
+  #count = 0;
+  #next = 0;
+  #last = -Infinity;
+  constructor(readonly gapUs = 600) {}
+
+  event(t: number): void {
+    if (!Number.isFinite(t)) return;
+    if (t - this.#last > this.gapUs) {
+      this.#starts[this.#next] = t;
+      this.#next = (this.#next + 1) & 63;
+      if (this.#count < 64) this.#count++;
+    }
+    if (t > this.#last) this.#last = t;
+  }
+
+  /** Forget everything (e.g. when the port reopens). */
+  reset(): void {
+    this.#count = 0;
+    this.#next = 0;
+    this.#last = -Infinity;
+  }
+
+  /** The burst period in µs over starts after `sinceUs`, or NaN. */
+  periodUs(sinceUs = -Infinity): number {
+    const starts: number[] = [];
+    for (let i = 0; i < this.#count; i++) {
+      const t = this.#starts[(this.#next - this.#count + i + 64) & 63] as number;
+      if (t >= sinceUs) starts.push(t);
+    }
+    if (starts.length < 6) return NaN;
+    const iv: number[] = [];
+    for (let i = 1; i < starts.length; i++) iv.push((starts[i] as number) - (starts[i - 1] as number));
+    iv.sort((a, b) => a - b);
+    const median = iv[iv.length >> 1] as number;
+    const close = iv.filter((x) => Math.abs(x - median) <= 0.1 * median).length;
+    return close >= 0.7 * iv.length ? median : NaN;
+  }
+}

@@ -1,0 +1,30 @@
+/**
+ * The doctor: findings about a satellite setup from what the wire shows. Every public name of
+ * src/analysis is exported here.
+ *
+ * Live use (one `Doctor` per session, every port on one clock):
+ *
+ * ```ts
+ * const doctor = new Doctor();                          // { timing: 'per-byte' } for logic-analyser times
+ * doctor.attach(id, { decoder, link, label: 'A' });     // the port's own decoder and link monitor
+ * doctor.open(id, nowUs());                             // when the port opens (again on reconnect)
+ * doctor.bytes(id, chunk, nowUs());                     // each chunk as it arrives
+ * for (let f = decoder.next(); f; f = decoder.next()) { link.frame(f); doctor.frame(id, f); }
+ * doctor.lineError(id, error.name, nowUs());            // FramingError, ParityError, BreakError, BufferOverrunError
+ * doctor.close(id);                                     // port closed or lost
+ * const findings = doctor.findings(nowUs());            // a few times a second: worst first
+ * ```
+ *
+ * A whole capture: `doctorCapture(capture)`.
+ */
+export {
+  Doctor, NOTHING_AFTER_US, NOTHING_CERTAIN_US, LINE_WINDOW_BINS,
+  type Confidence, type ConfirmProbe, type DoctorCode, type DoctorFinding, type DoctorOptions, type DoctorPortSource,
+  type Evidence, type Severity,
+} from './doctor.js';
+export { doctorCapture, type DoctorCaptureOptions, type DoctorReport, type DoctorTimelineEntry } from './doctor-capture.js';
+export {
+  ArduPilotGuess, ARDUPILOT_GUESS_FRAMES, bindPulses, channelSetText, foreignSettings, PROTOCOL_SETTINGS, satelliteSettings,
+  type FlightStack, type ForeignProtocol, type GuessTally, type StackSetting, type StreamFacts,
+} from './doctor-stacks.js';
+export { classifyLine, PacketScanner, PACKET_KINDS, type LineCounts, type LineVerdict, type PacketKind } from './doctor-line.js';

@@ -1,0 +1,133 @@
+/**
+ * `satscope doctor FILE`: what is wrong with the setup a capture was recorded from, and what to
+ * change, in plain text (or `--json` for scripts). A thin shell over `doctorCapture`.
+ *
+ * Exit codes: 0 no problem found at the end of the capture, 1 a problem found (or the file is
+ * not a capture), 2 bad usage or an unreadable file.
+ */
+import { readFileSync } from 'node:fs';
+import { basename } from 'node:path';
+import { parseArgs } from 'node:util';
+import { doctorCapture, type DoctorFinding, type DoctorReport } from '../analysis/index.js';
+import { CaptureFormatError, readCapture, type Capture } from '../decoder/index.js';
+
+export const DOCTOR_USAGE = `Usage:
+  satscope doctor FILE [--json] [--resolution auto|1024|2048]
+
+Diagnoses a capture (.sscap, raw .bin or Saleae CSV): nothing arriving, bytes that are not a
+Spektrum satellite (an inverted line, SRXL, SRXL2, IBUS, SBUS, CRSF, noise), flight-controller
+settings that will read the stream wrong (Betaflight/iNav serialrx_provider and
+spektrum_sat_bind, ArduPilot and PX4 auto-detection), a weak link and a wrong setup. Prints each
+finding with its evidence, how sure it is and what to do; --json prints the same as JSON.
+Exit code 0: no problem found; 1: a problem found, or not a capture; 2: bad usage.`;
+
+export interface DoctorIo {
+  out(text: string): void;
+  err(text: string): void;
+}
+
+const defaultIo: DoctorIo = {
+  out: (t) => process.stdout.write(t),
+  err: (t) => process.stderr.write(t),
+};
+
+/** Runs `satscope doctor` with the arguments after the command name; returns the exit code. */
+export function doctorCommand(argv: string[], io: DoctorIo = defaultIo): number {
+  let values: { json?: boolean; resolution?: string; help?: boolean };
+  let positionals: string[];
+  try {
+    ({ values, positionals } = parseArgs({
+      args: argv,
+      options: { json: { type: 'boolean' }, resolution: { type: 'string' }, help: { type: 'boolean', short: 'h' } },
+      allowPositionals: true,
+      strict: true,
+    }));
+  } catch (error) {
+    io.err(`satscope doctor: ${(error as Error).message}\n\n${DOCTOR_USAGE}\n`);
+    return 2;
+  }
+  if (values.help === true) {
+    io.out(`${DOCTOR_USAGE}\n`);
+    return 0;
+  }
+  const usage = (message: string): number => {
+    io.err(`satscope doctor: ${message}\n\n${DOCTOR_USAGE}\n`);
+    return 2;
+  };
+  if (positionals.length === 0) return usage('no FILE given');
+  if (positionals.length > 1) return usage(`unexpected argument '${positionals[1] as string}'`);
+  const resolution = values.resolution ?? 'auto';
+  if (resolution !== 'auto' && resolution !== '1024' && resolution !== '2048') return usage(`--resolution must be auto, 1024 or 2048, not '${resolution}'`);
+  const file = positionals[0] as string;
+
+  let bytes: Uint8Array;
+  try {
+    bytes = readFileSync(file);
+  } catch (error) {
+    const code = (error as NodeJS.ErrnoException).code;
+    const why = code === 'ENOENT' ? 'no such file' : code === 'EISDIR' ? 'it is a directory' : code === 'EACCES' ? 'permission denied' : String(error);
+    io.err(`satscope doctor: cannot read ${file}: ${why}\n`);
+    return 2;
+  }
+  let capture: Capture;
+  try {
+    capture = readCapture(new Uint8Array(bytes.buffer, bytes.byteOffset, bytes.byteLength), basename(file));
+  } catch (error) {
+    if (error instanceof CaptureFormatError) {
+      io.err(`satscope doctor: ${file}: ${error.message}\n`);
+      return 1;
+    }
+    throw error;
+  }
+  for (const issue of capture.issues) io.err(`satscope doctor: ${file}: ${issue.message}\n`);
+  const report = doctorCapture(capture, { resolution: resolution === 'auto' ? 'auto' : (Number(resolution) as 1024 | 2048) });
+  io.out(values.json === true ? `${JSON.stringify(report, null, 2)}\n` : formatDoctorReport(report, basename(file)));
+  return report.findings.some((f) => f.severity === 'problem') ? 1 : 0;
+}
+
+const LABEL: Record<DoctorFinding['severity'], string> = { problem: 'PROBLEM', warning: 'WARNING', info: 'INFO' };
+
+/** "0:02.1" from the capture's start. */
+function clock(us: number | null, origin: number | null): string {
+  if (us === null || origin === null || !Number.isFinite(us)) return '';
+  const s = Math.max(0, (us - origin) / 1e6);
+  const m = Math.floor(s / 60);
+  const rest = (s - m * 60).toFixed(1).padStart(4, '0');
+  return `${m}:${rest}`;
+}
+
+/** The report as text a person reads in a terminal. */
+export function formatDoctorReport(r: DoctorReport, name: string): string {
+  const lines: string[] = [];
+  const origin = r.source.startUs;
+  const span = r.source.startUs !== null && r.source.endUs !== null ? `, ${((r.source.endUs - r.source.startUs) / 1e6).toFixed(1)} s` : '';
+  lines.push(`satscope doctor: ${name} (${r.source.kind}, ${r.source.timing} timing, ${r.source.ports.length === 1 ? '1 port' : `${r.source.ports.length} ports`}, ${r.source.bytes} bytes${span})`);
+  lines.push('');
+  if (r.findings.length === 0) lines.push('No findings: nothing wrong was seen at the end of the capture.');
+  for (const f of r.findings) {
+    const since = clock(f.sinceUs, origin);
+    lines.push(`${LABEL[f.severity]}  ${f.title}  [${f.confidence}${since !== '' ? `, since ${since}` : ''}]`);
+    for (const e of f.evidence) lines.push(`  - ${e.text}`);
+    if (f.todo.length > 0) {
+      lines.push('  What to do:');
+      f.todo.forEach((t, i) => lines.push(`    ${i + 1}. ${t}`));
+    }
+    const withLines = f.settings.filter((s) => s.lines.length > 0 || s.note !== '');
+    if (withLines.length > 0) {
+      lines.push('  Settings:');
+      for (const s of withLines) {
+        lines.push(`    ${s.stack}: ${s.note}`);
+        for (const l of s.lines) lines.push(`      ${l}`);
+      }
+    }
+    if (f.confirm !== null) lines.push(`  To confirm: listen at ${f.confirm.baudRate} baud, ${f.confirm.parity} parity, ${f.confirm.stopBits} stop bit${f.confirm.stopBits === 1 ? '' : 's'}. ${f.confirm.note}`);
+    lines.push('');
+  }
+  const earlier = r.timeline.filter((e) => e.toUs !== null);
+  if (earlier.length > 0) {
+    lines.push('Seen earlier in the capture, cleared by its end:');
+    for (const e of earlier) lines.push(`  ${LABEL[e.severity].toLowerCase()}: ${e.title} (${clock(e.fromUs, origin)}–${clock(e.toUs, origin)})`);
+    lines.push('');
+  }
+  return `${lines.join('\n')}\n`;
+}
