@@ -678,10 +678,20 @@ export class SpektrumDecoder {
     return true;
   }
 
-  /** Whether the frame at `a` is valid and its header continues into frame `b`'s as acquisition chains them. */
+  /** Whether `layout` is the layout of one of the `frames` frames from `o`. */
+  #layoutInChain(layout: number, o: number, frames: number, resolution: Resolution): boolean {
+    for (let k = 0; k < frames; k++) if (slotLayout(this.#buf, o + k * FRAME_SIZE, resolution) === layout) return true;
+    return false;
+  }
+
+  /**
+   * Whether the frame at `a` is valid, has a layout of the chain that starts at `b`, and its
+   * header continues into frame `b`'s as acquisition chains them.
+   */
   #chainsInto(a: number, b: number, resolution: Resolution, internal: boolean, system: number): boolean {
     const buf = this.#buf;
-    if (slotLayout(buf, a, resolution) === INVALID) return false;
+    const layout = slotLayout(buf, a, resolution);
+    if (layout === INVALID || !this.#layoutInChain(layout, b, Math.min(ACQUIRE_FRAMES, Math.floor((this.#tail - b) / FRAME_SIZE)), resolution)) return false;
     if (internal) {
       const mode = this.#options.headerMode === 'rssi' ? B0_RSSI_FORCED : this.#options.headerMode === 'fades' ? B0_FADES : B0_UNKNOWN;
       return buf[a + 1] === system && buf[b + 1] === system && byte0Follows(buf[a] as number, buf[b] as number, mode, ACQUIRE_FADE_STEP);
@@ -803,10 +813,6 @@ export class SpektrumDecoder {
     let recurring = 0;
     let layout1 = INVALID;
     let layout2 = INVALID;
-    // Slots whose low byte is the same §8.3 system byte in every frame: an internal remote's
-    // header read as a slot (the stream read two bytes late, say).
-    let headerSlots = 0x7f;
-    let headerByte = -1;
     for (let k = 0; k < length; k++) {
       const f = o + k * FRAME_SIZE;
       const layout = slotLayout(buf, f, resolution);
@@ -818,12 +824,11 @@ export class SpektrumDecoder {
       layout1 = layout;
       channels |= layoutChannels(layout);
       zeroWords += countZeroWords(buf, f);
-      for (let i = 0; i < 7; i++) {
-        const low = buf[f + 3 + 2 * i] as number;
-        if (systemInfo(low) === undefined || (headerByte >= 0 && low !== headerByte)) headerSlots &= ~(1 << i);
-        else if ((headerSlots & (1 << i)) !== 0) headerByte = low;
-      }
     }
+    if (!internal && this.#readsInternalLate(o, resolution, length)) return -1;
+    // Transmitters repeat their layouts (a pair of frames, mostly): a first frame whose layout
+    // comes nowhere else in the chain may be damage (a stray byte that made a slot), not a frame.
+    if (length >= MIN_CHAIN && !this.#layoutInChain(slotLayout(buf, o, resolution), o + FRAME_SIZE, length - 1, resolution)) return -1;
     let score = 10 * length + recurring - zeroWords - (skipped >= 0 ? 5 : 0);
     if (internal) {
       // A §8.3 system byte in every frame is strong evidence of an internal remote.
@@ -832,7 +837,6 @@ export class SpektrumDecoder {
     } else if (((buf[o] as number) << 8 | s) < 256) {
       score += 1;
     }
-    if (length > 1 && headerSlots !== 0) score -= 6;
     // A header of 0xFFFF is an empty slot's filler more often than a fade count at its limit.
     if (((buf[o] as number) << 8 | s) === 0xffff) score -= 3;
     // Transmitters send channels 0…N-1: a contiguous set is the signature of the right reading.
@@ -843,6 +847,27 @@ export class SpektrumDecoder {
     this.#candSkipped = skipped;
     this.#candB0 = forcedB0 !== B0_UNKNOWN ? forcedB0 : positive ? B0_FADES : fell ? B0_RSSI : B0_UNKNOWN;
     return score;
+  }
+
+  /**
+   * Whether the external reading at `o` is an internal remote's stream read at the wrong offset:
+   * a slot whose low byte is a §8.3 system byte, where frames starting at that slot (as their
+   * header) are valid internal frames with that system byte, for as many frames as the reading
+   * has. A 1024-mode internal remote read two bytes late otherwise looks like an external one
+   * whose fade count is channel 0's position.
+   */
+  #readsInternalLate(o: number, resolution: Resolution, length: number): boolean {
+    const buf = this.#buf;
+    for (let i = 0; i < 7; i++) {
+      const system = buf[o + 3 + 2 * i] as number;
+      if (systemInfo(system) === undefined) continue;
+      let agree = 0;
+      for (let h = o + 2 + 2 * i - FRAME_SIZE; h + FRAME_SIZE <= this.#tail && h < o + length * FRAME_SIZE; h += FRAME_SIZE) {
+        if (h >= this.#head && buf[h + 1] === system && slotLayout(buf, h, resolution) !== INVALID) agree++;
+      }
+      if (agree >= Math.max(2, length - 1)) return true;
+    }
+    return false;
   }
 
   #headerReading(): HeaderReading {
