@@ -191,7 +191,7 @@ describe.skipIf(skip !== null)('the page', () => {
 
   it('shows the two demo remotes side by side and switches the views to the one clicked', async () => {
     const { page, errors } = await open();
-    const rows = page.locator('.remotes tbody tr');
+    const rows = page.locator('.remotes .remote-table tbody tr');
     await rows.nth(1).waitFor({ timeout: 10_000 });
     await expect(rows.count()).resolves.toBe(2);
     await page.locator('.remotes .state-chip', { hasText: 'live' }).nth(1).waitFor({ timeout: 10_000 });

@@ -47,6 +47,19 @@ function specs(rssi: boolean): ChartSpec[] {
   ];
 }
 
+/**
+ * A column for uPlot with its gaps as null: a bucket without frames has no period (NaN), and
+ * uPlot draws a line straight across NaN but breaks it at null.
+ */
+function gaps(col: ArrayLike<number>): (number | null)[] {
+  const out = new Array<number | null>(col.length);
+  for (let i = 0; i < col.length; i++) {
+    const v = col[i] as number;
+    out[i] = Number.isNaN(v) ? null : v;
+  }
+  return out;
+}
+
 function makeChart(el: HTMLElement, spec: ChartSpec, width: number, sync: uPlot.SyncPubSub): uPlot {
   const opts: uPlot.Options = {
     width,
@@ -116,7 +129,7 @@ export function Graphs({ windowUs }: { windowUs: Signal<number> }) {
       charts.forEach((chart, i) => {
         const key = (list[i] as ChartSpec).key;
         chart.batch(() => {
-          chart.setData([x as unknown as number[], s[key].subarray(from, s.length) as unknown as number[]], false);
+          chart.setData([x as unknown as number[], gaps(s[key].subarray(from, s.length))], false);
           chart.setScale('x', { min: start, max: end });
         });
         showNewest(chart, x.length);

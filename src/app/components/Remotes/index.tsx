@@ -141,7 +141,7 @@ export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
     <section class="remotes" aria-label="Remotes">
       <h2>Remotes side by side</h2>
       <div class="table-scroll" tabIndex={0} role="region" aria-label="Remotes table">
-      <table>
+      <table class="remote-table">
         <thead>
           <tr><th>Remote</th><th>State</th><th>Fades</th><th>Fade rate</th><th>Holds / failsafes</th><th>Frames</th><th>Source</th><th><span class="sr-only">Actions</span></th></tr>
         </thead>
