@@ -14,7 +14,7 @@ import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { readCapture, summarizeCapture } from '../../src/decoder/index.js';
 import { preset, simulate } from '../../src/simulator/index.js';
 import { agoLabel, agoSplits, niceSplits, niceTop, timeStep } from '../../src/app/axes.js';
-import { browserUnavailable, shot, startApp, usbChunks, writeCapture, type AppSession } from './app-fixture.js';
+import { SHOTS, browserUnavailable, shot, startApp, usbChunks, writeCapture, type AppSession } from './app-fixture.js';
 
 const skip = browserUnavailable();
 if (skip !== null) console.warn(`skipping the page tests: ${skip}`);
@@ -98,6 +98,7 @@ async function overflowing(page: Page): Promise<string[]> {
 
 /** axe-core's violations of impact serious or critical, as "rule: target" lines (and all counted). */
 async function axe(page: Page, label: string): Promise<string[]> {
+  const t0 = Date.now();
   await page.evaluate(AXE_SOURCE);
   const result = await page.evaluate(async () => {
     const w = window as unknown as { axe: { run(ctx: Document, opts: object): Promise<{ violations: { id: string; impact: string; nodes: { target: string[] }[] }[]; passes: unknown[] }> } };
@@ -105,7 +106,7 @@ async function axe(page: Page, label: string): Promise<string[]> {
     return { violations: r.violations.map((v) => ({ id: v.id, impact: v.impact, targets: v.nodes.map((n) => n.target.join(' ')) })), passes: r.passes.length };
   });
   const byImpact = result.violations.reduce<Record<string, number>>((acc, v) => ({ ...acc, [v.impact]: (acc[v.impact] ?? 0) + v.targets.length }), {});
-  console.log(`axe ${label}: ${JSON.stringify(byImpact)} ${result.violations.map((v) => `${v.id}(${v.impact})`).join(' ')}`);
+  console.log(`axe ${label} (${Date.now() - t0} ms): ${JSON.stringify(byImpact)} ${result.violations.map((v) => `${v.id}(${v.impact})`).join(' ')}`);
   return result.violations.filter((v) => v.impact === 'serious' || v.impact === 'critical').map((v) => `${v.id}: ${v.targets.slice(0, 3).join(', ')}`);
 }
 
@@ -251,6 +252,7 @@ describe.skipIf(skip !== null)('the page on any screen', () => {
       reached = focus.inB;
     }
     expect(reached).toBe(true);
+    await page.locator('.remotes').screenshot({ path: join(SHOTS, 'ui-keyboard-focus-1280-dark.png') });
     // Every stop on the way had a visible focus ring.
     for (const o of outlines) expect(o).toMatch(/^(solid|auto) [1-9]/);
     await page.keyboard.press('Enter');
@@ -323,6 +325,7 @@ describe.skipIf(skip !== null)('the page on any screen', () => {
     // A decoded value never breaks across lines.
     const broken = await page.$$eval('.inspector .summary .v', (els) => els.filter((e) => e.getClientRects().length > 1 || e.getBoundingClientRect().height > 24).length);
     expect(broken).toBe(0);
+    await page.locator('.inspector').screenshot({ path: join(SHOTS, 'ui-inspector-vtx-1280-dark.png') });
     expect(errors).toEqual([]);
     await page.context().close();
   });
@@ -339,6 +342,8 @@ describe.skipIf(skip !== null)('the page on any screen', () => {
       await demoRunning(demo.page);
       await demo.page.getByRole('button', { name: 'Inspect frames…' }).click();
       await demo.page.locator('.insp-table').waitFor();
+      // Paused, the inspector holds its thousand rows still while axe walks them.
+      await demo.page.getByRole('button', { name: 'Follow' }).click();
       await demo.page.locator('.counters .help summary').click();
       found.push(...(await axe(demo.page, `demo+inspector ${scheme}`)));
       await demo.page.getByRole('button', { name: 'Settings' }).click();
@@ -349,6 +354,7 @@ describe.skipIf(skip !== null)('the page on any screen', () => {
       await demo.page.locator('.bind').waitFor();
       await demo.page.locator('.bind .technical summary').click();
       found.push(...(await axe(demo.page, `demo+bind ${scheme}`)));
+      await shot(demo.page, `ui-bind-1280-${scheme}`);
       await demo.page.context().close();
 
       const rep = await open({ scheme, query: '?demo=0' });
@@ -357,7 +363,7 @@ describe.skipIf(skip !== null)('the page on any screen', () => {
       await rep.page.context().close();
     }
     expect(found).toEqual([]);
-  });
+  }, 180_000);
 
   it('takes screenshots of the demo, a replay and the empty state at three sizes in both themes, none wider than its viewport', async () => {
     const report: string[] = [];
