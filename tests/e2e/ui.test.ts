@@ -5,7 +5,7 @@
  * on hover, and axe-core with no serious or critical violation. Screenshots of the demo, a
  * replay and the empty state at three sizes in both themes go to test-results/screenshots/.
  */
-import { readFileSync, mkdtempSync, rmSync } from 'node:fs';
+import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { createRequire } from 'node:module';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
@@ -211,6 +211,14 @@ describe.skipIf(skip !== null)('the page on any screen', () => {
     console.log(`390 demo + inspector + bind: document ${bind.document} px, viewport ${bind.viewport} px`);
     expect(await overflowing(page)).toEqual([]);
     expect(bind.document).toBe(bind.viewport);
+    // A message with a long text wraps inside the page.
+    const notes = join(dir, 'a-file-with-a-rather-long-name-that-is-not-a-capture-at-all.txt');
+    writeFileSync(notes, 'shopping list\neggs\n');
+    await page.setInputFiles('input[type=file]', notes);
+    await page.getByRole('alert').first().waitFor();
+    const notice = await widths(page);
+    expect(await overflowing(page)).toEqual([]);
+    expect(notice.document).toBe(notice.viewport);
     expect(errors).toEqual([]);
     await page.context().close();
   });
