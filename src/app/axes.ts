@@ -144,11 +144,16 @@ export function legendValue(unit: string, digits: number): (u: uPlot, v: number 
   return (_u, v) => (v === null || !Number.isFinite(v) ? '—' : `${v.toFixed(digits).replace('-', '−')} ${unit}`);
 }
 
-/** The cursor of the live graphs: a vertical line, no zoom by dragging, shared by `syncKey`. */
+/**
+ * The cursor of the live graphs: a vertical line, no zoom by dragging, shared by `syncKey`.
+ * The legend is for reading only: uPlot's click-to-hide-a-series on its labels would be a
+ * control only a mouse can reach, so it is not bound.
+ */
 export function hoverCursor(syncKey?: string): uPlot.Cursor {
   return {
     y: false,
     drag: { x: false, y: false },
+    bind: { click: () => null },
     points: { size: 7 },
     ...(syncKey === undefined ? {} : { sync: { key: syncKey } }),
   };

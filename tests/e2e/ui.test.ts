@@ -172,6 +172,14 @@ describe.skipIf(skip !== null)('the page on any screen', () => {
     await expect(page.getByText('no data').count()).resolves.toBe(0);
     await expect(page.getByText('Last frame').count()).resolves.toBe(0);
     await expect(page.getByTestId('source-status').textContent()).resolves.toBe('No receiver');
+    // Open capture asks for a file, and the file replays.
+    const chooser = page.waitForEvent('filechooser');
+    await empty.getByRole('button', { name: 'Open capture…' }).click();
+    await (await chooser).setFiles(capture);
+    await page.locator('section.replay').waitFor();
+    await empty.waitFor({ state: 'detached' });
+    await page.reload();
+    await page.getByTestId('empty-state').waitFor();
     await empty.getByRole('button', { name: 'Start demo' }).click();
     await page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor({ timeout: 10_000 });
     await empty.waitFor({ state: 'detached' });
