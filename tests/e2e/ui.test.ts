@@ -238,6 +238,13 @@ describe.skipIf(skip !== null)('the page on any screen', () => {
     const height = await page.locator('.toolbar').evaluate((e) => e.getBoundingClientRect().height);
     console.log(`1280 toolbar: ${rows} distinct row centres, ${Math.round(height)} px high`);
     expect(height).toBeLessThan(56);
+    // Still one row while recording and with an export to offer.
+    await page.getByRole('button', { name: '● Record' }).click();
+    await page.waitForTimeout(1200);
+    await expect(page.locator('.toolbar').evaluate((e) => e.getBoundingClientRect().height)).resolves.toBeLessThan(56);
+    await page.getByRole('button', { name: 'Stop recording' }).click();
+    await page.getByRole('button', { name: 'Export .sscap' }).waitFor();
+    await expect(page.locator('.toolbar').evaluate((e) => e.getBoundingClientRect().height)).resolves.toBeLessThan(56);
     // No text links among the buttons.
     await expect(page.locator('.toolbar > .tb-group > button.link').count()).resolves.toBe(0);
     // Resolution lives in Settings.

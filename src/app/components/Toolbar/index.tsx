@@ -84,6 +84,7 @@ export function Toolbar({ granted, onBind }: { granted: SerialPort[]; onBind(): 
               <>
                 <button type="button" onClick={() => { close(); void chooseAndConnect(false); }}>Any serial port…</button>
                 <p class="hint">Connect receiver lists USB-serial adapters (FTDI, CP210x, CH340, PL2303…). This lists every serial port.</p>
+                {kind === 'serial' ? <button type="button" onClick={() => { close(); send({ type: 'close-all' }); }}>Disconnect all</button> : null}
               </>
             )}
           </Menu>
@@ -93,7 +94,6 @@ export function Toolbar({ granted, onBind }: { granted: SerialPort[]; onBind(): 
             {portLabel(port)}
           </button>
         ))}
-        {kind === 'serial' ? <button type="button" onClick={() => send({ type: 'close-all' })}>Disconnect all</button> : null}
         {kind === 'demo' ? (
           <button type="button" onClick={() => send({ type: 'demo-stop' })}>Stop demo</button>
         ) : (
