@@ -164,3 +164,42 @@ export function showNewest(u: uPlot, points: number): void {
   const left = u.cursor.left ?? -1;
   if (left < 0 && points > 0) u.setLegend({ idx: points - 1 }, false);
 }
+
+/** uPlot's setCursor also takes whether to publish to the synced charts (not in its typings). */
+type SetCursor = (opts: { left: number; top: number }, fire?: boolean, publish?: boolean) => void;
+
+/**
+ * The keyboard's way to what hovering shows: the chart takes focus (Tab), the arrow keys move
+ * the cursor a bucket at a time (with Shift, ten), Home and End jump to the ends, and the legend
+ * reads the values there, in every synced chart. Leaving the chart hides the cursor again.
+ * Returns the function that removes the listeners.
+ */
+export function keyboardCursor(u: uPlot, el: HTMLElement): () => void {
+  el.tabIndex = 0;
+  const setCursor = u.setCursor as unknown as SetCursor;
+  const key = (e: KeyboardEvent) => {
+    const xs = u.data[0];
+    if (xs === undefined || xs.length === 0) return;
+    const last = xs.length - 1;
+    // From where the cursor is now (the data slides under it), or from the newest bucket.
+    const at = (u.cursor.left ?? -1) >= 0 ? u.cursor.idx : null;
+    let i = at === null || at === undefined ? last : Math.min(at, last);
+    const step = e.shiftKey ? 10 : 1;
+    if (e.key === 'ArrowLeft') i = Math.max(0, i - step);
+    else if (e.key === 'ArrowRight') i = Math.min(last, i + step);
+    else if (e.key === 'Home') i = 0;
+    else if (e.key === 'End') i = last;
+    else return;
+    e.preventDefault();
+    setCursor.call(u, { left: u.valToPos(xs[i] as number, 'x'), top: u.bbox.height / devicePixelRatio / 2 }, true, true);
+  };
+  const blur = () => {
+    setCursor.call(u, { left: -10, top: -10 }, true, true);
+  };
+  el.addEventListener('keydown', key);
+  el.addEventListener('blur', blur);
+  return () => {
+    el.removeEventListener('keydown', key);
+    el.removeEventListener('blur', blur);
+  };
+}

@@ -316,7 +316,7 @@ describe.skipIf(skip !== null)('the page on any screen', () => {
     await dark.page.context().close();
   });
 
-  it('shows the values under the cursor when a graph is hovered', async () => {
+  it('shows the values under the cursor when a graph is hovered, or stepped through from the keyboard', async () => {
     const { page } = await open({ width: 1280, height: 800 });
     await demoRunning(page);
     await page.waitForTimeout(3000);
@@ -329,6 +329,16 @@ describe.skipIf(skip !== null)('the page on any screen', () => {
     await expect(legend.nth(0).textContent()).resolves.toMatch(/^(now|−\d+\.\d s)$/);
     // The other graphs follow the same cursor.
     await expect.poll(async () => page.locator('.chart[data-chart="fadeRate"] .u-legend .u-value').nth(1).textContent()).toMatch(/\/s$/);
+    // The keyboard gets there too: focus a graph, step back a second with the arrow keys.
+    await page.mouse.move(0, 0);
+    const lost = page.locator('.chart[data-chart="lost"]');
+    await lost.focus();
+    await page.keyboard.press('End');
+    for (let i = 0; i < 10; i++) await page.keyboard.press('ArrowLeft');
+    const time = async () => Number(((await lost.locator('.u-legend .u-value').nth(0).textContent()) ?? '').replace('−', '-').replace(' s', ''));
+    await expect.poll(time).toBeLessThan(-0.8);
+    // The other graphs show the same time.
+    await expect.poll(async () => page.locator('.chart[data-chart="periodMs"] .u-legend .u-value').nth(0).textContent()).toBe(await lost.locator('.u-legend .u-value').nth(0).textContent());
     await page.context().close();
   });
 

@@ -12,7 +12,7 @@ import 'uplot/dist/uPlot.min.css';
 import { onFrame } from '../../frame-loop.js';
 import type { Live, SeriesBuffer } from '../../live.js';
 import { current, status } from '../../store.js';
-import { agoAxis, hoverCursor, legendTime, legendValue, showNewest, valueAxis, valueScale, type ValueScale } from '../../axes.js';
+import { agoAxis, hoverCursor, keyboardCursor, legendTime, legendValue, showNewest, valueAxis, valueScale, type ValueScale } from '../../axes.js';
 import { chartColors, theme } from '../../theme.js';
 import './style.css';
 
@@ -99,11 +99,12 @@ export function Graphs({ windowUs }: { windowUs: Signal<number> }) {
       const box = document.createElement('div');
       box.className = 'chart';
       box.setAttribute('role', 'figure');
-      box.setAttribute('aria-label', `${spec.title} over time: hover for the values`);
+      box.setAttribute('aria-label', `${spec.title} over time: hover, or the arrow keys, for the values`);
       box.dataset.chart = spec.key;
       el.append(box);
       return makeChart(box, spec, width(), sync);
     });
+    const keys = charts.map((c) => keyboardCursor(c, c.root.parentElement as HTMLElement));
     const resize = new ResizeObserver(() => charts.forEach((c) => c.setSize({ width: width(), height: HEIGHT })));
     resize.observe(el);
     let version = -1;
@@ -138,6 +139,7 @@ export function Graphs({ windowUs }: { windowUs: Signal<number> }) {
     return () => {
       stop();
       resize.disconnect();
+      keys.forEach((off) => off());
       charts.forEach((c) => c.destroy());
       el.replaceChildren();
     };

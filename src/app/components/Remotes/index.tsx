@@ -13,7 +13,7 @@ import { onFrame } from '../../frame-loop.js';
 import type { Live } from '../../live.js';
 import { allLives, select, selected, send, sources } from '../../store.js';
 import { drawEpisodes } from '../../timeline.js';
-import { agoAxis, hoverCursor, legendTime, legendValue, showNewest, valueAxis, valueScale } from '../../axes.js';
+import { agoAxis, hoverCursor, keyboardCursor, legendTime, legendValue, showNewest, valueAxis, valueScale } from '../../axes.js';
 import { chartColors, theme } from '../../theme.js';
 import './style.css';
 
@@ -51,6 +51,7 @@ export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
         })),
       ],
     }, [[], ...order.map(() => [])], box);
+    const keys = keyboardCursor(plot, box);
     const resize = new ResizeObserver(() => plot.setSize({ width: Math.max(200, box.clientWidth), height: 120 }));
     resize.observe(box);
     let drawnAt = 0;
@@ -100,6 +101,7 @@ export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
     return () => {
       stop();
       resize.disconnect();
+      keys();
       plot.destroy();
     };
   }, [ids, windowUs, palette]);
@@ -173,7 +175,7 @@ export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
         </tbody>
       </table>
       </div>
-      <div class="remote-chart" ref={chart} role="figure" aria-label="Fade rate of every remote over time: hover for the values" />
+      <div class="remote-chart" ref={chart} role="figure" aria-label="Fade rate of every remote over time: hover, or the arrow keys, for the values" />
       <div class="lanes" ref={lanes} role="group" aria-label="Hold and failsafe episodes per remote">
         {list.map((s, i) => (
           <div key={s.id} class="lane">
