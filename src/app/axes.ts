@@ -83,8 +83,11 @@ function labelsFor(u: uPlot): number {
   return Math.max(1, Math.min(5, Math.floor(u.bbox.height / devicePixelRatio / 18)));
 }
 
-function decimals(step: number): number {
-  return step >= 1 ? 0 : step >= 0.1 ? 1 : 2;
+/** The decimals that write every multiple of `step` exactly (0.25 → 2, 0.5 → 1, 5 → 0). */
+export function decimals(step: number): number {
+  let d = 0;
+  while (d < 4 && Math.abs(step * 10 ** d - Math.round(step * 10 ** d)) > 1e-6) d++;
+  return d;
 }
 
 export interface ValueScale {

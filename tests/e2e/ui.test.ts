@@ -13,7 +13,7 @@ import type { Page } from 'playwright-core';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { readCapture, summarizeCapture } from '../../src/decoder/index.js';
 import { preset, simulate } from '../../src/simulator/index.js';
-import { agoLabel, agoSplits, niceSplits, niceTop, timeStep } from '../../src/app/axes.js';
+import { agoLabel, agoSplits, decimals, niceSplits, niceTop, timeStep } from '../../src/app/axes.js';
 import { SHOTS, browserUnavailable, shot, startApp, usbChunks, writeCapture, type AppSession } from './app-fixture.js';
 
 const skip = browserUnavailable();
@@ -152,6 +152,12 @@ describe('the graphs\' axes', () => {
     expect(niceSplits(500, false, 2)).toEqual([0, 250, 500]);
     expect(niceSplits(20, true, 2)).toEqual([0, 10, 20]);
     expect(niceSplits(1, false, 3)).toEqual([0, 0.5, 1]);
+    // Labels are exact: 0.25 is "0.25", never "0.3".
+    expect(niceSplits(1, false, 4)).toEqual([0, 0.25, 0.5, 0.75, 1]);
+    expect(decimals(0.25)).toBe(2);
+    expect(decimals(0.2)).toBe(1);
+    expect(decimals(2.5)).toBe(1);
+    expect(decimals(250)).toBe(0);
   });
 });
 
