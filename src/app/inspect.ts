@@ -94,6 +94,10 @@ export interface FrameDescription {
   phase: 0 | 1 | null;
   /** Everything in one line: "fades 62 · 0xB2 DSMX 11 ms · 1p Aileron 1023 1500 µs · …". */
   summary: string;
+  /** The summary's items, each one value that must not be broken across lines. */
+  parts: string[];
+  /** Slots sent as 0xFFFF. */
+  emptySlots: number;
 }
 
 const hex2 = (v: number) => `0x${v.toString(16).toUpperCase().padStart(2, '0')}`;
@@ -271,5 +275,21 @@ export function describeFrame(bytes: Uint8Array, resolution: Resolution, remote:
     resolution, remote, headerMode, header, slots, vtx,
     phase: resolution === 2048 ? (((bytes[2] as number) & 0x80) !== 0 ? 1 : 0) : null,
     summary: parts.join(' · '),
+    parts,
+    emptySlots: empty,
   };
+}
+
+/**
+ * Empty (0xFFFF) slots and whether it is a VTX frame, for counting over many frames without
+ * describing each (the same rules as describeFrame: VTX slots 6–7 are not empty slots).
+ */
+export function countSlots(bytes: Uint8Array): { empty: number; vtx: boolean } {
+  if (bytes.length < FRAME_SIZE) return { empty: 0, vtx: false };
+  const vtx = isVtx(bytes);
+  let empty = 0;
+  for (let i = 0; i < (vtx ? 5 : 7); i++) {
+    if ((((bytes[2 + 2 * i] as number) << 8) | (bytes[3 + 2 * i] as number)) === EMPTY_SLOT) empty++;
+  }
+  return { empty, vtx };
 }

@@ -3,6 +3,8 @@
  * starts the demo receiver when there are none, so a newcomer sees everything at once.
  */
 import { render } from 'preact';
+// First: sets <html data-theme> before anything is drawn.
+import './theme.js';
 import { App } from './components/App/index.js';
 import { serialUnavailable } from './serial.js';
 import { send, startWorker } from './store.js';

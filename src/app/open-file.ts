@@ -16,3 +16,15 @@ export async function openCapture(file: File): Promise<void> {
   const data = await file.arrayBuffer();
   send({ type: 'replay-open', name: file.name, data }, [data]);
 }
+
+/** The page's one file input (the toolbar's), which every "Open capture" button clicks. */
+let input: HTMLInputElement | null = null;
+
+export function setCaptureInput(el: HTMLInputElement | null): void {
+  input = el;
+}
+
+/** Shows the browser's file chooser for a capture. */
+export function chooseCapture(): void {
+  input?.click();
+}

@@ -3,6 +3,7 @@
  * user gesture, so it cannot happen in the worker), and naming granted ports for the worker.
  */
 import { portName, type PortIdentity } from '../worker/protocol.js';
+import { notify, send } from './store.js';
 
 /** USB-serial chips people put on a satellite's DATA line, as picker hints; any port may be chosen. */
 export const USB_SERIAL_FILTERS: SerialPortFilter[] = [
@@ -46,7 +47,7 @@ export async function pickPort(filters: SerialPortFilter[]): Promise<SerialPort 
         problem: {
           title: 'No port chosen',
           detail: filters.length > 0
-            ? 'Pick the USB-serial adapter wired to the satellite\'s DATA line (gray wire). If it is not in the list, use "any port…" to see every serial port.'
+            ? 'Pick the USB-serial adapter wired to the satellite\'s DATA line (gray wire). If it is not in the list, choose "Any serial port…" under the arrow beside Connect receiver.'
             : 'Pick the USB-serial adapter wired to the satellite\'s DATA line (gray wire). If it is not listed, check the cable and its driver.',
         },
       };
@@ -58,4 +59,24 @@ export async function pickPort(filters: SerialPortFilter[]): Promise<SerialPort 
 
 export function portLabel(port: SerialPort): string {
   return portName(port.getInfo());
+}
+
+/** Reads a port the page was granted as one more source. */
+export async function connect(port: SerialPort): Promise<void> {
+  send({ type: 'serial-open', port: await identify(port) });
+}
+
+/**
+ * "Connect receiver": the browser's picker (USB-serial adapters only when `filtered`), then the
+ * chosen port; what went wrong, and what to do, as a notice.
+ */
+export async function chooseAndConnect(filtered: boolean): Promise<void> {
+  const missing = serialUnavailable();
+  if (missing !== null) {
+    notify('error', missing.title, missing.detail);
+    return;
+  }
+  const picked = await pickPort(filtered ? USB_SERIAL_FILTERS : []);
+  if ('problem' in picked) notify('warning', picked.problem.title, picked.problem.detail);
+  else await connect(picked);
 }

@@ -1,8 +1,7 @@
 /**
- * Pieces the time-axis views share: hold/failsafe episodes drawn as bands on a strip, and
- * uPlot's x axis labelled in seconds before now.
+ * Pieces the time-axis views share: hold/failsafe episodes drawn as bands on a strip. (The
+ * graphs' axes, seconds before now and labelled values, are in axes.ts.)
  */
-import type uPlot from 'uplot';
 import type { Episode } from './live.js';
 
 /**
@@ -27,20 +26,4 @@ export function drawEpisodes(strip: HTMLElement, episodes: Iterable<Episode>, no
     drawn.push(e.kind);
   }
   return drawn;
-}
-
-/** The dark-theme x axis of the live graphs: seconds before the window's end. */
-export const SECONDS_BEFORE_NOW_AXIS: uPlot.Axis = {
-  stroke: '#8a97a8',
-  grid: { stroke: '#1e2835' },
-  ticks: { stroke: '#1e2835' },
-  values: (u, vals) => {
-    const end = u.scales.x?.max ?? 0;
-    return vals.map((v) => `${(v - end).toFixed(0)} s`);
-  },
-};
-
-/** The matching y axis, labelled. */
-export function valueAxis(label: string): uPlot.Axis {
-  return { stroke: '#8a97a8', grid: { stroke: '#1e2835' }, ticks: { stroke: '#1e2835' }, size: 48, label, labelSize: 18 };
 }

@@ -124,13 +124,15 @@ describe.skipIf(skip !== null)('the page', () => {
     // The health report of the capture, as a page and as JSON.
     const html = page.waitForEvent('download');
     await page.getByRole('button', { name: 'Report', exact: true }).click();
+    await page.getByRole('button', { name: 'Report as a page (HTML)' }).click();
     const htmlFile = join(dir, 'report.html');
     await (await html).saveAs(htmlFile);
     const text = readFileSync(htmlFile, 'utf8');
     expect(text).toMatch(/<svg/);
     expect(text).not.toMatch(/<script/i);
     const json = page.waitForEvent('download');
-    await page.getByRole('button', { name: 'json', exact: true }).click();
+    await page.getByRole('button', { name: 'Report', exact: true }).click();
+    await page.getByRole('button', { name: 'Report as data (JSON)' }).click();
     const jsonFile = join(dir, 'report.json');
     await (await json).saveAs(jsonFile);
     const report = JSON.parse(readFileSync(jsonFile, 'utf8')) as { remotes: { failsafes: unknown[] }[] };
@@ -160,7 +162,8 @@ describe.skipIf(skip !== null)('the page', () => {
     expect(capture.meta.ports?.map((p) => p.name)).toEqual(['A', 'B']);
     // A report on the live session's recording, made off the reading worker.
     const reportDownload = page.waitForEvent('download');
-    await page.getByRole('button', { name: 'json', exact: true }).click();
+    await page.getByRole('button', { name: 'Report', exact: true }).click();
+    await page.getByRole('button', { name: 'Report as data (JSON)' }).click();
     const reportFile = join(dir, 'live.report.json');
     await (await reportDownload).saveAs(reportFile);
     const liveReport = JSON.parse(readFileSync(reportFile, 'utf8')) as { remotes: { frames: number }[] };
@@ -188,7 +191,7 @@ describe.skipIf(skip !== null)('the page', () => {
 
   it('shows the two demo remotes side by side and switches the views to the one clicked', async () => {
     const { page, errors } = await open();
-    const rows = page.locator('.remotes tbody tr');
+    const rows = page.locator('.remotes .remote-table tbody tr');
     await rows.nth(1).waitFor({ timeout: 10_000 });
     await expect(rows.count()).resolves.toBe(2);
     await page.locator('.remotes .state-chip', { hasText: 'live' }).nth(1).waitFor({ timeout: 10_000 });
@@ -311,7 +314,9 @@ describe.skipIf(skip !== null)('the page', () => {
     await context.addInitScript(() => { delete (Navigator.prototype as unknown as { serial?: unknown }).serial; });
     const page = await context.newPage();
     await page.goto(app.server.url('/?demo=0'));
-    await page.getByRole('button', { name: 'Connect receiver' }).click();
+    // The empty state says so before anything is pressed, and the button says it again.
+    await expect(page.getByTestId('empty-state').textContent()).resolves.toMatch(/This browser has no Web Serial/);
+    await page.getByRole('banner').getByRole('button', { name: 'Connect receiver' }).click();
     const alert = page.getByRole('alert').filter({ hasText: 'This browser has no Web Serial' });
     await alert.waitFor();
     await expect(alert.textContent()).resolves.toMatch(/Use Chrome, Edge or Opera/);

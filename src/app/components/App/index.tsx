@@ -1,15 +1,17 @@
 /**
  * The page: sources and recorder on top, replay controls when replaying, then the link state
- * and system beside the channel bars, X-Plus when it arrives, and the graphs.
+ * and system beside the channel bars, X-Plus when it arrives, and the graphs. With nothing to
+ * show (no receiver, no demo, no capture), what to wire and how to start instead.
  */
 import { signal } from '@preact/signals';
 import { useEffect, useState } from 'preact/hooks';
 import { lazy } from '../../lazy.js';
 import { openCapture } from '../../open-file.js';
-import { sources, status, xplusSeen } from '../../store.js';
+import { replay, sources, status, xplusSeen } from '../../store.js';
 import { ChannelBars } from '../ChannelBars/index.js';
 import { Counters } from '../Counters/index.js';
-import { Graphs } from '../Graphs/index.js';
+import { EmptyState } from '../EmptyState/index.js';
+import { Graphs, WINDOWS } from '../Graphs/index.js';
 import { LinkPanel } from '../LinkPanel/index.js';
 import { Notices } from '../Notices/index.js';
 import { Remotes } from '../Remotes/index.js';
@@ -54,26 +56,37 @@ export function App({ granted }: { granted: SerialPort[] }) {
       window.removeEventListener('drop', drop);
     };
   }, []);
+  const empty = sources.value.length === 0 && replay.value === null;
+  // A capture shorter than the graphs' window would be a sliver at its right edge: fit it.
+  const replayName = replay.value?.name;
+  const replaySpan = replay.value === null ? 0 : replay.value.endUs - replay.value.startUs;
+  useEffect(() => {
+    if (replayName === undefined || replaySpan <= 0) return;
+    windowUs.value = WINDOWS.find(([us]) => us >= replaySpan)?.[0] ?? windowUs.value;
+  }, [replayName, replaySpan > 0]);
   return (
     <>
       <Toolbar granted={granted} onBind={() => { binding.value = !binding.value; }} />
       {binding.value ? <BindPanel granted={granted} onClose={() => { binding.value = false; }} /> : null}
       <ReplayBar />
       <Notices />
+      {empty ? <main class="start"><EmptyState onBind={() => { binding.value = true; }} /></main> : (
       <main class="grid">
+        {/* On a phone both columns dissolve into one, ordered by what matters first (style.css). */}
         <aside class="side">
-          <div class="panel"><LinkPanel windowUs={windowUs} /></div>
-          <div class="panel"><h2>System</h2><SystemBadge /></div>
-          <div class="panel"><h2>Counters</h2><Counters /></div>
+          <div class="panel p-link"><LinkPanel windowUs={windowUs} /></div>
+          <div class="panel p-system"><h2>System</h2><SystemBadge /></div>
+          <div class="panel p-counters"><h2>Counters</h2><Counters /></div>
         </aside>
         <div class="main">
-          {sources.value.length > 1 ? <div class="panel"><Remotes windowUs={windowUs} /></div> : null}
-          <div class="panel"><h2>Channels{sources.value.length > 1 ? ` — remote ${status.value.label}` : ''}</h2><ChannelBars ids={NORMAL} label="Channels 0–11" /></div>
-          {xplusSeen.value ? <div class="panel"><h2>X-Plus</h2><ChannelBars ids={XPLUS} label="X-Plus channels" /></div> : null}
-          <div class="panel"><Graphs windowUs={windowUs} /></div>
-          <div class="panel"><InspectorPanel /></div>
+          {sources.value.length > 1 ? <div class="panel p-remotes"><Remotes windowUs={windowUs} /></div> : null}
+          <div class="panel p-channels"><h2>Channels{sources.value.length > 1 ? ` — remote ${status.value.label}` : ''}</h2><ChannelBars ids={NORMAL} label="Channels 0–11" /></div>
+          {xplusSeen.value ? <div class="panel p-xplus"><h2>X-Plus</h2><ChannelBars ids={XPLUS} label="X-Plus channels" /></div> : null}
+          <div class="panel p-graphs"><Graphs windowUs={windowUs} /></div>
+          <div class="panel p-inspector"><InspectorPanel /></div>
         </div>
       </main>
+      )}
       {dragging ? <div class="drop" aria-hidden="true">Drop a capture (.sscap, raw .bin, Saleae CSV) to replay it</div> : null}
     </>
   );

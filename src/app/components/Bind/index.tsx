@@ -1,16 +1,42 @@
 /**
  * Binding a satellite from the page (spec §7.2): choose the bind mode (DSMX 11 ms by default,
  * internal or external explained), the line that switches the satellite's power, and the port;
- * see the wiring and the exact timeline; bind; then watch the bind take in the live view.
+ * see the wiring and the timeline in plain words ("power off", "power on", "9 pulses"), with
+ * the exact serial-port calls in a details view for whoever checks them; bind; then watch the
+ * bind take in the live view. Tables scroll inside the panel on a phone.
  */
 import { useMemo, useState } from 'preact/hooks';
-import { BIND_MODES, bindTimeline, planPulses, type PowerLine, type PowerPolarity } from '../../../bind/index.js';
+import { BIND_MODES, bindTimeline, planPulses, type BindStep, type PowerLine, type PowerPolarity } from '../../../bind/index.js';
 import wiring from '../../../bind/wiring.svg';
 import { identify, pickPort, portLabel, serialUnavailable } from '../../serial.js';
 import { bindLog, notify, send } from '../../store.js';
 import './style.css';
 
 const hex = (v: number) => `0x${v.toString(16).toUpperCase().padStart(2, '0')}`;
+
+const at = (ms: number) => (ms >= 0 ? `t0 + ${ms.toFixed(0)} ms` : `t0 − ${(-ms).toFixed(0)} ms`);
+
+/** A step as a hobbyist says it: what to call it, and what happens to the satellite. */
+function plain(step: BindStep, steps: readonly BindStep[], pulses: number): { name: string; what: string } {
+  switch (step.action) {
+    case 'open':
+      return { name: 'Open the adapter', what: `The adapter is set up to draw the pulses (${step.baudRate} baud).` };
+    case 'power-off': {
+      const on = steps.find((x) => x.action === 'power-on');
+      const offMs = on === undefined ? 0 : on.atMs - step.atMs;
+      return { name: 'Power off', what: `The satellite is switched off for ${offMs.toFixed(0)} ms, so it starts afresh.` };
+    }
+    case 'power-on':
+      return { name: 'Power on', what: 'The satellite is switched on. The time of every later step counts from here (t0).' };
+    case 'write':
+      return {
+        name: `${pulses} pulses`,
+        what: `${pulses} short pulses on the DATA wire, ${(step.durationUs / 1000).toFixed(1)} ms in all: the satellite enters bind mode and its light blinks fast.`,
+      };
+    case 'reopen':
+      return { name: 'Back to reading', what: 'The adapter goes back to reading frames. Now put the transmitter in bind mode; frames appear once the bind takes.' };
+  }
+}
 
 export function BindPanel({ granted, onClose }: { granted: SerialPort[]; onClose(): void }) {
   const [pulses, setPulses] = useState(9);
@@ -46,8 +72,9 @@ export function BindPanel({ granted, onClose }: { granted: SerialPort[]; onClose
       </div>
       <div class="bind-grid">
         <div>
+          <div class="table-scroll" tabIndex={0} role="region" aria-label="Bind modes">
           <table class="modes">
-            <thead><tr><th /><th>Pulses</th><th>Remote</th><th>Protocol</th><th>Reports</th></tr></thead>
+            <thead><tr><th><span class="sr-only">Choose</span></th><th>Pulses</th><th>Remote</th><th>Protocol</th><th>Reports</th></tr></thead>
             <tbody>
               {BIND_MODES.map((m) => (
                 <tr key={m.pulses} class={m.pulses === pulses ? 'on' : ''} onClick={() => setPulses(m.pulses)}>
@@ -60,6 +87,7 @@ export function BindPanel({ granted, onClose }: { granted: SerialPort[]; onClose
               ))}
             </tbody>
           </table>
+          </div>
           <p class="explain">
             {mode?.description} Bind exactly one remote as <strong>internal</strong> (the A receiver: it negotiates
             with the transmitter and its system byte tells every remote's format); bind all the others
@@ -79,22 +107,35 @@ export function BindPanel({ granted, onClose }: { granted: SerialPort[]; onClose
               </select>
             </label>
           </div>
-          <p class="plan">
-            Pulses: {pulses} × <code>{hex(plan.bytes[0] ?? 0)}</code> at {plan.baudRate} baud 8N{plan.stopBits}: each {Math.round(plan.lowUs[0] ?? 0)} µs low,
-            {' '}{Math.round(plan.highUs[0] ?? 0)} µs high, {(plan.totalUs / 1000).toFixed(2)} ms in all.
-          </p>
+          <div class="table-scroll" tabIndex={0} role="region" aria-label="What the bind does">
           <table class="timeline" aria-label="Bind timeline">
-            <thead><tr><th>At</th><th>Step</th><th>What happens</th></tr></thead>
+            <thead><tr><th>When</th><th>Step</th><th>What happens</th></tr></thead>
             <tbody>
-              {steps.map((s) => (
-                <tr key={s.action}>
-                  <td class="num">{s.sincePowerOnMs >= 0 ? `t0 + ${s.sincePowerOnMs.toFixed(0)} ms` : `t0 − ${(-s.sincePowerOnMs).toFixed(0)} ms`}</td>
-                  <td>{s.action}</td>
-                  <td class="note">{s.note}</td>
-                </tr>
-              ))}
+              {steps.map((s) => {
+                const p = plain(s, steps, pulses);
+                return (
+                  <tr key={s.action}>
+                    <td class="num">{at(s.sincePowerOnMs)}</td>
+                    <td class="step">{p.name}</td>
+                    <td class="note">{p.what}</td>
+                  </tr>
+                );
+              })}
             </tbody>
           </table>
+          </div>
+          <details class="technical">
+            <summary>Technical details: the serial-port calls</summary>
+            <p class="plan">
+              Pulses: {pulses} × <code>{hex(plan.bytes[0] ?? 0)}</code> at {plan.baudRate} baud 8N{plan.stopBits}: each {Math.round(plan.lowUs[0] ?? 0)} µs low,
+              {' '}{Math.round(plan.highUs[0] ?? 0)} µs high, {(plan.totalUs / 1000).toFixed(2)} ms in all.
+            </p>
+            <ol class="calls">
+              {steps.map((s) => (
+                <li key={s.action}><span class="num">{at(s.sincePowerOnMs)}</span> <code>{s.action}</code>: {s.note}</li>
+              ))}
+            </ol>
+          </details>
           <div class="go">
             {granted.map((port, i) => (
               <button key={i} type="button" class="primary" onClick={() => void start(port)}>Bind on {portLabel(port)}</button>

@@ -2,7 +2,9 @@
  * Channel bars: one meter per channel with its name, pulse width, raw position and % travel,
  * centre and ±100 % marks. The rows are rendered once; values are written straight to the DOM
  * once per animation frame when they change (no virtual DOM on the 91 Hz path). A channel that
- * stops arriving greys out and shows its age.
+ * stops arriving greys out and shows its age. A scale row names the marks (−100 %, 0, +100 %
+ * at 1102, 1500 and 1898 µs). On a narrow screen the raw and % columns go first and the age
+ * moves into the track, so the bar itself always keeps its room.
  */
 import { useEffect, useRef } from 'preact/hooks';
 import { channelName, channelResolution, PULSE_MAX_US, PULSE_MIN_US, servoToMicros, servoToPercent } from '../../../decoder/index.js';
@@ -60,8 +62,10 @@ export function ChannelBars({ ids, label }: { ids: number[]; label: string }) {
           row.raw.textContent = '';
           row.pct.textContent = '';
           row.fill.style.left = row.fill.style.width = '0';
-          row.root.setAttribute('aria-valuetext', 'no data');
-          row.root.removeAttribute('aria-valuenow');
+          // A meter must have a value: a channel that never came is a labelled image until it does.
+          row.root.setAttribute('role', 'img');
+          row.root.setAttribute('aria-label', `${channelName(id)}: no data`);
+          for (const a of ['aria-valuetext', 'aria-valuenow', 'aria-valuemin', 'aria-valuemax']) row.root.removeAttribute(a);
           return;
         }
         const us = servoToMicros(pos, resolution);
@@ -73,6 +77,10 @@ export function ChannelBars({ ids, label }: { ids: number[]; label: string }) {
         const b = Math.max(us, 1500);
         row.fill.style.left = left(a);
         row.fill.style.width = `${(((b - a) / SPAN_US) * 100).toFixed(3)}%`;
+        row.root.setAttribute('role', 'meter');
+        row.root.setAttribute('aria-label', channelName(id));
+        row.root.setAttribute('aria-valuemin', String(PULSE_MIN_US));
+        row.root.setAttribute('aria-valuemax', String(PULSE_MAX_US));
         row.root.setAttribute('aria-valuenow', String(us));
         row.root.setAttribute('aria-valuetext', `${us} µs, ${pct.toFixed(0)} %${stale ? ', stale' : ''}`);
       });
@@ -81,9 +89,19 @@ export function ChannelBars({ ids, label }: { ids: number[]; label: string }) {
 
   return (
     <section class="channels" aria-label={label}>
+      {/* The scale: the same columns as a bar, labels only over the track. */}
+      <div class="bar scale" aria-hidden="true">
+        <span class="name" /><span class="id" />
+        <div class="track-scale">
+          <span style={{ left: left(1102) }}>−100 %</span>
+          <span style={{ left: left(1500) }}>0</span>
+          <span style={{ left: left(1898) }}>+100 %</span>
+        </div>
+        <span class="us" /><span class="raw" /><span class="pct" /><span class="age" />
+      </div>
       <div class="channel-list" ref={list}>
         {ids.map((id) => (
-          <div key={id} class="bar never" role="meter" aria-label={channelName(id)} aria-valuemin={PULSE_MIN_US} aria-valuemax={PULSE_MAX_US} aria-valuetext="no data">
+          <div key={id} class="bar never" role="img" aria-label={`${channelName(id)}: no data`}>
             <span class="name">{channelName(id)}</span>
             <span class="id">{id}</span>
             <div class="track">

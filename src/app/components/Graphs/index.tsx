@@ -1,7 +1,9 @@
 /**
  * Graphs over a chosen window: fade rate (or RSSI in dBm on an SPM4649T), frame period and
  * lost frames, drawn with uPlot from the columnar buckets (100 ms each) with one setData per
- * animation frame when new buckets arrived. The x axis is seconds before now.
+ * animation frame when new buckets arrived. The x axis is seconds before now, in round steps
+ * (axes.ts); hovering a graph shows every graph's value at that time in its legend (the
+ * cursors are synced). The charts are rebuilt when the theme changes: canvas colours are not CSS.
  */
 import type { Signal } from '@preact/signals';
 import { useEffect, useRef } from 'preact/hooks';
@@ -10,7 +12,8 @@ import 'uplot/dist/uPlot.min.css';
 import { onFrame } from '../../frame-loop.js';
 import type { Live, SeriesBuffer } from '../../live.js';
 import { current, status } from '../../store.js';
-import { SECONDS_BEFORE_NOW_AXIS, valueAxis } from '../../timeline.js';
+import { agoAxis, hoverCursor, keyboardCursor, legendTime, legendValue, showNewest, valueAxis, valueScale, type ValueScale } from '../../axes.js';
+import { chartColors, theme } from '../../theme.js';
 import './style.css';
 
 export const WINDOWS = [
@@ -19,38 +22,54 @@ export const WINDOWS = [
   [600e6, '10 min'],
 ] as const;
 
+/** Each chart's height, px: room for 4–6 labelled ticks on the y axis. */
+const HEIGHT = 140;
+
 interface ChartSpec {
   key: 'fadeRate' | 'rssi' | 'periodMs' | 'lost';
   title: string;
   unit: string;
   color: string;
-  range?: [number, number];
+  scale: ValueScale;
+  /** Decimals in the hover legend. */
+  digits: number;
   bars?: boolean;
 }
 
 function specs(rssi: boolean): ChartSpec[] {
+  const c = chartColors();
   return [
     rssi
-      ? { key: 'rssi', title: 'RSSI', unit: 'dBm', color: '#7cc4ff', range: [-100, -30] }
-      : { key: 'fadeRate', title: 'Fades', unit: '/s', color: '#f0b429' },
-    { key: 'periodMs', title: 'Period', unit: 'ms', color: '#4fd1a5', range: [0, 30] },
-    { key: 'lost', title: 'Lost', unit: '/100 ms', color: '#ff6b6b', bars: true },
+      ? { key: 'rssi', title: 'RSSI', unit: 'dBm', color: c.rssi, scale: { fixed: { min: -100, max: -30, step: 10 } }, digits: 0 }
+      : { key: 'fadeRate', title: 'Fades', unit: '/s', color: c.fades, scale: { floor: 1 }, digits: 1 },
+    { key: 'periodMs', title: 'Period', unit: 'ms', color: c.period, scale: { fixed: { min: 0, max: 30, step: 10 } }, digits: 2 },
+    { key: 'lost', title: 'Lost', unit: '/100 ms', color: c.lost, scale: { floor: 2, integer: true }, digits: 0, bars: true },
   ];
+}
+
+/**
+ * A column for uPlot with its gaps as null: a bucket without frames has no period (NaN), and
+ * uPlot draws a line straight across NaN but breaks it at null.
+ */
+function gaps(col: ArrayLike<number>): (number | null)[] {
+  const out = new Array<number | null>(col.length);
+  for (let i = 0; i < col.length; i++) {
+    const v = col[i] as number;
+    out[i] = Number.isNaN(v) ? null : v;
+  }
+  return out;
 }
 
 function makeChart(el: HTMLElement, spec: ChartSpec, width: number, sync: uPlot.SyncPubSub): uPlot {
   const opts: uPlot.Options = {
     width,
-    height: 120,
-    cursor: { sync: { key: sync.key }, drag: { x: false, y: false } },
-    legend: { show: false },
-    scales: {
-      x: { time: false },
-      y: spec.range ? { range: () => spec.range as [number, number] } : { range: (_u, _min, max) => [0, Math.max(1, max * 1.15)] },
-    },
-    axes: [SECONDS_BEFORE_NOW_AXIS, valueAxis(`${spec.title} ${spec.unit}`)],
+    height: HEIGHT,
+    cursor: hoverCursor(sync.key),
+    legend: { show: true, live: true },
+    scales: { x: { time: false }, y: valueScale(spec.scale) },
+    axes: [agoAxis(), valueAxis(`${spec.title} ${spec.unit}`, spec.scale)],
     series: [
-      {},
+      { label: 'Time', value: legendTime },
       {
         label: spec.title,
         stroke: spec.color,
@@ -59,6 +78,7 @@ function makeChart(el: HTMLElement, spec: ChartSpec, width: number, sync: uPlot.
         paths: spec.bars ? uPlot.paths.bars?.({ size: [1, Infinity] }) : undefined,
         points: { show: false },
         spanGaps: false,
+        value: legendValue(spec.unit, spec.digits),
       },
     ],
   };
@@ -68,22 +88,24 @@ function makeChart(el: HTMLElement, spec: ChartSpec, width: number, sync: uPlot.
 export function Graphs({ windowUs }: { windowUs: Signal<number> }) {
   const host = useRef<HTMLDivElement>(null);
   const rssi = status.value.format.headerMode === 'rssi';
+  const palette = theme.value;
   useEffect(() => {
     const el = host.current;
     if (el === null) return undefined;
     const sync = uPlot.sync('satscope');
     const list = specs(rssi);
-    const width = () => Math.max(300, el.clientWidth - 4);
+    const width = () => Math.max(200, el.clientWidth - 4);
     const charts = list.map((spec) => {
       const box = document.createElement('div');
       box.className = 'chart';
-      box.setAttribute('role', 'img');
-      box.setAttribute('aria-label', `${spec.title} over time`);
+      box.setAttribute('role', 'figure');
+      box.setAttribute('aria-label', `${spec.title} over time: hover, or the arrow keys, for the values`);
       box.dataset.chart = spec.key;
       el.append(box);
       return makeChart(box, spec, width(), sync);
     });
-    const resize = new ResizeObserver(() => charts.forEach((c) => c.setSize({ width: width(), height: 120 })));
+    const keys = charts.map((c) => keyboardCursor(c, c.root.parentElement as HTMLElement));
+    const resize = new ResizeObserver(() => charts.forEach((c) => c.setSize({ width: width(), height: HEIGHT })));
     resize.observe(el);
     let version = -1;
     let drawnAt = 0;
@@ -108,18 +130,20 @@ export function Graphs({ windowUs }: { windowUs: Signal<number> }) {
       charts.forEach((chart, i) => {
         const key = (list[i] as ChartSpec).key;
         chart.batch(() => {
-          chart.setData([x as unknown as number[], s[key].subarray(from, s.length) as unknown as number[]], false);
+          chart.setData([x as unknown as number[], gaps(s[key].subarray(from, s.length))], false);
           chart.setScale('x', { min: start, max: end });
         });
+        showNewest(chart, x.length);
       });
     });
     return () => {
       stop();
       resize.disconnect();
+      keys.forEach((off) => off());
       charts.forEach((c) => c.destroy());
       el.replaceChildren();
     };
-  }, [rssi, windowUs]);
+  }, [rssi, windowUs, palette]);
 
   return (
     <section class="graphs" aria-label="Graphs">

@@ -12,7 +12,7 @@
 import { Component } from 'preact';
 import { useEffect, useLayoutEffect, useRef } from 'preact/hooks';
 import type { InspectEntry } from '../../../worker/inspector.js';
-import { describeFrame } from '../../inspect.js';
+import { countSlots, describeFrame } from '../../inspect.js';
 import './style.css';
 
 const REASONS: Record<string, string> = {
@@ -51,7 +51,8 @@ function FrameCells({ e }: { e: InspectEntry }) {
           <span key={s.first} class={`g k-${s.kind}`} title={s.title} data-tag={s.label}>{hex(b, s.first, s.last + 1)}</span>
         ))}
       </span>
-      <span role="cell" class="summary">{d.summary}</span>
+      {/* One item per value, each unbreakable: a line breaks between values, never inside one. */}
+      <span role="cell" class="summary">{d.parts.map((p, i) => <span key={i} class="v">{p}</span>)}</span>
     </>
   );
 }
@@ -167,6 +168,20 @@ export function Inspector({ entries, onRefresh, following, onFollow }: {
     };
   }, []);
 
+  // What the snapshot holds: empty slots and VTX frames are easy to miss in a thousand rows.
+  let frames = 0;
+  let emptySlots = 0;
+  let emptyFrames = 0;
+  let vtxFrames = 0;
+  for (const e of entries ?? []) {
+    if (e.kind !== 'frame' || e.bytes === null) continue;
+    frames++;
+    const c = countSlots(e.bytes);
+    emptySlots += c.empty;
+    if (c.empty > 0) emptyFrames++;
+    if (c.vtx) vtxFrames++;
+  }
+
   let prev = '';
   let dup = 0;
   const rows = entries?.map((e) => {
@@ -194,6 +209,13 @@ export function Inspector({ entries, onRefresh, following, onFollow }: {
           <button type="button" onClick={onRefresh}>Refresh</button>
         </div>
       </div>
+      {frames > 0 ? (
+        <p class="insp-counts" data-testid="inspector-counts">
+          {frames} frame{frames === 1 ? '' : 's'} shown
+          {emptySlots > 0 ? <> · <span class="k-empty-text">{emptySlots} empty slot{emptySlots === 1 ? '' : 's'} (0xFFFF) in {emptyFrames} frame{emptyFrames === 1 ? '' : 's'}</span></> : ' · no empty slots'}
+          {vtxFrames > 0 ? <> · <span class="k-vtx-text">{vtxFrames} VTX frame{vtxFrames === 1 ? '' : 's'}</span></> : null}
+        </p>
+      ) : null}
       <ul class="insp-legend" aria-label="Colour key">
         {LEGEND.map(([cls, label]) => (
           <li key={cls}><span class={`swatch ${cls}`} aria-hidden="true" />{label}</li>

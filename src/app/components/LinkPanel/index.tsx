@@ -13,7 +13,7 @@ import './style.css';
 
 const LABEL = { waiting: 'Waiting', live: 'Live', hold: 'Hold', failsafe: 'Failsafe' } as const;
 const HINT = {
-  waiting: 'No frame yet',
+  waiting: 'No frame yet. Nothing for long? Check RX on the grey DATA wire and that the satellite is bound.',
   live: 'Frames arriving',
   hold: 'Frames missing: last values held',
   failsafe: 'No frame for 1 s: failsafe',
@@ -38,7 +38,7 @@ export function LinkPanel({ windowUs }: { windowUs: Signal<number> }) {
       const live = current();
       const l = live.link;
       const now = live.nowUs();
-      const text = l === null ? '—' : ago(now - l.lastFrameUs);
+      const text = l === null ? 'none yet' : `${ago(now - l.lastFrameUs)} ago`;
       if (text !== shown && since.current !== null) {
         since.current.textContent = text;
         shown = text;
@@ -48,7 +48,7 @@ export function LinkPanel({ windowUs }: { windowUs: Signal<number> }) {
       stripVersion = live.version;
       stripLive = live;
       stripAt = nowMs;
-      if (counts.current !== null) counts.current.textContent = l === null ? '' : `${l.holds} holds · ${l.failsafes} failsafes`;
+      if (counts.current !== null) counts.current.textContent = l === null ? 'none' : `${l.holds} holds · ${l.failsafes} failsafes`;
       const parts = drawEpisodes(strip.current, live.episodes.values(), now, windowUs.value);
       const el = strip.current;
       el.setAttribute('aria-label', parts.length === 0 ? 'No hold or failsafe in this window' : `${parts.filter((p) => p === 'failsafe').length} failsafe and ${parts.filter((p) => p === 'hold').length} hold episodes in this window`);
@@ -61,8 +61,8 @@ export function LinkPanel({ windowUs }: { windowUs: Signal<number> }) {
       <div class="state" role="status" aria-live="polite" data-testid="link-state">{LABEL[state]}</div>
       <div class="hint">{HINT[state]}</div>
       <dl>
-        <dt>Last frame</dt><dd><span ref={since}>—</span> ago</dd>
-        <dt>Episodes</dt><dd><span ref={counts} /></dd>
+        <dt>Last frame</dt><dd><span ref={since}>none yet</span></dd>
+        <dt>Episodes</dt><dd><span ref={counts}>none</span></dd>
       </dl>
       <div class="timeline" ref={strip} role="img" aria-label="No hold or failsafe in this window" />
     </section>

@@ -1,8 +1,9 @@
 /**
  * Several remotes side by side (spec §5, §7.3): one row per remote with its label (A, B, R, L),
- * failsafe state, frames, fades and fade rate, and below them every remote's fade rate and
+ * failsafe state, fades and fade rate, frames, and below them every remote's fade rate and
  * hold/failsafe episodes on one time axis, so a user can see which antenna drops when. Clicking
- * a row shows that remote in the views below.
+ * a row, or its remote's button from the keyboard, shows that remote in the views below. The
+ * table scrolls inside the panel on a narrow screen.
  */
 import type { Signal } from '@preact/signals';
 import { useEffect, useRef } from 'preact/hooks';
@@ -11,10 +12,13 @@ import { REMOTE_LABELS } from '../../../worker/protocol.js';
 import { onFrame } from '../../frame-loop.js';
 import type { Live } from '../../live.js';
 import { allLives, select, selected, send, sources } from '../../store.js';
-import { drawEpisodes, SECONDS_BEFORE_NOW_AXIS, valueAxis } from '../../timeline.js';
+import { drawEpisodes } from '../../timeline.js';
+import { agoAxis, hoverCursor, keyboardCursor, legendTime, legendValue, showNewest, valueAxis, valueScale } from '../../axes.js';
+import { chartColors, theme } from '../../theme.js';
 import './style.css';
 
-const COLORS = ['#4fd1a5', '#f0b429', '#7cc4ff', '#ff8fab', '#c3a6ff'];
+/** Fade rate in the chart: at least 0–1 /s, so an all-zero window still has labelled ticks. */
+const FADE_SCALE = { floor: 1 };
 
 function stateOf(live: Live | undefined): string {
   return live?.link?.state ?? 'waiting';
@@ -26,24 +30,29 @@ export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
   const chart = useRef<HTMLDivElement>(null);
   const lanes = useRef<HTMLDivElement>(null);
   const ids = list.map((s) => s.id).join(',');
+  const palette = theme.value;
+  const colors = chartColors(palette).remotes;
 
   useEffect(() => {
     const box = chart.current;
     if (box === null || list.length < 2) return undefined;
     const order = list.map((s) => s.id);
     const plot = new uPlot({
-      width: Math.max(300, box.clientWidth),
-      height: 110,
-      legend: { show: false },
-      cursor: { drag: { x: false, y: false } },
-      scales: { x: { time: false }, y: { range: (_u, _min, max) => [0, Math.max(1, max * 1.15)] } },
-      axes: [
-        SECONDS_BEFORE_NOW_AXIS,
-        valueAxis('Fades /s'),
+      width: Math.max(200, box.clientWidth),
+      height: 120,
+      legend: { show: true, live: true },
+      cursor: hoverCursor(),
+      scales: { x: { time: false }, y: valueScale(FADE_SCALE) },
+      axes: [agoAxis(), valueAxis('Fades /s', FADE_SCALE)],
+      series: [
+        { label: 'Time', value: legendTime },
+        ...order.map((id, i) => ({
+          label: list[i]?.label ?? String(id), stroke: colors[i % colors.length], width: 1.5, points: { show: false }, value: legendValue('/s', 1),
+        })),
       ],
-      series: [{}, ...order.map((id, i) => ({ label: list[i]?.label ?? String(id), stroke: COLORS[i % COLORS.length], width: 1.5, points: { show: false } }))],
     }, [[], ...order.map(() => [])], box);
-    const resize = new ResizeObserver(() => plot.setSize({ width: Math.max(300, box.clientWidth), height: 110 }));
+    const keys = keyboardCursor(plot, box);
+    const resize = new ResizeObserver(() => plot.setSize({ width: Math.max(200, box.clientWidth), height: 120 }));
     resize.observe(box);
     let drawnAt = 0;
     const stop = onFrame((nowMs) => {
@@ -78,6 +87,7 @@ export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
         plot.setData([x as unknown as number[], ...columns] as uPlot.AlignedData, false);
         plot.setScale('x', { min: start, max: end });
       });
+      showNewest(plot, x.length);
       // Episode lanes, one per remote, on the same window.
       const el = lanes.current;
       if (el === null) return;
@@ -91,9 +101,10 @@ export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
     return () => {
       stop();
       resize.disconnect();
+      keys();
       plot.destroy();
     };
-  }, [ids, windowUs]);
+  }, [ids, windowUs, palette]);
 
   useEffect(() => {
     let shown = '';
@@ -131,36 +142,44 @@ export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
   return (
     <section class="remotes" aria-label="Remotes">
       <h2>Remotes side by side</h2>
-      <table>
+      <div class="table-scroll" tabIndex={0} role="region" aria-label="Remotes table">
+      <table class="remote-table">
         <thead>
-          <tr><th>Remote</th><th>Source</th><th>State</th><th>Frames</th><th>Fades</th><th>Fade rate</th><th>Holds / failsafes</th><th /></tr>
+          <tr><th>Remote</th><th>State</th><th>Fades</th><th>Fade rate</th><th>Holds / failsafes</th><th>Frames</th><th>Source</th><th><span class="sr-only">Actions</span></th></tr>
         </thead>
         <tbody ref={table}>
           {list.map((s, i) => (
             <tr key={s.id} class={selected.value === s.id ? 'on' : ''} onClick={() => select(s.id)} data-testid={`remote-${s.label}`}>
-              <td>
-                <span class="swatch" style={{ background: COLORS[i % COLORS.length] }} />
+              <td class="remote-cell">
+                <span class="swatch" aria-hidden="true" style={{ background: colors[i % colors.length] }} />
                 <select aria-label={`Label of ${s.name}`} value={s.label} onClick={(e) => e.stopPropagation()} onChange={(e) => send({ type: 'set-label', source: s.id, label: (e.currentTarget as HTMLSelectElement).value })}>
                   {[...new Set([...REMOTE_LABELS, s.label])].map((l) => <option key={l} value={l}>{l}</option>)}
                 </select>
                 <span class="kind">{s.format.remote === 'internal' ? 'internal' : s.format.remote === 'external' ? 'external' : ''}</span>
               </td>
-              <td class="name" title={s.name}>{s.name}</td>
               <td><span data-cell="state" class="state-chip waiting">waiting</span></td>
-              <td data-cell="frames" class="num">0</td>
               <td data-cell="fades" class="num">0</td>
               <td data-cell="rate" class="num">—</td>
               <td data-cell="episodes" class="num">0 / 0</td>
+              <td data-cell="frames" class="num">0</td>
+              <td class="name">
+                {/* The row's keyboard way in: a real button, so Tab reaches it and Enter or Space shows the remote. */}
+                <button type="button" class="show" aria-pressed={selected.value === s.id} title={`Show remote ${s.label} in the views below`}
+                  onClick={(e) => { e.stopPropagation(); select(s.id); }}>
+                  {s.name}
+                </button>
+              </td>
               <td>{s.kind === 'serial' ? <button type="button" class="link" onClick={(e) => { e.stopPropagation(); send({ type: 'serial-close', source: s.id }); }}>Disconnect</button> : null}</td>
             </tr>
           ))}
         </tbody>
       </table>
-      <div class="remote-chart" ref={chart} role="img" aria-label="Fade rate of every remote over time" />
-      <div class="lanes" ref={lanes} aria-label="Hold and failsafe episodes per remote">
+      </div>
+      <div class="remote-chart" ref={chart} role="figure" aria-label="Fade rate of every remote over time: hover, or the arrow keys, for the values" />
+      <div class="lanes" ref={lanes} role="group" aria-label="Hold and failsafe episodes per remote">
         {list.map((s, i) => (
           <div key={s.id} class="lane">
-            <span class="lane-label" style={{ color: COLORS[i % COLORS.length] }}>{s.label}</span>
+            <span class="lane-label" style={{ color: colors[i % colors.length] }}>{s.label}</span>
             <div class="lane-strip" />
           </div>
         ))}

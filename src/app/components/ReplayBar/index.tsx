@@ -5,6 +5,7 @@
 import { useEffect, useRef, useState } from 'preact/hooks';
 import uPlot from 'uplot';
 import { overview, replay, send } from '../../store.js';
+import { chartColors, theme } from '../../theme.js';
 import './style.css';
 
 const SPEEDS = [
@@ -23,11 +24,13 @@ export function ReplayBar() {
   const chart = useRef<HTMLDivElement>(null);
   const [dragging, setDragging] = useState<number | null>(null);
   const o = overview.value;
+  const palette = theme.value;
   useEffect(() => {
     const el = chart.current;
     if (el === null || o === null || o.t.length === 0) return undefined;
     const x = Array.from(o.t, (t) => t / 1e6);
     const bands = o.failsafe;
+    const c = chartColors(palette);
     const plot = new uPlot({
       width: Math.max(300, el.clientWidth),
       height: 56,
@@ -37,15 +40,15 @@ export function ReplayBar() {
       scales: { x: { time: false } },
       series: [
         {},
-        { stroke: '#ff6b6b', fill: '#ff6b6b66', paths: uPlot.paths.bars?.({ size: [1, Infinity] }), points: { show: false } },
-        { stroke: '#f0b429', width: 1, points: { show: false } },
+        { stroke: c.lost, fill: `${c.lost}66`, paths: uPlot.paths.bars?.({ size: [1, Infinity] }), points: { show: false } },
+        { stroke: c.fades, width: 1, points: { show: false } },
       ],
       hooks: {
         drawClear: [(u) => {
           // Failsafe episodes as red bands behind the series.
           const ctx = u.ctx;
           ctx.save();
-          ctx.fillStyle = 'rgba(255,60,60,0.25)';
+          ctx.fillStyle = c.failsafeBand;
           for (const b of bands) {
             const a = u.valToPos(b.startUs / 1e6, 'x', true);
             const z = u.valToPos(b.endUs / 1e6, 'x', true);
@@ -57,7 +60,7 @@ export function ReplayBar() {
     }, [x, Array.from(o.lost), Array.from(o.fadeRate)], el);
     return () => plot.destroy();
     // The overview can arrive before the replay status that makes this bar (and its box) appear.
-  }, [o, r !== null]);
+  }, [o, r !== null, palette]);
   if (r === null) return null;
   const span = Math.max(1, r.endUs - r.startUs);
   return (

@@ -1,0 +1,74 @@
+/**
+ * Light and dark. The page follows the system's prefers-color-scheme until the user picks one
+ * with the toggle; the pick is remembered (localStorage). CSS reads the theme from
+ * `<html data-theme>`; the canvas charts, which cannot read CSS custom properties cheaply, take
+ * their colours from `chartColors()` and are rebuilt when `theme` changes.
+ */
+import { computed, signal } from '@preact/signals';
+
+export type Theme = 'light' | 'dark';
+
+const KEY = 'satscope-theme';
+const media = typeof matchMedia === 'function' ? matchMedia('(prefers-color-scheme: dark)') : null;
+
+function stored(): Theme | null {
+  try {
+    if (typeof localStorage === 'undefined') return null;
+    const v = localStorage.getItem(KEY);
+    return v === 'light' || v === 'dark' ? v : null;
+  } catch {
+    return null; // storage blocked: follow the system
+  }
+}
+
+/** The user's pick, or null: follow the system. */
+export const themeChoice = signal<Theme | null>(stored());
+const systemDark = signal(media?.matches ?? true);
+media?.addEventListener('change', (e) => { systemDark.value = e.matches; });
+
+/** The theme on screen. */
+export const theme = computed<Theme>(() => themeChoice.value ?? (systemDark.value ? 'dark' : 'light'));
+
+function apply(t: Theme): void {
+  document.documentElement.dataset.theme = t;
+}
+// (Outside a page, e.g. a test importing the chart helpers, there is nothing to apply it to.)
+if (typeof document !== 'undefined') theme.subscribe(apply);
+
+export function setTheme(choice: Theme | null): void {
+  themeChoice.value = choice;
+  try {
+    if (choice === null) localStorage.removeItem(KEY);
+    else localStorage.setItem(KEY, choice);
+  } catch {
+    // Not remembered, but still applied.
+  }
+}
+
+export interface ChartColors {
+  axis: string;
+  grid: string;
+  cursor: string;
+  fades: string;
+  rssi: string;
+  period: string;
+  lost: string;
+  failsafeBand: string;
+  remotes: string[];
+}
+
+const DARK: ChartColors = {
+  axis: '#8a97a8', grid: '#1e2835', cursor: '#8a97a8',
+  fades: '#f0b429', rssi: '#7cc4ff', period: '#4fd1a5', lost: '#ff6b6b', failsafeBand: 'rgba(255,60,60,0.25)',
+  remotes: ['#4fd1a5', '#f0b429', '#7cc4ff', '#ff8fab', '#c3a6ff'],
+};
+
+const LIGHT: ChartColors = {
+  axis: '#4f5b6b', grid: '#e3e8ee', cursor: '#4f5b6b',
+  fades: '#b7791f', rssi: '#1f6fd1', period: '#0a7d5a', lost: '#d1343a', failsafeBand: 'rgba(209,52,58,0.16)',
+  remotes: ['#0a7d5a', '#b7791f', '#1f6fd1', '#c2185b', '#7048e8'],
+};
+
+export function chartColors(t: Theme = theme.value): ChartColors {
+  return t === 'dark' ? DARK : LIGHT;
+}
