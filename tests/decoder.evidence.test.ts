@@ -2,8 +2,12 @@
  * Regressions for the decoder's evidence rules (issue "The decoder never hangs, and never
  * invents a frame, a fade or a format"): each defect found in review, as the behaviour it breaks.
  */
+import { existsSync, readFileSync } from 'node:fs';
 import { describe, expect, it } from 'vitest';
-import { SpektrumDecoder, copyFrame, type DecoderEvent, type DecoderOptions, type FrameSnapshot } from '../src/decoder/index.js';
+import {
+  SpektrumDecoder, copyFrame, healthReport, importRaw, importSaleaeCsv, summarizeCapture,
+  type DecoderEvent, type DecoderOptions, type FrameSnapshot,
+} from '../src/decoder/index.js';
 import { encodeExternalFrame, encodeInternalFrame, encodeServo2048 } from '../src/simulator/encode.js';
 import { concatBytes as join } from './bytes.js';
 import { runBounded } from './bounded.js';
@@ -175,5 +179,20 @@ describe('forced resolution', () => {
     expect(frames).toHaveLength(0);
     expect(decoder.format.forcedMismatch).toBe(2048);
     expect(decoder.format.explanation).toBe('Forced 1024: no frame matches; the stream looks like 2048.');
+  });
+});
+
+describe('the real captures under one stray byte', () => {
+  const file = new URL('../../shared/captures/px4/dsm_x_dx9_data.txt', import.meta.url);
+  it.skipIf(!existsSync(file))('gives 0 fades in info and report alike when a stray 0x3E lands in any byte of a header', () => {
+    const clean = importSaleaeCsv(new Uint8Array(readFileSync(file))).bytes;
+    for (let at = 16 * 40; at < 16 * 40 + 18; at++) {
+      const bytes = join([clean.subarray(0, at), Uint8Array.of(0x3e), clean.subarray(at)]);
+      const summary = summarizeCapture(importRaw(bytes));
+      const report = healthReport(importRaw(bytes)).remotes[0]!;
+      expect(summary.link.fades, `0x3E at ${at}`).toBe(0);
+      expect(report.fades?.total ?? 0, `0x3E at ${at}`).toBe(0);
+      expect(summary.decoder.frames).toBeGreaterThan(450);
+    }
   });
 });
