@@ -5,10 +5,10 @@
 import { existsSync, readFileSync } from 'node:fs';
 import { fileURLToPath } from 'node:url';
 import { describe, expect, it } from 'vitest';
-import { CaptureFormatError, CaptureWriter, captureChunks, parseCapture, readCapture } from '../src/decoder/capture/index.js';
-import type { Capture, ParsedCapture } from '../src/decoder/capture/index.js';
+import { CaptureFormatError, CaptureWriter, captureChunks, parseCapture, readCapture } from '../src/capture/index.js';
+import type { Capture, ParsedCapture } from '../src/capture/index.js';
 // A test hook, not part of the package: what the reader did, counted.
-import { parseCaptureCounting } from '../src/decoder/capture/format.js';
+import { parseCaptureCounting } from '../src/capture/reader.js';
 import { preset, simulate } from '../src/simulator/index.js';
 import { concatBytes } from './bytes.js';
 

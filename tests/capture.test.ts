@@ -13,10 +13,8 @@ import {
   importSaleaeCsv,
   parseCapture,
   readCapture,
-  utf8Decode,
-  utf8Encode,
-} from '../src/decoder/capture/index.js';
-import type { Capture, CaptureMeta, CaptureRecordInput } from '../src/decoder/capture/index.js';
+} from '../src/capture/index.js';
+import type { Capture, CaptureMeta, CaptureRecordInput } from '../src/capture/index.js';
 import { concatBytes } from './bytes.js';
 
 // ---------------------------------------------------------------------------------------------
@@ -121,26 +119,6 @@ describe('crc32', () => {
   });
 });
 
-describe('utf8', () => {
-  const samples = ['', 'plain ASCII', 'ünïcödé ✈ 日本語', 'emoji 🔌🛩️ and a lone surrogate \ud800 here', 'x'.repeat(20_000) + '€'];
-
-  it('encodes exactly as TextEncoder does', () => {
-    for (const s of samples) expect(utf8Encode(s)).toEqual(new TextEncoder().encode(s));
-  });
-
-  it('decodes exactly as TextDecoder does on well-formed text', () => {
-    for (const s of samples) {
-      const bytes = new TextEncoder().encode(s);
-      expect(utf8Decode(bytes)).toBe(new TextDecoder().decode(bytes));
-    }
-  });
-
-  it('turns malformed bytes into U+FFFD instead of failing', () => {
-    expect(utf8Decode(Uint8Array.from([0x61, 0xff, 0x62, 0xc3]))).toBe('a\ufffdb\ufffd');
-    expect(utf8Decode(Uint8Array.from([0xed, 0xa0, 0x80]))).toBe('\ufffd\ufffd\ufffd'); // encoded surrogate
-  });
-});
-
 // ---------------------------------------------------------------------------------------------
 // .sscap writer and reader
 // ---------------------------------------------------------------------------------------------
@@ -182,7 +160,7 @@ describe('.sscap round trip', () => {
 
   it('costs RECORD_OVERHEAD bytes per record on top of the payload', () => {
     const header = new CaptureWriter(META).header();
-    const payload = DATA_RECORDS.reduce((n, r) => n + r.bytes.length, 0) + utf8Encode('port opened').length + utf8Encode('device lost 🔌').length;
+    const payload = DATA_RECORDS.reduce((n, r) => n + r.bytes.length, 0) + new TextEncoder().encode('port opened').length + new TextEncoder().encode('device lost 🔌').length;
     expect(file.length).toBe(header.length + payload + RECORDS.length * RECORD_OVERHEAD);
   });
 });

@@ -44,14 +44,15 @@ describe('the npm package', () => {
     expect(pkg.bin).toEqual({ satscope: './dist/cli/main.js' });
   });
 
-  it('packs only the built library, simulator, CLI, README, LICENSE and package.json', () => {
+  it('packs only the built library, capture files, simulator, CLI, README, LICENSE and package.json', () => {
     expect(files).toContain('dist/decoder/index.js');
+    expect(files).toContain('dist/capture/index.js');
     expect(files).toContain('dist/decoder/index.d.ts');
     expect(files).toContain('dist/simulator/index.js');
     expect(files).toContain('dist/cli/main.js');
     expect(files).toContain('README.md');
     expect(files).toContain('LICENSE');
-    const stray = files.filter((f) => !/^(dist\/(decoder|simulator|cli)\/.+\.(js|d\.ts)|README\.md|LICENSE|package\.json)$/.test(f));
+    const stray = files.filter((f) => !/^(dist\/(decoder|capture|simulator|cli)\/.+\.(js|d\.ts)|README\.md|LICENSE|package\.json)$/.test(f));
     expect(stray).toEqual([]);
   });
 

@@ -8,7 +8,7 @@
  */
 import { readFileSync, writeFileSync } from 'node:fs';
 import { basename } from 'node:path';
-import { CaptureFormatError, captureChunks, capturePorts, readCapture, type Capture, type CaptureChunk } from '../decoder/capture/index.js';
+import { CaptureFormatError, captureChunks, capturePorts, readCapture, type Capture, type CaptureChunk } from '../capture/index.js';
 import { SpektrumDecoder } from '../decoder/decoder.js';
 import { healthReport, reportHtml } from '../decoder/report.js';
 import { summarizeCapture } from '../decoder/summary.js';

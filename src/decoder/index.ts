@@ -20,7 +20,7 @@ export {
   parseCapture, readCapture, CAPTURE_FILE_EXTENSION, CAPTURE_FORMAT_VERSION,
   type Capture, type CaptureChunk, type CaptureEvent, type CaptureIssue, type CaptureIssueKind, type CaptureKind,
   type CaptureMeta, type CapturePortInfo, type CaptureRecordInput, type CaptureTiming, type ParsedCapture,
-} from './capture/index.js';
+} from '../capture/index.js';
 export {
   decodeCapture, summarizeCapture, type CaptureSummary, type ChannelSummary, type DecodeCaptureOptions,
 } from './summary.js';

@@ -9,8 +9,8 @@
  * report's time zero (`timeline.originUs`, the earliest time recorded in the capture on any
  * port), so that the ports of a multi-port capture share one time axis.
  */
-import type { Capture, CaptureKind, CaptureTiming } from './capture/index.js';
-import { captureChunks, capturePorts } from './capture/index.js';
+import type { Capture, CaptureKind, CaptureTiming } from '../capture/index.js';
+import { captureChunks, capturePorts } from '../capture/index.js';
 import type { LinkEpisode } from './link.js';
 import { BYTE_TIME_US, CHANNEL_COUNT, channelResolution, FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US, XPLUS_FIRST, channelName, servoToMicros, servoToPercent, systemInfo, type Resolution, USB_CHUNK_JITTER_US } from './spec.js';
 import { decodeCapture } from './summary.js';

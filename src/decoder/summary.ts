@@ -2,8 +2,8 @@
  * Decoding a whole capture, and the summary `satscope info` prints. Pure: the capture is
  * already in memory, and the caller chooses how to show the result.
  */
-import type { Capture, CaptureIssue } from './capture/index.js';
-import { captureChunks } from './capture/index.js';
+import type { Capture, CaptureIssue } from '../capture/index.js';
+import { captureChunks } from '../capture/index.js';
 import { SpektrumDecoder, type DecoderOptions } from './decoder.js';
 import { LinkMonitor, type LinkEpisode, type LinkStats } from './link.js';
 import { channelName, channelResolution, CHANNEL_COUNT, servoToMicros, USB_CHUNK_JITTER_US } from './spec.js';

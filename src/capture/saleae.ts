@@ -1,47 +1,10 @@
 /**
- * Importers for captures that SatScope did not write (raw byte dumps, Saleae Logic "Async
- * Serial" CSV exports), and `readCapture`, which recognises any supported file by its content.
- * Each returns the same columnar `Capture` as `parseCapture`.
+ * Saleae Logic "Async Serial" CSV exports (Logic 1 and 2): one byte per line with its time.
  */
+import { utf8Decode, utf8Encode } from './text.js';
+import { CaptureFormatError } from './model.js';
+import type { Capture, CaptureIssue, CaptureMeta } from './model.js';
 
-import {
-  CaptureFormatError,
-  looksLikeCaptureMagic,
-  isCaptureMagicPrefix,
-  parseCapture,
-  CAPTURE_FILE_EXTENSION,
-} from './format.js';
-import type { Capture, CaptureIssue, CaptureMeta } from './format.js';
-import { isUtf8, utf8Decode, utf8Encode } from './utf8.js';
-
-// ---------------------------------------------------------------------------------------------
-// Raw
-// ---------------------------------------------------------------------------------------------
-
-/**
- * A raw byte dump (e.g. `cat /dev/ttyUSB0 > capture.bin`): one chunk on port 0, no timing.
- * `capture.bytes` is `bytes` itself (no copy). An empty input gives a capture with no chunks.
- * @throws {TypeError} when `bytes` is not a Uint8Array.
- */
-export function importRaw(bytes: Uint8Array): Capture {
-  if (!(bytes instanceof Uint8Array)) throw new TypeError('importRaw expects a Uint8Array');
-  const chunks = bytes.length > 0 ? 1 : 0;
-  return {
-    kind: 'raw',
-    meta: { source: 'raw' },
-    timing: 'none',
-    bytes,
-    chunkEnds: Uint32Array.from(chunks ? [bytes.length] : []),
-    chunkTimesUs: Float64Array.from(chunks ? [NaN] : []),
-    chunkPorts: new Uint8Array(chunks),
-    events: [],
-    issues: [],
-  };
-}
-
-// ---------------------------------------------------------------------------------------------
-// Saleae CSV
-// ---------------------------------------------------------------------------------------------
 //
 // The parser works on the file's bytes, not on a decoded string: Saleae exports are ASCII, and
 // reading numbers straight from the bytes avoids a string (and an array of strings) per row.
@@ -49,8 +12,8 @@ export function importRaw(bytes: Uint8Array): Capture {
 
 const COMMA = 0x2c;
 const QUOTE = 0x22;
-const LF = 0x0a;
-const CR = 0x0d;
+export const LF = 0x0a;
+export const CR = 0x0d;
 const SPACE = 0x20;
 const TAB = 0x09;
 const DOT = 0x2e;
@@ -82,7 +45,7 @@ const DECIMAL_NUMBER = /^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$/;
 const NO_ERROR = new Set(['', '0', 'false', 'no', 'none']);
 const UTF8_BOM = [0xef, 0xbb, 0xbf] as const;
 
-function bomLength(bytes: Uint8Array): number {
+export function bomLength(bytes: Uint8Array): number {
   return bytes[0] === UTF8_BOM[0] && bytes[1] === UTF8_BOM[1] && bytes[2] === UTF8_BOM[2] ? 3 : 0;
 }
 
@@ -184,7 +147,7 @@ class CsvFields {
 }
 
 /** The columns of a Saleae async-serial header at `[ls, le)`, or undefined when it is not one. */
-function csvColumns(bytes: Uint8Array, ls: number, le: number): CsvColumns | undefined {
+export function csvColumns(bytes: Uint8Array, ls: number, le: number): CsvColumns | undefined {
   // Count fields first so that every title is recorded.
   let commas = 0;
   for (let i = ls; i < le; i++) if (bytes[i] === COMMA) commas++;
@@ -266,7 +229,7 @@ function byteValue(bytes: Uint8Array, s: number, e: number): number {
 }
 
 /** Shortens text for quoting in a message. */
-function quote(text: string, max = 60): string {
+export function quote(text: string, max = 60): string {
   return JSON.stringify(text.length > max ? `${text.slice(0, max)}…` : text);
 }
 
@@ -288,7 +251,7 @@ class Column<T extends Float64Array | Uint8Array> {
 }
 
 /** True when `[ls, le)` holds only spaces, tabs and CR. */
-function isBlank(bytes: Uint8Array, ls: number, le: number): boolean {
+export function isBlank(bytes: Uint8Array, ls: number, le: number): boolean {
   for (let i = ls; i < le; i++) {
     const c = bytes[i];
     if (c !== SPACE && c !== TAB && c !== CR) return false;
@@ -495,77 +458,4 @@ export function importSaleaeCsv(input: string | Uint8Array): Capture {
     events: [],
     issues,
   };
-}
-
-// ---------------------------------------------------------------------------------------------
-// Sniffing
-// ---------------------------------------------------------------------------------------------
-
-/** How much of a file the text check looks at. */
-const SNIFF_BYTES = 4096;
-
-/**
- * True when the start of the file reads as text: well-formed UTF-8, no NUL, and at most 1 %
- * other control characters (tab, CR, LF and form feed do not count). Spektrum streams are
- * full of 0x00 (fade counters, channel 0), so real serial dumps fail this at once.
- */
-function looksLikeText(bytes: Uint8Array): boolean {
-  const end = Math.min(bytes.length, SNIFF_BYTES);
-  let controls = 0;
-  for (let i = 0; i < end; i++) {
-    const b = bytes[i] ?? 0;
-    if (b === 0) return false;
-    if ((b < 0x20 && b !== 0x09 && b !== 0x0a && b !== 0x0d && b !== 0x0c) || b === 0x7f) controls++;
-  }
-  return controls * 100 <= end && isUtf8(bytes, 0, end, end < bytes.length);
-}
-
-/** Byte range of the first non-blank line within the sniffed sample (BOM and CR excluded). */
-function firstLine(bytes: Uint8Array): [number, number] {
-  const end = Math.min(bytes.length, SNIFF_BYTES);
-  let ls = bomLength(bytes);
-  while (ls < end) {
-    const nl = bytes.indexOf(LF, ls);
-    let le = nl < 0 || nl > end ? end : nl;
-    const next = le + 1;
-    if (le > ls && bytes[le - 1] === CR) le--;
-    if (!isBlank(bytes, ls, le)) return [ls, le];
-    ls = next;
-  }
-  return [end, end];
-}
-
-function hasExtension(fileName: string | undefined, ext: string): boolean {
-  return fileName !== undefined && fileName.toLowerCase().endsWith(ext);
-}
-
-/**
- * Reads any supported capture file, deciding by content (the name is only a hint):
- *
- * 1. the .sscap signature, even with up to two bits flipped (or a `.sscap` name) → `parseCapture`;
- * 2. text whose first line is a Saleae async-serial header → `importSaleaeCsv`;
- * 3. a `.bin` name, or content that is not text → `importRaw`;
- * 4. any other text (JSON, a README…) → `CaptureFormatError`.
- *
- * @throws {CaptureFormatError} for an empty file, a .sscap with nothing to recover (see
- *   `parseCapture`), or text that is not a Saleae async-serial CSV.
- * @throws {TypeError} when `bytes` is not a Uint8Array.
- */
-export function readCapture(bytes: Uint8Array, fileName?: string): Capture {
-  if (!(bytes instanceof Uint8Array)) throw new TypeError('readCapture expects a Uint8Array');
-  const named = fileName ? ` (${fileName})` : '';
-  if (bytes.length === 0) throw new CaptureFormatError(`empty file${named}: there is nothing to decode`);
-  const isBin = hasExtension(fileName, '.bin');
-  // A file shorter than the signature that matches its start is a cut-off .sscap, unless named .bin.
-  if (looksLikeCaptureMagic(bytes) || (!isBin && isCaptureMagicPrefix(bytes)) || hasExtension(fileName, CAPTURE_FILE_EXTENSION)) {
-    return parseCapture(bytes);
-  }
-  const text = looksLikeText(bytes);
-  const [ls, le] = firstLine(bytes);
-  if (text && csvColumns(bytes, ls, le)) return importSaleaeCsv(bytes);
-  if (isBin || !text) return importRaw(bytes);
-  throw new CaptureFormatError(
-    `unrecognised file${named}: it looks like text but not a Saleae async-serial CSV ` +
-      `(its first line is ${quote(utf8Decode(bytes, ls, le))}; expected a header such as "Time [s],Value,Parity Error,Framing Error")`,
-  );
 }
