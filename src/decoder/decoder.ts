@@ -426,6 +426,8 @@ export class SpektrumDecoder {
     // remote taking over (`00 00` then `00 B2`), which acquisition decides.
     if (this.#remote !== 'internal' || !this.#knownLayout(layout) || o + 2 * FRAME_SIZE > this.#tail) return false;
     if (buf[o + 1] !== this.#system || (this.#b0Mode === B0_RSSI && !plausibleRssi(buf[o] as number))) return false;
+    // Fades rise: a fall is something else (a restarted receiver, RSSI), for acquisition to read.
+    if (this.#b0Mode !== B0_RSSI && this.#haveLast && (((buf[o] as number) - this.#last0) & 0xff) >= 0x80) return false;
     return slotLayout(buf, o + FRAME_SIZE, this.#resolution as Resolution) !== INVALID && this.#follows(o, o + FRAME_SIZE);
   }
 
