@@ -22,9 +22,10 @@ function run(cmd: string, args: string[], cwd: string): string {
 }
 
 beforeAll(() => {
+  // dist/ was built by npm test; --ignore-scripts keeps prepack from rebuilding it under the tests that read it.
   if (!existsSync(join(root, 'dist/decoder/index.js'))) throw new Error('dist/ is missing: run `npm run build:lib` first (npm test does)');
   scratch = mkdtempSync(join(tmpdir(), 'satscope-pack-'));
-  const out = JSON.parse(run('npm', ['pack', '--json', '--pack-destination', scratch], root)) as { filename: string; files: { path: string }[] }[];
+  const out = JSON.parse(run('npm', ['pack', '--json', '--ignore-scripts', '--pack-destination', scratch], root)) as { filename: string; files: { path: string }[] }[];
   tarball = join(scratch, out[0]!.filename);
   files = out[0]!.files.map((f) => f.path).sort();
 });
