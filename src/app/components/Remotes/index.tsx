@@ -8,7 +8,7 @@
 import type { Signal } from '@preact/signals';
 import { useEffect, useRef } from 'preact/hooks';
 import uPlot from 'uplot';
-import { REMOTE_LABELS } from '../../../worker/protocol.js';
+import { BUCKET_US, REMOTE_LABELS } from '../../../worker/protocol.js';
 import { onFrame } from '../../frame-loop.js';
 import type { Live } from '../../live.js';
 import { allLives, select, selected, send, sources } from '../../store.js';
@@ -17,6 +17,8 @@ import { agoAxis, hoverCursor, keyboardCursor, legendTime, legendValue, showNewe
 import { chartColors, theme } from '../../theme.js';
 import './style.css';
 
+/** The worker's graph buckets, in seconds of the source's clock (uPlot's x). */
+const BUCKET_S = BUCKET_US / 1e6;
 /** Fade rate in the chart: at least 0–1 /s, so an all-zero window still has labelled ticks. */
 const FADE_SCALE = { floor: 1 };
 
@@ -54,6 +56,8 @@ export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
     const keys = keyboardCursor(plot, box);
     const resize = new ResizeObserver(() => plot.setSize({ width: Math.max(200, box.clientWidth), height: 120 }));
     resize.observe(box);
+    const x: number[] = [];
+    const columns: (number | null)[][] = order.map(() => []);
     let drawnAt = 0;
     const stop = onFrame((nowMs) => {
       if (nowMs - drawnAt < 200) return;
@@ -65,26 +69,25 @@ export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
       const end = first.nowUs() / 1e6;
       if (!Number.isFinite(end)) return;
       const start = end - windowUs.value / 1e6;
-      const times = new Set<number>();
-      for (const id of order) {
+      // The remotes' buckets share one 100 ms grid on one clock: the x axis is that grid, and
+      // each column is filled in place (no union, no sort, no new arrays per redraw).
+      const k0 = Math.ceil(start / BUCKET_S - 1e-6);
+      const n = Math.max(0, Math.floor(end / BUCKET_S + 1e-6) - k0 + 1);
+      x.length = n;
+      for (let i = 0; i < n; i++) x[i] = (k0 + i) * BUCKET_S;
+      order.forEach((id, r) => {
+        const col = columns[r] as (number | null)[];
+        col.length = n;
+        col.fill(null);
         const s = lives.get(id)?.series;
-        if (s !== undefined) for (let i = s.indexAt(start); i < s.length; i++) times.add(s.t[i] as number);
-      }
-      const x = Float64Array.from([...times].sort((a, b) => a - b));
-      const columns = order.map((id) => {
-        const s = lives.get(id)?.series;
-        const col = new Array<number | null>(x.length).fill(null);
-        if (s === undefined) return col;
-        let j = 0;
+        if (s === undefined) return;
         for (let i = s.indexAt(start); i < s.length; i++) {
-          const t = s.t[i] as number;
-          while (j < x.length && (x[j] as number) < t) j++;
-          if (x[j] === t) col[j] = s.fadeRate[i] as number;
+          const k = Math.round((s.t[i] as number) / BUCKET_S) - k0;
+          if (k >= 0 && k < n) col[k] = s.fadeRate[i] as number;
         }
-        return col;
       });
       plot.batch(() => {
-        plot.setData([x as unknown as number[], ...columns] as uPlot.AlignedData, false);
+        plot.setData([x, ...columns] as uPlot.AlignedData, false);
         plot.setScale('x', { min: start, max: end });
       });
       showNewest(plot, x.length);
