@@ -2,19 +2,15 @@
  * The window's part of WebSerial: checking it exists, asking for a port (requestPort needs a
  * user gesture, so it cannot happen in the worker), and naming granted ports for the worker.
  */
-import { portName, type PortIdentity } from '../worker/protocol.js';
+import { USB_SERIAL_VENDORS, portName } from '../bind/index.js';
+import type { PortIdentity } from '../worker/protocol.js';
 import { notify, send } from './store.js';
 
-/** USB-serial chips people put on a satellite's DATA line, as picker hints; any port may be chosen. */
-export const USB_SERIAL_FILTERS: SerialPortFilter[] = [
-  { usbVendorId: 0x0403 }, // FTDI FT232R/FT231X
-  { usbVendorId: 0x10c4 }, // Silicon Labs CP210x
-  { usbVendorId: 0x1a86 }, // WCH CH340/CH341
-  { usbVendorId: 0x067b }, // Prolific PL2303
-  { usbVendorId: 0x2341 }, // Arduino
-  { usbVendorId: 0x239a }, // Adafruit
-  { usbVendorId: 0x0483 }, // STMicroelectronics (flight controllers in passthrough)
-];
+/**
+ * USB-serial adapters people put on a satellite's DATA line (the one table, src/bind/chips.ts),
+ * as picker hints; any port may be chosen.
+ */
+export const USB_SERIAL_FILTERS: SerialPortFilter[] = USB_SERIAL_VENDORS.map(({ usbVendorId }) => ({ usbVendorId }));
 
 /** Why WebSerial cannot be used here, with what to do, or null when it can. */
 export function serialUnavailable(): { title: string; detail: string } | null {

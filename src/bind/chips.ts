@@ -51,8 +51,6 @@ export interface UsbSerialVendor {
   readonly usbVendorId: number;
   /** Short name for a port list: "FTDI (0403:6001)". */
   readonly name: string;
-  /** Who makes what: the picker's hint. */
-  readonly makes: string;
   /** The chips this vendor's product may be, or undefined when it is not a chip modelled here. */
   readonly chips: (usbProductId: number | undefined) => readonly UsbSerialChip[] | undefined;
 }
@@ -62,13 +60,13 @@ const isPl2303g = (pid: number | undefined) => pid !== undefined && pid >= 0x23a
 
 /** USB vendors of the USB-serial chips and boards people wire to a satellite. */
 export const USB_SERIAL_VENDORS: readonly UsbSerialVendor[] = [
-  { usbVendorId: 0x0403, name: 'FTDI', makes: 'FTDI FT232R/FT231X', chips: () => ['ft232r'] },
-  { usbVendorId: 0x10c4, name: 'CP210x', makes: 'Silicon Labs CP210x', chips: () => ['cp2102', 'cp2102n'] },
-  { usbVendorId: 0x1a86, name: 'CH340', makes: 'WCH CH340/CH341', chips: () => ['ch340'] },
-  { usbVendorId: 0x067b, name: 'PL2303', makes: 'Prolific PL2303', chips: (pid) => (isPl2303g(pid) ? ['pl2303g'] : ['pl2303', 'pl2303ta']) },
-  { usbVendorId: 0x2341, name: 'Arduino', makes: 'Arduino', chips: () => undefined },
-  { usbVendorId: 0x239a, name: 'Adafruit', makes: 'Adafruit', chips: () => undefined },
-  { usbVendorId: 0x0483, name: 'STM32', makes: 'STMicroelectronics (flight controllers in passthrough)', chips: () => undefined },
+  { usbVendorId: 0x0403, name: 'FTDI', chips: () => ['ft232r'] }, // FT232R/FT231X
+  { usbVendorId: 0x10c4, name: 'CP210x', chips: () => ['cp2102', 'cp2102n'] }, // Silicon Labs
+  { usbVendorId: 0x1a86, name: 'CH340', chips: () => ['ch340'] }, // WCH CH340/CH341
+  { usbVendorId: 0x067b, name: 'PL2303', chips: (pid) => (isPl2303g(pid) ? ['pl2303g'] : ['pl2303', 'pl2303ta']) }, // Prolific
+  { usbVendorId: 0x2341, name: 'Arduino', chips: () => undefined },
+  { usbVendorId: 0x239a, name: 'Adafruit', chips: () => undefined },
+  { usbVendorId: 0x0483, name: 'STM32', chips: () => undefined }, // flight controllers in passthrough
 ];
 
 const vendor = (usbVendorId: number | undefined) => USB_SERIAL_VENDORS.find((v) => v.usbVendorId === usbVendorId);
@@ -116,7 +114,9 @@ const PL2303_DIRECT: readonly number[] = [
  * Every rate a fixed-table chip makes exactly (the CP2102's table, then the PL2303's direct
  * rates), so a planner can try them. Not exported from the package.
  */
-export const TABLE_RATES: readonly number[] = [...CP2102_TABLE.map(([rate]) => rate), ...PL2303_DIRECT];
+export function tableRates(): number[] {
+  return [...CP2102_TABLE.map(([rate]) => rate), ...PL2303_DIRECT];
+}
 
 /** `Math.round(a / b)` as C's DIV_ROUND_CLOSEST for positive integers. */
 const divRoundClosest = (a: number, b: number) => Math.floor((a + Math.floor(b / 2)) / b);

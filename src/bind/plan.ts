@@ -7,7 +7,7 @@
  */
 import type { BindStep } from './timeline.js';
 import { BIND_PULSE_MAX_US, BIND_PULSE_MIN_US, BIND_PULSE_TARGET_US, BIND_WINDOW, MAX_BIND_PULSES, MIN_BIND_PULSES, checkPulses } from './modes.js';
-import { DEFAULT_CHIPS, TABLE_RATES, chipBaudRate, type UsbSerialChip } from './chips.js';
+import { DEFAULT_CHIPS, tableRates, chipBaudRate, type UsbSerialChip } from './chips.js';
 import { frameRuns, measurePulses, uartWaveform, type PulseMeasurement, type StopBits } from './uart.js';
 
 export interface PlanOptions {
@@ -73,7 +73,7 @@ export interface PulsePlan {
 function candidateRates(targetUs: number): number[] {
   const set = new Set<number>();
   for (let bitsPerPhase = 1; bitsPerPhase <= 9; bitsPerPhase++) set.add(Math.round((bitsPerPhase * 1e6) / targetUs));
-  for (const rate of TABLE_RATES) set.add(rate);
+  for (const rate of tableRates()) set.add(rate);
   // A phase is at least one bit and a frame at most 11: beyond these rates no frame reaches 120 µs.
   const max = Math.ceil((11 * 1e6) / (targetUs * 0.5));
   return [...set].filter((r) => r >= 300 && r <= max).sort((a, b) => a - b);

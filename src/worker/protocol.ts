@@ -16,19 +16,6 @@ export interface PortIdentity {
 
 export type SourceKind = 'serial' | 'demo' | 'replay';
 
-/** USB vendors of the USB-serial chips people wire to a satellite. */
-const USB_CHIPS: Record<number, string> = {
-  0x0403: 'FTDI', 0x10c4: 'CP210x', 0x1a86: 'CH340', 0x067b: 'PL2303', 0x2341: 'Arduino', 0x239a: 'Adafruit', 0x0483: 'STM32',
-};
-
-/** A port's name for people, from its USB IDs: "FTDI (0403:6001)", or "Serial port". */
-export function portName(info: { usbVendorId?: number; usbProductId?: number }): string {
-  const { usbVendorId, usbProductId } = info;
-  if (usbVendorId === undefined) return 'Serial port';
-  const hex = (v: number) => v.toString(16).padStart(4, '0');
-  return `${USB_CHIPS[usbVendorId] ?? 'USB serial'} (${hex(usbVendorId)}:${hex(usbProductId ?? 0)})`;
-}
-
 /** Remote labels as Spektrum names them (spec §7.3): A is the internal one; B, R, L external. */
 export const REMOTE_LABELS = ['A', 'B', 'R', 'L'] as const;
 

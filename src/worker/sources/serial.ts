@@ -5,7 +5,8 @@
  * the session: a fresh reader is taken from the new `port.readable`.
  */
 import { BAUD_RATE } from '../../decoder/index.js';
-import { portName, type PortIdentity } from '../protocol.js';
+import { portName } from '../../bind/index.js';
+import type { PortIdentity } from '../protocol.js';
 
 /** Errors after which `port.readable` is replaced and reading goes on (WebSerial spec). */
 const RECOVERABLE = new Set(['BufferOverrunError', 'FramingError', 'BreakError', 'ParityError']);
