@@ -4,7 +4,7 @@
  * then close and reopen at 115200 with the power line asserted again at once — each at its time.
  * The worker then reads the port as usual, so the user sees the bind take.
  */
-import { bindTimeline, chipsForUsbId, planPulses, type BindStep, type PowerLine, type PowerPolarity } from '../bind/index.js';
+import { bindForAdapter, type BindStep, type PowerLine, type PowerPolarity } from '../bind/index.js';
 import type { BindProgress } from './protocol.js';
 
 const sleepUntil = (ms: number) => new Promise<void>((resolve) => setTimeout(resolve, Math.max(0, ms - performance.now())));
@@ -19,9 +19,8 @@ export async function runBind(
   options: { pulses: number; powerLine: PowerLine; polarity: PowerPolarity },
   report: (progress: BindProgress) => void,
 ): Promise<SerialOutputSignals> {
-  const info = port.getInfo();
-  const plan = planPulses(options.pulses, { chips: chipsForUsbId(info.usbVendorId, info.usbProductId) });
-  const steps: BindStep[] = bindTimeline(options.pulses, { powerLine: options.powerLine, polarity: options.polarity, plan });
+  // The plan for this port's chip, made by the same call the Bind panel previews it with.
+  const { plan, steps } = bindForAdapter(options.pulses, port.getInfo(), { powerLine: options.powerLine, polarity: options.polarity });
   const start = performance.now();
   let powerOffAt = NaN;
   let powerOnAt = NaN;

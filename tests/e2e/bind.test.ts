@@ -51,6 +51,9 @@ describe.skipIf(skip !== null)('binding a satellite', () => {
     await page.goto(server.url('/'));
     await page.getByRole('button', { name: 'Bind…' }).click();
     await expect(page.getByRole('radio', { name: '9 pulses' }).isChecked()).resolves.toBe(true);
+    // A pty has no USB IDs: the panel says it shows the common adapters' plan, the one the worker runs.
+    await expect(page.getByTestId('bind-adapter').textContent()).resolves.toMatch(/does not know this adapter's chip/);
+    const preview = (await page.getByTestId('bind-plan').textContent())?.replace(/\s+/g, ' ') ?? '';
     await shot(page, 'bind-panel');
     const since = fake.signalChanges.length;
     await page.getByRole('button', { name: 'Bind on Serial port' }).click();
@@ -70,6 +73,9 @@ describe.skipIf(skip !== null)('binding a satellite', () => {
     const pulses = written.filter((w) => w.tUs > on.tUs);
     const bytes = Uint8Array.from(pulses.flatMap((w) => Array.from(w.bytes)));
     expect(Array.from(bytes)).toEqual(Array.from(planPulses(9).bytes)); // 9 × 0xF0: nothing else
+    // What the panel showed before the bind is what went on the wire.
+    const hex = (v: number) => `0x${v.toString(16).toUpperCase().padStart(2, '0')}`;
+    expect(preview).toContain(`Pulses: ${Array.from(bytes, hex).join(' ')} at ${planPulses(9).baudRate} baud`);
     const writeMs = (pulses[0]!.tUs - on.tUs) / 1000;
     // Sent 60 ms after power-on as firmware does; Chromium's serial pipeline adds 0–40 ms here.
     expect(writeMs).toBeGreaterThan(55); // the satellite has settled…

@@ -3,63 +3,66 @@
  * internal or external explained), the line that switches the satellite's power, and the port;
  * see the wiring and the timeline in plain words ("power off", "power on", "9 pulses"), with
  * the exact serial-port calls in a details view for whoever checks them; bind; then watch the
- * bind take in the live view. Tables scroll inside the panel on a phone.
+ * bind take in the live view. What it shows is the bind the worker runs on the chosen port
+ * (preview.ts): pulses for that adapter's chip, or for the common chips, saying so. Tables
+ * scroll inside the panel on a phone.
  */
 import { useMemo, useState } from 'preact/hooks';
-import { BIND_MODES, bindTimeline, planPulses, type BindStep, type PowerLine, type PowerPolarity } from '../../../bind/index.js';
+import { BIND_MODES, type PowerLine, type PowerPolarity } from '../../../bind/index.js';
 import wiring from '../../../bind/wiring.svg';
 import { identify, pickPort, portLabel, serialUnavailable } from '../../serial.js';
 import { bindLog, notify, send } from '../../store.js';
+import { bindPreview, plainStep, sincePowerOn } from './preview.js';
 import './style.css';
 
 const hex = (v: number) => `0x${v.toString(16).toUpperCase().padStart(2, '0')}`;
 
-const at = (ms: number) => (ms >= 0 ? `t0 + ${ms.toFixed(0)} ms` : `t0 − ${(-ms).toFixed(0)} ms`);
-
-/** A step as a hobbyist says it: what to call it, and what happens to the satellite. */
-function plain(step: BindStep, steps: readonly BindStep[], pulses: number): { name: string; what: string } {
-  switch (step.action) {
-    case 'open':
-      return { name: 'Open the adapter', what: `The adapter is set up to draw the pulses (${step.baudRate} baud).` };
-    case 'power-off': {
-      const on = steps.find((x) => x.action === 'power-on');
-      const offMs = on === undefined ? 0 : on.atMs - step.atMs;
-      return { name: 'Power off', what: `The satellite is switched off for ${offMs.toFixed(0)} ms, so it starts afresh.` };
-    }
-    case 'power-on':
-      return { name: 'Power on', what: 'The satellite is switched on. The time of every later step counts from here (t0).' };
-    case 'write':
-      return {
-        name: `${pulses} pulses`,
-        what: `${pulses} short pulses on the DATA wire, ${(step.durationUs / 1000).toFixed(1)} ms in all: the satellite enters bind mode and its light blinks fast.`,
-      };
-    case 'reopen':
-      return { name: 'Back to reading', what: 'The adapter goes back to reading frames. Now put the transmitter in bind mode; frames appear once the bind takes.' };
-  }
-}
+/** No port chosen yet: the bind asks for one when it starts. */
+const ANOTHER = -1;
 
 export function BindPanel({ granted, onClose }: { granted: SerialPort[]; onClose(): void }) {
   const [pulses, setPulses] = useState(9);
   const [powerLine, setPowerLine] = useState<PowerLine>('rts');
   const [polarity, setPolarity] = useState<PowerPolarity>('asserted');
-  const plan = useMemo(() => planPulses(pulses), [pulses]);
-  const steps = useMemo(() => bindTimeline(pulses, { powerLine, polarity, plan }), [pulses, powerLine, polarity, plan]);
+  // Ports chosen in the picker from this panel join the granted ones.
+  const [picked, setPicked] = useState<SerialPort[]>([]);
+  const ports = useMemo(() => [...granted, ...picked.filter((p) => !granted.includes(p))], [granted, picked]);
+  const [choice, setChoice] = useState(granted.length > 0 ? 0 : ANOTHER);
+  const port = ports[choice];
+  // The preview is the bind the worker will run: the same call, with this port's USB IDs.
+  const info = port?.getInfo();
+  const vid = info?.usbVendorId;
+  const pid = info?.usbProductId;
+  const preview = useMemo(
+    () => bindPreview(pulses, port === undefined ? null : { usbVendorId: vid, usbProductId: pid }, powerLine, polarity),
+    [pulses, port, vid, pid, powerLine, polarity],
+  );
+  const { plan, steps } = preview;
   const mode = BIND_MODES.find((m) => m.pulses === pulses);
+  const labels = ports.map((p) => portLabel(p));
+  const optionLabel = (i: number) => (labels.filter((l) => l === labels[i]).length > 1 ? `${labels[i]} (${i + 1})` : labels[i]);
 
-  const start = async (port: SerialPort | null) => {
+  const start = async () => {
     const missing = serialUnavailable();
     if (missing !== null) {
       notify('error', missing.title, missing.detail);
       return;
     }
     let chosen = port;
-    if (chosen === null) {
-      const picked = await pickPort([]);
-      if ('problem' in picked) {
-        notify('warning', picked.problem.title, picked.problem.detail);
+    if (chosen === undefined) {
+      const answer = await pickPort([]);
+      if ('problem' in answer) {
+        notify('warning', answer.problem.title, answer.problem.detail);
         return;
       }
-      chosen = picked;
+      chosen = answer;
+      // Show this port's plan from now on: it is the one the worker runs.
+      const known = ports.indexOf(chosen);
+      if (known >= 0) setChoice(known);
+      else {
+        setPicked([...picked, chosen]);
+        setChoice(ports.length);
+      }
     }
     send({ type: 'bind', port: await identify(chosen), pulses, powerLine, polarity });
   };
@@ -106,16 +109,23 @@ export function BindPanel({ granted, onClose }: { granted: SerialPort[]; onClose
                 <option value="deasserted">deasserted (pin high)</option>
               </select>
             </label>
+            <label>Adapter
+              <select value={String(choice)} onChange={(e) => setChoice(Number((e.currentTarget as HTMLSelectElement).value))}>
+                {ports.map((_, i) => <option key={i} value={String(i)}>{optionLabel(i)}</option>)}
+                <option value={String(ANOTHER)}>{ports.length > 0 ? 'Another port…' : 'Choose when binding…'}</option>
+              </select>
+            </label>
           </div>
+          <p class="adapter" data-testid="bind-adapter">{preview.adapter}</p>
           <div class="table-scroll" tabIndex={0} role="region" aria-label="What the bind does">
           <table class="timeline" aria-label="Bind timeline">
             <thead><tr><th>When</th><th>Step</th><th>What happens</th></tr></thead>
             <tbody>
               {steps.map((s) => {
-                const p = plain(s, steps, pulses);
+                const p = plainStep(s, steps, pulses);
                 return (
                   <tr key={s.action}>
-                    <td class="num">{at(s.sincePowerOnMs)}</td>
+                    <td class="num">{sincePowerOn(s.sincePowerOnMs)}</td>
                     <td class="step">{p.name}</td>
                     <td class="note">{p.what}</td>
                   </tr>
@@ -126,21 +136,21 @@ export function BindPanel({ granted, onClose }: { granted: SerialPort[]; onClose
           </div>
           <details class="technical">
             <summary>Technical details: the serial-port calls</summary>
-            <p class="plan">
-              Pulses: {pulses} × <code>{hex(plan.bytes[0] ?? 0)}</code> at {plan.baudRate} baud 8N{plan.stopBits}: each {Math.round(plan.lowUs[0] ?? 0)} µs low,
-              {' '}{Math.round(plan.highUs[0] ?? 0)} µs high, {(plan.totalUs / 1000).toFixed(2)} ms in all.
+            <p class="plan" data-testid="bind-plan">
+              Pulses: <code>{Array.from(plan.bytes, hex).join(' ')}</code> at {plan.baudRate} baud 8N{plan.stopBits}: each {Math.round(plan.lowUs[0] ?? 0)} µs low,
+              {' '}{Math.round(plan.highUs[0] ?? 0)} µs high, {(plan.totalUs / 1000).toFixed(2)} ms in all. Planned for
+              {' '}{plan.chipRates.map((c) => `${c.chip} (${Math.round(c.baudRate)} baud)`).join(', ')}{preview.chipsKnown ? '' : ': the default chips, as the port\'s USB IDs name none'}.
             </p>
             <ol class="calls">
               {steps.map((s) => (
-                <li key={s.action}><span class="num">{at(s.sincePowerOnMs)}</span> <code>{s.action}</code>: {s.note}</li>
+                <li key={s.action}><span class="num">{sincePowerOn(s.sincePowerOnMs)}</span> <code>{s.action}</code>: {s.note}</li>
               ))}
             </ol>
           </details>
           <div class="go">
-            {granted.map((port, i) => (
-              <button key={i} type="button" class="primary" onClick={() => void start(port)}>Bind on {portLabel(port)}</button>
-            ))}
-            <button type="button" class={granted.length === 0 ? 'primary' : ''} onClick={() => void start(null)}>Bind on a port…</button>
+            <button type="button" class="primary" onClick={() => void start()}>
+              {port === undefined ? 'Choose a port and bind…' : `Bind on ${optionLabel(choice)}`}
+            </button>
           </div>
           {bindLog.value.length > 0 ? (
             <ol class="progress" aria-label="Bind progress" aria-live="polite">
