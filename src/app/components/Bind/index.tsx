@@ -139,7 +139,7 @@ export function BindPanel({ granted, onClose }: { granted: SerialPort[]; onClose
             <p class="plan" data-testid="bind-plan">
               Pulses: <code>{Array.from(plan.bytes, hex).join(' ')}</code> at {plan.baudRate} baud 8N{plan.stopBits}: each {Math.round(plan.lowUs[0] ?? 0)} µs low,
               {' '}{Math.round(plan.highUs[0] ?? 0)} µs high, {(plan.totalUs / 1000).toFixed(2)} ms in all. Planned for
-              {' '}{plan.chipRates.map((c) => `${c.chip} (${Math.round(c.baudRate)} baud)`).join(', ')}{preview.chipsKnown ? '' : ': the default chips, as the port\'s USB IDs name none'}.
+              {' '}{plan.chipRates.map((c) => `${c.chip} (${Math.round(c.baudRate)} baud)`).join(', ')}{preview.chipsKnown ? '' : port === undefined ? ': the default chips, as no port is chosen yet' : ': the default chips, as the port\'s USB IDs name none'}.
             </p>
             <ol class="calls">
               {steps.map((s) => (
