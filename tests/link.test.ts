@@ -1,14 +1,42 @@
-/** The link monitor: the failsafe state machine of spec §7.1, episodes, period, missed frames. */
+/** The link monitor: the failsafe state machine of spec §7.1, episodes, period, missed frames, delivery. */
 import { describe, expect, it } from 'vitest';
-import { LinkMonitor, type DecodedFrame } from '../src/decoder/index.js';
+import { BYTE_TIME_US, HOLD_MIN_US, LinkMonitor, LinkSeries, monitorWithSeries, type DecodedFrame } from '../src/decoder/index.js';
 
-/** A stand-in frame: only what the monitor reads. */
-function frame(timeUs: number, fadesDelta = 0, system: number | null = 0xb2): DecodedFrame {
-  return { timeUs, fadesDelta, system, rssi: null } as DecodedFrame;
+/** A stand-in frame: only what the monitor reads. `fades: null` is a receiver without a counter. */
+function frame(timeUs: number, fadesDelta = 0, system: number | null = 0xb2, fades: number | null = 0): DecodedFrame {
+  return { timeUs, fadesDelta, system, rssi: null, fades } as DecodedFrame;
 }
 
-describe('LinkMonitor', () => {
-  it('goes live on a frame, holds after 40 ms without one, fails safe after 1 s, and is live again on the next', () => {
+/** A counter-less receiver (a clone's 00 00 header) with no system byte: only the clock can tell. */
+const bare = (t: number) => frame(t, 0, null, null);
+
+/**
+ * Frames due every `periodUs` (slots in `lost` never sent), as a browser stamps them: bytes
+ * delivered in 16 ms USB chunks, each frame dated from its chunk's arrival less the bytes after
+ * it at line rate; chunk `k` is held back a further `stallUs(k)`.
+ */
+function usbDelivered(slots: number, periodUs: number, lost: Set<number>, stallUs: (k: number) => number): number[] {
+  const ends = [];
+  for (let i = 0; i < slots; i++) if (!lost.has(i)) ends.push({ slot: i, end: i * periodUs + 16 * BYTE_TIME_US });
+  const times: number[] = [];
+  let k = 0;
+  let i = 0;
+  let last = 0;
+  while (i < ends.length) {
+    const tick = (k + 1) * 16_000;
+    const chunk = [];
+    while (i < ends.length && ends[i]!.end <= tick) chunk.push(ends[i++]!);
+    // A chunk held back holds back the ones after it: they come in one burst.
+    const arrival = Math.max(tick + stallUs(k), last);
+    last = arrival;
+    chunk.forEach((_, j) => times.push(arrival - (chunk.length - 1 - j) * 16 * BYTE_TIME_US - 15 * BYTE_TIME_US));
+    k++;
+  }
+  return times;
+}
+
+describe('LinkMonitor: hold and failsafe', () => {
+  it('holds once no frame has come for 40 ms, dated from when the next frame was due; fails safe after 1 s; is live again on the next', () => {
     const link = new LinkMonitor();
     expect(link.state).toBe('waiting');
     for (let t = 0; t <= 110_000; t += 11_000) link.frame(frame(t));
@@ -17,13 +45,29 @@ describe('LinkMonitor', () => {
     expect(link.update(110_000 + 41_000)).toBe('hold');
     expect(link.update(110_000 + 999_000)).toBe('hold');
     expect(link.update(110_000 + 1_000_000)).toBe('failsafe');
-    link.frame(frame(1_500_000));
+    link.frame(frame(1_500_000, 125));
     expect(link.state).toBe('live');
     expect(link.stats).toMatchObject({ holds: 1, failsafes: 1 });
     expect(link.episodes.map((e) => [e.id, e.kind, e.startUs, e.endUs])).toEqual([
-      [0, 'hold', 110_000 + 40_000, 110_000 + 1_000_000],
+      [0, 'hold', 110_000 + 11_000, 110_000 + 1_000_000],
       [1, 'failsafe', 110_000 + 1_000_000, 1_500_000],
     ]);
+  });
+
+  it('a real 1.5 s dropout gives one hold and one failsafe at the right capture times, and the counter\'s missed frames', () => {
+    const link = new LinkMonitor();
+    let t = 5_000_000;
+    for (let i = 0; i < 200; i++, t += 11_000) link.frame(frame(t, 0, 0xb2, 7));
+    const last = t - 11_000;
+    // Silent from the slot after `last` for 1.5 s: 136 frames not sent, the counter says so.
+    const back = last + 137 * 11_000;
+    for (let i = 0; i < 100; i++) link.frame(frame(back + i * 11_000, i === 0 ? 136 : 0, 0xb2, 143));
+    expect(link.stats).toMatchObject({ holds: 1, failsafes: 1, missedFrames: 136, missedBasis: 'fade-counter', fades: 136 });
+    expect(link.episodes.map((e) => [e.kind, e.startUs, e.endUs, e.lastFrameUs])).toEqual([
+      ['hold', last + 11_000, last + 1_000_000, last],
+      ['failsafe', last + 1_000_000, back, last],
+    ]);
+    expect(link.stats.longestGapUs).toBe(back - last);
   });
 
   it('opens the episodes of a gap even when nothing called update() during it', () => {
@@ -33,9 +77,108 @@ describe('LinkMonitor', () => {
     link.frame(frame(2_011_000));
     expect(link.episodes.map((e) => e.kind)).toEqual(['hold', 'failsafe']);
     expect(link.stats.longestGapUs).toBe(2_000_000);
-    expect(link.stats.missedFrames).toBe(181);
   });
 
+  it('waits longer before a hold on a stream whose delivery jitters: the measured jitter is added', () => {
+    const jittery = new LinkMonitor();
+    const times = usbDelivered(300, 11_000, new Set(), () => 0);
+    for (const t of times) jittery.frame(bare(t));
+    expect(jittery.stats.deliveryJitterUs).toBeGreaterThan(10_000);
+    expect(jittery.holdAfterUs).toBeGreaterThan(HOLD_MIN_US + 10_000);
+    const exact = new LinkMonitor();
+    for (let i = 0; i < 300; i++) exact.frame(bare(i * 11_000));
+    expect(exact.stats.deliveryJitterUs).toBeLessThan(1);
+    expect(exact.holdAfterUs).toBeLessThan(HOLD_MIN_US + 1);
+  });
+});
+
+describe('LinkMonitor: missed means missed', () => {
+  it('a late USB chunk is not a missed frame; once the delivery is measured, a 45 ms stall then a burst opens no hold', () => {
+    for (const fades of [null, 0] as const) {
+      const link = new LinkMonitor({ jitterUs: 20_000 });
+      // A stall now and then from the start; after 2 s, every 25th chunk held back by the host
+      // for 45 ms (a scheduling stall), the rest on time.
+      const times = usbDelivered(2000, 11_000, new Set(), (k) => (k === 40 || k === 90 || (k > 125 && k % 25 === 24) ? 45_000 : 0));
+      const early = new LinkMonitor({ jitterUs: 20_000 });
+      for (const t of times.filter((x) => x < 1_500_000)) early.frame(frame(t, 0, fades === null ? null : 0xb2, fades));
+      expect(early.stats.missedFrames).toBe(0);
+      let maxGap = 0;
+      times.forEach((t, i) => {
+        if (i > 0) maxGap = Math.max(maxGap, t - times[i - 1]!);
+        link.frame(frame(t, 0, fades === null ? null : 0xb2, fades));
+        // The page asks for the state between chunks too.
+        link.update(t + 8_000);
+      });
+      link.finish(times.at(-1)! + 2_000);
+      expect(maxGap).toBeGreaterThan(50_000);
+      expect(link.stats).toMatchObject({ frames: 2000, missedFrames: 0, failsafes: 0 });
+      // The first stalls came before the delivery was measured: at most they, never the later ones.
+      expect(link.stats.holds).toBeLessThanOrEqual(2);
+      expect(link.episodes.every((e) => e.startUs < 1_600_000)).toBe(true);
+      expect(link.stats.deliveryJitterUs).toBeGreaterThan(30_000);
+      expect(link.stats.deliveryDelayUs).toBeGreaterThan(0);
+    }
+  });
+
+  it('a fade-counter jump is a missed frame, at once, with no gap to see', () => {
+    const link = new LinkMonitor();
+    for (let i = 0; i < 50; i++) link.frame(frame(i * 11_000, 0, 0xb2, 5));
+    link.frame(frame(50 * 11_000, 1, 0xb2, 6));
+    expect(link.stats).toMatchObject({ missedFrames: 1, missedBasis: 'fade-counter', fades: 1, holds: 0 });
+  });
+
+  it('a counter rise larger than the frames due is a corrupted header: no fades, no missed frames', () => {
+    const link = new LinkMonitor();
+    for (let i = 0; i < 50; i++) link.frame(frame(i * 11_000, 0, 0xb2, 5));
+    link.frame(frame(50 * 11_000, 64, 0xb2, 69));
+    link.frame(frame(51 * 11_000, 0, 0xb2, 69));
+    expect(link.stats).toMatchObject({ missedFrames: 0, fades: 0, implausibleFades: 1 });
+  });
+
+  it('without a counter, frames missing are counted against frames expected once a window shows it, through USB jitter', () => {
+    const link = new LinkMonitor({ jitterUs: 20_000 });
+    const lost = new Set([300, 301, 700, 1200, 1201, 1202]);
+    const times = usbDelivered(1500, 11_000, lost, () => 0);
+    for (const t of times) link.frame(bare(t));
+    link.finish(times.at(-1)! + 2_000);
+    expect(link.stats).toMatchObject({ missedBasis: 'frame-count', missedFrames: lost.size, holds: 0 });
+  });
+
+  it('places missing frames where they were due, for the binned series', () => {
+    const series = new LinkSeries(100_000, 0);
+    const link = monitorWithSeries({}, series);
+    for (let i = 0; i < 200; i++) if (i < 50 || i > 52) link.frame(frame(i * 11_000, i === 53 ? 3 : 0, 0xb2, i > 52 ? 3 : 0));
+    expect(link.stats.missedFrames).toBe(3);
+    // Slots 50–52 were due at 550–572 ms: bin 5.
+    expect(series.lost(5)).toBe(3);
+    expect(series.lost(4) + series.lost(6)).toBe(0);
+  });
+
+  it('at the end of a stream counts the frames due in a silence longer than a hold', () => {
+    const link = new LinkMonitor();
+    for (let i = 0; i < 100; i++) link.frame(frame(i * 11_000, 0, 0xb2, 9));
+    expect(link.finish(99 * 11_000 + 500_000)).toBe('hold');
+    expect(link.stats.missedFrames).toBe(45);
+    const clean = new LinkMonitor();
+    for (let i = 0; i < 100; i++) clean.frame(frame(i * 11_000, 0, 0xb2, 9));
+    expect(clean.finish(99 * 11_000 + 16 * BYTE_TIME_US)).toBe('live');
+    expect(clean.stats.missedFrames).toBe(0);
+  });
+
+  it('counts nothing for the time an interrupt() covers: no gap, episode or missed frame', () => {
+    const link = new LinkMonitor();
+    for (let i = 0; i < 50; i++) link.frame(bare(i * 11_000));
+    link.interrupt(50 * 11_000);
+    expect(link.update(5_000_000)).toBe('waiting');
+    for (let i = 0; i < 100; i++) link.frame(bare(6_000_000 + i * 11_000));
+    link.finish(6_000_000 + 99 * 11_000 + 2_000);
+    expect(link.state).toBe('live');
+    expect(link.stats).toMatchObject({ holds: 0, failsafes: 0, missedFrames: 0 });
+    expect(link.episodes).toEqual([]);
+  });
+});
+
+describe('LinkMonitor: period and bounds', () => {
   it('measures the period over the window and snaps it to 11 or 22 ms without a system byte', () => {
     const link = new LinkMonitor();
     // Five frames lost right after the start must not fix the period at 22 ms.

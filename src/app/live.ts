@@ -70,6 +70,10 @@ export class Live {
   link: Batch['link'] | null = null;
   counters: Batch['counters'] = { bytes: 0, frames: 0, resyncs: 0, discardedBytes: 0, badFrames: 0 };
   resolution: 1024 | 2048 | null = null;
+  /** The source has ended: its clock and state stand still. */
+  ended = false;
+  /** While a forced resolution matches no frame: the resolution the stream looks like. */
+  mismatch: 1024 | 2048 | null = null;
   /** Source clock at the last batch, and when (performance.now()) it arrived. */
   #clockUs = NaN;
   #clockAtMs = 0;
@@ -85,6 +89,8 @@ export class Live {
     this.link = batch.link;
     this.counters = batch.counters;
     this.resolution = batch.resolution;
+    this.ended = batch.ended;
+    this.mismatch = batch.mismatch;
     this.series.append(batch.series);
     for (const e of batch.episodes) this.episodes.set(e.id, { kind: e.kind, startUs: e.startUs, endUs: e.endUs });
     // Nothing shows episodes older than the longest window: a long session must not pile them up.
@@ -103,12 +109,15 @@ export class Live {
     this.link = null;
     this.counters = { bytes: 0, frames: 0, resyncs: 0, discardedBytes: 0, badFrames: 0 };
     this.resolution = null;
+    this.ended = false;
+    this.mismatch = null;
     this.#clockUs = NaN;
     this.version++;
   }
 
-  /** The source clock now, extrapolated from the last batch (frozen when paused). */
+  /** The source clock now, extrapolated from the last batch (frozen when paused or ended). */
   nowUs(): number {
+    if (this.ended) return this.#clockUs;
     return this.#clockUs + (performance.now() - this.#clockAtMs) * 1000 * this.clockRate;
   }
 }

@@ -4,7 +4,7 @@
  * routes every message the worker posts. The views show the selected remote; the Remotes panel
  * shows them all.
  */
-import { computed, signal } from '@preact/signals';
+import { batch, computed, signal } from '@preact/signals';
 import type { InspectEntry } from '../worker/inspector.js';
 import type { BindProgress, FromWorker, Overview, RecordingStatus, ReplayStatus, SourceStatus, ToWorker } from '../worker/protocol.js';
 import { Live } from './live.js';
@@ -62,13 +62,23 @@ export const nominalPeriodUs = signal(NaN);
 export const linkState = signal<'waiting' | 'live' | 'hold' | 'failsafe'>('waiting');
 /** Set once X-Plus channels have been seen, so the panel appears and stays. */
 export const xplusSeen = signal(false);
+/** The selected source has ended (a replay at its end): `linkState` is its last state, frozen. */
+export const linkEnded = signal(false);
+/** While a forced resolution matches no frame: the resolution the stream looks like. */
+export const linkMismatch = signal<1024 | 2048 | null>(null);
 
 function refreshSelected(): void {
   const live = current();
   const l = live.link;
   if (!Object.is(l?.nominalPeriodUs ?? NaN, nominalPeriodUs.value)) nominalPeriodUs.value = l?.nominalPeriodUs ?? NaN;
   const state = l?.state ?? 'waiting';
-  if (state !== linkState.value) linkState.value = state;
+  const ended = live.ended || status.value.state === 'ended';
+  const mismatch = live.mismatch;
+  batch(() => {
+    if (state !== linkState.value) linkState.value = state;
+    if (ended !== linkEnded.value) linkEnded.value = ended;
+    if (mismatch !== linkMismatch.value) linkMismatch.value = mismatch;
+  });
   let x = false;
   for (let id = 12; id < 20; id++) if (!Number.isNaN(live.seenUs[id])) x = true;
   if (x !== xplusSeen.value) xplusSeen.value = x;
@@ -110,6 +120,7 @@ function receive(message: FromWorker): void {
   switch (message.type) {
     case 'sources': {
       sources.value = message.sources;
+      refreshSelected();
       for (const s of message.sources) liveOf(s.id).clockRate = s.clockRate;
       for (const id of lives.keys()) if (!message.sources.some((s) => s.id === id)) lives.delete(id);
       // Keep the selection on a remote that exists, preferring the internal one.

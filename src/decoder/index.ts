@@ -3,7 +3,11 @@
  * Every public name is exported here and only here.
  */
 export { SpektrumDecoder, type DecoderOptions } from './decoder.js';
-export { LinkMonitor, type LinkEpisode, type LinkOptions, type LinkState, type LinkStats } from './link.js';
+export {
+  FADE_DELTA_SLACK, HOLD_MIN_US, LEDGER_WINDOW_US, LinkMonitor, PERIOD_SNAP_US, holdThresholdUs, isFrameInterval, nominalPeriodOf, plausibleFades,
+  type LinkEpisode, type LinkOptions, type LinkState, type LinkStats, type MissedBasis,
+} from './link.js';
+export { LinkSeries, monitorWithSeries } from './series.js';
 export { copyFrame, type ChannelValue, type FrameSnapshot } from './snapshot.js';
 export { decodeStream, type TimedChunk } from './stream.js';
 export type {
@@ -22,7 +26,8 @@ export {
   type CaptureMeta, type CapturePortInfo, type CaptureRecordInput, type CaptureTiming, type ParsedCapture,
 } from '../capture/index.js';
 export {
-  decodeCapture, summarizeCapture, type CaptureSummary, type ChannelSummary, type DecodeCaptureOptions,
+  captureSpan, decodeCapture, resolutionKey, summarizeCapture, timingJitterUs,
+  type CaptureSummary, type ChannelSummary, type DecodeCaptureOptions,
 } from './summary.js';
 export {
   healthReport, reportHtml, REPORT_THRESHOLDS,

@@ -1,8 +1,29 @@
 /**
- * Link health from decoded frames: fades, frame period, missed frames, and the failsafe state
- * machine of spec §7.1 (live → hold last values → failsafe after one second without a frame →
- * live again on the next frame). Time is always the caller's: `frame()` uses the frame's own
- * time and `update(now)` advances the clock between frames; nothing here reads a clock.
+ * Link health from decoded frames: fades, frame period, missed frames, the adapter's delivery
+ * delay, and the failsafe state machine of spec §7.1 (live → hold last values → failsafe after
+ * one second without a frame → live again on the next frame). Time is always the caller's:
+ * `frame()` uses the frame's own time and `update(now)` advances the clock between frames;
+ * nothing here reads a clock.
+ *
+ * This file is the one home of the link rules every surface shares (live page, replay,
+ * `satscope info`, `satscope report`):
+ *
+ * - **Missed frames** rest on the receiver's own evidence where it gives some: the fade counter
+ *   (UINT8 of an internal remote, UINT16 of an external one, §8.3/§8.4: "missed frames for this
+ *   remote"). A receiver whose counter never moved from 0 (a clone's `00 00` header, or an
+ *   SPM4649T that sends RSSI instead) gives none; then frames received are counted against
+ *   frames expected over windows of at least `LEDGER_WINDOW_US`, anchored on the most punctual
+ *   frame of each window, so that bytes a USB adapter held back and delivered in a burst are
+ *   never counted as missing (`FrameLedger`).
+ * - **Hold** starts only when no frame has come for longer than `HOLD_MIN_US` (at least 2.5
+ *   periods) plus the delivery jitter measured on this stream; its episode is dated from the
+ *   moment the next frame was due (last frame + one period), so that every surface dates it the
+ *   same whatever its timing. Failsafe follows one second after the last frame (§7.1).
+ * - **Delivery delay and jitter** (how late frames reach us against the receiver's own
+ *   schedule) are a measure of their own (`deliveryDelayUs`, `deliveryJitterUs`), never loss.
+ * - **The frame period** snaps to 11 or 22 ms at `PERIOD_SNAP_US` (`nominalPeriodOf`).
+ * - **A fade-counter rise** larger than the frames due by the clock allow (`FADE_DELTA_SLACK`)
+ *   is a corrupted header, not fades (`plausibleFades`).
  */
 import { FAILSAFE_TIMEOUT_US, FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US, systemInfo } from './spec.js';
 import type { DecodedFrame } from './types.js';
@@ -14,18 +35,24 @@ export interface LinkEpisode {
   /** 0, 1, 2, … in the order the episodes began (stays with an episode when older ones are dropped). */
   id: number;
   kind: 'hold' | 'failsafe';
-  /** When the hold (last frame + hold threshold) or the failsafe (last frame + 1 s) began, µs. */
+  /** When the hold (the last frame + one period: the next frame was due) or the failsafe (last frame + 1 s) began, µs. */
   startUs: number;
   endUs: number | null;
   /** Time of the last frame before the gap, µs. */
   lastFrameUs: number;
 }
 
+/** Where the missed-frame count comes from. */
+export type MissedBasis =
+  /** The receiver's fade counter (it has been seen counting). */
+  | 'fade-counter'
+  /** Frames received against frames expected, over windows that absorb delivery bursts. */
+  | 'frame-count'
+  /** Neither yet: no timing, or no period known. */
+  | 'none';
+
 export interface LinkOptions {
-  /**
-   * Gap after the last frame before the link counts as "hold", µs. Default: 2.5 frame periods,
-   * at least 40 ms, so that USB adapters that deliver bytes in 16 ms batches do not flicker.
-   */
+  /** Gap after the last frame before the link counts as "hold", µs. Default: see `holdThresholdUs`. */
   holdAfterUs?: number;
   /** Gap before failsafe, µs. Default 1 s (§7.1). */
   failsafeAfterUs?: number;
@@ -35,25 +62,32 @@ export interface LinkOptions {
    */
   maxEpisodes?: number;
   /**
-   * How late a frame may arrive from timing jitter alone, µs (16 ms for an FTDI adapter's
-   * latency timer, 0 for a logic analyser). Gaps shorter than 1.5 periods plus this do not
-   * count as missed frames. Default 0.
+   * The delivery jitter to assume until it has been measured on the stream, µs
+   * (`USB_CHUNK_JITTER_US` for chunk-timed data, 0 for a logic analyser). Default 0.
    */
   jitterUs?: number;
+  /**
+   * Called when frames are found missing: `count` frames that were due from `fromUs` on,
+   * one period apart, none after `toUs`. For binned series (`LinkSeries`).
+   */
+  onMissed?: (fromUs: number, toUs: number, count: number, periodUs: number) => void;
 }
 
 export interface LinkStats {
   frames: number;
-  /** Sum of the receiver's fade deltas (frames it reported missing). */
+  /** Sum of the receiver's fade deltas (frames it reported missing), implausible rises left out. */
   fades: number;
-  /** Frames missing by the clock: gaps longer than a period, in periods. */
+  /** Fade-counter rises left out as corrupted headers (`plausibleFades`). */
+  implausibleFades: number;
+  /** Frames missed: by the fade counter where the receiver counts, else by frames expected against received. */
   missedFrames: number;
+  missedBasis: MissedBasis;
   /** Hold episodes (each failsafe began as a hold). */
   holds: number;
   failsafes: number;
   /** Measured frame period over the last 32 frames without a gap, µs; NaN until known. */
   periodUs: number;
-  /** 11000 or 22000: the system byte's period, else the measured one rounded to the nearer. */
+  /** 11000 or 22000: the system byte's period, else the measured one snapped (`nominalPeriodOf`). */
   nominalPeriodUs: number;
   /** Fades per second over the last ~512 frames. */
   fadeRate: number;
@@ -62,16 +96,229 @@ export interface LinkStats {
   /** Last RSSI (dBm) and lowest seen, NaN without RSSI. */
   rssi: number;
   minRssi: number;
+  /**
+   * How late frames reach us on average against the receiver's own schedule (the most punctual
+   * frame of the last window), µs: the adapter's and the host's delay. NaN until measured.
+   */
+  deliveryDelayUs: number;
+  /** The spread of that lateness over the last few windows, µs: what a gap must exceed to mean anything. NaN until measured. */
+  deliveryJitterUs: number;
+}
+
+/** §7.1 has no hold threshold: a gap shorter than this (and 2.5 periods) is never a hold. */
+export const HOLD_MIN_US = 40_000;
+/** Mean intervals below this are an 11 ms system, above a 22 ms one. */
+export const PERIOD_SNAP_US = 16_500;
+/** The shortest window over which frames received are counted against frames expected, µs. */
+export const LEDGER_WINDOW_US = 500_000;
+/** At the end of a stream, the least late of this many last frames tells what is missing after the last window's most punctual frame. */
+const TAIL_FRAMES = 4;
+/** Delivery jitter is the largest spread of the last this many windows. */
+const JITTER_WINDOWS = 8;
+/**
+ * How many more fades than frames due (by the clock, since the previous frame) a frame's fade
+ * counter may add before the rise is taken for a corrupted header and left out: a satellite can
+ * count a fade it recovered from without dropping a frame, and chunk times blur a gap by a
+ * frame or two. A bit flipped in the counter adds 2^n (and takes it back on the next frame).
+ */
+export const FADE_DELTA_SLACK = 3;
+
+/** 11 or 22 ms: the system period a mean frame interval belongs to. */
+export function nominalPeriodOf(meanIntervalUs: number): number {
+  return meanIntervalUs < PERIOD_SNAP_US ? FRAME_PERIOD_11MS_US : FRAME_PERIOD_22MS_US;
+}
+
+/**
+ * Whether an interval between two frames is an ordinary one (no frame missing in it as far as
+ * timing can tell): at most 1.5 periods plus the delivery jitter. Period statistics use only these.
+ */
+export function isFrameInterval(intervalUs: number, nominalPeriodUs: number, jitterUs: number): boolean {
+  return intervalUs <= 1.5 * nominalPeriodUs + jitterUs;
+}
+
+/** The gap after which the link is in hold: `HOLD_MIN_US` or 2.5 periods, whichever is longer, plus the delivery jitter. */
+export function holdThresholdUs(nominalPeriodUs: number, jitterUs: number): number {
+  const base = Number.isFinite(nominalPeriodUs) ? Math.max(HOLD_MIN_US, 2.5 * nominalPeriodUs) : HOLD_MIN_US;
+  return base + (Number.isFinite(jitterUs) ? jitterUs : 0);
+}
+
+/**
+ * The fades a counter rise stands for: `delta`, or 0 when it is more than the frames due since
+ * the previous frame (`gapUs`) allow (a corrupted header). Without a period or a gap, `delta`.
+ */
+export function plausibleFades(delta: number, gapUs: number, nominalPeriodUs: number): number {
+  if (delta <= 0 || !Number.isFinite(gapUs) || !Number.isFinite(nominalPeriodUs)) return delta;
+  const due = Math.max(0, Math.round(gapUs / nominalPeriodUs) - 1);
+  return delta > due + FADE_DELTA_SLACK ? 0 : delta;
 }
 
 const PERIOD_WINDOW = 33;
 const RATE_WINDOW = 512;
-const MIN_HOLD_US = 40_000;
+
+/**
+ * Frames received against frames expected. Each frame is given the next slot of the receiver's
+ * schedule; its lateness is how far after that slot it came, against a reference frame. Frames
+ * can only come late (an adapter holds bytes back; it never delivers them before they were
+ * sent), so the most punctual frame of a window tells the schedule: when even it is a whole
+ * period or more late, frames are missing, and the window's largest gap is where.
+ */
+class FrameLedger {
+  #period = NaN;
+  #refUs = NaN;
+  #refSlot = 0;
+  #slot = 0;
+  #lastUs = NaN;
+  // The open window.
+  #winStartUs = NaN;
+  #winFrames = 0;
+  #winMinL = Infinity;
+  #winMinSlot = 0;
+  #winMinUs = NaN;
+  #winMaxL = -Infinity;
+  /** The last frames' times and slots (a ring), for the end of the stream. */
+  readonly #tailUs = new Float64Array(TAIL_FRAMES);
+  readonly #tailSlot = new Float64Array(TAIL_FRAMES);
+  #tailCount = 0;
+  #winSumL = 0;
+  #winGapUs = 0;
+  #winGapFromUs = NaN;
+  #winGapToUs = NaN;
+  readonly #spreads: number[] = [];
+  #pendingSpread = NaN;
+  #pendingDelay = NaN;
+  delayUs = NaN;
+  jitterUs = NaN;
+
+  /** @param priorJitterUs the delivery jitter to assume until measured */
+  constructor(readonly priorJitterUs: number) {}
+
+  reset(): void {
+    this.#period = NaN;
+    this.#refUs = NaN;
+    this.#lastUs = NaN;
+    this.#openWindow(NaN);
+  }
+
+  #openWindow(t: number): void {
+    this.#winStartUs = t;
+    this.#winFrames = 0;
+    this.#winMinL = Infinity;
+    this.#winMaxL = -Infinity;
+    this.#winSumL = 0;
+    this.#winGapUs = 0;
+    this.#winGapFromUs = this.#winGapToUs = NaN;
+  }
+
+  /** Feeds a frame at `t`; returns frames confirmed missing (and reports where through `missed`). */
+  frame(t: number, period: number, missed: (fromUs: number, toUs: number, count: number) => void): number {
+    if (!Number.isFinite(period)) return 0;
+    // Chunk-time estimates of two chunks delivered together can overlap a little: not a clock step.
+    if (t < this.#lastUs && t > this.#lastUs - period) t = this.#lastUs;
+    if (period !== this.#period || !Number.isFinite(this.#refUs) || !(t >= this.#lastUs || Number.isNaN(this.#lastUs))) {
+      // A new period (or the first frame, or time going back): start the schedule here.
+      this.#period = period;
+      this.#refUs = t;
+      this.#refSlot = this.#slot = 0;
+      this.#lastUs = t;
+      this.#tailCount = 0;
+      this.#openWindow(t);
+      this.#take(t, 0, 0);
+      return 0;
+    }
+    const gap = t - this.#lastUs;
+    this.#slot++;
+    let late = t - this.#refUs - (this.#slot - this.#refSlot) * period;
+    if (late < 0) {
+      // More punctual than the reference: it becomes the reference, and the window's lateness shifts.
+      this.#winMinL -= late;
+      this.#winMaxL -= late;
+      this.#winSumL -= late * this.#winFrames;
+      this.#refUs = t;
+      this.#refSlot = this.#slot;
+      late = 0;
+    }
+    if (gap > this.#winGapUs) {
+      this.#winGapUs = gap;
+      this.#winGapFromUs = this.#lastUs;
+      this.#winGapToUs = t;
+    }
+    this.#lastUs = t;
+    this.#take(t, late, this.#slot);
+    if (t - this.#winStartUs < LEDGER_WINDOW_US || this.#winFrames < 8) return 0;
+    return this.#close(missed);
+  }
+
+  #take(t: number, late: number, slot: number): void {
+    this.#winFrames++;
+    this.#winSumL += late;
+    if (late > this.#winMaxL) this.#winMaxL = late;
+    if (late < this.#winMinL) {
+      this.#winMinL = late;
+      this.#winMinSlot = slot;
+      this.#winMinUs = t;
+    }
+    this.#tailUs[this.#tailCount % TAIL_FRAMES] = t;
+    this.#tailSlot[this.#tailCount % TAIL_FRAMES] = slot;
+    this.#tailCount++;
+  }
+
+  /** Closes the window: confirms what even its most punctual frame says is missing. */
+  #close(missed: (fromUs: number, toUs: number, count: number) => void): number {
+    const p = this.#period;
+    const k = Math.max(0, Math.round(this.#winMinL / p));
+    if (k > 0 && Number.isFinite(this.#winGapFromUs)) missed(this.#winGapFromUs + p, this.#winGapToUs, k);
+    else if (k > 0) missed(this.#winMinUs - k * p, this.#winMinUs, k);
+    // The most punctual frame is the schedule from now on (this also follows clock drift).
+    // Jitter from windows with nothing missing in them. A frame missed after a window's most
+    // punctual frame is only confirmed by the next window, and would pass a period off as
+    // lateness: a window's spread counts once the next one has found nothing missing.
+    if (k === 0 && Number.isFinite(this.#pendingSpread)) {
+      this.#spreads.push(this.#pendingSpread);
+      if (this.#spreads.length > JITTER_WINDOWS) this.#spreads.shift();
+      this.jitterUs = Math.max(...this.#spreads);
+      this.delayUs = this.#pendingDelay;
+    }
+    this.#pendingSpread = k === 0 && this.#winFrames > 1 ? this.#winMaxL - this.#winMinL : NaN;
+    this.#pendingDelay = this.#winSumL / this.#winFrames - this.#winMinL;
+    this.#refUs = this.#winMinUs;
+    this.#refSlot = this.#winMinSlot + k;
+    this.#slot += k;
+    this.#openWindow(this.#lastUs);
+    return k;
+  }
+
+  /** End of the stream: closes the open window, then counts the frames due in the silence before `endUs` beyond `graceUs`. */
+  finish(endUs: number, graceUs: number, missed: (fromUs: number, toUs: number, count: number) => void): number {
+    if (!Number.isFinite(this.#refUs)) return 0;
+    const p = this.#period;
+    // No later window will look at the frames after the last window's most punctual one: even
+    // the least late of them is the evidence there will be.
+    let tailMin = Infinity;
+    for (let i = 0; i < Math.min(TAIL_FRAMES, this.#tailCount); i++) {
+      const late = (this.#tailUs[i] as number) - this.#refUs - ((this.#tailSlot[i] as number) - this.#refSlot) * p;
+      if (late < tailMin) tailMin = late;
+    }
+    const after = Number.isFinite(tailMin) ? Math.max(0, Math.round((tailMin - this.#winMinL) / p)) : 0;
+    const gapFrom = this.#winGapFromUs;
+    const gapTo = this.#winGapToUs;
+    let n = this.#winFrames > 1 ? this.#close(missed) : 0;
+    if (after > 0) missed(Number.isFinite(gapFrom) ? gapFrom + p : this.#lastUs, Number.isFinite(gapTo) ? gapTo : this.#lastUs, after);
+    n += after;
+    const silence = endUs - this.#lastUs;
+    if (silence > graceUs) {
+      const k = Math.max(0, Math.floor((silence - graceUs) / p));
+      if (k > 0) missed(this.#lastUs + p, endUs, k);
+      n += k;
+    }
+    return n;
+  }
+}
 
 export class LinkMonitor {
   readonly #holdOption: number | undefined;
   readonly #failsafeAfterUs: number;
-  readonly #jitterUs: number;
+  readonly #jitterPrior: number;
+  readonly #onMissed: LinkOptions['onMissed'];
   #state: LinkState = 'waiting';
   #lastUs = NaN;
   #systemPeriod = NaN;
@@ -85,9 +332,16 @@ export class LinkMonitor {
   readonly #maxEpisodes: number;
   #nextEpisode = 0;
   #open: LinkEpisode | null = null;
+  readonly #ledger: FrameLedger;
+  /** The fade counter has shown that it counts (a value other than 0, or a rise). */
+  #counting = false;
+  #countedMissed = 0;
+  #lastFades = 0;
+  #lastInterval = NaN;
+  #finished = false;
   readonly #stats: LinkStats = {
-    frames: 0, fades: 0, missedFrames: 0, holds: 0, failsafes: 0, periodUs: NaN,
-    nominalPeriodUs: NaN, fadeRate: 0, longestGapUs: 0, rssi: NaN, minRssi: NaN,
+    frames: 0, fades: 0, implausibleFades: 0, missedFrames: 0, missedBasis: 'none', holds: 0, failsafes: 0, periodUs: NaN,
+    nominalPeriodUs: NaN, fadeRate: 0, longestGapUs: 0, rssi: NaN, minRssi: NaN, deliveryDelayUs: NaN, deliveryJitterUs: NaN,
   };
 
   /** @throws {TypeError} when a duration is not a positive finite number. */
@@ -98,8 +352,10 @@ export class LinkMonitor {
     }
     this.#holdOption = options.holdAfterUs;
     this.#failsafeAfterUs = options.failsafeAfterUs ?? FAILSAFE_TIMEOUT_US;
-    this.#jitterUs = options.jitterUs ?? 0;
+    this.#jitterPrior = options.jitterUs ?? 0;
     this.#maxEpisodes = options.maxEpisodes ?? Infinity;
+    this.#onMissed = options.onMissed;
+    this.#ledger = new FrameLedger(this.#jitterPrior);
   }
 
   get state(): LinkState {
@@ -116,16 +372,30 @@ export class LinkMonitor {
     return this.#episodes;
   }
 
-  /** Time of the last frame, µs (NaN before the first or without timing). */
+  /** Time of the last frame, µs (NaN before the first, without timing, or after `interrupt()`). */
   get lastFrameUs(): number {
     return this.#lastUs;
   }
 
-  /** The hold threshold in force, µs. */
+  /** Fades the last frame stood for (its counter rise, implausible rises as 0). */
+  get lastFades(): number {
+    return this.#lastFades;
+  }
+
+  /** The interval before the last frame when it was an ordinary one (`isFrameInterval`), else NaN. */
+  get lastIntervalUs(): number {
+    return this.#lastInterval;
+  }
+
+  /** The delivery jitter in force: measured, else the `jitterUs` option, µs. */
+  get jitterUs(): number {
+    const j = this.#stats.deliveryJitterUs;
+    return Number.isFinite(j) ? j : this.#jitterPrior;
+  }
+
+  /** The hold threshold in force, µs (`holdThresholdUs`, unless the `holdAfterUs` option fixes it). */
   get holdAfterUs(): number {
-    if (this.#holdOption !== undefined) return this.#holdOption;
-    const p = this.#stats.nominalPeriodUs;
-    return Number.isFinite(p) ? Math.max(MIN_HOLD_US, 2.5 * p) : MIN_HOLD_US;
+    return this.#holdOption ?? holdThresholdUs(this.#stats.nominalPeriodUs, this.jitterUs);
   }
 
   /** Feeds one decoded frame (in stream order). */
@@ -133,7 +403,6 @@ export class LinkMonitor {
     const s = this.#stats;
     const t = frame.timeUs;
     s.frames++;
-    s.fades += frame.fadesDelta;
     if (frame.rssi !== null) {
       s.rssi = frame.rssi;
       if (!(s.minRssi <= frame.rssi)) s.minRssi = frame.rssi;
@@ -145,25 +414,54 @@ export class LinkMonitor {
         s.nominalPeriodUs = this.#systemPeriod;
       }
     }
+    const last = this.#lastUs;
+    const gap = Number.isFinite(t) && Number.isFinite(last) && t >= last ? t - last : NaN;
+    const fades = plausibleFades(frame.fadesDelta, gap, s.nominalPeriodUs);
+    if (fades !== frame.fadesDelta) s.implausibleFades++;
+    s.fades += fades;
+    this.#lastFades = fades;
+    if (frame.fades !== null && (frame.fades !== 0 || fades > 0)) this.#counting = true;
+    this.#lastInterval = NaN;
     if (Number.isFinite(t)) {
-      const last = this.#lastUs;
-      if (Number.isFinite(last) && t >= last) {
-        const gap = t - last;
+      if (!Number.isNaN(gap)) {
         // Open the episodes a caller that never called update() in the gap would have missed.
         this.update(t);
         if (gap > s.longestGapUs) s.longestGapUs = gap;
         const p = s.nominalPeriodUs;
-        if (Number.isFinite(p) && gap > 1.5 * p + this.#jitterUs) s.missedFrames += Math.max(0, Math.round(gap / p) - 1);
+        if (Number.isFinite(p) && isFrameInterval(gap, p, this.jitterUs)) this.#lastInterval = gap;
         if (gap > 3 * (Number.isFinite(p) ? p : FRAME_PERIOD_22MS_US)) this.#periodCount = 0;
       }
       this.#lastUs = t;
-      this.#measure(t, frame.fadesDelta);
+      this.#measure(t, fades);
+      this.#ledger.frame(t, s.nominalPeriodUs, (a, b, n) => this.#missedByCount(a, b, n));
+      s.deliveryDelayUs = this.#ledger.delayUs;
+      s.deliveryJitterUs = this.#ledger.jitterUs;
+    }
+    if (this.#counting) {
+      s.missedBasis = 'fade-counter';
+      if (fades > 0) {
+        s.missedFrames += fades;
+        if (Number.isFinite(t)) {
+          const p = Number.isFinite(s.nominalPeriodUs) ? s.nominalPeriodUs : FRAME_PERIOD_11MS_US;
+          this.#onMissed?.(Number.isNaN(gap) ? t : t - gap + p, t, fades, p);
+        }
+      }
+    } else if (Number.isFinite(s.nominalPeriodUs) && Number.isFinite(t)) {
+      s.missedBasis = 'frame-count';
     }
     if (this.#open !== null) {
       this.#open.endUs = Number.isFinite(t) ? t : this.#open.startUs;
       this.#open = null;
     }
     this.#state = 'live';
+  }
+
+  /** Frames the ledger found missing: they count while the receiver has given no counter to go by. */
+  #missedByCount(fromUs: number, toUs: number, count: number): void {
+    this.#countedMissed += count;
+    if (this.#counting) return;
+    this.#stats.missedFrames += count;
+    this.#onMissed?.(fromUs, toUs, count, this.#stats.nominalPeriodUs);
   }
 
   /**
@@ -178,7 +476,9 @@ export class LinkMonitor {
     if (gap > this.holdAfterUs && this.#state === 'live') {
       this.#state = 'hold';
       s.holds++;
-      this.#openEpisode('hold', last + this.holdAfterUs, last);
+      // The hold began when the next frame was due, whenever it was noticed.
+      const p = s.nominalPeriodUs;
+      this.#openEpisode('hold', last + (Number.isFinite(p) ? p : this.holdAfterUs), last);
     }
     if (gap >= this.#failsafeAfterUs && this.#state === 'hold') {
       this.#state = 'failsafe';
@@ -187,6 +487,54 @@ export class LinkMonitor {
       this.#openEpisode('failsafe', last + this.#failsafeAfterUs, last);
     }
     return this.#state;
+  }
+
+  /**
+   * The end of the stream at `endUs` (the capture's last recorded time): the state there, and
+   * the frames due in a silence before it that the delivery jitter does not explain, counted as
+   * missed. Call once; frames fed afterwards are not expected.
+   */
+  finish(endUs: number): LinkState {
+    if (this.#finished) return this.#state;
+    this.#finished = true;
+    const state = this.update(endUs);
+    const s = this.#stats;
+    if (!Number.isFinite(endUs) || !Number.isFinite(this.#lastUs) || !Number.isFinite(s.nominalPeriodUs)) return state;
+    const silence = endUs - this.#lastUs;
+    const grace = this.holdAfterUs;
+    if (silence > grace && silence > s.longestGapUs) s.longestGapUs = silence;
+    if (this.#counting) {
+      // The receiver never got to report these: frames due in a silence longer than a hold.
+      this.#ledger.finish(endUs, Infinity, (a, b, n) => this.#missedByCount(a, b, n));
+      if (silence > grace) {
+        const p = s.nominalPeriodUs;
+        const k = Math.max(0, Math.floor((silence - this.jitterUs) / p));
+        if (k > 0) {
+          s.missedFrames += k;
+          this.#onMissed?.(this.#lastUs + p, endUs, k, p);
+        }
+      }
+    } else {
+      this.#ledger.finish(endUs, silence > grace ? this.jitterUs : Infinity, (a, b, n) => this.#missedByCount(a, b, n));
+    }
+    return state;
+  }
+
+  /**
+   * The frames stopped at `atUs` for a reason that is not the link (the user forced a resolution
+   * that no frame fits, the source was paused or moved): an open episode ends there, the state
+   * is 'waiting', and the next frame starts afresh, with no gap, missed frame or episode counted
+   * for the time in between.
+   */
+  interrupt(atUs: number): void {
+    if (this.#open !== null) {
+      this.#open.endUs = Number.isFinite(atUs) ? Math.max(atUs, this.#open.startUs) : this.#open.startUs;
+      this.#open = null;
+    }
+    this.#lastUs = NaN;
+    this.#periodCount = 0;
+    this.#ledger.reset();
+    this.#state = 'waiting';
   }
 
   #openEpisode(kind: 'hold' | 'failsafe', startUs: number, lastFrameUs: number): void {
@@ -212,7 +560,7 @@ export class LinkMonitor {
       if (!Number.isFinite(this.#systemPeriod) && (!Number.isFinite(s.nominalPeriodUs) || this.#periodCount === PERIOD_WINDOW)) {
         // Without a system byte: snap the mean interval to 11 or 22 ms, first over 8 intervals,
         // then again over every full window, so a few frames missing early do not stick.
-        s.nominalPeriodUs = span / (this.#periodCount - 1) < 16_500 ? FRAME_PERIOD_11MS_US : FRAME_PERIOD_22MS_US;
+        s.nominalPeriodUs = nominalPeriodOf(span / (this.#periodCount - 1));
       }
       // Whole periods in the span (a missed frame makes one interval two periods long), so a
       // short gap does not bias the measurement and chunk-time jitter averages out.

@@ -11,9 +11,9 @@
  */
 import type { Capture, CaptureKind, CaptureTiming } from '../capture/index.js';
 import { captureChunks, capturePorts } from '../capture/index.js';
-import type { LinkEpisode } from './link.js';
-import { BYTE_TIME_US, CHANNEL_COUNT, channelResolution, FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US, XPLUS_FIRST, channelName, servoToMicros, servoToPercent, systemInfo, type Resolution, USB_CHUNK_JITTER_US } from './spec.js';
-import { decodeCapture } from './summary.js';
+import { FADE_DELTA_SLACK, type LinkEpisode, type MissedBasis } from './link.js';
+import { CHANNEL_COUNT, channelResolution, XPLUS_FIRST, channelName, servoToMicros, servoToPercent, systemInfo, type Resolution, USB_CHUNK_JITTER_US } from './spec.js';
+import { captureSpan, decodeCapture, resolutionKey } from './summary.js';
 import type { HeaderReading, RemoteKind, ResolutionReason } from './types.js';
 
 // ---------------------------------------------------------------------------------------------
@@ -93,13 +93,7 @@ export const SPIKE_RETURN_PERCENT = 5;
 export const SPIKE_WINDOW_US = 100_000;
 /** The same window in decoded frames, for captures without timing. */
 export const SPIKE_WINDOW_FRAMES = 9;
-/**
- * How many more fades than frames due (by the clock, since the previous frame) a frame's fade
- * counter may add before the rise is taken for a corrupted header and left out: a satellite can
- * count a fade it recovered from without dropping a frame, and chunk times blur a gap by a
- * frame or two. A bit flipped in the counter adds 2^n (and takes it back on the next frame).
- */
-export const FADE_DELTA_SLACK = 3;
+export { FADE_DELTA_SLACK };
 /** At most this many glitches are listed (all are counted). */
 export const MAX_LISTED_GLITCHES = 200;
 /** At most this many hold episodes are listed (all are counted). */
@@ -261,13 +255,21 @@ export interface RemoteReport {
   /** First to last frame. */
   durationUs: number | null;
   frames: number;
-  /** Frames the clock says were due: `frames + missedFrames`. */
+  /** Frames that were due: `frames + missedFrames`. */
   expectedFrames: number | null;
   /**
-   * Frames missing by the clock: each gap longer than 1.5 periods (plus the chunk-timing
-   * allowance) counts round(gap ÷ period) − 1, and silence at the end of the capture counts too.
+   * Frames missed, as the link monitor counts them (`LinkMonitor`): by the receiver's fade
+   * counter where it counts, else frames expected against frames received over windows that
+   * absorb delivery bursts; frames due in a silence at the end of the capture count too.
    */
   missedFrames: number | null;
+  /** What `missedFrames` rests on. */
+  missedBasis: MissedBasis;
+  /**
+   * How late frames reached the recorder against the receiver's own schedule (mean) and the
+   * spread of that lateness, µs: the adapter's delivery, not link loss. `null` without timing.
+   */
+  delivery: { delayUs: number | null; jitterUs: number | null };
   /** missedFrames ÷ expectedFrames. */
   lostRatio: number | null;
   /** 11000 or 22000 µs. */
@@ -374,24 +376,6 @@ class Column {
   }
 }
 
-/** The earliest and latest time recorded on any port (data and events), on the capture's clock. */
-function captureSpan(capture: Capture): { start: number; end: number } {
-  let start = Infinity;
-  let end = -Infinity;
-  for (const chunk of captureChunks(capture)) {
-    if (chunk.bytes.length === 0) continue;
-    const first = chunk.byteTimesUs ? (chunk.byteTimesUs[0] as number) : chunk.timeUs - (chunk.bytes.length - 1) * BYTE_TIME_US;
-    const last = chunk.byteTimesUs ? (chunk.byteTimesUs[chunk.byteTimesUs.length - 1] as number) : chunk.timeUs;
-    if (first < start) start = first;
-    if (last > end) end = last;
-  }
-  for (const e of capture.events) {
-    if (e.timeUs < start) start = e.timeUs;
-    if (e.timeUs > end) end = e.timeUs;
-  }
-  return { start, end };
-}
-
 /** Nearest-rank percentile of sorted values. */
 function percentile(sorted: Float64Array, p: number): number {
   if (sorted.length === 0) return NaN;
@@ -404,10 +388,11 @@ type RawGlitch = Omit<ReportGlitch, 'timeUs'> & { absUs: number };
 /** What one port's decode leaves for the report. */
 interface PortData {
   port: number;
-  /** Per frame: time (µs, capture clock), fades delta, RSSI (NaN when none). */
+  /** Per frame: time (µs, capture clock), RSSI (NaN when none). */
   times: Float64Array;
-  fadesDelta: Float64Array;
   rssi: Float64Array;
+  /** The ordinary frame intervals (the link monitor's `lastIntervalUs`), µs. */
+  intervals: Float64Array;
   remote: ReturnType<typeof decodeCapture>;
   channelFrames: Uint32Array;
   channelMin: Float64Array;
@@ -425,7 +410,7 @@ interface PortData {
 /** Decodes one port, keeping what the report needs per frame, and finds spikes as it goes. */
 function decodePort(capture: Capture, port: number, resolution: 'auto' | Resolution, resolutionFrom: 'user' | 'internal-remote' = 'user'): PortData {
   const times = new Column();
-  const fades = new Column();
+  const intervals = new Column();
   const rssi = new Column();
   const channelFrames = new Uint32Array(CHANNEL_COUNT);
   const channelMin = new Float64Array(CHANNEL_COUNT).fill(Infinity);
@@ -447,12 +432,13 @@ function decodePort(capture: Capture, port: number, resolution: 'auto' | Resolut
     port,
     resolution,
     resolutionFrom,
+    binUs: REPORT_BIN_US,
     onEvent: (e) => {
       if (e.type === 'format-changed') formatChanges++;
     },
-  }, (f) => {
+  }, (f, link) => {
     times.push(f.timeUs);
-    fades.push(f.fadesDelta);
+    if (Number.isFinite(link.lastIntervalUs)) intervals.push(link.lastIntervalUs);
     rssi.push(f.rssi ?? NaN);
     if (f.fades !== null && f.fades !== 0) fadeCounterMoved = true;
     for (let i = 0; i < f.count; i++) {
@@ -505,7 +491,7 @@ function decodePort(capture: Capture, port: number, resolution: 'auto' | Resolut
   let bytes = 0;
   for (const chunk of captureChunks(capture, port)) bytes += chunk.bytes.length;
   return {
-    port, times: times.view(), fadesDelta: fades.view(), rssi: rssi.view(), remote,
+    port, times: times.view(), rssi: rssi.view(), intervals: intervals.view(), remote,
     channelFrames, channelMin, channelMax, channelSum, glitchesRaw, glitchCount, glitchFrames, formatChanges, bytes, fadeCounterMoved,
   };
 }
@@ -642,12 +628,11 @@ function statusOf(findings: readonly ReportFinding[], frames: number): ReportSta
 export function healthReport(capture: Capture, options: HealthReportOptions = {}): HealthReport {
   const ports = capturePorts(capture);
   const timed = capture.timing !== 'none';
-  const allowance = capture.timing === 'per-chunk' ? CHUNK_TIMING_ALLOWANCE_US : 0;
   let decoded = ports.map((p) => decodePort(capture, p, options.resolution ?? 'auto'));
   // §8: the internal remote holds the key for every remote; external ports take its resolution.
   if ((options.resolution ?? 'auto') === 'auto' && ports.length > 1) {
-    const key = decoded.map((d) => d.remote.decoder.format).find((f) => f.remote === 'internal' && f.system !== null && systemInfo(f.system) !== undefined)?.resolution;
-    if (key != null) {
+    const key = resolutionKey(decoded.map((d) => d.remote.decoder.format));
+    if (key !== undefined) {
       decoded = decoded.map((d, i) => {
         if (d.remote.decoder.format.remote === 'internal') return d;
         // Kept only if it reads at least as many frames: a port of another system (or a
@@ -658,124 +643,65 @@ export function healthReport(capture: Capture, options: HealthReportOptions = {}
     }
   }
 
-  // The shared clock: from the earliest to the latest time recorded on any port.
+  // The shared clock: from the earliest to the latest time recorded on any port (decodeCapture
+  // bins from the same origin and ends each link there).
   const span = captureSpan(capture);
-  let origin = span.start;
-  let end = span.end;
-  for (const d of decoded) {
-    if (d.times.length === 0) continue;
-    origin = Math.min(origin, d.times[0] as number);
-    end = Math.max(end, d.times[d.times.length - 1] as number);
-  }
-  const hasClock = timed && Number.isFinite(origin) && Number.isFinite(end);
-  if (!hasClock) {
-    origin = NaN;
-    end = NaN;
-  }
+  const hasClock = timed && Number.isFinite(span.startUs) && Number.isFinite(span.endUs);
+  const origin = hasClock ? span.startUs : NaN;
+  const end = hasClock ? span.endUs : NaN;
   const bins = hasClock ? Math.max(1, Math.ceil((end - origin) / REPORT_BIN_US)) : 0;
-  const binOf = (t: number): number => Math.min(bins - 1, Math.max(0, Math.floor((t - origin) / REPORT_BIN_US)));
 
   const remotes: RemoteReport[] = decoded.map((d) => {
-    const { decoder, link } = d.remote;
-    // Open the episodes of a receiver that fell silent before the capture ended.
-    if (hasClock) link.update(end);
+    const { decoder, link, series } = d.remote;
     const stats = decoder.stats;
     const format = decoder.format;
+    const ls = link.stats;
     const n = d.times.length;
     const first = n > 0 ? (d.times[0] as number) : NaN;
     const last = n > 0 ? (d.times[n - 1] as number) : NaN;
-
-    // Nominal period: the link monitor's, else the median interval snapped to 11 or 22 ms.
-    let period = link.stats.nominalPeriodUs;
-    if (!Number.isFinite(period) && hasClock && n >= 2) {
-      const iv = new Float64Array(n - 1);
-      for (let i = 1; i < n; i++) iv[i - 1] = (d.times[i] as number) - (d.times[i - 1] as number);
-      iv.sort();
-      period = percentile(iv, 50) < 16_500 ? FRAME_PERIOD_11MS_US : FRAME_PERIOD_22MS_US;
-    }
+    const period = ls.nominalPeriodUs;
     const havePeriod = hasClock && Number.isFinite(period) && n > 0;
+    const missed = ls.missedFrames;
+    const rssiMode = format.headerMode === 'rssi';
 
-    // Series, missed frames, intervals.
+    // The link monitor's series, on the report's bins.
     const framesS = new Array<number>(bins).fill(0);
     const lostS = new Array<number>(bins).fill(0);
-    const rssiMode = format.headerMode === 'rssi';
     const fadesS = rssiMode ? null : new Array<number>(bins).fill(0);
-    const rssiSum = new Float64Array(bins);
-    const rssiN = new Uint32Array(bins);
-    const rssiMinB = new Float64Array(bins).fill(Infinity);
+    const rssiMeanS = new Array<number | null>(bins).fill(null);
+    const rssiMinS = new Array<number | null>(bins).fill(null);
+    for (let b = 0; b < bins; b++) {
+      framesS[b] = series.frames(b);
+      lostS[b] = series.lost(b);
+      if (fadesS) fadesS[b] = series.fades(b);
+      const mean = series.rssiMean(b);
+      rssiMeanS[b] = Number.isNaN(mean) ? null : Math.round(mean * 10) / 10;
+      const low = series.rssiMin(b);
+      rssiMinS[b] = Number.isNaN(low) ? null : low;
+    }
     let rssiFrames = 0;
     let rssiLoss = 0;
     let rssiLo = Infinity;
     let rssiHi = -Infinity;
     let rssiTotal = 0;
-    let missed = 0;
-    let longestGap = 0;
-    let fadesTotal = 0;
-    let fadeJumps = 0;
-    const threshold = 1.5 * period + allowance;
-    const intervals = new Column();
     for (let i = 0; i < n; i++) {
-      const t = d.times[i] as number;
       const rs = d.rssi[i] as number;
-      let fd = d.fadesDelta[i] as number;
-      if (havePeriod && i > 0 && fd > 0) {
-        // A counter cannot count more fades than frames were due since the last frame.
-        const due = Math.max(0, Math.round((t - (d.times[i - 1] as number)) / period) - 1);
-        if (fd > due + FADE_DELTA_SLACK) {
-          fadeJumps++;
-          fd = 0;
-        }
-      }
-      fadesTotal += fd;
-      if (!Number.isNaN(rs)) {
-        if (rs === -128) rssiLoss++;
-        else {
-          rssiFrames++;
-          rssiTotal += rs;
-          if (rs < rssiLo) rssiLo = rs;
-          if (rs > rssiHi) rssiHi = rs;
-        }
-      }
-      if (!hasClock || !Number.isFinite(t)) continue;
-      const b = binOf(t);
-      framesS[b] = (framesS[b] as number) + 1;
-      if (fadesS) fadesS[b] = (fadesS[b] as number) + fd;
-      if (!Number.isNaN(rs) && rs !== -128) {
-        rssiSum[b] = (rssiSum[b] as number) + rs;
-        rssiN[b] = (rssiN[b] as number) + 1;
-        if (rs < (rssiMinB[b] as number)) rssiMinB[b] = rs;
-      }
-      if (i === 0) continue;
-      const prev = d.times[i - 1] as number;
-      const gap = t - prev;
-      if (!(gap >= 0)) continue;
-      if (gap > longestGap) longestGap = gap;
-      if (!havePeriod) continue;
-      if (gap > threshold) {
-        const m = Math.max(0, Math.round(gap / period) - 1);
-        missed += m;
-        for (let k = 1; k <= m; k++) {
-          const lb = binOf(prev + k * period);
-          lostS[lb] = (lostS[lb] as number) + 1;
-        }
-      } else {
-        intervals.push(gap);
+      if (Number.isNaN(rs)) continue;
+      if (rs === -128) rssiLoss++;
+      else {
+        rssiFrames++;
+        rssiTotal += rs;
+        if (rs < rssiLo) rssiLo = rs;
+        if (rs > rssiHi) rssiHi = rs;
       }
     }
-    // Silence at the end of the capture: the frames due before it ended were lost too.
-    if (havePeriod && end - last > threshold) {
-      const m = Math.max(0, Math.floor((end - allowance - last) / period));
-      missed += m;
-      for (let k = 1; k <= m; k++) {
-        const lb = binOf(last + k * period);
-        lostS[lb] = (lostS[lb] as number) + 1;
-      }
-      if (end - last > longestGap) longestGap = end - last;
-    }
+    const fadesTotal = ls.fades;
+    const fadeJumps = ls.implausibleFades;
+    const intervals = d.intervals;
 
     let framePeriod: ReportPeriodStats | null = null;
     if (havePeriod && intervals.length > 0) {
-      const iv = intervals.view().slice().sort();
+      const iv = intervals.slice().sort();
       let sum = 0;
       for (const v of iv) sum += v;
       const mean = sum / iv.length;
@@ -832,6 +758,8 @@ export function healthReport(capture: Capture, options: HealthReportOptions = {}
       frames: stats.frames,
       expectedFrames: havePeriod ? stats.frames + missed : null,
       missedFrames: havePeriod ? missed : null,
+      missedBasis: ls.missedBasis,
+      delivery: { delayUs: hasClock ? r1n(ls.deliveryDelayUs) : null, jitterUs: hasClock ? r1n(ls.deliveryJitterUs) : null },
       lostRatio: havePeriod ? Math.round((missed / Math.max(1, stats.frames + missed)) * 1e6) / 1e6 : null,
       nominalPeriodUs: havePeriod ? period : null,
       fades: rssiMode ? null : {
@@ -852,7 +780,7 @@ export function healthReport(capture: Capture, options: HealthReportOptions = {}
         episodes: holdEpisodes.slice(0, MAX_LISTED_HOLDS),
       },
       failsafes,
-      longestGapUs: hasClock && n > 1 ? r1(longestGap) : null,
+      longestGapUs: hasClock && n > 1 ? r1(ls.longestGapUs) : null,
       framePeriod,
       channels,
       glitches: {
@@ -868,8 +796,8 @@ export function healthReport(capture: Capture, options: HealthReportOptions = {}
         frames: framesS,
         fades: fadesS,
         lost: lostS,
-        rssiMean: rssiMode ? Array.from(rssiN, (c, b) => (c > 0 ? Math.round(((rssiSum[b] as number) / c) * 10) / 10 : null)) : null,
-        rssiMin: rssiMode ? Array.from(rssiMinB, (v) => finite(v)) : null,
+        rssiMean: rssiMode ? rssiMeanS : null,
+        rssiMin: rssiMode ? rssiMinS : null,
       },
       findings: [],
     };

@@ -1,35 +1,40 @@
 /**
- * The decode pipeline every source feeds (serial, demo, replay): the library's decoder and link
- * monitor, the latest value of each channel, and 100 ms graph buckets. `batch()` hands the page
- * what changed since the last call.
+ * The decode pipeline every source feeds (serial, demo, replay): the library's decoder, link
+ * monitor and binned series (the same ones `satscope report` uses), the latest value of each
+ * channel, and 100 ms graph buckets. `batch()` hands the page what changed since the last call.
+ * Time is always passed in: the arrival clock live, the capture's own clock in replay.
  */
 import {
-  CHANNEL_COUNT, LinkMonitor, SpektrumDecoder, type LinkEpisode,
+  CHANNEL_COUNT, LinkMonitor, LinkSeries, SpektrumDecoder, type FormatInfo, type LinkEpisode, type Resolution,
 } from '../decoder/index.js';
 import { InspectorLog } from './inspector.js';
 import { BUCKET_US, type Batch } from './protocol.js';
 
 export interface EngineOptions {
   resolution: 'auto' | 1024 | 2048;
-  /** How late chunk times may be from USB batching (see LinkMonitor). */
+  /** The delivery jitter to assume until it is measured (see LinkMonitor's `jitterUs`). */
   jitterUs: number;
 }
 
-/** A growable set of columns for completed buckets. */
-class Series {
-  t: number[] = [];
-  fadeRate: number[] = [];
-  rssi: number[] = [];
-  periodMs: number[] = [];
-  lost: number[] = [];
-  take(): Batch['series'] {
-    const out = {
-      t: Float64Array.from(this.t), fadeRate: Float32Array.from(this.fadeRate), rssi: Float32Array.from(this.rssi),
-      periodMs: Float32Array.from(this.periodMs), lost: Float32Array.from(this.lost),
-    };
-    this.t = []; this.fadeRate = []; this.rssi = []; this.periodMs = []; this.lost = [];
-    return out;
-  }
+/**
+ * How far back frames found missing may still be placed in the graph buckets, µs: the link
+ * monitor confirms frames missing by count over windows (`LEDGER_WINDOW_US`), so a bucket is
+ * handed to the page only once it is this old. Missing frames due earlier go into the oldest
+ * bucket not yet handed out. Placing them by the time they were reported, never by when the
+ * page asked, keeps replay identical at every speed.
+ */
+export const SETTLE_US = 1_000_000;
+
+/** Bytes a forced resolution may discard without a frame before it is called a mismatch. */
+const MISMATCH_AFTER_BYTES = 256;
+
+/**
+ * The resolution the bytes only decode at, when the user forced the other one: the decoder's
+ * `forcedMismatch` where it reports one, else judged here (frames stopped and bytes pile up).
+ */
+function decoderMismatch(format: FormatInfo): Resolution | null | undefined {
+  const f = format as FormatInfo & { forcedMismatch?: Resolution | null };
+  return f.forcedMismatch;
 }
 
 export class Engine {
@@ -37,36 +42,42 @@ export class Engine {
   /** The recent frames, discards and resyncs with their bytes, for the frame inspector. */
   readonly inspector = new InspectorLog();
   readonly link: LinkMonitor;
+  readonly series = new LinkSeries(BUCKET_US);
   readonly #positions = new Uint16Array(CHANNEL_COUNT);
   readonly #seenUs = new Float64Array(CHANNEL_COUNT).fill(NaN);
   #frames = 0;
   #arrivedMs = 0;
   #changed = false;
-  // The open bucket.
-  #bucketStart = NaN;
-  #bFades = 0;
-  #bRssiSum = 0;
-  #bRssiN = 0;
-  #bIntervalSum = 0;
-  #bIntervalN = 0;
-  #bFrames = 0;
-  /** Frames missing by the clock (the link monitor's count) that arrived in this bucket. */
-  #bLost = 0;
-  /** Frames already shown as lost in the empty buckets of the current gap. */
-  #gapLost = 0;
-  #lastFrameUs = NaN;
-  readonly #series = new Series();
+  /** Time of the frame (or end) being handled, for placing missing frames. */
+  #currentUs = NaN;
+  /** The next bucket to hand out. */
+  #nextBin = 0;
+  /** `end()` was called; the end of the stream, when known (replay): the clock never goes past it. */
+  #ended = false;
+  #endUs = NaN;
   /** Episode ids up to which every episode has been reported as ended; and open ones reported. */
   #episodesDone = 0;
-  #episodesOpenSent = new Set<number>();
+  readonly #episodesOpenSent = new Set<number>();
+  /** Since the user forced a resolution: counters then, and the mismatch found. */
+  #forcedAt: { frames: number; discarded: number } | null = null;
+  #mismatch: Resolution | null = null;
 
   constructor(readonly options: EngineOptions) {
     this.decoder = new SpektrumDecoder({ resolution: options.resolution, onEvent: (e) => this.inspector.onEvent(e) });
     // A live view may run for days: keep the newest episodes (the page shows ten minutes).
-    this.link = new LinkMonitor({ jitterUs: options.jitterUs, maxEpisodes: 1000 });
+    this.link = new LinkMonitor({
+      jitterUs: options.jitterUs,
+      maxEpisodes: 1000,
+      // Missing frames due before the settled buckets go into the oldest one still open.
+      onMissed: (from, to, n, p) => {
+        const floor = this.#currentUs - SETTLE_US;
+        this.series.missed(Math.max(from, floor), Math.max(to, floor), n, p);
+      },
+    });
+    if (options.resolution !== 'auto') this.#forcedAt = { frames: 0, discarded: 0 };
   }
 
-  /** Bytes as they arrived: `timeUs` is the chunk's arrival (or per-byte times). */
+  /** Bytes as they arrived: `time` is the chunk's arrival (or per-byte times). */
   push(bytes: Uint8Array, time: number | Float64Array | undefined, arrivedMs: number): void {
     // The log first: the decoder's events (fired in next()) take their times from these chunks.
     this.inspector.onBytes(bytes, time);
@@ -75,10 +86,58 @@ export class Engine {
     this.#drain();
   }
 
-  /** End of the source: decide the bytes still held. */
-  end(): void {
+  /**
+   * End of the source at `endUs` (the capture's last recorded time; NaN when unknown): decide
+   * the bytes still held, and judge the link there. The state then stays as it was at the end.
+   */
+  end(endUs = NaN): void {
     this.decoder.end();
     this.#drain();
+    this.#ended = true;
+    this.#endUs = endUs;
+    this.#currentUs = Number.isFinite(endUs) ? endUs : this.#currentUs;
+    if (this.#mismatch === null) this.link.finish(endUs);
+    this.#changed = true;
+  }
+
+  /**
+   * Forces (or frees) the resolution at source time `nowUs`. The frames may stop until the
+   * decoder finds them again: that is the user's doing, not the link's, so the link monitor
+   * counts nothing for the time in between (no hold, failsafe or missed frame).
+   */
+  setResolution(resolution: 'auto' | 1024 | 2048, nowUs: number, by: 'user' | 'internal-remote' = 'user'): void {
+    this.decoder.setResolution(resolution, by);
+    this.link.interrupt(nowUs);
+    const s = this.decoder.stats;
+    this.#forcedAt = resolution === 'auto' || by !== 'user' ? null : { frames: s.frames, discarded: s.discardedBytes };
+    this.#mismatch = null;
+    this.#changed = true;
+  }
+
+  /**
+   * The resolution the stream looks like while a forced one matches no frame (e.g. 2048 when
+   * 1024 was forced on a 2048 stream), else null.
+   */
+  get mismatch(): Resolution | null {
+    return this.#mismatch;
+  }
+
+  #checkMismatch(): void {
+    const fromDecoder = decoderMismatch(this.decoder.format);
+    let mismatch: Resolution | null = null;
+    if (fromDecoder !== undefined) {
+      mismatch = fromDecoder;
+    } else if (this.#forcedAt !== null) {
+      const s = this.decoder.stats;
+      const forced = this.decoder.format.resolution;
+      if (s.frames === this.#forcedAt.frames && s.discardedBytes - this.#forcedAt.discarded > MISMATCH_AFTER_BYTES) {
+        mismatch = forced === 1024 ? 2048 : 1024;
+      }
+    }
+    if (mismatch !== this.#mismatch) {
+      this.#mismatch = mismatch;
+      this.#changed = true;
+    }
   }
 
   #drain(): void {
@@ -87,12 +146,9 @@ export class Engine {
     for (let f = d.next(); f !== undefined; f = d.next()) {
       this.inspector.onFrame(f);
       const t = f.timeUs;
-      if (Number.isFinite(t)) this.#closeBuckets(t);
-      const missed = this.link.stats.missedFrames;
+      this.#currentUs = t;
       this.link.frame(f);
-      // A gap's frames were shown in its empty buckets already; the rest belong here.
-      this.#bLost += Math.max(0, this.link.stats.missedFrames - missed - this.#gapLost);
-      this.#gapLost = 0;
+      this.series.frame(f, this.link);
       this.#frames++;
       for (let i = 0; i < f.count; i++) {
         const id = f.ids[i] as number;
@@ -100,69 +156,55 @@ export class Engine {
         // Untimed data (a raw .bin) still marks the channel as seen, at an unknown time.
         this.#seenUs[id] = Number.isFinite(t) ? t : Infinity;
       }
-      this.#bFades += f.fadesDelta;
-      if (f.rssi !== null) {
-        this.#bRssiSum += f.rssi;
-        this.#bRssiN++;
-      }
-      // Frame spacing, without the gaps (those are lost frames, graphed on their own).
-      const nominal = this.link.stats.nominalPeriodUs;
-      const maxInterval = Number.isFinite(nominal) ? 1.5 * nominal + this.options.jitterUs : 5 * BUCKET_US;
-      if (Number.isFinite(this.#lastFrameUs) && t > this.#lastFrameUs && t - this.#lastFrameUs < maxInterval) {
-        this.#bIntervalSum += t - this.#lastFrameUs;
-        this.#bIntervalN++;
-      }
-      this.#bFrames++;
-      this.#lastFrameUs = t;
     }
+    this.#checkMismatch();
   }
 
-  /** Closes buckets that end at or before `t` (also the empty ones of a dropout). */
-  #closeBuckets(t: number): void {
-    const start = Math.floor(t / BUCKET_US) * BUCKET_US;
-    if (Number.isNaN(this.#bucketStart)) {
-      this.#bucketStart = start;
-      return;
+  /** Buckets that end by `untilUs`, with the newer ones before it that have settled. */
+  #takeSeries(untilUs: number): Batch['series'] {
+    const s = this.series;
+    let last = Number.isFinite(untilUs) && !Number.isNaN(s.originUs) ? s.binOf(untilUs - SETTLE_US) : -1;
+    // At the end of a replay everything has settled.
+    if (this.#ended && Number.isFinite(this.#endUs) && !Number.isNaN(s.originUs)) last = s.binOf(this.#endUs) + 1;
+    s.extendTo(untilUs);
+    last = Math.min(last, s.bins);
+    const from = this.#nextBin;
+    const n = Math.max(0, last - from);
+    const out = {
+      t: new Float64Array(n), fadeRate: new Float32Array(n), rssi: new Float32Array(n), periodMs: new Float32Array(n), lost: new Float32Array(n),
+    };
+    for (let k = 0; k < n; k++) {
+      const b = from + k;
+      out.t[k] = s.startOf(b);
+      out.fadeRate[k] = s.fades(b) / (BUCKET_US / 1e6);
+      out.rssi[k] = s.rssiMean(b);
+      const iv = s.intervalMean(b);
+      out.periodMs[k] = iv / 1000;
+      out.lost[k] = s.lost(b);
     }
-    // A jump far ahead (a long pause in a replay) emits at most ten minutes of empty buckets.
-    if (start - this.#bucketStart > 6000 * BUCKET_US) this.#bucketStart = start - 6000 * BUCKET_US;
-    while (this.#bucketStart < start) {
-      const s = this.#series;
-      const period = this.link.stats.nominalPeriodUs;
-      const expected = Number.isFinite(period) ? BUCKET_US / period : NaN;
-      s.t.push(this.#bucketStart);
-      s.fadeRate.push(this.#bFades / (BUCKET_US / 1e6));
-      s.rssi.push(this.#bRssiN > 0 ? this.#bRssiSum / this.#bRssiN : NaN);
-      s.periodMs.push(this.#bIntervalN > 0 ? this.#bIntervalSum / this.#bIntervalN / 1000 : NaN);
-      // A bucket without a single frame is silence: all its frames were lost.
-      let lost = this.#bLost;
-      if (this.#bFrames === 0 && Number.isFinite(expected)) {
-        lost = Math.round(expected);
-        this.#gapLost += lost;
-      }
-      s.lost.push(lost);
-      this.#bFades = this.#bRssiSum = this.#bRssiN = this.#bIntervalSum = this.#bIntervalN = this.#bFrames = this.#bLost = 0;
-      this.#bucketStart += BUCKET_US;
-      this.#changed = true;
-    }
+    this.#nextBin = from + n;
+    return out;
   }
 
   /**
    * What changed since the last call, at source time `nowUs` (advances the failsafe timer and
-   * closes silent buckets), or null when nothing did. The typed arrays are fresh: transfer them.
+   * closes silent buckets), or null when nothing did. After `end()`, and while a forced
+   * resolution matches no frame, the link's state stands still. The typed arrays are fresh:
+   * transfer them.
    */
   batch(nowUs: number): { batch: Batch; transfer: ArrayBuffer[] } | null {
     const before = this.link.state;
-    this.link.update(nowUs);
-    if (this.link.state !== 'waiting' && this.link.state !== 'live') this.#closeBuckets(nowUs);
+    const ended = this.#ended;
+    const now = ended && Number.isFinite(this.#endUs) ? this.#endUs : nowUs;
+    if (!ended && this.#mismatch === null) this.link.update(now);
     const episodes = this.#newEpisodes();
-    if (!this.#changed && before === this.link.state && episodes.length === 0) return null;
+    const series = this.#takeSeries(now);
+    if (!this.#changed && before === this.link.state && episodes.length === 0 && series.t.length === 0) return null;
     this.#changed = false;
     const l = this.link.stats;
     const s = this.decoder.stats;
-    const series = this.#series.take();
     const batch: Batch = {
-      nowUs,
+      nowUs: now,
       arrivedMs: this.#arrivedMs,
       frames: this.#frames,
       positions: this.#positions.slice(),
@@ -171,8 +213,11 @@ export class Engine {
       link: {
         state: this.link.state, lastFrameUs: this.link.lastFrameUs, holds: l.holds, failsafes: l.failsafes,
         periodUs: l.periodUs, nominalPeriodUs: l.nominalPeriodUs, fades: l.fades, fadeRate: l.fadeRate,
-        missedFrames: l.missedFrames, rssi: l.rssi,
+        missedFrames: l.missedFrames, missedBasis: l.missedBasis, rssi: l.rssi,
+        deliveryDelayUs: l.deliveryDelayUs, deliveryJitterUs: l.deliveryJitterUs,
       },
+      mismatch: this.#mismatch,
+      ended,
       counters: { bytes: s.bytes, frames: s.frames, resyncs: s.resyncs, discardedBytes: s.discardedBytes, badFrames: s.badFrames },
       series,
       episodes,

@@ -4,7 +4,7 @@
  * gesture (requestPort) and the display. High-rate data crosses as typed arrays in batches, a
  * few per animation frame at most, transferred, never one message per Spektrum frame.
  */
-import type { FormatInfo, LinkState } from '../decoder/index.js';
+import type { FormatInfo, LinkState, MissedBasis } from '../decoder/index.js';
 import type { InspectEntry } from './inspector.js';
 
 /** How the page names a port it was granted: its place in getPorts() and its USB IDs. */
@@ -89,9 +89,21 @@ export interface Batch {
     nominalPeriodUs: number;
     fades: number;
     fadeRate: number;
+    /** Frames missed (LinkMonitor): by the fade counter where the receiver counts, else by count. */
     missedFrames: number;
+    missedBasis: MissedBasis;
     rssi: number;
+    /** How late frames reach us against the receiver's schedule, and the spread of it, µs (NaN until measured): the adapter, not the link. */
+    deliveryDelayUs: number;
+    deliveryJitterUs: number;
   };
+  /**
+   * While a forced resolution matches no frame: the resolution the stream looks like (the link
+   * counts nothing meanwhile); else null.
+   */
+  mismatch: 1024 | 2048 | null;
+  /** The source has ended (a replay at its end): the state shown is the last one, frozen. */
+  ended: boolean;
   counters: { bytes: number; frames: number; resyncs: number; discardedBytes: number; badFrames: number };
   /** Completed graph buckets: start time, fades/s, mean RSSI (NaN without), mean frame interval ms (NaN if <2 frames), lost frames. */
   series: { t: Float64Array; fadeRate: Float32Array; rssi: Float32Array; periodMs: Float32Array; lost: Float32Array };
@@ -121,6 +133,10 @@ export interface ReplayStatus {
   speed: number;
   frames: number;
   issues: string[];
+  /** False for a capture without timing (raw .bin): it plays at the receiver's pace, and nothing is measured from that clock. */
+  recordedTiming: boolean;
+  /** The replay reached the end: the clock stops there and every state is frozen as it was. */
+  ended: boolean;
 }
 
 /** Whole-capture series for the replay timeline, made once when a capture opens. */

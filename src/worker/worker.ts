@@ -5,7 +5,10 @@
  * capture being replayed. A source's id is its port number in recordings.
  */
 /// <reference lib="webworker" />
-import { CaptureFormatError, USB_CHUNK_JITTER_US, decodeCapture, readCapture, systemInfo, type Capture } from '../decoder/index.js';
+import {
+  CaptureFormatError, FRAME_PERIOD_11MS_US, capturePorts, FRAME_PERIOD_22MS_US, LinkSeries, USB_CHUNK_JITTER_US, decodeCapture, readCapture, resolutionKey,
+  systemInfo, timingJitterUs, type Capture,
+} from '../decoder/index.js';
 import { Engine } from './engine.js';
 import { runBind } from './bind.js';
 import { REMOTE_LABELS, type BindProgress, type FromWorker, type Overview, type PortIdentity, type SourceKind, type SourceStatus, type ToWorker } from './protocol.js';
@@ -45,6 +48,8 @@ interface Source {
   identity?: PortIdentity;
   /** Signals to set whenever the port is (re)opened: the satellite's power after a bind. */
   signals?: SerialOutputSignals;
+  /** The resolution the stream looked like when a forced one matched no frame, as last told. */
+  toldMismatch?: 1024 | 2048 | null;
   /** The internal remote's resolution this (external) remote was given, and its counters then. */
   sharedKey?: 1024 | 2048;
   sharedAt?: { frames: number; discarded: number };
@@ -114,27 +119,35 @@ function setState(source: Source, state: string, name = source.name): void {
  * (spec §8: "the internal remote provides the key for … all remotes").
  */
 function shareResolution(): void {
-  let key: 1024 | 2048 | undefined;
-  for (const s of sources.values()) {
-    const f = s.engine.decoder.format;
-    const info = f.remote === 'internal' && f.system !== null ? systemInfo(f.system) : undefined;
-    if (info !== undefined && f.resolution !== null) key = f.resolution;
-  }
+  const key = resolutionKey([...sources.values()].map((s) => s.engine.decoder.format));
   for (const s of sources.values()) {
     const d = s.engine.decoder;
     if (d.format.remote === 'internal' || resolution !== 'auto' || (key !== undefined && s.refusedKey === key)) continue;
     if (s.sharedKey !== key) {
-      d.setResolution(key ?? 'auto', 'internal-remote');
+      s.engine.setResolution(key ?? 'auto', clockUs(), 'internal-remote');
       s.sharedKey = key;
       s.sharedAt = { frames: d.stats.frames, discarded: d.stats.discardedBytes };
     } else if (s.sharedAt !== undefined && d.stats.frames === s.sharedAt.frames && d.stats.discardedBytes - s.sharedAt.discarded > REFUSE_AFTER_BYTES) {
       // Its bytes do not read at that resolution (a remote of another system?): its own reading wins.
-      d.setResolution('auto');
+      s.engine.setResolution('auto', clockUs());
       s.refusedKey = key;
       s.sharedKey = undefined;
       notice('warning', `Remote ${s.label} does not read at the internal remote's resolution`, `Its frames only make sense at the other resolution; it is decoded on its own (${key ?? ''} did not fit). Are both remotes bound to the same transmitter?`);
     }
   }
+}
+
+/**
+ * Tells the user once when the resolution they forced matches no frame: the link counts
+ * nothing meanwhile (no hold, failsafe or missed frame), and the page shows it as waiting.
+ */
+function tellMismatch(s: Source): void {
+  const m = s.engine.mismatch;
+  if (m === (s.toldMismatch ?? null)) return;
+  s.toldMismatch = m;
+  if (m === null || resolution === 'auto') return;
+  notice('warning', `Remote ${s.label}: forced ${resolution}: no frame matches; the stream looks like ${m}`,
+    `Nothing is counted as missed while no frame decodes. Choose Auto or ${m} to decode it again.`);
 }
 
 /** Bytes an external remote may discard at the internal remote's resolution before it is given up. */
@@ -144,10 +157,11 @@ const REFUSE_AFTER_BYTES = 512;
 function flush(): void {
   flushTimer = undefined;
   lastBatchMs = performance.now();
-  const now = clockUs();
   for (const s of sources.values()) {
-    const out = s.engine.batch(now);
+    // Replay judges each link on the capture's clock, never past a byte still to come.
+    const out = s.engine.batch(replay !== undefined ? replay.linkNowUs(s.id) : nowUs());
     if (out !== null) post({ type: 'batch', source: s.id, batch: out.batch }, out.transfer);
+    tellMismatch(s);
   }
   shareResolution();
   sendSources();
@@ -354,38 +368,35 @@ async function startDemo(): Promise<void> {
 // ---- replay ---------------------------------------------------------------------------------
 
 /**
- * Whole-capture series for the replay timeline, every port on one time axis in 1 s bins: fades,
- * and frames missing by the clock counted where each gap ends (so a port that starts late, or a
- * partial first or last second, shows no loss that is not there), and the failsafe episodes.
+ * Whole-capture series for the replay timeline, every port on one time axis in 1 s bins: the
+ * library's binned link series (the report's), fades and lost frames summed over the ports,
+ * and the failsafe episodes. Also the frame period to pace a capture without timing at.
  */
-function overviewOf(capture: Capture, ports: readonly number[]): Overview {
+function overviewOf(capture: Capture, ports: readonly number[]): { overview: Overview; periodUs: number } {
   const BIN_US = 1_000_000;
-  const t: number[] = [];
-  const fades: number[] = [];
-  const lost: number[] = [];
+  const all: LinkSeries[] = [];
   const failsafe: Overview['failsafe'] = [];
-  let first = NaN;
+  let periodUs = NaN;
   for (const port of ports) {
-    // decodeCapture's link monitor has counted each frame before we see it: remember its
-    // missed-frame count from the frame before.
-    let missed = 0;
-    const { link } = decodeCapture(capture, { resolution, port }, (f, monitor) => {
-      const before = missed;
-      missed = monitor.stats.missedFrames;
-      if (!Number.isFinite(f.timeUs)) return;
-      if (Number.isNaN(first)) first = Math.floor(f.timeUs / BIN_US) * BIN_US;
-      const bin = Math.max(0, Math.floor((f.timeUs - first) / BIN_US));
-      while (t.length <= bin) {
-        t.push(first + t.length * BIN_US);
-        fades.push(0);
-        lost.push(0);
-      }
-      fades[bin] = (fades[bin] as number) + f.fadesDelta;
-      lost[bin] = (lost[bin] as number) + missed - before;
-    });
+    const { link, series, decoder } = decodeCapture(capture, { resolution, port, binUs: BIN_US }, () => {});
+    all.push(series);
     for (const e of link.episodes) if (e.kind === 'failsafe') failsafe.push({ startUs: e.startUs, endUs: e.endUs ?? e.startUs });
+    const info = decoder.format.system === null ? undefined : systemInfo(decoder.format.system);
+    if (Number.isNaN(periodUs)) periodUs = info ? (info.periodMs === 11 ? FRAME_PERIOD_11MS_US : FRAME_PERIOD_22MS_US) : decoder.format.resolution === 1024 ? FRAME_PERIOD_22MS_US : NaN;
   }
-  return { t: Float64Array.from(t), fadeRate: Float32Array.from(fades), lost: Float32Array.from(lost), failsafe };
+  const bins = Math.max(0, ...all.map((x) => x.bins));
+  const origin = all[0]?.originUs ?? NaN;
+  const t = new Float64Array(Number.isNaN(origin) ? 0 : bins);
+  const fades = new Float32Array(t.length);
+  const lost = new Float32Array(t.length);
+  for (let b = 0; b < t.length; b++) {
+    t[b] = origin + b * BIN_US;
+    for (const x of all) {
+      fades[b] = (fades[b] as number) + x.fades(b);
+      lost[b] = (lost[b] as number) + x.lost(b);
+    }
+  }
+  return { overview: { t, fadeRate: fades, lost, failsafe }, periodUs: Number.isNaN(periodUs) ? FRAME_PERIOD_11MS_US : periodUs };
 }
 
 const REPLAY_STATUS_MS = 200;
@@ -402,20 +413,18 @@ function replayStatus(): void {
     replay: {
       name: replayName, kind: c.kind, timing: c.timing, startUs: replay.startUs, endUs: replay.endUs,
       positionUs: replay.positionUs, playing: replay.playing, speed: replay.speed, frames, issues: c.issues.map((i) => i.message),
+      recordedTiming: replay.recordedTiming, ended: replay.ended,
     },
   });
 }
 
-function replayJitter(capture: Capture): number {
-  return capture.timing === 'per-chunk' ? USB_CHUNK_JITTER_US : 0;
-}
 
 /** Fresh decodes for every port of the replayed capture. */
 function resetReplaySources(capture: Capture, ports: readonly number[]): void {
   sources.clear();
   post({ type: 'reset' });
   for (const port of ports) {
-    const s = addSource('replay', port, `${replayName}${ports.length > 1 ? ` port ${port}` : ''}`, replayJitter(capture));
+    const s = addSource('replay', port, `${replayName}${ports.length > 1 ? ` port ${port}` : ''}`, timingJitterUs(capture.timing));
     // The label the remote had when it was recorded.
     const saved = capture.meta.ports?.[port]?.name;
     if (typeof saved === 'string' && saved !== '') s.label = saved;
@@ -438,6 +447,7 @@ async function openReplay(name: string, data: ArrayBuffer): Promise<void> {
   if (capture.issues.length > 0) {
     notice('warning', `${name}: ${capture.issues.length} damaged part(s) skipped`, `${capture.issues[0]?.message ?? ''} Every intact record is kept.`);
   }
+  const { overview, periodUs } = overviewOf(capture, capturePorts(capture));
   const r = new ReplaySource(
     capture,
     (port, bytes, time) => sources.get(port)?.engine.push(bytes, time, performance.timeOrigin + performance.now()),
@@ -447,17 +457,21 @@ async function openReplay(name: string, data: ArrayBuffer): Promise<void> {
       if (performance.now() - lastReplayStatusMs >= REPLAY_STATUS_MS) replayStatus();
     },
     () => {
+      // The end: every link is judged at the capture's last recorded time, and stays so.
       for (const s of sources.values()) {
-        s.engine.end();
+        s.engine.end(r.recordedTiming ? r.endUs : Number.NaN);
         s.state = 'ended';
       }
       flush();
       replayStatus();
     },
+    { untimedPeriodUs: periodUs },
   );
   replay = r;
-  const overview = overviewOf(capture, r.ports);
   post({ type: 'overview', overview }, [overview.t.buffer, overview.fadeRate.buffer, overview.lost.buffer]);
+  if (!r.recordedTiming) {
+    notice('info', `${name}: no recorded timing`, `Replayed at the receiver's pace (a frame every ${periodUs / 1000} ms). Holds, failsafes, lost frames and the frame period cannot be measured without the recorded times.`);
+  }
   resetReplaySources(capture, r.ports);
   r.play();
   setReplayState('playing');
@@ -584,6 +598,11 @@ async function handle(message: ToWorker): Promise<void> {
       break;
     case 'replay-play':
       if (replay !== undefined) {
+        // At the end, play starts over.
+        if (replay.ended) {
+          resetReplaySources(replay.capture, replay.ports);
+          replay.seek(replay.startUs);
+        }
         replay.play();
         setReplayState('playing');
         replayStatus();
@@ -612,7 +631,11 @@ async function handle(message: ToWorker): Promise<void> {
       break;
     case 'set-resolution':
       resolution = message.resolution;
-      for (const s of sources.values()) s.engine.decoder.setResolution(resolution);
+      // The frames may stop while the decoder finds them at the new resolution: not link loss.
+      for (const s of sources.values()) {
+        s.engine.setResolution(resolution, replay !== undefined ? replay.linkNowUs(s.id) : clockUs());
+        s.sharedKey = undefined;
+      }
       scheduleFlush();
       break;
     default: {

@@ -4,7 +4,31 @@
  * several ports (remotes) with one common clock: each port feeds its own decode, and all of
  * them advance with the one replay clock.
  */
-import { capturePorts, type Capture } from '../../decoder/index.js';
+import { BYTE_TIME_US, FRAME_PERIOD_11MS_US, FRAME_SIZE, captureSpan, capturePorts, type Capture } from '../../decoder/index.js';
+
+/** Wall time and ticks, passed in so that tests drive replay with a simulated clock. */
+export interface ReplayClock {
+  /** Milliseconds, monotonic (performance.now()). */
+  now(): number;
+  every(ms: number, fn: () => void): unknown;
+  cancel(handle: unknown): void;
+}
+
+export const REAL_CLOCK: ReplayClock = {
+  now: () => performance.now(),
+  every: (ms, fn) => setInterval(fn, ms),
+  cancel: (handle) => clearInterval(handle as ReturnType<typeof setInterval>),
+};
+
+export interface ReplayOptions {
+  clock?: ReplayClock;
+  /**
+   * For a capture without timing (raw .bin): the receiver's frame period, µs, at whose pace
+   * (16 bytes a period) its bytes are played. The bytes are decoded without times all the same:
+   * nothing is measured from a made-up clock. Default 11 ms.
+   */
+  untimedPeriodUs?: number;
+}
 
 /** One chunk's bytes with their times. */
 interface Chunk {
@@ -26,17 +50,32 @@ class PortChunks {
   next = 0;
   nextByte = 0;
 
-  constructor(readonly capture: Capture, readonly port: number) {
+  /** Without timing: this port's bytes up to the end of each chunk, for the paced clock. */
+  readonly #bytesBefore: Float64Array | undefined;
+
+  /** @param usPerByte without timing, the pace bytes are played at (µs a byte); NaN with timing */
+  constructor(readonly capture: Capture, readonly port: number, readonly usPerByte: number) {
     const ports = capture.chunkPorts;
     let n = 0;
     const index = new Uint32Array(ports.length);
     for (let i = 0; i < ports.length; i++) if (ports[i] === port) index[n++] = i;
     this.#index = index.subarray(0, n);
     this.length = n;
+    if (Number.isFinite(usPerByte)) {
+      const before = new Float64Array(n);
+      let total = 0;
+      for (let k = 0; k < n; k++) {
+        const i = this.#index[k] as number;
+        total += (capture.chunkEnds[i] as number) - (i === 0 ? 0 : (capture.chunkEnds[i - 1] as number));
+        before[k] = total;
+      }
+      this.#bytesBefore = before;
+    }
   }
 
-  /** Arrival time of chunk k (µs), NaN without timing. */
+  /** Arrival time of chunk k (µs): recorded, or on the paced clock without timing. */
   atUs(k: number): number {
+    if (this.#bytesBefore !== undefined) return (this.#bytesBefore[k] as number) * this.usPerByte;
     const i = this.#index[k] as number;
     const times = this.capture.byteTimesUs;
     if (times !== undefined) return times[(this.capture.chunkEnds[i] as number) - 1] ?? NaN;
@@ -51,8 +90,28 @@ class PortChunks {
     return { bytes: c.bytes.subarray(start, end), byteTimes: c.byteTimesUs?.subarray(start, end), atUs: this.atUs(k) };
   }
 
+  /** Whether chunk k's bytes are decoded with times (recorded ones); not on the paced clock. */
+  get timed(): boolean {
+    return this.#bytesBefore === undefined;
+  }
+
   get done(): boolean {
     return this.next >= this.length;
+  }
+
+  /**
+   * The earliest time a byte not fed yet can carry, µs (Infinity when all are fed): its own
+   * time, or for a chunk-timed chunk, the chunk's arrival less its bytes at line rate, which
+   * is as early as the decoder dates a frame in it.
+   */
+  nextByteUs(): number {
+    if (this.done) return Infinity;
+    const i = this.#index[this.next] as number;
+    const c = this.capture;
+    const start = i === 0 ? 0 : (c.chunkEnds[i - 1] as number);
+    if (c.byteTimesUs !== undefined) return c.byteTimesUs[start + this.nextByte] ?? Infinity;
+    if (!this.timed) return Infinity;
+    return this.atUs(this.next) - ((c.chunkEnds[i] as number) - start - 1) * BYTE_TIME_US;
   }
 }
 
@@ -69,56 +128,69 @@ const SEEK_HISTORY_US = 10 * 60e6;
 export class ReplaySource {
   readonly ports: readonly number[];
   readonly #chunks: PortChunks[];
+  /** The capture's first and last recorded time (`captureSpan`), or the paced clock's span without timing. */
   readonly startUs: number;
   readonly endUs: number;
+  /** False for a capture without timing: its clock is the receiver's pace, not a recording. */
+  readonly recordedTiming: boolean;
+  readonly #clock: ReplayClock;
   #clockUs: number;
   #wallMs = 0;
   #speed = 1;
   #playing = false;
+  #ended = false;
   #lastFedUs = NaN;
-  #timer: ReturnType<typeof setInterval> | undefined;
+  #timer: unknown;
 
   /**
    * @param sink gets each piece of a port's bytes with its time argument and arrival time
    * @param onTick after each tick that moved the clock (the worker sends batches)
-   * @param onEnd when every port's last chunk has been fed
+   * @param onEnd when the clock has reached the end and every port's last chunk has been fed
    */
   constructor(
     readonly capture: Capture,
     readonly sink: ReplaySink,
     readonly onTick: (clockUs: number) => void,
     readonly onEnd: () => void,
+    options: ReplayOptions = {},
   ) {
+    this.#clock = options.clock ?? REAL_CLOCK;
     this.ports = capturePorts(capture);
-    this.#chunks = this.ports.map((p) => new PortChunks(capture, p));
-    let start = Infinity;
-    let end = -Infinity;
-    for (const c of this.#chunks) {
-      for (let k = 0; k < c.length; k++) {
-        const t = c.atUs(k);
-        if (Number.isFinite(t)) {
-          start = Math.min(start, t);
-          break;
-        }
-      }
-      for (let k = c.length - 1; k >= 0; k--) {
-        const t = c.atUs(k);
-        if (Number.isFinite(t)) {
-          end = Math.max(end, t);
-          break;
-        }
-      }
+    const span = captureSpan(capture);
+    this.recordedTiming = Number.isFinite(span.startUs);
+    const usPerByte = this.recordedTiming ? NaN : (options.untimedPeriodUs ?? FRAME_PERIOD_11MS_US) / FRAME_SIZE;
+    this.#chunks = this.ports.map((p) => new PortChunks(capture, p, usPerByte));
+    if (this.recordedTiming) {
+      this.startUs = span.startUs;
+      this.endUs = span.endUs;
+    } else {
+      let end = 0;
+      for (const c of this.#chunks) if (c.length > 0) end = Math.max(end, c.atUs(c.length - 1));
+      this.startUs = 0;
+      this.endUs = end;
     }
-    const timed = start <= end;
-    this.startUs = timed ? start : 0;
-    this.endUs = timed ? end : 0;
     this.#clockUs = this.startUs;
-    // Untimed captures (raw .bin) play as fast as possible: there is no clock to follow.
-    if (!timed) this.#speed = 0;
   }
 
+  /** Whether there is a timeline to play and seek on. */
   get timed(): boolean {
     return this.endUs > this.startUs;
+  }
+
+  /**
+   * The time a port's link is judged at (hold, failsafe): the replay clock, but never past the
+   * next byte not fed yet, so that a frame still to come is never taken for silence. This keeps
+   * every state the same at 1×, 4× and full speed. NaN without recorded timing.
+   */
+  linkNowUs(port: number): number {
+    if (!this.recordedTiming) return NaN;
+    const c = this.#chunks[this.ports.indexOf(port)];
+    return c === undefined ? this.#clockUs : Math.min(this.#clockUs, c.nextByteUs());
+  }
+
+  /** Whether the replay has reached its end. */
+  get ended(): boolean {
+    return this.#ended;
   }
 
   get playing(): boolean {
@@ -134,22 +206,21 @@ export class ReplaySource {
   }
 
   play(): void {
-    if (this.#playing || this.#chunks.every((c) => c.done)) return;
+    if (this.#playing || this.#ended) return;
     this.#playing = true;
-    this.#wallMs = performance.now();
-    this.#timer = setInterval(() => this.#tick(), TICK_MS);
+    this.#wallMs = this.#clock.now();
+    this.#timer = this.#clock.every(TICK_MS, () => this.#tick());
   }
 
   pause(): void {
     this.#playing = false;
-    clearInterval(this.#timer);
+    if (this.#timer !== undefined) this.#clock.cancel(this.#timer);
     this.#timer = undefined;
   }
 
   setSpeed(speed: number): void {
-    if (!this.timed) return;
     this.#speed = speed;
-    this.#wallMs = performance.now();
+    this.#wallMs = this.#clock.now();
   }
 
   /**
@@ -159,15 +230,20 @@ export class ReplaySource {
   seek(timeUs: number): void {
     const target = Math.min(Math.max(timeUs, this.startUs), this.endUs);
     this.#lastFedUs = NaN;
+    this.#ended = false;
     const from = target - SEEK_HISTORY_US;
     for (const c of this.#chunks) {
       c.next = 0;
       c.nextByte = 0;
       while (c.next < c.length && c.atUs(c.next) < from) c.next++;
     }
-    this.#feedUntil(target, Infinity);
+    const done = this.#feedUntil(target, Infinity);
     this.#clockUs = target;
-    this.#wallMs = performance.now();
+    this.#wallMs = this.#clock.now();
+    if (done && target >= this.endUs) {
+      this.#finish();
+      return;
+    }
     this.onTick(this.#clockUs);
   }
 
@@ -186,14 +262,15 @@ export class ReplaySource {
    * `budgetMs` of wall time. Returns whether everything has been fed.
    */
   #feedUntil(clockUs: number, budgetMs: number): boolean {
-    const started = performance.now();
+    const started = this.#clock.now();
     for (const c of this.#chunks) {
       while (c.next < c.length) {
-        if (budgetMs !== Infinity && performance.now() - started > budgetMs) return false;
+        if (budgetMs !== Infinity && this.#clock.now() - started > budgetMs) return false;
         const chunk = c.get(c.next);
         if (chunk.byteTimes === undefined) {
           if (chunk.atUs > clockUs) break;
-          this.#feed(c.port, chunk.bytes, Number.isNaN(chunk.atUs) ? undefined : chunk.atUs, chunk.atUs);
+          // Without recorded timing the bytes go in untimed: the pace is not a measurement.
+          this.#feed(c.port, chunk.bytes, c.timed && !Number.isNaN(chunk.atUs) ? chunk.atUs : undefined, chunk.atUs);
           c.next++;
           continue;
         }
@@ -215,26 +292,32 @@ export class ReplaySource {
   }
 
   #tick(): void {
-    const nowMs = performance.now();
+    const nowMs = this.#clock.now();
     let done: boolean;
     if (this.#speed === 0) {
       // As fast as possible, in slices so the worker stays responsive; the clock follows the data.
       done = this.#feedUntil(Infinity, SLICE_MS);
-      if (this.timed && Number.isFinite(this.#lastFedUs)) this.#clockUs = Math.max(this.#clockUs, this.#lastFedUs);
+      if (Number.isFinite(this.#lastFedUs)) this.#clockUs = Math.min(this.endUs, Math.max(this.#clockUs, this.#lastFedUs));
     } else {
       // A stall (a long task, a background tab) must not jump the clock past silent data: that
-      // would show a hold or failsafe that is not in the capture.
-      this.#clockUs += Math.min(nowMs - this.#wallMs, MAX_STEP_MS) * 1000 * this.#speed;
-      done = this.#feedUntil(this.#clockUs, SLICE_MS);
+      // would show a hold or failsafe that is not in the capture. Nor does it run past the end.
+      this.#clockUs = Math.min(this.endUs, this.#clockUs + Math.min(nowMs - this.#wallMs, MAX_STEP_MS) * 1000 * this.#speed);
+      done = this.#feedUntil(this.#clockUs, SLICE_MS) && this.#clockUs >= this.endUs;
     }
     this.#wallMs = nowMs;
     if (done) {
-      this.#clockUs = Math.max(this.#clockUs, this.endUs);
-      this.pause();
-      this.onTick(this.#clockUs);
-      this.onEnd();
+      this.#finish();
       return;
     }
     this.onTick(this.#clockUs);
+  }
+
+  /** The end: the clock stops at the capture's last recorded time, never past it. */
+  #finish(): void {
+    this.#clockUs = this.endUs;
+    this.#ended = true;
+    this.pause();
+    this.onTick(this.#clockUs);
+    this.onEnd();
   }
 }

@@ -7,7 +7,7 @@ import type { Signal } from '@preact/signals';
 import { useEffect, useRef } from 'preact/hooks';
 import { onFrame } from '../../frame-loop.js';
 import type { Live } from '../../live.js';
-import { current, linkState } from '../../store.js';
+import { current, linkEnded, linkMismatch, linkState, resolutionOverride } from '../../store.js';
 import { drawEpisodes } from '../../timeline.js';
 import './style.css';
 
@@ -56,10 +56,15 @@ export function LinkPanel({ windowUs }: { windowUs: Signal<number> }) {
   }, [windowUs]);
 
   const state = linkState.value;
+  const mismatch = linkMismatch.value;
+  // A replay at its end keeps its last state, said as such; a forced resolution that matches no frame is not link loss.
+  const label = linkEnded.value ? 'Replay ended' : LABEL[state];
+  const hint = linkEnded.value ? `Last state: ${LABEL[state]}` : mismatch !== null
+    ? `Forced ${resolutionOverride.value}: no frame matches; the stream looks like ${mismatch}` : HINT[state];
   return (
     <section class={`link ${state}`} aria-label="Link state">
-      <div class="state" role="status" aria-live="polite" data-testid="link-state">{LABEL[state]}</div>
-      <div class="hint">{HINT[state]}</div>
+      <div class="state" role="status" aria-live="polite" data-testid="link-state">{label}</div>
+      <div class="hint" data-testid="link-hint">{hint}</div>
       <dl>
         <dt>Last frame</dt><dd><span ref={since}>none yet</span></dd>
         <dt>Episodes</dt><dd><span ref={counts}>none</span></dd>

@@ -1,0 +1,149 @@
+/**
+ * The one binned time series of a link: frames, fades, lost frames, RSSI and frame intervals
+ * per time bin, made from what a `LinkMonitor` decided (plausible fades, ordinary intervals,
+ * missed frames placed where they were due). The live page (100 ms bins), the replay overview
+ * and the health report (1 s bins) all fill it the same way.
+ */
+import { LinkMonitor, type LinkOptions } from './link.js';
+import type { DecodedFrame } from './types.js';
+
+/** A growable Float64Array column. */
+class Column {
+  data: Float64Array;
+  constructor(fill: number) {
+    this.data = new Float64Array(64).fill(fill);
+    this.fill = fill;
+  }
+  readonly fill: number;
+  ensure(n: number): void {
+    if (n <= this.data.length) return;
+    let size = this.data.length;
+    while (size < n) size *= 2;
+    const next = new Float64Array(size).fill(this.fill);
+    next.set(this.data);
+    this.data = next;
+  }
+}
+
+/** Per-bin sums; bin `i` covers [originUs + i × binUs, originUs + (i + 1) × binUs). */
+export class LinkSeries {
+  readonly binUs: number;
+  #origin: number;
+  #bins = 0;
+  /** Bins below this are sealed (handed out): later additions go to the first open bin. */
+  #sealed = 0;
+  readonly #frames = new Column(0);
+  readonly #fades = new Column(0);
+  readonly #lost = new Column(0);
+  readonly #rssiSum = new Column(0);
+  readonly #rssiN = new Column(0);
+  readonly #rssiMin = new Column(Infinity);
+  readonly #intervalSum = new Column(0);
+  readonly #intervalN = new Column(0);
+  readonly #columns: Column[];
+
+  /**
+   * @param binUs bin width, µs
+   * @param originUs start of bin 0; default: the first frame's time, down to a multiple of `binUs`
+   * @throws {TypeError} when `binUs` is not a positive finite number
+   */
+  constructor(binUs: number, originUs = NaN) {
+    if (!(Number.isFinite(binUs) && binUs > 0)) throw new TypeError(`binUs must be a positive finite number, not ${String(binUs)}`);
+    this.binUs = binUs;
+    this.#origin = originUs;
+    this.#columns = [this.#frames, this.#fades, this.#lost, this.#rssiSum, this.#rssiN, this.#rssiMin, this.#intervalSum, this.#intervalN];
+  }
+
+  /** Start of bin 0, µs (NaN until the first timed frame when not given). */
+  get originUs(): number {
+    return this.#origin;
+  }
+
+  /** Bins so far (up to the last one anything went into, or `extendTo`). */
+  get bins(): number {
+    return this.#bins;
+  }
+
+  #bin(t: number): number {
+    if (Number.isNaN(this.#origin)) this.#origin = Math.floor(t / this.binUs) * this.binUs;
+    const b = Math.max(this.#sealed, Math.floor((t - this.#origin) / this.binUs));
+    if (b >= this.#bins) {
+      for (const c of this.#columns) c.ensure(b + 1);
+      this.#bins = b + 1;
+    }
+    return b;
+  }
+
+  /** Makes the series at least as long as the bin holding `t`. */
+  extendTo(t: number): void {
+    if (Number.isFinite(t) && !Number.isNaN(this.#origin)) this.#bin(t);
+  }
+
+  /** Counts a frame `link` has just counted (its plausible fades, RSSI and ordinary interval). */
+  frame(f: DecodedFrame, link: LinkMonitor): void {
+    const t = f.timeUs;
+    if (!Number.isFinite(t)) return;
+    const b = this.#bin(t);
+    this.#frames.data[b]! += 1;
+    this.#fades.data[b]! += link.lastFades;
+    if (f.rssi !== null && f.rssi !== -128) {
+      this.#rssiSum.data[b]! += f.rssi;
+      this.#rssiN.data[b]! += 1;
+      if (f.rssi < this.#rssiMin.data[b]!) this.#rssiMin.data[b] = f.rssi;
+    }
+    const iv = link.lastIntervalUs;
+    if (Number.isFinite(iv)) {
+      this.#intervalSum.data[b]! += iv;
+      this.#intervalN.data[b]! += 1;
+    }
+  }
+
+  /** `count` frames missing, due one `periodUs` apart from `fromUs`, none after `toUs`. */
+  missed(fromUs: number, toUs: number, count: number, periodUs: number): void {
+    if (!Number.isFinite(fromUs)) return;
+    const p = Number.isFinite(periodUs) && periodUs > 0 ? periodUs : 0;
+    for (let k = 0; k < count; k++) {
+      const t = Math.min(fromUs + k * p, Number.isFinite(toUs) ? toUs : Infinity);
+      this.#lost.data[this.#bin(t)]! += 1;
+    }
+  }
+
+  /** Seals the bins before `bin`: nothing is added to them any more (the live view has shown them). */
+  seal(bin: number): void {
+    if (bin > this.#sealed) this.#sealed = bin;
+  }
+
+  /** The bin that holds time `t` (can be negative or past the end). */
+  binOf(t: number): number {
+    return Math.floor((t - this.#origin) / this.binUs);
+  }
+
+  /** Start time of bin `i`, µs. */
+  startOf(i: number): number {
+    return this.#origin + i * this.binUs;
+  }
+
+  frames(i: number): number { return this.#frames.data[i] ?? 0; }
+  fades(i: number): number { return this.#fades.data[i] ?? 0; }
+  lost(i: number): number { return this.#lost.data[i] ?? 0; }
+  /** Mean RSSI of bin `i` (loss reports of −128 left out), NaN without. */
+  rssiMean(i: number): number {
+    const n = this.#rssiN.data[i] ?? 0;
+    return n > 0 ? (this.#rssiSum.data[i] as number) / n : NaN;
+  }
+  /** Lowest RSSI of bin `i`, NaN without. */
+  rssiMin(i: number): number {
+    const v = this.#rssiMin.data[i] ?? Infinity;
+    return Number.isFinite(v) ? v : NaN;
+  }
+  /** Mean ordinary frame interval of bin `i`, µs, NaN without one. */
+  intervalMean(i: number): number {
+    const n = this.#intervalN.data[i] ?? 0;
+    return n > 0 ? (this.#intervalSum.data[i] as number) / n : NaN;
+  }
+}
+
+/** A link monitor whose missed frames go into `series` too. */
+export function monitorWithSeries(options: Omit<LinkOptions, 'onMissed'>, series: LinkSeries): LinkMonitor {
+  return new LinkMonitor({ ...options, onMissed: (from, to, n, p) => series.missed(from, to, n, p) });
+}
