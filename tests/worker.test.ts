@@ -1,57 +1,104 @@
 /**
  * The worker's parts that run without a browser: the engine's batches (graph buckets, lost
- * frames, episodes) and the wording of port errors.
+ * frames, episodes, a forced resolution), replay on the capture's own clock, and the wording
+ * of port errors.
  */
 import { describe, expect, it } from 'vitest';
-import { Engine } from '../src/worker/engine.js';
-import { openProblem } from '../src/worker/sources/serial.js';
+import { captureSpan, encodeCapture, importRaw, readCapture, type Capture } from '../src/decoder/index.js';
+import type { Batch } from '../src/worker/protocol.js';
 import { preset, simulate } from '../src/simulator/index.js';
-import { usbChunks } from './e2e/app-fixture.js';
+import { Engine, SETTLE_US } from '../src/worker/engine.js';
+import { ReplaySource, type ReplayClock } from '../src/worker/sources/replay.js';
+import { openProblem } from '../src/worker/sources/serial.js';
 
-function run(name: string, seed: number, durationUs: number, tickAfterEndUs = 0) {
-  const sim = simulate({ ...preset(name), seed }, durationUs, { truth: true });
-  const engine = new Engine({ resolution: 'auto', jitterUs: 20_000 });
-  const series = { t: [] as number[], fadeRate: [] as number[], lost: [] as number[], periodMs: [] as number[] };
-  const episodes: { id: number; kind: string; endUs: number | null }[] = [];
+/** What a USB adapter delivers: whatever arrived in each 16 ms window, stamped at its end. */
+function usbChunks(bytes: Uint8Array, times: Float64Array): { bytes: Uint8Array; timeUs: number }[] {
+  const out: { bytes: Uint8Array; timeUs: number }[] = [];
+  let start = 0;
+  for (let i = 0; i <= bytes.length; i++) {
+    const deadline = Math.floor(times[start]! / 16_000) * 16_000 + 16_000;
+    if (i === bytes.length || times[i]! >= deadline) {
+      if (i > start) out.push({ bytes: bytes.slice(start, i), timeUs: deadline });
+      start = i;
+    }
+  }
+  return out;
+}
+
+/** A capture with the time of every byte in one chunk, as `readCapture` returns a Saleae export. */
+function saleae(sim: { bytes: Uint8Array; timesUs: Float64Array }): Capture {
+  return {
+    kind: 'saleae-csv', meta: {}, timing: 'per-byte', bytes: sim.bytes,
+    chunkEnds: Uint32Array.of(sim.bytes.length), chunkTimesUs: Float64Array.of(sim.timesUs[sim.timesUs.length - 1]!),
+    chunkPorts: new Uint8Array(1), byteTimesUs: sim.timesUs, events: [], issues: [],
+  };
+}
+
+interface Collected {
+  series: { t: number[]; fadeRate: number[]; lost: number[]; periodMs: number[] };
+  episodes: Batch['episodes'];
+  last: Batch | null;
+}
+
+function collector(engine: Engine) {
+  const c: Collected = { series: { t: [], fadeRate: [], lost: [], periodMs: [] }, episodes: [], last: null };
   const take = (now: number) => {
     const out = engine.batch(now);
     if (out === null) return;
-    series.t.push(...out.batch.series.t);
-    series.fadeRate.push(...out.batch.series.fadeRate);
-    series.lost.push(...out.batch.series.lost);
-    series.periodMs.push(...out.batch.series.periodMs);
-    episodes.push(...out.batch.episodes);
+    c.series.t.push(...out.batch.series.t);
+    c.series.fadeRate.push(...out.batch.series.fadeRate);
+    c.series.lost.push(...out.batch.series.lost);
+    c.series.periodMs.push(...out.batch.series.periodMs);
+    c.episodes.push(...out.batch.episodes);
+    c.last = out.batch;
   };
+  return { c, take };
+}
+
+/** The live path: 16 ms chunks, the worker's 50 ms idle ticks between them, and the end of the stream. */
+function run(name: string, seed: number, durationUs: number) {
+  const sim = simulate({ ...preset(name), seed }, durationUs, { truth: true });
+  const engine = new Engine({ resolution: 'auto', jitterUs: 20_000 });
+  const { c, take } = collector(engine);
   const chunks = usbChunks(sim.bytes, sim.timesUs);
-  let last = 0;
-  for (const c of chunks) {
-    // Ticks between chunks, as the worker's idle timer makes them.
-    for (let t = last + 50_000; t < c.timeUs; t += 50_000) take(t);
-    engine.push(c.bytes, c.timeUs, 0);
-    take(c.timeUs);
-    last = c.timeUs;
+  let last = chunks[0]!.timeUs;
+  for (const chunk of chunks) {
+    for (let t = last + 50_000; t < chunk.timeUs; t += 50_000) take(t);
+    engine.push(chunk.bytes, chunk.timeUs, 0);
+    take(chunk.timeUs);
+    last = chunk.timeUs;
   }
-  // Time passing after the last frame closes the open buckets (and counts the silence as lost).
-  if (tickAfterEndUs > 0) take(last + tickAfterEndUs);
-  return { sim, series, episodes, engine };
+  engine.end(last);
+  take(last + 5_000_000);
+  return { sim, engine, ...c };
 }
 
 describe('the engine', () => {
-  it('sums frames into 100 ms buckets whose lost frames add up to what the receiver missed', () => {
-    const { sim, series } = run('dropouts-failsafe', 3, 3_200_000);
-    expect(series.t.every((t, i) => i === 0 || t - (series.t[i - 1] as number) === 100_000)).toBe(true);
-    const missed = sim.truth!.gaps.reduce((n, g) => n + g.missedFrames, 0);
+  it('sums frames into 100 ms buckets whose lost frames add up to the missed frames, each counted once', () => {
+    const { sim, series, engine } = run('dropouts-failsafe', 3, 3_200_000);
+    expect(series.t.every((t, i) => i === 0 || t - series.t[i - 1]! === 100_000)).toBe(true);
     const lost = series.lost.reduce((a, b) => a + b, 0);
-    // Buckets round to whole frames: within a frame or two of the truth, never counted twice.
-    expect(Math.abs(lost - missed)).toBeLessThanOrEqual(3);
-    // Frame spacing leaves the gaps out (longer than 1.5 periods plus USB jitter): about 11 ms,
-    // a bucket with one missed frame reads more.
+    expect(lost).toBe(engine.link.stats.missedFrames);
+    // The receiver's counter says what it missed: every frame the dropouts took, and no more than it counted.
+    const truth = sim.truth!.gaps.reduce((n, g) => n + g.missedFrames, 0);
+    expect(engine.link.stats.missedBasis).toBe('fade-counter');
+    expect(engine.link.stats.missedFrames).toBeGreaterThanOrEqual(truth);
+    expect(engine.link.stats.missedFrames).toBe(engine.link.stats.fades);
+    // Frame spacing leaves the gaps out: about 11 ms.
     const periods = series.periodMs.filter(Number.isFinite);
     expect(periods.filter((p) => p > 9 && p < 13).length).toBeGreaterThan(periods.length * 0.8);
-    for (const p of periods) {
-      expect(p).toBeGreaterThan(5);
-      expect(p).toBeLessThan(37);
+  });
+
+  it('hands a bucket to the page only once missing frames can no longer be placed in it', () => {
+    const sim = simulate({ ...preset('dsmx-11ms-2048-internal'), seed: 2 }, 3_000_000);
+    const engine = new Engine({ resolution: 'auto', jitterUs: 20_000 });
+    const { c, take } = collector(engine);
+    for (const chunk of usbChunks(sim.bytes, sim.timesUs)) {
+      engine.push(chunk.bytes, chunk.timeUs, 0);
+      take(chunk.timeUs);
+      expect(c.series.t.every((t) => t + 100_000 <= chunk.timeUs - SETTLE_US)).toBe(true);
     }
+    expect(c.series.t.length).toBeGreaterThan(15);
   });
 
   it('reports each hold and failsafe once when it starts and once when it ends', () => {
@@ -68,10 +115,167 @@ describe('the engine', () => {
   });
 
   it('shows fades as a rate per second in the bucket they were reported', () => {
-    const { series, engine } = run('fade-wrap-internal', 4, 2_000_000, 1_500_000);
+    const { series, engine } = run('fade-wrap-internal', 4, 2_000_000);
     const total = series.fadeRate.reduce((a, b) => a + b * 0.1, 0);
     expect(engine.link.stats.fades).toBeGreaterThan(5);
     expect(Math.round(total)).toBe(engine.link.stats.fades);
+  });
+
+  it('after the end, stands still: the state and clock stay as they were at the end however late the page asks', () => {
+    const { engine, last } = run('dsmx-11ms-2048-internal', 5, 1_000_000);
+    expect(last!.ended).toBe(true);
+    expect(last!.link.state).toBe('live');
+    const later = engine.batch(1e12);
+    expect(later?.batch.link.state ?? 'live').toBe('live');
+    expect(engine.link.stats.holds).toBe(0);
+  });
+});
+
+describe('a forced resolution is not link loss', () => {
+  it('counts nothing while a forced 1024 matches no frame of a 2048 stream, says what the stream looks like, and leaves nothing after switching back', () => {
+    const sim = simulate({ ...preset('dsmx-11ms-2048-internal'), seed: 6 }, 8_000_000);
+    const engine = new Engine({ resolution: 'auto', jitterUs: 20_000 });
+    const { c, take } = collector(engine);
+    const chunks = usbChunks(sim.bytes, sim.timesUs);
+    let framesWhileForced = -1;
+    for (const chunk of chunks) {
+      if (chunk.timeUs >= 2_000_000 && framesWhileForced < 0) {
+        engine.setResolution(1024, chunk.timeUs);
+        framesWhileForced = engine.decoder.stats.frames;
+      }
+      if (chunk.timeUs >= 5_000_000 && framesWhileForced >= 0 && engine.mismatch !== null) {
+        expect(engine.decoder.stats.frames).toBe(framesWhileForced);
+        expect(c.last!.mismatch).toBe(2048);
+        expect(c.last!.link.state).toBe('waiting');
+        engine.setResolution('auto', chunk.timeUs);
+        framesWhileForced = Infinity;
+      }
+      engine.push(chunk.bytes, chunk.timeUs, 0);
+      for (let t = chunk.timeUs; t < chunk.timeUs + 16_000; t += 8_000) take(t);
+    }
+    expect(framesWhileForced).toBe(Infinity);
+    expect(engine.decoder.format.resolution).toBe(2048);
+    expect(c.last!.mismatch).toBeNull();
+    expect(c.last!.link.state).toBe('live');
+    expect(engine.link.stats).toMatchObject({ holds: 0, failsafes: 0, missedFrames: engine.link.stats.fades });
+    expect(engine.link.episodes).toEqual([]);
+    expect(c.episodes).toEqual([]);
+  });
+});
+
+/** Wall time for replay: each tick moves it 10 ms; every reading a µs, so slices end. */
+class SimulatedClock implements ReplayClock {
+  ms = 0;
+  readonly timers = new Map<number, () => void>();
+  #next = 1;
+  now(): number {
+    this.ms += 0.001;
+    return this.ms;
+  }
+  every(_ms: number, fn: () => void): unknown {
+    const id = this.#next++;
+    this.timers.set(id, fn);
+    return id;
+  }
+  cancel(handle: unknown): void {
+    this.timers.delete(handle as number);
+  }
+  tick(n = 1): void {
+    for (let i = 0; i < n && this.timers.size > 0; i++) {
+      this.ms += 10;
+      for (const fn of [...this.timers.values()]) fn();
+    }
+  }
+}
+
+function replayOf(capture: Capture, options: { untimedPeriodUs?: number } = {}) {
+  const clock = new SimulatedClock();
+  const positions: number[] = [];
+  let ended = 0;
+  const engine = new Engine({ resolution: 'auto', jitterUs: 0 });
+  const r: ReplaySource = new ReplaySource(
+    capture,
+    (_p, bytes, time) => engine.push(bytes, time, 0),
+    (clockUs) => {
+      positions.push(clockUs);
+      engine.batch(r.linkNowUs(0));
+    },
+    () => {
+      ended++;
+      engine.end(r.recordedTiming ? r.endUs : Number.NaN);
+    },
+    { clock, ...options },
+  );
+  return { r, clock, positions, engine, ended: () => ended };
+}
+
+describe('replay runs on the capture\'s clock', () => {
+  const sim = simulate({ ...preset('dropouts-failsafe'), seed: 3 }, 4_000_000);
+
+  it('gives a Saleae export (one chunk, per-byte times) its timeline: start, end, 1× pace, seeking and full speed', () => {
+    const capture = saleae(sim);
+    const { r, clock, positions, engine, ended } = replayOf(capture);
+    expect(r.startUs).toBe(sim.timesUs[0]);
+    expect(r.endUs).toBe(sim.timesUs.at(-1));
+    expect(r.timed).toBe(true);
+    r.play();
+    clock.tick(100); // 1 s of wall time at 1×
+    expect(r.positionUs - r.startUs).toBeCloseTo(1_000_000, -3);
+    expect(ended()).toBe(0);
+    const framesAt1s = engine.decoder.stats.frames;
+    expect(framesAt1s).toBeGreaterThan(60);
+    expect(framesAt1s).toBeLessThan(100);
+    r.setSpeed(4);
+    clock.tick(25); // 1 s more of capture
+    expect(r.positionUs - r.startUs).toBeCloseTo(2_000_000, -4);
+    r.seek(r.startUs + 3_000_000);
+    expect(r.positionUs).toBe(r.startUs + 3_000_000);
+    r.setSpeed(0);
+    clock.tick(10);
+    expect(ended()).toBe(1);
+    expect(r.positionUs).toBe(r.endUs);
+    expect(Math.max(...positions)).toBeLessThanOrEqual(r.endUs);
+  });
+
+  it('ends at the last recorded time, never past it, and freezes the state there', () => {
+    const capture = saleae(simulate({ ...preset('dsmx-11ms-2048-internal'), seed: 8 }, 1_500_000));
+    const { r, clock, positions, engine, ended } = replayOf(capture);
+    r.play();
+    clock.tick(1000);
+    expect(ended()).toBe(1);
+    expect(r.ended).toBe(true);
+    expect(Math.max(...positions)).toBe(r.endUs);
+    const atEnd = engine.batch(r.endUs + 60e6)?.batch;
+    expect(atEnd?.ended ?? true).toBe(true);
+    expect(engine.link.state).toBe('live');
+    expect(engine.link.stats.holds).toBe(0);
+  });
+
+  it('plays a raw .bin at the receiver\'s pace, decoded without times: a timeline, but nothing measured from it', () => {
+    const capture = importRaw(sim.bytes);
+    expect(captureSpan(capture).startUs).toBeNaN();
+    const { r, clock, engine, ended } = replayOf(capture, { untimedPeriodUs: 11_000 });
+    expect(r.recordedTiming).toBe(false);
+    expect(r.timed).toBe(true);
+    expect(r.endUs).toBeCloseTo((sim.bytes.length / 16) * 11_000, -3);
+    r.play();
+    clock.tick(100);
+    expect(engine.decoder.stats.frames).toBeGreaterThan(70);
+    expect(engine.decoder.stats.frames).toBeLessThan(110);
+    r.setSpeed(0);
+    clock.tick(20);
+    expect(ended()).toBe(1);
+    // Nothing from the paced clock; the receiver's own fade count needs none.
+    expect(engine.link.stats).toMatchObject({ holds: 0, failsafes: 0, missedBasis: 'fade-counter', missedFrames: engine.link.stats.fades });
+    expect(engine.link.stats.periodUs).toBeNaN();
+  });
+
+  it('plays a chunk-timed recording (.sscap) from its first chunk to its last', () => {
+    const chunks = usbChunks(sim.bytes, sim.timesUs);
+    const capture = readCapture(encodeCapture({ baudRate: 115200 }, chunks.map((c) => ({ type: 'data', bytes: c.bytes, timeUs: c.timeUs, port: 0 }))), 'x.sscap');
+    const { r } = replayOf(capture);
+    expect(r.endUs).toBe(chunks.at(-1)!.timeUs);
+    expect(r.startUs).toBeLessThan(chunks[0]!.timeUs);
   });
 });
 

@@ -583,8 +583,8 @@ function remoteFindings(r: RemoteReport, timing: CaptureTiming): ReportFinding[]
       }
     }
   } else {
-    add('info', 'no-timing', 'No timing in this file: no lost frames, rates, holds, failsafes or jitter');
-    if (r.fades !== null) add('info', 'fade-rate', `${plural(r.fades.total, 'fade')} counted by the receiver`);
+    add('info', 'no-timing', `No timing in this file: no rates, holds, failsafes or jitter${r.missedFrames === null ? ', and no lost frames' : ''}`);
+    if (r.fades !== null) add('info', 'fade-rate', `${plural(r.fades.total, 'fade')} counted by the receiver${r.missedFrames !== null ? ' (its count of frames lost)' : ''}`);
   }
   if (r.rssi !== null) {
     if (r.rssi.minDbm !== null && r.rssi.minDbm < RSSI_LOW_DBM) {
@@ -661,6 +661,8 @@ export function healthReport(capture: Capture, options: HealthReportOptions = {}
     const last = n > 0 ? (d.times[n - 1] as number) : NaN;
     const period = ls.nominalPeriodUs;
     const havePeriod = hasClock && Number.isFinite(period) && n > 0;
+    // The receiver's own count needs no clock: a file without timing still has it.
+    const haveMissed = havePeriod || (ls.missedBasis === 'fade-counter' && n > 0);
     const missed = ls.missedFrames;
     const rssiMode = format.headerMode === 'rssi';
 
@@ -756,11 +758,11 @@ export function healthReport(capture: Capture, options: HealthReportOptions = {}
       lastFrameUs: hasClock && n > 0 ? r1(last - origin) : null,
       durationUs: r1n(duration),
       frames: stats.frames,
-      expectedFrames: havePeriod ? stats.frames + missed : null,
-      missedFrames: havePeriod ? missed : null,
+      expectedFrames: haveMissed ? stats.frames + missed : null,
+      missedFrames: haveMissed ? missed : null,
       missedBasis: ls.missedBasis,
       delivery: { delayUs: hasClock ? r1n(ls.deliveryDelayUs) : null, jitterUs: hasClock ? r1n(ls.deliveryJitterUs) : null },
-      lostRatio: havePeriod ? Math.round((missed / Math.max(1, stats.frames + missed)) * 1e6) / 1e6 : null,
+      lostRatio: haveMissed ? Math.round((missed / Math.max(1, stats.frames + missed)) * 1e6) / 1e6 : null,
       nominalPeriodUs: havePeriod ? period : null,
       fades: rssiMode ? null : {
         total: fadesTotal,

@@ -59,7 +59,7 @@ export class Engine {
   #episodesDone = 0;
   readonly #episodesOpenSent = new Set<number>();
   /** Since the user forced a resolution: counters then, and the mismatch found. */
-  #forcedAt: { frames: number; discarded: number } | null = null;
+  #forcedAt: { resolution: Resolution; frames: number; discarded: number } | null = null;
   #mismatch: Resolution | null = null;
 
   constructor(readonly options: EngineOptions) {
@@ -74,7 +74,7 @@ export class Engine {
         this.series.missed(Math.max(from, floor), Math.max(to, floor), n, p);
       },
     });
-    if (options.resolution !== 'auto') this.#forcedAt = { frames: 0, discarded: 0 };
+    if (options.resolution !== 'auto') this.#forcedAt = { resolution: options.resolution, frames: 0, discarded: 0 };
   }
 
   /** Bytes as they arrived: `time` is the chunk's arrival (or per-byte times). */
@@ -109,7 +109,7 @@ export class Engine {
     this.decoder.setResolution(resolution, by);
     this.link.interrupt(nowUs);
     const s = this.decoder.stats;
-    this.#forcedAt = resolution === 'auto' || by !== 'user' ? null : { frames: s.frames, discarded: s.discardedBytes };
+    this.#forcedAt = resolution === 'auto' || by !== 'user' ? null : { resolution, frames: s.frames, discarded: s.discardedBytes };
     this.#mismatch = null;
     this.#changed = true;
   }
@@ -129,9 +129,8 @@ export class Engine {
       mismatch = fromDecoder;
     } else if (this.#forcedAt !== null) {
       const s = this.decoder.stats;
-      const forced = this.decoder.format.resolution;
       if (s.frames === this.#forcedAt.frames && s.discardedBytes - this.#forcedAt.discarded > MISMATCH_AFTER_BYTES) {
-        mismatch = forced === 1024 ? 2048 : 1024;
+        mismatch = this.#forcedAt.resolution === 1024 ? 2048 : 1024;
       }
     }
     if (mismatch !== this.#mismatch) {

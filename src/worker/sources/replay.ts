@@ -90,6 +90,11 @@ class PortChunks {
     return { bytes: c.bytes.subarray(start, end), byteTimes: c.byteTimesUs?.subarray(start, end), atUs: this.atUs(k) };
   }
 
+  /** Without timing: the port's bytes before chunk k. */
+  bytesBeforeChunk(k: number): number {
+    return k === 0 || this.#bytesBefore === undefined ? 0 : (this.#bytesBefore[k - 1] as number);
+  }
+
   /** Whether chunk k's bytes are decoded with times (recorded ones); not on the paced clock. */
   get timed(): boolean {
     return this.#bytesBefore === undefined;
@@ -110,7 +115,7 @@ class PortChunks {
     const c = this.capture;
     const start = i === 0 ? 0 : (c.chunkEnds[i - 1] as number);
     if (c.byteTimesUs !== undefined) return c.byteTimesUs[start + this.nextByte] ?? Infinity;
-    if (!this.timed) return Infinity;
+    if (!this.timed) return (this.bytesBeforeChunk(this.next) + this.nextByte + 1) * this.usPerByte;
     return this.atUs(this.next) - ((c.chunkEnds[i] as number) - start - 1) * BYTE_TIME_US;
   }
 }
@@ -267,6 +272,21 @@ export class ReplaySource {
       while (c.next < c.length) {
         if (budgetMs !== Infinity && this.#clock.now() - started > budgetMs) return false;
         const chunk = c.get(c.next);
+        if (!c.timed) {
+          // The paced clock: byte j of the port is due at (j + 1) × usPerByte; fed untimed.
+          const first = c.bytesBeforeChunk(c.next);
+          const due = Math.min(chunk.bytes.length, Math.floor(clockUs / c.usPerByte + 1e-9) - first);
+          if (due > c.nextByte) {
+            this.#feed(c.port, chunk.bytes.subarray(c.nextByte, due), undefined, (first + due) * c.usPerByte);
+            c.nextByte = due;
+          }
+          if (c.nextByte === chunk.bytes.length) {
+            c.next++;
+            c.nextByte = 0;
+            continue;
+          }
+          break;
+        }
         if (chunk.byteTimes === undefined) {
           if (chunk.atUs > clockUs) break;
           // Without recorded timing the bytes go in untimed: the pace is not a measurement.
