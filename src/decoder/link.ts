@@ -22,8 +22,8 @@
  * - **Delivery delay and jitter** (how late frames reach us against the receiver's own
  *   schedule) are a measure of their own (`deliveryDelayUs`, `deliveryJitterUs`), never loss.
  * - **The frame period** snaps to 11 or 22 ms at `PERIOD_SNAP_US` (`nominalPeriodOf`).
- * - **A fade-counter rise** larger than the frames due by the clock allow (`FADE_DELTA_SLACK`)
- *   is a corrupted header, not fades (`plausibleFades`).
+ * - Fades are the decoder's `fadesDelta`: the decoder already leaves out counter jumps it cannot
+ *   attribute to the receiver (`DecoderStats.fadeJumps`).
  */
 import { FAILSAFE_TIMEOUT_US, FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US, systemInfo } from './spec.js';
 import type { DecodedFrame } from './types.js';
@@ -75,10 +75,8 @@ export interface LinkOptions {
 
 export interface LinkStats {
   frames: number;
-  /** Sum of the receiver's fade deltas (frames it reported missing), implausible rises left out. */
+  /** Sum of the receiver's fade deltas (frames it reported missing). */
   fades: number;
-  /** Fade-counter rises left out as corrupted headers (`plausibleFades`). */
-  implausibleFades: number;
   /** Frames missed: by the fade counter where the receiver counts, else by frames expected against received. */
   missedFrames: number;
   missedBasis: MissedBasis;
@@ -115,13 +113,6 @@ export const LEDGER_WINDOW_US = 500_000;
 const TAIL_FRAMES = 4;
 /** Delivery jitter is the largest spread of the last this many windows. */
 const JITTER_WINDOWS = 8;
-/**
- * How many more fades than frames due (by the clock, since the previous frame) a frame's fade
- * counter may add before the rise is taken for a corrupted header and left out: a satellite can
- * count a fade it recovered from without dropping a frame, and chunk times blur a gap by a
- * frame or two. A bit flipped in the counter adds 2^n (and takes it back on the next frame).
- */
-export const FADE_DELTA_SLACK = 3;
 
 /** 11 or 22 ms: the system period a mean frame interval belongs to. */
 export function nominalPeriodOf(meanIntervalUs: number): number {
@@ -140,16 +131,6 @@ export function isFrameInterval(intervalUs: number, nominalPeriodUs: number, jit
 export function holdThresholdUs(nominalPeriodUs: number, jitterUs: number): number {
   const base = Number.isFinite(nominalPeriodUs) ? Math.max(HOLD_MIN_US, 2.5 * nominalPeriodUs) : HOLD_MIN_US;
   return base + (Number.isFinite(jitterUs) ? jitterUs : 0);
-}
-
-/**
- * The fades a counter rise stands for: `delta`, or 0 when it is more than the frames due since
- * the previous frame (`gapUs`) allow (a corrupted header). Without a period or a gap, `delta`.
- */
-export function plausibleFades(delta: number, gapUs: number, nominalPeriodUs: number): number {
-  if (delta <= 0 || !Number.isFinite(gapUs) || !Number.isFinite(nominalPeriodUs)) return delta;
-  const due = Math.max(0, Math.round(gapUs / nominalPeriodUs) - 1);
-  return delta > due + FADE_DELTA_SLACK ? 0 : delta;
 }
 
 const PERIOD_WINDOW = 33;
@@ -340,7 +321,7 @@ export class LinkMonitor {
   #lastInterval = NaN;
   #finished = false;
   readonly #stats: LinkStats = {
-    frames: 0, fades: 0, implausibleFades: 0, missedFrames: 0, missedBasis: 'none', holds: 0, failsafes: 0, periodUs: NaN,
+    frames: 0, fades: 0, missedFrames: 0, missedBasis: 'none', holds: 0, failsafes: 0, periodUs: NaN,
     nominalPeriodUs: NaN, fadeRate: 0, longestGapUs: 0, rssi: NaN, minRssi: NaN, deliveryDelayUs: NaN, deliveryJitterUs: NaN,
   };
 
@@ -377,7 +358,7 @@ export class LinkMonitor {
     return this.#lastUs;
   }
 
-  /** Fades the last frame stood for (its counter rise, implausible rises as 0). */
+  /** Fades the last frame reported (its `fadesDelta`). */
   get lastFades(): number {
     return this.#lastFades;
   }
@@ -415,9 +396,14 @@ export class LinkMonitor {
       }
     }
     const last = this.#lastUs;
+    const open = this.#open;
+    if (open !== null && Number.isFinite(last) && open.lastFrameUs > last && !(t <= open.lastFrameUs)) {
+      // The silence was counted from bytes the decoder held and then discarded (not a frame):
+      // it is dated from the last frame instead, as it would have been without them.
+      this.#redate(open.lastFrameUs, last);
+    }
     const gap = Number.isFinite(t) && Number.isFinite(last) && t >= last ? t - last : NaN;
-    const fades = plausibleFades(frame.fadesDelta, gap, s.nominalPeriodUs);
-    if (fades !== frame.fadesDelta) s.implausibleFades++;
+    const fades = frame.fadesDelta;
     s.fades += fades;
     this.#lastFades = fades;
     if (frame.fades !== null && (frame.fades !== 0 || fades > 0)) this.#counting = true;
@@ -449,6 +435,9 @@ export class LinkMonitor {
     } else if (Number.isFinite(s.nominalPeriodUs) && Number.isFinite(t)) {
       s.missedBasis = 'frame-count';
     }
+    // The frame a silence was already counted from (it was pending in the decoder, `update`'s
+    // `pendingUs`): the silence goes on until a later frame.
+    if (this.#open !== null && Number.isFinite(t) && t <= this.#open.lastFrameUs) return;
     if (this.#open !== null) {
       this.#open.endUs = Number.isFinite(t) ? t : this.#open.startUs;
       this.#open = null;
@@ -467,9 +456,12 @@ export class LinkMonitor {
   /**
    * Advances the clock to `nowUs` (the caller's time, same clock as the frames) and returns
    * the state: 'hold' once the hold threshold has passed without a frame, 'failsafe' after 1 s.
+   * `pendingUs`: the time of a frame received but not handed out yet (a decoder holds a frame
+   * until the next one confirms where it ends): the silence counts from it, as it will once
+   * the frame comes.
    */
-  update(nowUs: number): LinkState {
-    const last = this.#lastUs;
+  update(nowUs: number, pendingUs = Number.NaN): LinkState {
+    const last = pendingUs > this.#lastUs ? pendingUs : this.#lastUs;
     if (this.#state === 'waiting' || !Number.isFinite(last) || !Number.isFinite(nowUs)) return this.#state;
     const gap = nowUs - last;
     const s = this.#stats;
@@ -535,6 +527,22 @@ export class LinkMonitor {
     this.#periodCount = 0;
     this.#ledger.reset();
     this.#state = 'waiting';
+  }
+
+  /** Re-dates the episodes counted from `fromUs` to count from the frame at `lastUs`. */
+  #redate(fromUs: number, lastUs: number): void {
+    const p = this.#stats.nominalPeriodUs;
+    for (let i = this.#episodes.length - 1; i >= 0; i--) {
+      const e = this.#episodes[i] as LinkEpisode;
+      if (e.lastFrameUs !== fromUs) break;
+      e.lastFrameUs = lastUs;
+      if (e.kind === 'failsafe') {
+        e.startUs = lastUs + this.#failsafeAfterUs;
+      } else {
+        e.startUs = lastUs + (Number.isFinite(p) ? p : this.holdAfterUs);
+        if (e.endUs !== null) e.endUs = lastUs + this.#failsafeAfterUs;
+      }
+    }
   }
 
   #openEpisode(kind: 'hold' | 'failsafe', startUs: number, lastFrameUs: number): void {

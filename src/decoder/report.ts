@@ -11,7 +11,7 @@
  */
 import type { Capture, CaptureKind, CaptureTiming } from '../capture/index.js';
 import { captureChunks, capturePorts } from '../capture/index.js';
-import { FADE_DELTA_SLACK, type LinkEpisode, type MissedBasis } from './link.js';
+import type { LinkEpisode, MissedBasis } from './link.js';
 import { CHANNEL_COUNT, channelResolution, XPLUS_FIRST, channelName, servoToMicros, servoToPercent, systemInfo, type Resolution, USB_CHUNK_JITTER_US } from './spec.js';
 import { captureSpan, decodeCapture, resolutionKey } from './summary.js';
 import type { HeaderReading, RemoteKind, ResolutionReason } from './types.js';
@@ -93,7 +93,11 @@ export const SPIKE_RETURN_PERCENT = 5;
 export const SPIKE_WINDOW_US = 100_000;
 /** The same window in decoded frames, for captures without timing. */
 export const SPIKE_WINDOW_FRAMES = 9;
-export { FADE_DELTA_SLACK };
+/**
+ * Recorded in the report's thresholds for readers of older reports: the decoder now judges
+ * fade-counter jumps itself (a rise of 8 or more outside a confirmed chain counts nothing).
+ */
+export const FADE_DELTA_SLACK = 3;
 /** At most this many glitches are listed (all are counted). */
 export const MAX_LISTED_GLITCHES = 200;
 /** At most this many hold episodes are listed (all are counted). */
@@ -278,8 +282,8 @@ export interface RemoteReport {
    * The receiver's fade counter: total over the capture and per minute of `durationUs`;
    * `null` for an RSSI receiver. `counterMoved` is false when every frame said 0 (a receiver
    * that does not count, e.g. a clone's 00 00 header, or simply a perfect link).
-   * `implausibleJumps` counts frames whose counter rose by more than the frames due since the
-   * previous one allow (`FADE_DELTA_SLACK`): a corrupted header, left out of `total`.
+   * `implausibleJumps` counts the counter jumps the decoder could not attribute to the receiver
+   * (`DecoderStats.fadeJumps`): left out of `total`.
    */
   fades: { total: number; perMinute: number | null; counterMoved: boolean; implausibleJumps: number } | null;
   /** SPM4649T RSSI over the frames that carried a level (−128 loss reports counted apart); `null` without RSSI. */
@@ -698,7 +702,7 @@ export function healthReport(capture: Capture, options: HealthReportOptions = {}
       }
     }
     const fadesTotal = ls.fades;
-    const fadeJumps = ls.implausibleFades;
+    const fadeJumps = stats.fadeJumps;
     const intervals = d.intervals;
 
     let framePeriod: ReportPeriodStats | null = null;

@@ -55,7 +55,7 @@ export function captureSpan(capture: Capture): { startUs: number; endUs: number 
 export function resolutionKey(formats: Iterable<FormatInfo>): Resolution | undefined {
   let key: Resolution | undefined;
   for (const f of formats) {
-    if (f.remote === 'internal' && f.system !== null && systemInfo(f.system) !== undefined && f.resolution !== null) key = f.resolution;
+    if (f.remote === 'internal' && f.system !== null && f.systemValid && systemInfo(f.system) !== undefined && f.resolution !== null) key = f.resolution;
   }
   return key;
 }

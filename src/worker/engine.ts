@@ -5,7 +5,7 @@
  * Time is always passed in: the arrival clock live, the capture's own clock in replay.
  */
 import {
-  CHANNEL_COUNT, LinkMonitor, LinkSeries, SpektrumDecoder, type FormatInfo, type LinkEpisode, type Resolution,
+  BYTE_TIME_US, CHANNEL_COUNT, LinkMonitor, LinkSeries, SpektrumDecoder, type LinkEpisode, type Resolution,
 } from '../decoder/index.js';
 import { InspectorLog } from './inspector.js';
 import { BUCKET_US, type Batch } from './protocol.js';
@@ -25,17 +25,8 @@ export interface EngineOptions {
  */
 export const SETTLE_US = 1_000_000;
 
-/** Bytes a forced resolution may discard without a frame before it is called a mismatch. */
-const MISMATCH_AFTER_BYTES = 256;
-
-/**
- * The resolution the bytes only decode at, when the user forced the other one: the decoder's
- * `forcedMismatch` where it reports one, else judged here (frames stopped and bytes pile up).
- */
-function decoderMismatch(format: FormatInfo): Resolution | null | undefined {
-  const f = format as FormatInfo & { forcedMismatch?: Resolution | null };
-  return f.forcedMismatch;
-}
+/** Pushes remembered to date the bytes the decoder still holds. */
+const PUSHES_KEPT = 32;
 
 export class Engine {
   readonly decoder: SpektrumDecoder;
@@ -58,8 +49,7 @@ export class Engine {
   /** Episode ids up to which every episode has been reported as ended; and open ones reported. */
   #episodesDone = 0;
   readonly #episodesOpenSent = new Set<number>();
-  /** Since the user forced a resolution: counters then, and the mismatch found. */
-  #forcedAt: { resolution: Resolution; frames: number; discarded: number } | null = null;
+  /** While a forced resolution matches no frame: the resolution the stream looks like. */
   #mismatch: Resolution | null = null;
 
   constructor(readonly options: EngineOptions) {
@@ -74,14 +64,18 @@ export class Engine {
         this.series.missed(Math.max(from, floor), Math.max(to, floor), n, p);
       },
     });
-    if (options.resolution !== 'auto') this.#forcedAt = { resolution: options.resolution, frames: 0, discarded: 0 };
   }
+
+  /** The last few pushes: the stream offset after each, and its time argument (for `#pendingUs`). */
+  readonly #pushes: { end: number; time: number | Float64Array | undefined }[] = [];
 
   /** Bytes as they arrived: `time` is the chunk's arrival (or per-byte times). */
   push(bytes: Uint8Array, time: number | Float64Array | undefined, arrivedMs: number): void {
     // The log first: the decoder's events (fired in next()) take their times from these chunks.
     this.inspector.onBytes(bytes, time);
     this.decoder.push(bytes, time);
+    this.#pushes.push({ end: this.decoder.stats.bytes, time });
+    if (this.#pushes.length > PUSHES_KEPT) this.#pushes.shift();
     this.#arrivedMs = arrivedMs;
     this.#drain();
   }
@@ -108,8 +102,6 @@ export class Engine {
   setResolution(resolution: 'auto' | 1024 | 2048, nowUs: number, by: 'user' | 'internal-remote' = 'user'): void {
     this.decoder.setResolution(resolution, by);
     this.link.interrupt(nowUs);
-    const s = this.decoder.stats;
-    this.#forcedAt = resolution === 'auto' || by !== 'user' ? null : { resolution, frames: s.frames, discarded: s.discardedBytes };
     this.#mismatch = null;
     this.#changed = true;
   }
@@ -123,16 +115,8 @@ export class Engine {
   }
 
   #checkMismatch(): void {
-    const fromDecoder = decoderMismatch(this.decoder.format);
-    let mismatch: Resolution | null = null;
-    if (fromDecoder !== undefined) {
-      mismatch = fromDecoder;
-    } else if (this.#forcedAt !== null) {
-      const s = this.decoder.stats;
-      if (s.frames === this.#forcedAt.frames && s.discardedBytes - this.#forcedAt.discarded > MISMATCH_AFTER_BYTES) {
-        mismatch = this.#forcedAt.resolution === 1024 ? 2048 : 1024;
-      }
-    }
+    // The decoder's word: the forced resolution fits no frame, the other one does.
+    const mismatch = this.decoder.format.forcedMismatch;
     if (mismatch !== this.#mismatch) {
       this.#mismatch = mismatch;
       this.#changed = true;
@@ -157,6 +141,27 @@ export class Engine {
       }
     }
     this.#checkMismatch();
+  }
+
+  /**
+   * The time of the oldest byte the decoder still holds (a frame it will hand out once the next
+   * one confirms it), dated as the decoder dates frames; NaN when it holds none or it is unknown.
+   */
+  #pendingUs(): number {
+    const s = this.decoder.stats;
+    if (s.pendingBytes === 0) return Number.NaN;
+    const b = s.bytes - s.pendingBytes;
+    let start = NaN;
+    for (let i = this.#pushes.length - 1; i >= 0; i--) {
+      const p = this.#pushes[i] as { end: number; time: number | Float64Array | undefined };
+      start = i === 0 ? NaN : (this.#pushes[i - 1] as { end: number }).end;
+      if (i > 0 && b < start) continue;
+      if (p.time === undefined) return Number.NaN;
+      if (typeof p.time === 'number') return p.time - (p.end - 1 - b) * BYTE_TIME_US;
+      const j = b - (p.end - p.time.length);
+      return j >= 0 ? (p.time[j] ?? Number.NaN) : Number.NaN;
+    }
+    return Number.NaN;
   }
 
   /** Buckets that end by `untilUs`, with the newer ones before it that have settled. */
@@ -195,7 +200,7 @@ export class Engine {
     const before = this.link.state;
     const ended = this.#ended;
     const now = ended && Number.isFinite(this.#endUs) ? this.#endUs : nowUs;
-    if (!ended && this.#mismatch === null) this.link.update(now);
+    if (!ended && this.#mismatch === null) this.link.update(now, this.#pendingUs());
     const episodes = this.#newEpisodes();
     const series = this.#takeSeries(now);
     if (!this.#changed && before === this.link.state && episodes.length === 0 && series.t.length === 0) return null;
