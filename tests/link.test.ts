@@ -125,6 +125,8 @@ describe('LinkMonitor: missed means missed', () => {
     for (let i = 0; i < 50; i++) link.frame(frame(i * 11_000, 0, 0xb2, 5));
     link.frame(frame(50 * 11_000, 1, 0xb2, 6));
     expect(link.stats).toMatchObject({ missedFrames: 1, missedBasis: 'fade-counter', fades: 1, holds: 0 });
+    // No frame is absent from the stream: the count of frames not received stays 0.
+    expect(link.stats.lostFrames).toBe(0);
   });
 
   it('without a counter, frames missing are counted against frames expected once a window shows it, through USB jitter', () => {
@@ -133,7 +135,7 @@ describe('LinkMonitor: missed means missed', () => {
     const times = usbDelivered(1500, 11_000, lost, () => 0);
     for (const t of times) link.frame(bare(t));
     link.finish(times.at(-1)! + 2_000);
-    expect(link.stats).toMatchObject({ missedBasis: 'frame-count', missedFrames: lost.size, holds: 0 });
+    expect(link.stats).toMatchObject({ missedBasis: 'frame-count', missedFrames: lost.size, lostFrames: lost.size, holds: 0 });
   });
 
   it('places missing frames where they were due, for the binned series', () => {

@@ -80,6 +80,13 @@ export interface LinkStats {
   /** Frames missed: by the fade counter where the receiver counts, else by frames expected against received. */
   missedFrames: number;
   missedBasis: MissedBasis;
+  /**
+   * Frames expected but not received, counted over windows that absorb delivery bursts,
+   * whatever the receiver's counter says: the one measure every receiver shares (an SPM4649T
+   * has no fade counter), and what the flight controller did not get. `missedFrames` equals it
+   * where the receiver gives no counter.
+   */
+  lostFrames: number;
   /** Hold episodes (each failsafe began as a hold). */
   holds: number;
   failsafes: number;
@@ -316,12 +323,11 @@ export class LinkMonitor {
   readonly #ledger: FrameLedger;
   /** The fade counter has shown that it counts (a value other than 0, or a rise). */
   #counting = false;
-  #countedMissed = 0;
   #lastFades = 0;
   #lastInterval = NaN;
   #finished = false;
   readonly #stats: LinkStats = {
-    frames: 0, fades: 0, missedFrames: 0, missedBasis: 'none', holds: 0, failsafes: 0, periodUs: NaN,
+    frames: 0, fades: 0, missedFrames: 0, missedBasis: 'none', lostFrames: 0, holds: 0, failsafes: 0, periodUs: NaN,
     nominalPeriodUs: NaN, fadeRate: 0, longestGapUs: 0, rssi: NaN, minRssi: NaN, deliveryDelayUs: NaN, deliveryJitterUs: NaN,
   };
 
@@ -447,7 +453,7 @@ export class LinkMonitor {
 
   /** Frames the ledger found missing: they count while the receiver has given no counter to go by. */
   #missedByCount(fromUs: number, toUs: number, count: number): void {
-    this.#countedMissed += count;
+    this.#stats.lostFrames += count;
     if (this.#counting) return;
     this.#stats.missedFrames += count;
     this.#onMissed?.(fromUs, toUs, count, this.#stats.nominalPeriodUs);
@@ -503,6 +509,7 @@ export class LinkMonitor {
         const k = Math.max(0, Math.floor((silence - this.jitterUs) / p));
         if (k > 0) {
           s.missedFrames += k;
+          s.lostFrames += k;
           this.#onMissed?.(this.#lastUs + p, endUs, k, p);
         }
       }
