@@ -23,7 +23,7 @@ export interface EngineOptions {
  * bucket not yet handed out. Placing them by the time they were reported, never by when the
  * page asked, keeps replay identical at every speed.
  */
-export const SETTLE_US = 1_000_000;
+export const SETTLE_US = 500_000;
 
 /** Pushes remembered to date the bytes the decoder still holds. */
 const PUSHES_KEPT = 32;
