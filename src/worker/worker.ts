@@ -6,7 +6,7 @@
  */
 /// <reference lib="webworker" />
 import {
-  CaptureFormatError, FRAME_PERIOD_11MS_US, capturePorts, FRAME_PERIOD_22MS_US, LinkSeries, USB_CHUNK_JITTER_US, decodeCapture, readCapture, resolutionKey,
+  CaptureFormatError, FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US, FRAME_SIZE, LinkSeries, USB_CHUNK_JITTER_US, capturePorts, decodeCapture, readCapture, resolutionKey,
   systemInfo, timingJitterUs, type Capture,
 } from '../decoder/index.js';
 import { Engine } from './engine.js';
@@ -377,12 +377,38 @@ function overviewOf(capture: Capture, ports: readonly number[]): { overview: Ove
   const all: LinkSeries[] = [];
   const failsafe: Overview['failsafe'] = [];
   let periodUs = NaN;
+  // Without recorded timing, the fades and the receiver's missed frames go on the paced clock
+  // replay plays at (a frame every period from the first byte): where in the file, not when.
+  const untimed: { offset: number; fades: number; missed: number }[][] = [];
   for (const port of ports) {
-    const { link, series, decoder } = decodeCapture(capture, { resolution, port, binUs: BIN_US }, () => {});
+    const marks: { offset: number; fades: number; missed: number }[] = [];
+    let missed = 0;
+    const { link, series, decoder } = decodeCapture(capture, { resolution, port, binUs: BIN_US }, (f, l) => {
+      if (capture.timing === 'none') marks.push({ offset: f.offset, fades: l.lastFades, missed: l.stats.missedFrames - missed });
+      missed = l.stats.missedFrames;
+    });
     all.push(series);
+    untimed.push(marks);
     for (const e of link.episodes) if (e.kind === 'failsafe') failsafe.push({ startUs: e.startUs, endUs: e.endUs ?? e.startUs });
     const info = decoder.format.system === null ? undefined : systemInfo(decoder.format.system);
     if (Number.isNaN(periodUs)) periodUs = info ? (info.periodMs === 11 ? FRAME_PERIOD_11MS_US : FRAME_PERIOD_22MS_US) : decoder.format.resolution === 1024 ? FRAME_PERIOD_22MS_US : NaN;
+  }
+  if (Number.isNaN(periodUs)) periodUs = FRAME_PERIOD_11MS_US;
+  if (capture.timing === 'none') {
+    const usPerByte = periodUs / FRAME_SIZE;
+    let bins = 0;
+    for (const marks of untimed) for (const m of marks) bins = Math.max(bins, Math.floor(((m.offset + FRAME_SIZE) * usPerByte) / BIN_US) + 1);
+    const t = Float64Array.from({ length: bins }, (_, b) => b * BIN_US);
+    const fades = new Float32Array(bins);
+    const lost = new Float32Array(bins);
+    for (const marks of untimed) {
+      for (const m of marks) {
+        const b = Math.floor(((m.offset + FRAME_SIZE) * usPerByte) / BIN_US);
+        fades[b] = (fades[b] as number) + m.fades;
+        lost[b] = (lost[b] as number) + m.missed;
+      }
+    }
+    return { overview: { t, fadeRate: fades, lost, failsafe: [] }, periodUs };
   }
   const bins = Math.max(0, ...all.map((x) => x.bins));
   const origin = all[0]?.originUs ?? NaN;
@@ -396,7 +422,7 @@ function overviewOf(capture: Capture, ports: readonly number[]): { overview: Ove
       lost[b] = (lost[b] as number) + x.lost(b);
     }
   }
-  return { overview: { t, fadeRate: fades, lost, failsafe }, periodUs: Number.isNaN(periodUs) ? FRAME_PERIOD_11MS_US : periodUs };
+  return { overview: { t, fadeRate: fades, lost, failsafe }, periodUs };
 }
 
 const REPLAY_STATUS_MS = 200;
