@@ -57,9 +57,10 @@ export function LinkPanel({ windowUs }: { windowUs: Signal<number> }) {
 
   const state = linkState.value;
   const mismatch = linkMismatch.value;
-  // A replay at its end keeps its last state, said as such; a forced resolution that matches no frame is not link loss.
-  const label = linkEnded.value ? 'Replay ended' : LABEL[state];
-  const hint = linkEnded.value ? `Last state: ${LABEL[state]}` : mismatch !== null
+  // A replay at its end keeps its last state, frozen, and says it ended; a forced resolution
+  // that matches no frame is not link loss.
+  const label = LABEL[state];
+  const hint = linkEnded.value ? `Replay ended: the state at the end of the capture` : mismatch !== null
     ? `Forced ${resolutionOverride.value}: no frame matches; the stream looks like ${mismatch}` : HINT[state];
   return (
     <section class={`link ${state}`} aria-label="Link state">
