@@ -93,6 +93,7 @@ export class Live {
     this.mismatch = batch.mismatch;
     this.series.append(batch.series);
     for (const e of batch.episodes) this.episodes.set(e.id, { kind: e.kind, startUs: e.startUs, endUs: e.endUs });
+    for (const id of batch.retracted) this.episodes.delete(id);
     // Nothing shows episodes older than the longest window: a long session must not pile them up.
     for (const [id, e] of this.episodes) if (e.endUs !== null && e.endUs < batch.nowUs - EPISODE_KEEP_US) this.episodes.delete(id);
     this.#clockUs = batch.nowUs;

@@ -176,6 +176,10 @@ class FrameLedger {
   #pendingDelay = NaN;
   delayUs = NaN;
   jitterUs = NaN;
+  /** Windows closed so far, and of the last: the frames it found missing and its most punctual frame's time. */
+  closes = 0;
+  closedMissing = 0;
+  closedPunctualUs = NaN;
 
   /** @param priorJitterUs the delivery jitter to assume until measured */
   constructor(readonly priorJitterUs: number) {}
@@ -268,6 +272,9 @@ class FrameLedger {
     }
     this.#pendingSpread = k === 0 && this.#winFrames > 1 ? this.#winMaxL - this.#winMinL : NaN;
     this.#pendingDelay = this.#winSumL / this.#winFrames - this.#winMinL;
+    this.closes++;
+    this.closedMissing = k;
+    this.closedPunctualUs = this.#winMinUs;
     this.#refUs = this.#winMinUs;
     this.#refSlot = this.#winMinSlot + k;
     this.#slot += k;
@@ -321,6 +328,14 @@ export class LinkMonitor {
   #nextEpisode = 0;
   #open: LinkEpisode | null = null;
   readonly #ledger: FrameLedger;
+  /**
+   * Holds not yet confirmed, with the receiver's fade count when each began: a hold whose
+   * silence the next punctual frame shows held no missing frame was the adapter holding bytes
+   * back (a delivery stall), not the link: it is withdrawn (`retracted`).
+   */
+  readonly #unconfirmed: { episode: LinkEpisode; endFades: number }[] = [];
+  readonly #retracted: number[] = [];
+  #closesSeen = 0;
   /** The fade counter has shown that it counts (a value other than 0, or a rise). */
   #counting = false;
   #lastFades = 0;
@@ -426,6 +441,7 @@ export class LinkMonitor {
       this.#lastUs = t;
       this.#measure(t, fades);
       this.#ledger.frame(t, s.nominalPeriodUs, (a, b, n) => this.#missedByCount(a, b, n));
+      this.#confirmHolds();
       s.deliveryDelayUs = this.#ledger.delayUs;
       s.deliveryJitterUs = this.#ledger.jitterUs;
     }
@@ -446,9 +462,45 @@ export class LinkMonitor {
     if (this.#open !== null && Number.isFinite(t) && t <= this.#open.lastFrameUs) return;
     if (this.#open !== null) {
       this.#open.endUs = Number.isFinite(t) ? t : this.#open.startUs;
+      // What the receiver says it missed in the silence, for confirming the hold.
+      const u = this.#unconfirmed.find((x) => x.episode === this.#open);
+      if (u !== undefined) u.endFades = fades;
       this.#open = null;
     }
     this.#state = 'live';
+  }
+
+  /**
+   * Ids of hold episodes withdrawn since the last call (a silence that was only the adapter
+   * holding bytes back, as the frames that followed showed); they are gone from `episodes` and
+   * from the count of holds.
+   */
+  takeRetracted(): number[] {
+    return this.#retracted.splice(0, this.#retracted.length);
+  }
+
+  /** After a ledger window: holds before its most punctual frame are confirmed or withdrawn. */
+  #confirmHolds(): void {
+    const l = this.#ledger;
+    if (l.closes === this.#closesSeen) return;
+    this.#closesSeen = l.closes;
+    const p = this.#stats.nominalPeriodUs;
+    for (let i = 0; i < this.#unconfirmed.length;) {
+      const { episode: e, endFades } = this.#unconfirmed[i] as { episode: LinkEpisode; endFades: number };
+      if (!(e.lastFrameUs < l.closedPunctualUs) || e.endUs === null) {
+        i++;
+        continue;
+      }
+      this.#unconfirmed.splice(i, 1);
+      // Frames the silence would have held had the link lost them; a stall delivers them after it.
+      const due = Number.isFinite(p) ? Math.round((e.endUs - e.lastFrameUs) / p) - 1 : 0;
+      const failsafe = this.#episodes.some((f) => f.kind === 'failsafe' && f.lastFrameUs === e.lastFrameUs);
+      if (failsafe || due < 2 || l.closedMissing >= due / 2 || endFades >= due / 2) continue;
+      const at = this.#episodes.indexOf(e);
+      if (at >= 0) this.#episodes.splice(at, 1);
+      this.#stats.holds--;
+      this.#retracted.push(e.id);
+    }
   }
 
   /** Frames the ledger found missing: they count while the receiver has given no counter to go by. */
@@ -477,6 +529,8 @@ export class LinkMonitor {
       // The hold began when the next frame was due, whenever it was noticed.
       const p = s.nominalPeriodUs;
       this.#openEpisode('hold', last + (Number.isFinite(p) ? p : this.holdAfterUs), last);
+      if (this.#open !== null) this.#unconfirmed.push({ episode: this.#open, endFades: 0 });
+      if (this.#unconfirmed.length > 64) this.#unconfirmed.shift();
     }
     if (gap >= this.#failsafeAfterUs && this.#state === 'hold') {
       this.#state = 'failsafe';
@@ -504,6 +558,7 @@ export class LinkMonitor {
     if (this.#counting) {
       // The receiver never got to report these: frames due in a silence longer than a hold.
       this.#ledger.finish(endUs, Infinity, (a, b, n) => this.#missedByCount(a, b, n));
+      this.#confirmHolds();
       if (silence > grace) {
         const p = s.nominalPeriodUs;
         const k = Math.max(0, Math.floor((silence - this.jitterUs) / p));
@@ -515,6 +570,7 @@ export class LinkMonitor {
       }
     } else {
       this.#ledger.finish(endUs, silence > grace ? this.jitterUs : Infinity, (a, b, n) => this.#missedByCount(a, b, n));
+      this.#confirmHolds();
     }
     return state;
   }

@@ -46,9 +46,8 @@ export class Engine {
   /** `end()` was called; the end of the stream, when known (replay): the clock never goes past it. */
   #ended = false;
   #endUs = NaN;
-  /** Episode ids up to which every episode has been reported as ended; and open ones reported. */
-  #episodesDone = 0;
-  readonly #episodesOpenSent = new Set<number>();
+  /** Each episode as last sent to the page. */
+  readonly #sent = new Map<number, { startUs: number; endUs: number | null }>();
   /** While a forced resolution matches no frame: the resolution the stream looks like. */
   #mismatch: Resolution | null = null;
 
@@ -202,8 +201,10 @@ export class Engine {
     const now = ended && Number.isFinite(this.#endUs) ? this.#endUs : nowUs;
     if (!ended && this.#mismatch === null) this.link.update(now, this.#pendingUs());
     const episodes = this.#newEpisodes();
+    const retracted = this.link.takeRetracted();
+    for (const id of retracted) this.#sent.delete(id);
     const series = this.#takeSeries(now);
-    if (!this.#changed && before === this.link.state && episodes.length === 0 && series.t.length === 0) return null;
+    if (!this.#changed && before === this.link.state && episodes.length === 0 && retracted.length === 0 && series.t.length === 0) return null;
     this.#changed = false;
     const l = this.link.stats;
     const s = this.decoder.stats;
@@ -225,6 +226,7 @@ export class Engine {
       counters: { bytes: s.bytes, frames: s.frames, resyncs: s.resyncs, discardedBytes: s.discardedBytes, badFrames: s.badFrames },
       series,
       episodes,
+      retracted,
     };
     this.#frames = 0;
     return {
@@ -233,20 +235,27 @@ export class Engine {
     };
   }
 
+  /**
+   * Episodes new or changed (ended, or re-dated) since they were last sent. Episodes are made
+   * in order and only the newest change, so the walk stops at the first one sent as it is.
+   */
   #newEpisodes(): Batch['episodes'] {
     const all: readonly LinkEpisode[] = this.link.episodes;
     const out: Batch['episodes'] = [];
-    for (const e of all) {
-      if (e.id < this.#episodesDone) continue;
-      if (e.endUs !== null) {
-        out.push({ id: e.id, kind: e.kind, startUs: e.startUs, endUs: e.endUs });
-        this.#episodesOpenSent.delete(e.id);
-        if (e.id === this.#episodesDone) this.#episodesDone++;
-      } else if (!this.#episodesOpenSent.has(e.id)) {
-        out.push({ id: e.id, kind: e.kind, startUs: e.startUs, endUs: null });
-        this.#episodesOpenSent.add(e.id);
+    for (let i = all.length - 1; i >= 0; i--) {
+      const e = all[i] as LinkEpisode;
+      const sent = this.#sent.get(e.id);
+      if (sent !== undefined && sent.endUs === e.endUs && sent.startUs === e.startUs) {
+        if (e.endUs !== null) break;
+        continue;
       }
+      this.#sent.set(e.id, { startUs: e.startUs, endUs: e.endUs });
+      out.push({ id: e.id, kind: e.kind, startUs: e.startUs, endUs: e.endUs });
     }
-    return out;
+    // Forget what the link no longer keeps.
+    const oldest = all[0]?.id ?? Infinity;
+    if (this.#sent.size > 2 * all.length + 16) for (const id of this.#sent.keys()) if (id < oldest) this.#sent.delete(id);
+    return out.reverse();
   }
+
 }

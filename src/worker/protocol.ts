@@ -107,8 +107,10 @@ export interface Batch {
   counters: { bytes: number; frames: number; resyncs: number; discardedBytes: number; badFrames: number };
   /** Completed graph buckets: start time, fades/s, mean RSSI (NaN without), mean frame interval ms (NaN if <2 frames), lost frames. */
   series: { t: Float64Array; fadeRate: Float32Array; rssi: Float32Array; periodMs: Float32Array; lost: Float32Array };
-  /** Hold and failsafe episodes that started or ended since the last batch. */
+  /** Hold and failsafe episodes that started, ended or were re-dated since the last batch. */
   episodes: { id: number; kind: 'hold' | 'failsafe'; startUs: number; endUs: number | null }[];
+  /** Ids of holds withdrawn: a silence the frames after it showed was the adapter holding bytes back. */
+  retracted: number[];
 }
 
 export interface RecordingStatus {

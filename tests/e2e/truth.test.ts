@@ -1,0 +1,138 @@
+/**
+ * Honest states on the page (issues "one truth" and "the page as an instrument"): a Saleae
+ * export replays on its own clock with a timeline, seeking and speeds, and ends frozen at its
+ * last recorded time; forcing a resolution that no frame fits says so and counts nothing as
+ * link loss. Needs the built page (`npm run build`) and Debian's Chromium.
+ */
+import { existsSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import type { Page } from 'playwright-core';
+import { afterAll, beforeAll, describe, expect, it } from 'vitest';
+import { importSaleaeCsv, summarizeCapture } from '../../src/decoder/index.js';
+import { preset, simulate } from '../../src/simulator/index.js';
+import { SHARED_CAPTURES, browserUnavailable, shot, startApp, type AppSession } from './app-fixture.js';
+
+const skip = browserUnavailable();
+if (skip !== null) console.warn(`skipping the honest-state page tests: ${skip}`);
+
+let app: AppSession;
+let dir = '';
+
+beforeAll(async () => {
+  if (skip !== null) return;
+  app = await startApp();
+  dir = mkdtempSync(join(tmpdir(), 'satscope-truth-'));
+});
+
+afterAll(async () => {
+  if (skip !== null) return;
+  await app.close();
+  rmSync(dir, { recursive: true, force: true });
+});
+
+async function open(query = ''): Promise<{ page: Page; errors: string[] }> {
+  const context = await app.browser.newContext({ viewport: { width: 1400, height: 1000 } });
+  const page = await context.newPage();
+  const errors: string[] = [];
+  page.on('pageerror', (e) => errors.push(e.message));
+  await page.goto(app.server.url(`/${query}`));
+  return { page, errors };
+}
+
+/** A Saleae async-serial export: the real PX4 DX9 capture when it is here, else one written from the simulator. */
+function saleaeFile(): string {
+  const real = join(SHARED_CAPTURES, 'dsm_x_dx9_px4_binding_data.txt');
+  if (existsSync(real)) return real;
+  const sim = simulate(preset('dsmx-11ms-2048-internal'), 5_000_000);
+  const lines = ['Time [s],Value,Parity Error,Framing Error'];
+  sim.bytes.forEach((b, i) => lines.push(`${(sim.timesUs[i]! / 1e6).toFixed(9)},0x${b.toString(16).toUpperCase().padStart(2, '0')},,`));
+  const path = join(dir, 'sim-saleae.txt');
+  writeFileSync(path, `${lines.join('\n')}\n`);
+  return path;
+}
+
+/** "m:ss.s / m:ss.s" → [position, span] in seconds. */
+async function replayTime(page: Page): Promise<[number, number]> {
+  const text = (await page.getByTestId('replay-time').textContent()) ?? '';
+  const m = /^(\d+):(\d+\.\d) \/ (\d+):(\d+\.\d)$/.exec(text.trim());
+  if (m === null) throw new Error(`replay time reads "${text}"`);
+  return [Number(m[1]) * 60 + Number(m[2]), Number(m[3]) * 60 + Number(m[4])];
+}
+
+describe.skipIf(skip !== null)('honest states', () => {
+  it('replays a Saleae export on its own clock: a timeline, 1×, seeking, full speed, and an end frozen at the last recorded time', async () => {
+    const path = saleaeFile();
+    const summary = summarizeCapture(importSaleaeCsv(new Uint8Array(readFileSync(path))));
+    const { page, errors } = await open('?demo=0');
+    await page.setInputFiles('input[type=file]', path);
+    await page.locator('section.replay').waitFor();
+    // The span is the capture's (about 5 s), not "0:00.0 / 0:00.0".
+    const [, span] = await replayTime(page);
+    expect(span).toBeGreaterThan(4.5);
+    expect(span).toBeLessThan(5.5);
+    // The overview is drawn.
+    await page.locator('.overview canvas').first().waitFor();
+    // 1× moves the clock about as fast as the wall clock.
+    const [a] = await replayTime(page);
+    await page.waitForTimeout(1500);
+    const [b] = await replayTime(page);
+    expect(b - a).toBeGreaterThan(0.8);
+    expect(b - a).toBeLessThan(2.5);
+    // Seeking moves it to where it was asked.
+    await page.getByRole('button', { name: 'Pause' }).click();
+    const start = Number(await page.locator('input.seek').getAttribute('min'));
+    await page.locator('input.seek').evaluate((el, v) => {
+      const input = el as HTMLInputElement;
+      input.value = String(v);
+      input.dispatchEvent(new Event('change', { bubbles: true }));
+    }, start + 3_000_000);
+    await page.waitForFunction(() => /^0:03\.0 \//.test(document.querySelector('[data-testid="replay-time"]')?.textContent ?? ''));
+    // Full speed to the end: the clock stops at the end, the state is frozen and says so.
+    await page.getByRole('radio', { name: 'max' }).click();
+    await page.getByRole('button', { name: 'Play' }).click();
+    await page.getByTestId('link-hint').filter({ hasText: 'Replay ended' }).waitFor({ timeout: 20_000 });
+    const [end, span2] = await replayTime(page);
+    expect(end).toBe(span2);
+    const state = await page.getByTestId('link-state').textContent();
+    expect(state).toBe('Live');
+    await expect(page.locator('.link dd').nth(1).textContent()).resolves.toBe(`${summary.link.holds} holds · ${summary.link.failsafes} failsafes`);
+    await expect(page.getByTestId('count-missed').textContent()).resolves.toBe(String(summary.link.missedFrames));
+    await shot(page, 'replay-ended');
+    // The wall clock moving on changes nothing.
+    await page.waitForTimeout(1500);
+    await expect(page.getByTestId('link-state').textContent()).resolves.toBe(state);
+    await expect(replayTime(page)).resolves.toEqual([end, span2]);
+    expect(errors).toEqual([]);
+    await page.context().close();
+  });
+
+  it('says a forced resolution matches no frame, counts nothing as lost meanwhile, and leaves no episode after switching back', async () => {
+    const { page, errors } = await open();
+    await page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor({ timeout: 10_000 });
+    // After the demo's first short dropout (at 4 s), before its long one (at 27 s).
+    await page.waitForTimeout(5500);
+    const episodes = await page.locator('.link dd').nth(1).textContent();
+    const missed = Number(await page.getByTestId('count-missed').textContent());
+    await page.getByRole('button', { name: 'Settings' }).click();
+    await page.getByRole('combobox', { name: 'Resolution' }).selectOption('1024');
+    await page.keyboard.press('Escape');
+    await page.getByTestId('link-hint').filter({ hasText: 'Forced 1024: no frame matches; the stream looks like 2048' }).waitFor({ timeout: 5000 });
+    await shot(page, 'forced-1024');
+    await page.waitForTimeout(2500);
+    await expect(page.getByTestId('link-state').textContent()).resolves.toBe('Waiting');
+    await expect(page.locator('.link dd').nth(1).textContent()).resolves.toBe(episodes);
+    await page.getByRole('button', { name: 'Settings' }).click();
+    await page.getByRole('combobox', { name: 'Resolution' }).selectOption('auto');
+    await page.keyboard.press('Escape');
+    await page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor({ timeout: 5000 });
+    await page.waitForTimeout(1000);
+    await expect(page.locator('.link dd').nth(1).textContent()).resolves.toBe(episodes);
+    // Remote B has no dropout in its first 12 s: whatever the worker's timers did, no hold.
+    await expect(page.locator('.remotes tbody tr').nth(1).textContent()).resolves.toMatch(/0 \/ 0/);
+    // At most what the receiver's own counter says it missed meanwhile (the demo fades a few an s), not the ~270 frames not decoded.
+    expect(Number(await page.getByTestId('count-missed').textContent()) - missed).toBeLessThan(20);
+    expect(errors).toEqual([]);
+    await page.context().close();
+  });
+});
