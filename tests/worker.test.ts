@@ -131,6 +131,35 @@ describe('the engine', () => {
   });
 });
 
+describe('delivery stalls are not holds', () => {
+  it('withdraws on the page a hold the worker showed during a stall, once the burst after it shows nothing was missing', () => {
+    const sim = simulate({ ...preset('dsmx-11ms-2048-internal'), seed: 9 }, 3_000_000);
+    const engine = new Engine({ resolution: 'auto', jitterUs: 20_000 });
+    const { c, take } = collector(engine);
+    const retracted: number[] = [];
+    // The worker stalls 200 ms at 0.5 s: the chunks due meanwhile arrive together after it.
+    let held: { bytes: Uint8Array; timeUs: number }[] = [];
+    for (const chunk of usbChunks(sim.bytes, sim.timesUs)) {
+      if (chunk.timeUs > 500_000 && chunk.timeUs < 700_000) {
+        held.push(chunk);
+        take(chunk.timeUs);
+        retracted.push(...(c.last?.retracted ?? []));
+        continue;
+      }
+      for (const h of held) engine.push(h.bytes, chunk.timeUs, 0);
+      held = [];
+      engine.push(chunk.bytes, chunk.timeUs, 0);
+      take(chunk.timeUs);
+      retracted.push(...(c.last?.retracted ?? []));
+    }
+    // It looked like a hold while it lasted; the page was told to drop it.
+    expect(c.episodes.some((e) => e.kind === 'hold')).toBe(true);
+    expect(retracted).toEqual(c.episodes.filter((e) => e.endUs === null).map((e) => e.id));
+    expect(engine.link.stats).toMatchObject({ holds: 0, failsafes: 0, missedFrames: 0 });
+    expect(c.last!.link.holds).toBe(0);
+  });
+});
+
 describe('a forced resolution is not link loss', () => {
   it('counts nothing while a forced 1024 matches no frame of a 2048 stream, says what the stream looks like, and leaves nothing after switching back', () => {
     const sim = simulate({ ...preset('dsmx-11ms-2048-internal'), seed: 6 }, 8_000_000);

@@ -457,9 +457,12 @@ export class LinkMonitor {
     } else if (Number.isFinite(s.nominalPeriodUs) && Number.isFinite(t)) {
       s.missedBasis = 'frame-count';
     }
-    // The frame a silence was already counted from (it was pending in the decoder, `update`'s
-    // `pendingUs`): the silence goes on until a later frame.
-    if (this.#open !== null && Number.isFinite(t) && t <= this.#open.lastFrameUs) return;
+    // A frame from before the silence began (the decoder held it, `update`'s `pendingUs`): the
+    // silence goes on, counted from this frame if it is the later one.
+    if (this.#open !== null && Number.isFinite(t) && t < this.#open.startUs) {
+      if (t > this.#open.lastFrameUs) this.#redate(this.#open.lastFrameUs, t);
+      return;
+    }
     if (this.#open !== null) {
       this.#open.endUs = Number.isFinite(t) ? t : this.#open.startUs;
       // What the receiver says it missed in the silence, for confirming the hold.
