@@ -104,9 +104,9 @@ export const MAX_LISTED_GLITCHES = 200;
 export const MAX_LISTED_HOLDS = 200;
 
 /**
- * How late a chunk-timed frame can arrive from USB batching alone, µs (the link monitor of
- * `decodeCapture` allows the same): gaps shorter than 1.5 periods plus this are not missed
- * frames, and the longer intervals are left out of the period statistics.
+ * How late a chunk-timed frame is assumed to arrive from USB batching alone until the link
+ * monitor has measured the delivery jitter on the capture itself, µs (`timingJitterUs`). Missed
+ * frames, holds and the period statistics all come from `LinkMonitor`; this is its prior.
  */
 export const CHUNK_TIMING_ALLOWANCE_US = USB_CHUNK_JITTER_US;
 
