@@ -214,6 +214,9 @@ interface PortState {
   prevFades: number | null;
   prevFrameUs: number;
   prevMissed: number;
+  /** Decoder's discarded bytes at the last frame, and the frame times that came after a discard (line damage). */
+  prevDiscarded: number;
+  damagedAtUs: number[];
   first: FormatSnapshot | null;
   changes: { timeUs: number; from: FormatSnapshot; to: FormatSnapshot }[];
   restarts: { timeUs: number; from: number; to: number; gapUs: number }[];
@@ -286,7 +289,7 @@ export class Doctor {
         confirmed: null,
         probePackets: { ibus: 0, 'srxl-v1': 0, srxl2: 0, crsf: 0, sbus: 0 },
         frames: 0, guess: new ArduPilotGuess(), xplusMask: 0, xplusFirstUs: NaN, vtxFrames: 0, vtxFirstUs: NaN,
-        prevFades: null, prevFrameUs: NaN, prevMissed: 0, first: null, changes: [], restarts: [], rssiFrames: 0,
+        prevFades: null, prevFrameUs: NaN, prevMissed: 0, prevDiscarded: 0, damagedAtUs: [], first: null, changes: [], restarts: [], rssiFrames: 0,
       };
       p = state;
       this.#ports.set(port, p);
@@ -402,8 +405,16 @@ export class Doctor {
     if (f.rssi !== null) p.rssiFrames++;
     // Fades and missed frames per second, for "which fades most" and "do they fade together".
     const link = p.source?.link;
+    // A frame after discarded bytes ends a gap the line made (the decoder dropped frames with the
+    // damage), not the radio link.
+    const discarded = p.source?.decoder.stats.discardedBytes ?? 0;
+    if (discarded > p.prevDiscarded && p.frames > 1 && Number.isFinite(t)) {
+      p.damagedAtUs.push(t);
+      if (p.damagedAtUs.length > 256) p.damagedAtUs.shift();
+    }
+    p.prevDiscarded = discarded;
     if (link !== undefined) {
-      const missed = link.stats.missedFrames;
+      const missed = link.stats.lostFrames;
       p.bins.add(M_MISSED, t, missed - p.prevMissed);
       p.prevMissed = missed;
     }
@@ -731,7 +742,11 @@ export class Doctor {
     const memoryStart = now - this.#memoryUs;
     const episodes = link.episodes.filter((e) => (e.endUs ?? now) >= memoryStart);
     const failsafes = episodes.filter((e) => e.kind === 'failsafe');
-    const holds = episodes.filter((e) => e.kind === 'hold' && !failsafes.some((f) => f.lastFrameUs === e.lastFrameUs));
+    // Holds that line damage explains (the frame that ended them came after discarded bytes) are
+    // the line's, not the link's.
+    const byLine = (e: { lastFrameUs: number; endUs: number | null }) =>
+      e.endUs !== null && p.damagedAtUs.some((d) => d > e.lastFrameUs && d <= e.endUs! + 50_000);
+    const holds = episodes.filter((e) => e.kind === 'hold' && !failsafes.some((f) => f.lastFrameUs === e.lastFrameUs) && !byLine(e));
     const fadesPerMin = s.fadeRate * 60;
     // A rate needs a few fades behind it: one corrupted header is not a weak link.
     const recentFades = p.bins.sum(M_FADES, Math.floor(now / 1e6) - 9, Math.floor(now / 1e6));
