@@ -7,7 +7,8 @@ import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
-import { CaptureWriter, readCapture, summarizeCapture } from '../src/decoder/index.js';
+import { CaptureWriter, readCapture } from '../src/capture/index.js';
+import { summarizeCapture } from '../src/analysis/index.js';
 import { preset, simulate } from '../src/simulator/index.js';
 import { concatBytes } from './bytes.js';
 

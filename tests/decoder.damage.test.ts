@@ -9,7 +9,7 @@ import { existsSync, readFileSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 import fc from 'fast-check';
 import { describe, expect, it } from 'vitest';
-import { importSaleaeCsv } from '../src/decoder/index.js';
+import { importSaleaeCsv } from '../src/capture/index.js';
 import { preset, simulate } from '../src/simulator/index.js';
 import { CLEAN_PRESETS, damage, framesOf, judge, sameReading, type Edit } from './damage.js';
 

@@ -4,10 +4,9 @@
  */
 import { existsSync, readFileSync } from 'node:fs';
 import { describe, expect, it } from 'vitest';
-import {
-  SpektrumDecoder, copyFrame, healthReport, importRaw, importSaleaeCsv, summarizeCapture,
-  type DecoderEvent, type DecoderOptions, type FrameSnapshot,
-} from '../src/decoder/index.js';
+import { SpektrumDecoder, copyFrame, type DecoderEvent, type DecoderOptions, type FrameSnapshot } from '../src/decoder/index.js';
+import { importRaw, importSaleaeCsv } from '../src/capture/index.js';
+import { healthReport, summarizeCapture } from '../src/analysis/index.js';
 import { encodeExternalFrame, encodeInternalFrame, encodeServo2048 } from '../src/simulator/encode.js';
 import { concatBytes as join } from './bytes.js';
 import { runBounded } from './bounded.js';

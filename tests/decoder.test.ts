@@ -1,8 +1,5 @@
 import { describe, expect, it } from 'vitest';
-import {
-  SpektrumDecoder, copyFrame, decodeStream, servoToMicros, servoToPercent, channelName,
-  type DecoderEvent, type FrameSnapshot,
-} from '../src/decoder/index.js';
+import { SpektrumDecoder, copyFrame, decodeStream, servoToMicros, servoToPercent, channelName, type DecoderEvent, type FrameSnapshot } from '../src/decoder/index.js';
 import {
   encodeExternalFrame, encodeInternalFrame, encodeServo1024, encodeServo2048, encodeXPlus, vtxWords,
 } from '../src/simulator/encode.js';

@@ -9,7 +9,7 @@ import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { doctorCommand } from '../src/cli/doctor.js';
-import { CaptureWriter } from '../src/decoder/index.js';
+import { CaptureWriter } from '../src/capture/index.js';
 import { ibusStream, preset, receiveAs, simulate } from '../src/simulator/index.js';
 import { concatBytes } from './bytes.js';
 

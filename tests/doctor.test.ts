@@ -7,7 +7,8 @@ import { existsSync, readFileSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 import { describe, expect, it } from 'vitest';
 import { Doctor, doctorCapture, type DoctorFinding, type DoctorOptions } from '../src/analysis/index.js';
-import { CaptureWriter, importSaleaeCsv, LinkMonitor, readCapture, SpektrumDecoder, USB_CHUNK_JITTER_US } from '../src/decoder/index.js';
+import { LinkMonitor, SpektrumDecoder, USB_CHUNK_JITTER_US } from '../src/decoder/index.js';
+import { CaptureWriter, importSaleaeCsv, readCapture } from '../src/capture/index.js';
 import {
   crsfStream, ibusStream, noiseSignal, preset, receiveAs, sbusStream, simulate, spektrumTransmission, srxl2Stream, srxlV1Stream, uartReceive,
   type Scenario, type UartResult,

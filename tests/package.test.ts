@@ -53,7 +53,7 @@ describe('the npm package', () => {
     expect(files).toContain('dist/cli/main.js');
     expect(files).toContain('README.md');
     expect(files).toContain('LICENSE');
-    const stray = files.filter((f) => !/^(dist\/(decoder|capture|simulator|cli)\/.+\.(js|d\.ts)|README\.md|LICENSE|package\.json)$/.test(f));
+    const stray = files.filter((f) => !/^(dist\/(decoder|capture|analysis|simulator|cli)\/.+\.(js|d\.ts)|README\.md|LICENSE|package\.json)$/.test(f));
     expect(stray).toEqual([]);
   });
 

@@ -8,7 +8,8 @@
 import { existsSync, readFileSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 import { describe, expect, it } from 'vitest';
-import { SpektrumDecoder, importSaleaeCsv, type DecodedFrame } from '../src/decoder/index.js';
+import { SpektrumDecoder, type DecodedFrame } from '../src/decoder/index.js';
+import { importSaleaeCsv } from '../src/capture/index.js';
 
 const dir = resolve(import.meta.dirname, '../../shared/captures/px4');
 const present = existsSync(dir);

@@ -8,11 +8,10 @@ import { existsSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'no
 import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
-import {
-  CaptureWriter, encodeCapture, healthReport, importRaw, importSaleaeCsv, readCapture, reportHtml, servoToMicros,
-  type Capture, type CaptureMeta, type CaptureRecordInput, type HealthReport,
-} from '../src/decoder/index.js';
-import { SPIKE_MIN_JUMP_PERCENT, escapeHtml } from '../src/decoder/report.js';
+import { servoToMicros } from '../src/decoder/index.js';
+import { CaptureWriter, encodeCapture, importRaw, importSaleaeCsv, readCapture, type Capture, type CaptureMeta, type CaptureRecordInput } from '../src/capture/index.js';
+import { healthReport, reportHtml, type HealthReport } from '../src/analysis/index.js';
+import { SPIKE_MIN_JUMP_PERCENT, escapeHtml } from '../src/analysis/index.js';
 import { encodeServo2048, preset, simulate, type Scenario, type SimChunk } from '../src/simulator/index.js';
 
 // ---------------------------------------------------------------------------------------------

@@ -4,7 +4,8 @@
  * of port errors.
  */
 import { describe, expect, it } from 'vitest';
-import { captureSpan, encodeCapture, importRaw, readCapture, type Capture } from '../src/decoder/index.js';
+import { encodeCapture, importRaw, readCapture, type Capture } from '../src/capture/index.js';
+import { captureSpan } from '../src/analysis/index.js';
 import type { Batch } from '../src/worker/protocol.js';
 import { preset, simulate } from '../src/simulator/index.js';
 import { Engine, SETTLE_US } from '../src/worker/engine.js';

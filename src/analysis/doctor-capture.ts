@@ -4,10 +4,8 @@
  * arrive, with the capture's events ("port opened", line errors) fed in where they happened.
  * Pure: same capture, same findings.
  */
-import {
-  BYTE_TIME_US, captureChunks, capturePorts, LinkMonitor, SpektrumDecoder, USB_CHUNK_JITTER_US,
-  type Capture, type CaptureKind, type CaptureTiming, type Resolution,
-} from '../decoder/index.js';
+import { BYTE_TIME_US, LinkMonitor, SpektrumDecoder, USB_CHUNK_JITTER_US, type Resolution } from '../decoder/index.js';
+import { captureChunks, capturePorts, type Capture, type CaptureKind, type CaptureTiming } from '../capture/index.js';
 import { Doctor, type DoctorCode, type DoctorFinding, type Severity } from './doctor.js';
 
 export interface DoctorCaptureOptions {

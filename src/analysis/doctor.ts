@@ -12,10 +12,8 @@
  * Feeding costs a few operations per byte and per frame and allocates nothing; `findings()`
  * builds its answer (call it a few times a second at most).
  */
-import {
-  FRAME_SIZE, REPORT_THRESHOLDS, systemInfo,
-  type DecodedFrame, type FormatInfo, type LinkMonitor, type Resolution, type SpektrumDecoder,
-} from '../decoder/index.js';
+import { FRAME_SIZE, systemInfo, type DecodedFrame, type FormatInfo, type LinkMonitor, type Resolution, type SpektrumDecoder } from '../decoder/index.js';
+import { REPORT_THRESHOLDS } from './report.js';
 import { BurstClock, classifyLine, PACKET_KINDS, PacketScanner, type LineVerdict, type PacketKind } from './doctor-line.js';
 import {
   ArduPilotGuess, ARDUPILOT_GUESS_FRAMES, bindPulses, channelSetText, foreignSettings, PROTOCOL_SETTINGS, satelliteSettings,

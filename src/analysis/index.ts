@@ -1,6 +1,10 @@
 /**
- * The doctor: findings about a satellite setup from what the wire shows. Every public name of
- * src/analysis is exported here.
+ * satscope/report: what a whole capture or a live session says. Decoding a capture
+ * (`decodeCapture`, `summarizeCapture` for `satscope info`), the one binned time series every
+ * graph is drawn from (`LinkSeries`), the health report (`healthReport`, rendered by
+ * `reportHtml`) and the doctor's findings. Every public name of src/analysis is exported here.
+ *
+ * The doctor: findings about a satellite setup from what the wire shows.
  *
  * Live use (one `Doctor` per session, every port on one clock):
  *
@@ -28,3 +32,15 @@ export {
   type FlightStack, type ForeignProtocol, type GuessTally, type StackSetting, type StreamFacts,
 } from './doctor-stacks.js';
 export { classifyLine, PacketScanner, PACKET_KINDS, type LineCounts, type LineVerdict, type PacketKind } from './doctor-line.js';
+export {
+  captureSpan, decodeCapture, resolutionKey, summarizeCapture, timingJitterUs,
+  type CaptureSummary, type ChannelSummary, type DecodeCaptureOptions,
+} from './summary.js';
+export { LinkSeries, monitorWithSeries } from './series.js';
+export {
+  healthReport, formatClock, formatDuration, REPORT_BIN_US, REPORT_THRESHOLDS, SPIKE_MIN_JUMP_PERCENT,
+  type FindingCode, type FindingLevel, type HealthReport, type HealthReportOptions, type RemoteReport, type ReportChannel,
+  type ReportEpisode, type ReportFinding, type ReportGlitch, type ReportPeriodStats, type ReportSeries, type ReportStatus,
+  type ReportThresholds,
+} from './report.js';
+export { escapeHtml, reportHtml } from './report-html.js';

@@ -5,10 +5,7 @@
  * of the bytes and the format the decoder settled on, so it shows the frame the way a firmware
  * decoder should read it, slot by slot, including what is wrong with a slot.
  */
-import {
-  EMPTY_SLOT, FRAME_SIZE, XPLUS_FIRST, channelName, servoToMicros, systemInfo,
-  type HeaderMode, type RemoteKind, type Resolution, type VtxControl,
-} from '../decoder/index.js';
+import { EMPTY_SLOT, FRAME_SIZE, XPLUS_FIRST, channelName, servoToMicros, systemInfo, type HeaderMode, type RemoteKind, type Resolution, type VtxControl } from '../decoder/index.js';
 
 // §8.1 and §8.2's masks. The library keeps them internal, so they are restated here.
 /** §8.1: 1024 mode, bits 15–10 channel ID, bits 9–0 position. */

@@ -9,7 +9,7 @@ import { readFileSync } from 'node:fs';
 import { basename } from 'node:path';
 import { parseArgs } from 'node:util';
 import { doctorCapture, type DoctorFinding, type DoctorReport } from '../analysis/index.js';
-import { CaptureFormatError, readCapture, type Capture } from '../decoder/index.js';
+import { CaptureFormatError, readCapture, type Capture } from '../capture/index.js';
 
 export const DOCTOR_USAGE = `Usage:
   satscope doctor FILE [--json] [--resolution auto|1024|2048]

@@ -1,6 +1,6 @@
 /** Text forms of frames and summaries for the CLI. */
-import type { HealthReport, ReportFinding } from '../decoder/report.js';
-import type { CaptureSummary } from '../decoder/summary.js';
+import type { HealthReport, ReportFinding } from '../analysis/index.js';
+import type { CaptureSummary } from '../analysis/index.js';
 import { channelResolution, servoToMicros, systemInfo, CHANNEL_COUNT } from '../decoder/spec.js';
 import type { DecodedFrame } from '../decoder/types.js';
 

@@ -1,13 +1,14 @@
 /**
- * satscope: decode Spektrum satellite ("remote receiver") serial streams.
- * Every public name is exported here and only here.
+ * satscope: decode Spektrum satellite ("remote receiver") serial streams: the decoder, the
+ * link monitor, frame snapshots, the stream adapter and the spec's constants. Every public name
+ * of the core is exported here. Capture files are `satscope/capture`, whole-capture analysis,
+ * the health report and the doctor `satscope/report`: importing the core pulls in neither.
  */
 export { SpektrumDecoder, type DecoderOptions } from './decoder.js';
 export {
   HOLD_MIN_US, LEDGER_WINDOW_US, LinkMonitor, PERIOD_SNAP_US, holdThresholdUs, isFrameInterval, nominalPeriodOf,
   type LinkEpisode, type LinkOptions, type LinkState, type LinkStats, type MissedBasis,
 } from './link.js';
-export { LinkSeries, monitorWithSeries } from './series.js';
 export { copyFrame, type ChannelValue, type FrameSnapshot } from './snapshot.js';
 export { decodeStream, type TimedChunk } from './stream.js';
 export type {
@@ -19,19 +20,3 @@ export {
   SYSTEM_DSMX_22MS_2048, SYSTEM_TYPES, XPLUS_FIRST, XPLUS_LAST, channelName, servoToMicros, servoToPercent,
   systemInfo, type Resolution, type SystemInfo,
 } from './spec.js';
-export {
-  CaptureFormatError, CaptureWriter, captureChunks, capturePorts, encodeCapture, importRaw, importSaleaeCsv,
-  parseCapture, readCapture, CAPTURE_FILE_EXTENSION, CAPTURE_FORMAT_VERSION,
-  type Capture, type CaptureChunk, type CaptureEvent, type CaptureIssue, type CaptureIssueKind, type CaptureKind,
-  type CaptureMeta, type CapturePortInfo, type CaptureRecordInput, type CaptureTiming, type ParsedCapture,
-} from '../capture/index.js';
-export {
-  captureSpan, decodeCapture, resolutionKey, summarizeCapture, timingJitterUs,
-  type CaptureSummary, type ChannelSummary, type DecodeCaptureOptions,
-} from './summary.js';
-export {
-  healthReport, reportHtml, REPORT_THRESHOLDS,
-  type FindingCode, type FindingLevel, type HealthReport, type HealthReportOptions, type RemoteReport, type ReportChannel,
-  type ReportEpisode, type ReportFinding, type ReportGlitch, type ReportPeriodStats, type ReportSeries, type ReportStatus,
-  type ReportThresholds,
-} from './report.js';

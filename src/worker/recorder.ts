@@ -5,7 +5,7 @@
  * carries a CRC, so an unfinished file is simply a capture that ends early: a marker file names
  * the recording in progress, and on the next start it is offered back.
  */
-import { CaptureWriter, parseCapture, type CaptureMeta } from '../decoder/index.js';
+import { CaptureWriter, parseCapture, type CaptureMeta } from '../capture/index.js';
 import type { RecordingStatus } from './protocol.js';
 
 const DIR = 'recordings';

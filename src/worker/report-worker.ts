@@ -3,7 +3,8 @@
  * worker reading the ports never stalls on it.
  */
 /// <reference lib="webworker" />
-import { healthReport, readCapture, reportHtml } from '../decoder/index.js';
+import { readCapture } from '../capture/index.js';
+import { healthReport, reportHtml } from '../analysis/index.js';
 
 export interface ReportRequest {
   bytes: Uint8Array;

@@ -5,10 +5,9 @@
  * capture being replayed. A source's id is its port number in recordings.
  */
 /// <reference lib="webworker" />
-import {
-  CaptureFormatError, FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US, FRAME_SIZE, LinkSeries, USB_CHUNK_JITTER_US, capturePorts, decodeCapture, readCapture, resolutionKey,
-  systemInfo, timingJitterUs, type Capture,
-} from '../decoder/index.js';
+import { FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US, FRAME_SIZE, USB_CHUNK_JITTER_US, systemInfo } from '../decoder/index.js';
+import { CaptureFormatError, capturePorts, readCapture, type Capture } from '../capture/index.js';
+import { LinkSeries, decodeCapture, resolutionKey, timingJitterUs } from '../analysis/index.js';
 import { Engine } from './engine.js';
 import { runBind } from './bind.js';
 import { REMOTE_LABELS, type BindProgress, type FromWorker, type Overview, type PortIdentity, type SourceKind, type SourceStatus, type ToWorker } from './protocol.js';

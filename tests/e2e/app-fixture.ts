@@ -5,7 +5,7 @@
 import { existsSync, mkdirSync, writeFileSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 import type { Browser, Page } from 'playwright-core';
-import { CaptureWriter } from '../../src/decoder/index.js';
+import { CaptureWriter } from '../../src/capture/index.js';
 import { concatBytes } from '../bytes.js';
 import { chromiumAvailable, launchChromium, startStaticServer, type StaticServer } from './harness/browser.js';
 

@@ -9,7 +9,9 @@ import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import type { Page } from 'playwright-core';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
-import { CaptureWriter, capturePorts, decodeCapture, parseCapture, readCapture, summarizeCapture, channelName } from '../../src/decoder/index.js';
+import { channelName } from '../../src/decoder/index.js';
+import { CaptureWriter, capturePorts, parseCapture, readCapture } from '../../src/capture/index.js';
+import { decodeCapture, summarizeCapture } from '../../src/analysis/index.js';
 import { preset, simulate } from '../../src/simulator/index.js';
 import { SHARED_CAPTURES, SHOTS as SHOTS_DIR, barValues, browserUnavailable, shot, startApp, usbChunks, writeCapture, type AppSession } from './app-fixture.js';
 

@@ -9,7 +9,8 @@ import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import type { Page } from 'playwright-core';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
-import { importSaleaeCsv, summarizeCapture } from '../../src/decoder/index.js';
+import { importSaleaeCsv } from '../../src/capture/index.js';
+import { summarizeCapture } from '../../src/analysis/index.js';
 import { preset, simulate } from '../../src/simulator/index.js';
 import { SHARED_CAPTURES, browserUnavailable, shot, startApp, type AppSession } from './app-fixture.js';
 

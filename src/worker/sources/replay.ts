@@ -4,7 +4,9 @@
  * several ports (remotes) with one common clock: each port feeds its own decode, and all of
  * them advance with the one replay clock.
  */
-import { BYTE_TIME_US, FRAME_PERIOD_11MS_US, FRAME_SIZE, captureSpan, capturePorts, type Capture } from '../../decoder/index.js';
+import { BYTE_TIME_US, FRAME_PERIOD_11MS_US, FRAME_SIZE } from '../../decoder/index.js';
+import { capturePorts, type Capture } from '../../capture/index.js';
+import { captureSpan } from '../../analysis/index.js';
 
 /** Wall time and ticks, passed in so that tests drive replay with a simulated clock. */
 export interface ReplayClock {

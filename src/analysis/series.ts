@@ -4,8 +4,8 @@
  * missed frames placed where they were due). The live page (100 ms bins), the replay overview
  * and the health report (1 s bins) all fill it the same way.
  */
-import { LinkMonitor, type LinkOptions } from './link.js';
-import type { DecodedFrame } from './types.js';
+import { LinkMonitor, type LinkOptions } from '../decoder/index.js';
+import type { DecodedFrame } from '../decoder/index.js';
 
 /** A growable Float64Array column. */
 class Column {

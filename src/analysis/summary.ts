@@ -4,11 +4,11 @@
  */
 import type { Capture, CaptureIssue, CaptureTiming } from '../capture/index.js';
 import { captureChunks } from '../capture/index.js';
-import { SpektrumDecoder, type DecoderOptions } from './decoder.js';
-import type { LinkEpisode, LinkMonitor, LinkStats } from './link.js';
+import { SpektrumDecoder, type DecoderOptions } from '../decoder/index.js';
+import type { LinkEpisode, LinkMonitor, LinkStats } from '../decoder/index.js';
 import { LinkSeries, monitorWithSeries } from './series.js';
-import { BYTE_TIME_US, channelName, channelResolution, CHANNEL_COUNT, servoToMicros, systemInfo, USB_CHUNK_JITTER_US, type Resolution } from './spec.js';
-import type { DecodedFrame, DecoderStats, FormatInfo } from './types.js';
+import { BYTE_TIME_US, channelName, channelResolution, CHANNEL_COUNT, servoToMicros, systemInfo, USB_CHUNK_JITTER_US, type Resolution } from '../decoder/index.js';
+import type { DecodedFrame, DecoderStats, FormatInfo } from '../decoder/index.js';
 
 export interface DecodeCaptureOptions extends DecoderOptions {
   /** Which serial port of a multi-port capture to decode. Default 0. */
