@@ -42,18 +42,22 @@ describe('the npm package', () => {
     expect(pkg.dependencies ?? {}).toEqual({});
     const dot = (pkg.exports as Record<string, Record<string, string>>)['.']!;
     expect(Object.keys(dot)[0]).toBe('types');
+    const doctor = (pkg.exports as Record<string, Record<string, string>>)['./doctor']!;
+    expect(Object.keys(doctor)).toEqual(['types', 'default']);
+    expect(doctor.default).toBe('./dist/analysis/index.js');
     expect(pkg.bin).toEqual({ satscope: './dist/cli/main.js' });
   });
 
-  it('packs only the built library, capture files, simulator, CLI, README, LICENSE and package.json', () => {
+  it('packs only the built library, capture files, simulator, doctor, CLI, README, LICENSE and package.json', () => {
     expect(files).toContain('dist/decoder/index.js');
     expect(files).toContain('dist/capture/index.js');
     expect(files).toContain('dist/decoder/index.d.ts');
     expect(files).toContain('dist/simulator/index.js');
+    expect(files).toContain('dist/analysis/index.js');
     expect(files).toContain('dist/cli/main.js');
     expect(files).toContain('README.md');
     expect(files).toContain('LICENSE');
-    const stray = files.filter((f) => !/^(dist\/(decoder|capture|simulator|cli)\/.+\.(js|d\.ts)|README\.md|LICENSE|package\.json)$/.test(f));
+    const stray = files.filter((f) => !/^(dist\/(decoder|capture|simulator|analysis|cli)\/.+\.(js|d\.ts)|README\.md|LICENSE|package\.json)$/.test(f));
     expect(stray).toEqual([]);
   });
 
