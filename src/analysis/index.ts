@@ -22,7 +22,7 @@ export {
   type Confidence, type ConfirmProbe, type DoctorCode, type DoctorFinding, type DoctorOptions, type DoctorPortSource,
   type Evidence, type Severity,
 } from './doctor.js';
-export { doctorCapture, type DoctorCaptureOptions, type DoctorReport, type DoctorTimelineEntry } from './doctor-capture.js';
+export { doctorCapture, doctorEvent, type DoctorCaptureOptions, type DoctorReport, type DoctorTimelineEntry } from './doctor-capture.js';
 export {
   ArduPilotGuess, ARDUPILOT_GUESS_FRAMES, bindPulses, channelSetText, foreignSettings, PROTOCOL_SETTINGS, satelliteSettings,
   type FlightStack, type ForeignProtocol, type GuessTally, type StackSetting, type StreamFacts,
