@@ -15,13 +15,15 @@
  * const findings = doctor.findings(nowUs());            // a few times a second: worst first
  * ```
  *
- * A whole capture: `doctorCapture(capture)`.
+ * A whole capture: `doctorCapture(capture)`; the health report with the findings in it:
+ * `diagnosedHealthReport(capture)`.
  */
 export {
   Doctor, NOTHING_AFTER_US, NOTHING_CERTAIN_US, LINE_WINDOW_BINS,
   type Confidence, type ConfirmProbe, type DoctorCode, type DoctorFinding, type DoctorOptions, type DoctorPortSource,
   type Evidence, type Severity,
 } from './doctor.js';
+export { diagnosedHealthReport } from './doctor-report.js';
 export { doctorCapture, doctorEvent, type DoctorCaptureOptions, type DoctorReport, type DoctorTimelineEntry } from './doctor-capture.js';
 export {
   ArduPilotGuess, ARDUPILOT_GUESS_FRAMES, bindPulses, channelSetText, foreignSettings, PROTOCOL_SETTINGS, satelliteSettings,

@@ -10,7 +10,7 @@ import { readFileSync, writeFileSync } from 'node:fs';
 import { basename } from 'node:path';
 import { CaptureFormatError, captureChunks, capturePorts, readCapture, type Capture, type CaptureChunk } from '../capture/index.js';
 import { SpektrumDecoder } from '../decoder/decoder.js';
-import { healthReport, reportHtml } from '../decoder/report.js';
+import { reportHtml } from '../decoder/report.js';
 import { summarizeCapture } from '../decoder/summary.js';
 import { parseCommandLine, UsageError, type Args } from './args.js';
 import { formatJsonLine, formatCsvHeader, formatCsvLine, formatReportVerdict, formatSummary } from './format.js';
@@ -179,10 +179,12 @@ async function finish(out: TextOutput, code: number): Promise<number> {
   return code;
 }
 
-/** `satscope report`: the health report of every port, as HTML or JSON, to stdout or --out. */
-function report(capture: Capture, args: Args, out: TextOutput): Promise<number> {
+/** `satscope report`: the health report of every port with the doctor's findings, as HTML or JSON, to stdout or --out. */
+async function report(capture: Capture, args: Args, out: TextOutput): Promise<number> {
   const name = basename(args.file);
-  const r = healthReport(capture, { resolution: args.resolution, name });
+  // The doctor's findings go in the report; its module is loaded only for this command.
+  const { diagnosedHealthReport } = await import('../analysis/doctor-report.js');
+  const r = diagnosedHealthReport(capture, { resolution: args.resolution, name });
   const text = args.json ? `${JSON.stringify(r, null, 2)}\n` : reportHtml(r);
   if (args.out !== null) {
     try {

@@ -33,5 +33,5 @@ export {
   healthReport, reportHtml, REPORT_THRESHOLDS,
   type FindingCode, type FindingLevel, type HealthReport, type HealthReportOptions, type RemoteReport, type ReportChannel,
   type ReportEpisode, type ReportFinding, type ReportGlitch, type ReportPeriodStats, type ReportSeries, type ReportStatus,
-  type ReportThresholds,
+  type ReportDiagnosis, type ReportThresholds,
 } from './report.js';

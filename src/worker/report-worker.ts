@@ -1,9 +1,10 @@
 /**
- * A short-lived worker that makes one health report (library: healthReport, reportHtml), so the
+ * A short-lived worker that makes one health report (diagnosedHealthReport, reportHtml), so the
  * worker reading the ports never stalls on it.
  */
 /// <reference lib="webworker" />
-import { healthReport, readCapture, reportHtml } from '../decoder/index.js';
+import { diagnosedHealthReport } from '../analysis/index.js';
+import { readCapture, reportHtml } from '../decoder/index.js';
 
 export interface ReportRequest {
   bytes: Uint8Array;
@@ -19,7 +20,7 @@ const scope = self as unknown as DedicatedWorkerGlobalScope;
 scope.addEventListener('message', (event: MessageEvent<ReportRequest>) => {
   const { bytes, name, format, resolution } = event.data;
   try {
-    const report = healthReport(readCapture(bytes, name), { resolution, name });
+    const report = diagnosedHealthReport(readCapture(bytes, name), { resolution, name });
     const text = format === 'html' ? reportHtml(report) : `${JSON.stringify(report, null, 2)}\n`;
     const data = new TextEncoder().encode(text).buffer as ArrayBuffer;
     const reply: ReportReply = { data };

@@ -120,8 +120,11 @@ function Finding({ f, open, onToggle }: { f: DoctorFinding; open: boolean; onTog
 export function DiagnosisPanel() {
   const d = diagnosis.value;
   const findings = d?.findings ?? [];
-  // Which findings the user opened or closed; the worst one starts open.
+  // Which findings the user opened or closed. The worst starts open when it is a problem (then
+  // there is little else to look at); warnings and advice stay one line each, so on a phone
+  // the channel bars are not pushed far down.
   const [toggled, setToggled] = useState<Record<string, boolean>>({});
+  const opened = (f: DoctorFinding, i: number): boolean => toggled[keyOf(f)] ?? (i === 0 && f.severity === 'problem');
   const which = stack.value;
   const paste = settingsFor(findings, which);
   const empty = d === null || d.mode === 'live' && sources.value.length === 0 ? 'Connect a receiver: findings appear here as the evidence comes in.'
@@ -156,8 +159,8 @@ export function DiagnosisPanel() {
         <ul class="findings" data-testid="findings">
           {findings.map((f, i) => {
             const key = keyOf(f);
-            return <Finding key={key} f={f} open={toggled[key] ?? i === 0} onToggle={(open) => {
-              if ((toggled[key] ?? i === 0) !== open) setToggled({ ...toggled, [key]: open });
+            return <Finding key={key} f={f} open={opened(f, i)} onToggle={(open) => {
+              if (opened(f, i) !== open) setToggled({ ...toggled, [key]: open });
             }} />;
           })}
         </ul>
