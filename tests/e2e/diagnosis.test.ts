@@ -193,7 +193,7 @@ describe.skipIf(skip !== null)('the Diagnosis panel in replay, on a phone and a 
           const w = await fits(page);
           expect(w.document, `${name} ${width} ${scheme}`).toBeLessThanOrEqual(w.viewport);
           await page.locator('.p-diagnosis').screenshot({ path: join(SHOTS, `diagnosis-${name}-panel-${width}-${scheme}.png`) });
-          if (width === 390) await page.screenshot({ path: join(SHOTS, `diagnosis-${name}-page-390-${scheme}.png`), fullPage: true });
+          await page.screenshot({ path: join(SHOTS, `diagnosis-${name}-page-${width}-${scheme}.png`), fullPage: width === 390 });
           expect(errors).toEqual([]);
           await context.close();
         }
