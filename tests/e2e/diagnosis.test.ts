@@ -6,7 +6,8 @@
  * Then the panel in replay at 390 and 1280 px, light and dark: it fits, and screenshots go to
  * test-results/screenshots/.
  */
-import { mkdirSync, mkdtempSync, rmSync } from 'node:fs';
+import { mkdirSync, mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { createRequire } from 'node:module';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import type { Browser, BrowserContext, Page } from 'playwright-core';
@@ -19,6 +20,18 @@ import { fakeSerialUnsupportedReason, openFakeSerialPort, type FakeSerialPort } 
 
 const skip = browserUnavailable() ?? fakeSerialUnsupportedReason();
 if (skip !== null) console.warn(`skipping the Diagnosis tests: ${skip}`);
+
+const AXE_SOURCE = readFileSync(createRequire(import.meta.url).resolve('axe-core/axe.min.js'), 'utf8');
+
+/** axe-core's serious and critical violations inside the Diagnosis panel and the top finding. */
+async function axe(page: Page): Promise<string[]> {
+  await page.evaluate(AXE_SOURCE);
+  return page.evaluate(async () => {
+    const w = window as unknown as { axe: { run(ctx: object, opts: object): Promise<{ violations: { id: string; impact: string; nodes: { target: string[] }[] }[] }> } };
+    const r = await w.axe.run({ include: [['.p-diagnosis'], ['.top-finding']] }, { resultTypes: ['violations'] });
+    return r.violations.filter((v) => v.impact === 'serious' || v.impact === 'critical').map((v) => `${v.id}: ${v.nodes.map((n) => n.target.join(' ')).join(', ')}`);
+  });
+}
 
 /** The issue's bar: the right finding on the panel within this long. */
 const WITHIN_MS = 2000;
@@ -167,6 +180,30 @@ describe.skipIf(skip !== null)('the Diagnosis panel on a real serial port', () =
   });
 });
 
+describe.skipIf(skip !== null)('the probe\'s line settings on Chromium\'s serial stack', () => {
+  it('opens the port at 420000 8N1 and 100000 8E2 and again at 115200, as "listen at the other speed" does', async () => {
+    await fake.reconnect();
+    const { context, page } = await open();
+    const opened = await page.evaluate(async () => {
+      const [port] = await navigator.serial.getPorts();
+      const out: string[] = [];
+      for (const o of [{ baudRate: 420_000 }, { baudRate: 100_000, parity: 'even' as const, stopBits: 2 as const }, { baudRate: 115_200 }]) {
+        try {
+          await port!.open(o);
+          out.push(`${o.baudRate} ok`);
+          await port!.close();
+        } catch (e) {
+          out.push(`${o.baudRate} ${(e as Error).name}`);
+        }
+      }
+      return out;
+    });
+    console.log(`probe settings on the pty: ${opened.join(', ')}`);
+    expect(opened).toEqual(['420000 ok', '100000 ok', '115200 ok']);
+    await context.close();
+  });
+});
+
 describe.skipIf(skip !== null)('the Diagnosis panel in replay, on a phone and a laptop, light and dark', () => {
   it('shows the findings of a replayed capture, fits 390 px, and looks right in both themes', async () => {
     const sim = simulate(preset('dsm2-22ms-1024-internal'), 3_000_000);
@@ -193,6 +230,7 @@ describe.skipIf(skip !== null)('the Diagnosis panel in replay, on a phone and a 
           const w = await fits(page);
           expect(w.document, `${name} ${width} ${scheme}`).toBeLessThanOrEqual(w.viewport);
           await page.locator('.p-diagnosis').screenshot({ path: join(SHOTS, `diagnosis-${name}-panel-${width}-${scheme}.png`) });
+          expect(await axe(page), `${name} ${width} ${scheme}`).toEqual([]);
           await page.screenshot({ path: join(SHOTS, `diagnosis-${name}-page-${width}-${scheme}.png`), fullPage: width === 390 });
           expect(errors).toEqual([]);
           await context.close();
