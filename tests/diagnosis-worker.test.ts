@@ -43,7 +43,11 @@ class FakePort {
 
 function setup() {
   const posts: FromWorker[] = [];
-  const diagnosis = new Diagnosis((m) => posts.push(m), nowUs, () => [0]);
+  const diagnosis = new Diagnosis(
+    (m) => posts.push(m),
+    nowUs,
+    () => [0],
+  );
   diagnosis.reset();
   const engine = new Engine({ resolution: 'auto', jitterUs: 20_000 });
   diagnosis.attach(0, engine, 'A');
@@ -55,7 +59,7 @@ function setup() {
   return { posts, diagnosis, engine, findings };
 }
 
-describe('the worker\'s doctor', () => {
+describe("the worker's doctor", () => {
   it('posts the findings when they change, at most every 250 ms, and the last change after that', async () => {
     const { posts, diagnosis } = setup();
     const count = () => posts.filter((p) => p.type === 'diagnosis').length;
@@ -103,7 +107,11 @@ describe('the worker\'s doctor', () => {
     const hooks: ProbeHooks = { nowUs, event: (text) => events.push(text), data: () => undefined, state: (s) => states.push(s) };
     const problem = await diagnosis.confirm(0, serial, undefined, before!.confirm!, hooks);
     expect(problem).toBeNull();
-    expect(port.opened.map((o) => [o.baudRate, o.parity, o.stopBits])).toEqual([[115_200, 'none', 1], [420_000, 'none', 1], [115_200, 'none', 1]]);
+    expect(port.opened.map((o) => [o.baudRate, o.parity, o.stopBits])).toEqual([
+      [115_200, 'none', 1],
+      [420_000, 'none', 1],
+      [115_200, 'none', 1],
+    ]);
     expect(events).toEqual(['port opened at 420000 baud', 'port opened at 115200 baud']);
     expect(states).toEqual(['probing', 'reading']);
     expect(serial.port).toBe(port);
@@ -123,7 +131,9 @@ describe('the worker\'s doctor', () => {
     const serial = new SerialSource(nowUs, { data: () => undefined, lineError: () => undefined, lost: () => undefined });
     await serial.open(port as unknown as SerialPort);
     const hooks: ProbeHooks = { nowUs, event: () => undefined, data: () => undefined, state: () => undefined };
-    await expect(diagnosis.confirm(0, serial, undefined, { baudRate: 9600, parity: 'none', stopBits: 1, listenUs: 500_000, note: '' }, hooks)).resolves.toMatch(/Not a line setting/);
+    await expect(
+      diagnosis.confirm(0, serial, undefined, { baudRate: 9600, parity: 'none', stopBits: 1, listenUs: 500_000, note: '' }, hooks),
+    ).resolves.toMatch(/Not a line setting/);
     expect(port.opened).toHaveLength(1);
     await serial.close();
   });

@@ -13,8 +13,12 @@ export function diagnosedHealthReport(capture: Capture, options: HealthReportOpt
   return {
     ...report,
     diagnosis: findings.map((f) => ({
-      severity: f.severity, confidence: f.confidence, title: f.title,
-      evidence: f.evidence.map((e) => ({ text: e.text })), todo: f.todo, settings: f.settings,
+      severity: f.severity,
+      confidence: f.confidence,
+      title: f.title,
+      evidence: f.evidence.map((e) => ({ text: e.text })),
+      todo: f.todo,
+      settings: f.settings,
     })),
   };
 }

@@ -148,13 +148,22 @@ export class Diagnosis {
     const nowMs = performance.now();
     const wait = this.#lastPostMs + MIN_POST_MS - nowMs;
     if (!force && wait > 0) {
-      if (this.#timer === undefined) this.#timer = setTimeout(() => { this.#timer = undefined; this.tick(); }, wait);
+      if (this.#timer === undefined)
+        this.#timer = setTimeout(() => {
+          this.#timer = undefined;
+          this.tick();
+        }, wait);
       return;
     }
     const now = this.clockUs();
     if (this.#mode === 'replay') this.#eventsUntil(now);
     const findings: DoctorFinding[] = Number.isFinite(now) ? this.#doctor.findings(now) : [];
-    const diagnosis: DiagnosisStatus = { mode: this.#mode, findings, probeable: this.#mode === 'live' ? this.probeable() : [], probing: this.#probing };
+    const diagnosis: DiagnosisStatus = {
+      mode: this.#mode,
+      findings,
+      probeable: this.#mode === 'live' ? this.probeable() : [],
+      probing: this.#probing,
+    };
     const key = JSON.stringify(diagnosis);
     this.#lastPostMs = nowMs;
     if (key === this.#lastKey && !force) return;
@@ -168,9 +177,16 @@ export class Diagnosis {
    * (what it recognises there makes its finding certain); the decoder does not. Returns why it
    * could not, or null.
    */
-  async confirm(id: number, serial: SerialSource, signals: SerialOutputSignals | undefined, probe: ConfirmProbe, hooks: ProbeHooks): Promise<string | null> {
+  async confirm(
+    id: number,
+    serial: SerialSource,
+    signals: SerialOutputSignals | undefined,
+    probe: ConfirmProbe,
+    hooks: ProbeHooks,
+  ): Promise<string | null> {
     if (this.#mode !== 'live' || this.#probing !== null) return 'A listen is already under way.';
-    if (!PROBE_BAUDS.has(probe.baudRate) || !(probe.listenUs > 0) || probe.listenUs > MAX_LISTEN_US) return 'Not a line setting the doctor asked for.';
+    if (!PROBE_BAUDS.has(probe.baudRate) || !(probe.listenUs > 0) || probe.listenUs > MAX_LISTEN_US)
+      return 'Not a line setting the doctor asked for.';
     const port = serial.port;
     if (port === undefined) return 'The port is not open.';
     const name = `${probe.baudRate} ${probe.parity === 'none' ? 'N' : probe.parity === 'even' ? 'E' : 'O'}${probe.stopBits}`;

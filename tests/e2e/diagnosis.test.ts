@@ -27,9 +27,13 @@ const AXE_SOURCE = readFileSync(createRequire(import.meta.url).resolve('axe-core
 async function axe(page: Page): Promise<string[]> {
   await page.evaluate(AXE_SOURCE);
   return page.evaluate(async () => {
-    const w = window as unknown as { axe: { run(ctx: object, opts: object): Promise<{ violations: { id: string; impact: string; nodes: { target: string[] }[] }[] }> } };
+    const w = window as unknown as {
+      axe: { run(ctx: object, opts: object): Promise<{ violations: { id: string; impact: string; nodes: { target: string[] }[] }[] }> };
+    };
     const r = await w.axe.run({ include: [['.p-diagnosis'], ['.top-finding']] }, { resultTypes: ['violations'] });
-    return r.violations.filter((v) => v.impact === 'serious' || v.impact === 'critical').map((v) => `${v.id}: ${v.nodes.map((n) => n.target.join(' ')).join(', ')}`);
+    return r.violations
+      .filter((v) => v.impact === 'serious' || v.impact === 'critical')
+      .map((v) => `${v.id}: ${v.nodes.map((n) => n.target.join(' ')).join(', ')}`);
   });
 }
 
@@ -68,8 +72,13 @@ afterAll(async () => {
   rmSync(dir, { recursive: true, force: true });
 });
 
-async function open(options: { width?: number; scheme?: 'light' | 'dark'; clipboard?: boolean } = {}): Promise<{ context: BrowserContext; page: Page; errors: string[] }> {
-  const context = await browser.newContext({ viewport: { width: options.width ?? 1280, height: 900 }, colorScheme: options.scheme ?? 'dark' });
+async function open(
+  options: { width?: number; scheme?: 'light' | 'dark'; clipboard?: boolean } = {},
+): Promise<{ context: BrowserContext; page: Page; errors: string[] }> {
+  const context = await browser.newContext({
+    viewport: { width: options.width ?? 1280, height: 900 },
+    colorScheme: options.scheme ?? 'dark',
+  });
   if (options.clipboard === true) await context.grantPermissions(['clipboard-read', 'clipboard-write'], { origin: server.origin });
   const page = await context.newPage();
   const errors: string[] = [];
@@ -164,7 +173,9 @@ describe.skipIf(skip !== null)('the Diagnosis panel on a real serial port', () =
     await page.locator('.diagnosis select').selectOption('iNav');
     await page.getByRole('button', { name: 'Copy settings' }).click();
     await page.locator('.diagnosis .copied', { hasText: 'iNav' }).waitFor();
-    await expect(page.evaluate(() => navigator.clipboard.readText())).resolves.toBe('set receiver_type = SERIAL\nset serialrx_provider = SPEK1024\nsave\n');
+    await expect(page.evaluate(() => navigator.clipboard.readText())).resolves.toBe(
+      'set receiver_type = SERIAL\nset serialrx_provider = SPEK1024\nsave\n',
+    );
 
     const summary = settings.locator('summary');
     await summary.focus();
@@ -180,14 +191,18 @@ describe.skipIf(skip !== null)('the Diagnosis panel on a real serial port', () =
   });
 });
 
-describe.skipIf(skip !== null)('the probe\'s line settings on Chromium\'s serial stack', () => {
+describe.skipIf(skip !== null)("the probe's line settings on Chromium's serial stack", () => {
   it('opens the port at 420000 8N1 and 100000 8E2 and again at 115200, as "listen at the other speed" does', async () => {
     await fake.reconnect();
     const { context, page } = await open();
     const opened = await page.evaluate(async () => {
       const [port] = await navigator.serial.getPorts();
       const out: string[] = [];
-      for (const o of [{ baudRate: 420_000 }, { baudRate: 100_000, parity: 'even' as const, stopBits: 2 as const }, { baudRate: 115_200 }]) {
+      for (const o of [
+        { baudRate: 420_000 },
+        { baudRate: 100_000, parity: 'even' as const, stopBits: 2 as const },
+        { baudRate: 115_200 },
+      ]) {
         try {
           await port!.open(o);
           out.push(`${o.baudRate} ok`);
@@ -212,7 +227,10 @@ describe.skipIf(skip !== null)('the Diagnosis panel in replay, on a phone and a 
     const i = ibus(2_000_000);
     const foreign = join(dir, 'ibus.sscap');
     writeCapture(foreign, usbChunks(i.bytes, i.timesUs));
-    for (const [name, file, code] of [['1024', sat, 'bind-mode'], ['ibus', foreign, 'ibus']] as const) {
+    for (const [name, file, code] of [
+      ['1024', sat, 'bind-mode'],
+      ['ibus', foreign, 'ibus'],
+    ] as const) {
       for (const width of [390, 1280]) {
         for (const scheme of ['light', 'dark'] as const) {
           const { context, page, errors } = await open({ width, scheme });
@@ -225,7 +243,8 @@ describe.skipIf(skip !== null)('the Diagnosis panel in replay, on a phone and a 
           await page.waitForTimeout(600);
           // Open the finding with settings, so the screenshot shows what a user copies.
           const withSettings = page.locator('.diagnosis .finding', { has: page.locator('pre') }).first();
-          if (!(await withSettings.locator('details').evaluate((d) => (d as HTMLDetailsElement).open))) await withSettings.locator('summary').click();
+          if (!(await withSettings.locator('details').evaluate((d) => (d as HTMLDetailsElement).open)))
+            await withSettings.locator('summary').click();
           await expect(page.getByTestId('top-finding').isVisible()).resolves.toBe(true);
           const w = await fits(page);
           expect(w.document, `${name} ${width} ${scheme}`).toBeLessThanOrEqual(w.viewport);

@@ -55,7 +55,9 @@ export function TopFinding() {
   if (top === undefined) return null;
   return (
     <a class={`top-finding ${top.severity}`} href="#diagnosis" title={top.title} data-testid="top-finding">
-      <span class="mark" aria-hidden="true">{top.severity === 'problem' ? '!' : top.severity === 'warning' ? '⚠' : 'i'}</span>
+      <span class="mark" aria-hidden="true">
+        {top.severity === 'problem' ? '!' : top.severity === 'warning' ? '⚠' : 'i'}
+      </span>
       <span class="text">{top.title}</span>
     </a>
   );
@@ -64,7 +66,8 @@ export function TopFinding() {
 function Finding({ f, open, onToggle }: { f: DoctorFinding; open: boolean; onToggle: (open: boolean) => void }) {
   const d = diagnosis.value;
   const port = f.ports[0];
-  const canProbe = f.confirm !== null && port !== undefined && d !== null && d.probeable.includes(port);
+  const probe = f.confirm;
+  const canProbe = probe !== null && port !== undefined && d?.probeable.includes(port) === true;
   const probing = d?.probing ?? null;
   return (
     <li class={`finding ${f.severity}`} data-code={f.code}>
@@ -78,13 +81,21 @@ function Finding({ f, open, onToggle }: { f: DoctorFinding; open: boolean; onTog
           {f.evidence.length > 0 ? (
             <>
               <h3>Evidence</h3>
-              <ul class="evidence">{f.evidence.map((e, i) => <li key={i}>{e.text}</li>)}</ul>
+              <ul class="evidence">
+                {f.evidence.map((e, i) => (
+                  <li key={i}>{e.text}</li>
+                ))}
+              </ul>
             </>
           ) : null}
           {f.todo.length > 0 ? (
             <>
               <h3>What to do</h3>
-              <ol class="todo">{f.todo.map((t, i) => <li key={i}>{t}</li>)}</ol>
+              <ol class="todo">
+                {f.todo.map((t, i) => (
+                  <li key={i}>{t}</li>
+                ))}
+              </ol>
             </>
           ) : null}
           {f.settings.length > 0 ? (
@@ -104,11 +115,20 @@ function Finding({ f, open, onToggle }: { f: DoctorFinding; open: boolean; onTog
           {f.confirm !== null ? (
             <div class="confirm">
               {canProbe ? (
-                <button type="button" disabled={probing !== null} onClick={() => send({ type: 'diagnosis-confirm', source: port, probe: f.confirm! })}>
-                  {probing !== null && probing.source === port ? `Listening at ${probing.baudRate} baud…` : `Listen at ${f.confirm.baudRate} baud for ${f.confirm.listenUs / 1e6} s`}
+                <button
+                  type="button"
+                  disabled={probing !== null}
+                  onClick={() => send({ type: 'diagnosis-confirm', source: port, probe })}
+                >
+                  {probing !== null && probing.source === port
+                    ? `Listening at ${probing.baudRate} baud…`
+                    : `Listen at ${f.confirm.baudRate} baud for ${f.confirm.listenUs / 1e6} s`}
                 </button>
               ) : null}
-              <p class="muted">{f.confirm.note}{canProbe ? ' Then reading returns to 115200.' : ''}</p>
+              <p class="muted">
+                {f.confirm.note}
+                {canProbe ? ' Then reading returns to 115200.' : ''}
+              </p>
             </div>
           ) : null}
         </div>
@@ -127,12 +147,18 @@ export function DiagnosisPanel() {
   const opened = (f: DoctorFinding, i: number): boolean => toggled[keyOf(f)] ?? (i === 0 && f.severity === 'problem');
   const which = stack.value;
   const paste = settingsFor(findings, which);
-  const empty = d === null || d.mode === 'live' && sources.value.length === 0 ? 'Connect a receiver: findings appear here as the evidence comes in.'
-    : d.mode === 'replay' ? 'Nothing wrong found at this point of the capture.' : 'Nothing wrong found so far.';
+  const empty =
+    d === null || (d.mode === 'live' && sources.value.length === 0)
+      ? 'Connect a receiver: findings appear here as the evidence comes in.'
+      : d.mode === 'replay'
+        ? 'Nothing wrong found at this point of the capture.'
+        : 'Nothing wrong found so far.';
   const onCopy = async () => {
     if (paste === null) return;
     const ok = await copy(`${paste.lines.join('\n')}\n`);
-    copied.value = ok ? `Copied ${paste.lines.length} ${which} lines (${paste.from.title}).` : 'The browser did not allow copying: select the lines below instead.';
+    copied.value = ok
+      ? `Copied ${paste.lines.length} ${which} lines (${paste.from.title}).`
+      : 'The browser did not allow copying: select the lines below instead.';
   };
   return (
     <section class="diagnosis" aria-labelledby="diagnosis-title">
@@ -141,27 +167,57 @@ export function DiagnosisPanel() {
         <div class="copy">
           <label>
             <span class="sr-only">Flight stack</span>
-            <select value={which} onChange={(e) => {
-              const v = (e.currentTarget as HTMLSelectElement).value as FlightStack;
-              stack.value = v;
-              copied.value = '';
-              try { localStorage.setItem(STACK_KEY, v); } catch { /* private mode: not remembered */ }
-            }}>
-              {STACKS.map((s) => <option key={s} value={s}>{s}</option>)}
+            <select
+              value={which}
+              onChange={(e) => {
+                const v = (e.currentTarget as HTMLSelectElement).value as FlightStack;
+                stack.value = v;
+                copied.value = '';
+                try {
+                  localStorage.setItem(STACK_KEY, v);
+                } catch {
+                  /* private mode: not remembered */
+                }
+              }}
+            >
+              {STACKS.map((s) => (
+                <option key={s} value={s}>
+                  {s}
+                </option>
+              ))}
             </select>
           </label>
-          <button type="button" disabled={paste === null} onClick={() => void onCopy()}
-            title={paste === null ? `No ${which} settings to copy for these findings` : `Copies: ${paste.lines.join('; ')}`}>Copy settings</button>
+          <button
+            type="button"
+            disabled={paste === null}
+            onClick={() => void onCopy()}
+            title={paste === null ? `No ${which} settings to copy for these findings` : `Copies: ${paste.lines.join('; ')}`}
+          >
+            Copy settings
+          </button>
         </div>
       </div>
-      <p class="copied" role="status">{copied.value}</p>
-      {findings.length === 0 ? <p class="none" data-testid="diagnosis-none">{empty}</p> : (
+      <p class="copied" role="status">
+        {copied.value}
+      </p>
+      {findings.length === 0 ? (
+        <p class="none" data-testid="diagnosis-none">
+          {empty}
+        </p>
+      ) : (
         <ul class="findings" data-testid="findings">
           {findings.map((f, i) => {
             const key = keyOf(f);
-            return <Finding key={key} f={f} open={opened(f, i)} onToggle={(open) => {
-              if (opened(f, i) !== open) setToggled({ ...toggled, [key]: open });
-            }} />;
+            return (
+              <Finding
+                key={key}
+                f={f}
+                open={opened(f, i)}
+                onToggle={(open) => {
+                  if (opened(f, i) !== open) setToggled({ ...toggled, [key]: open });
+                }}
+              />
+            );
           })}
         </ul>
       )}
