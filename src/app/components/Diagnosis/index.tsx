@@ -54,7 +54,7 @@ export function TopFinding() {
   const top = diagnosis.value?.findings[0];
   if (top === undefined) return null;
   return (
-    <a class={`top-finding ${top.severity}`} href="#diagnosis" title={top.title} data-testid="top-finding">
+    <a class={`top-finding sev-${top.severity}`} href="#diagnosis" title={top.title} data-testid="top-finding">
       <span class="mark" aria-hidden="true">
         {top.severity === 'problem' ? '!' : top.severity === 'warning' ? '⚠' : 'i'}
       </span>
@@ -70,7 +70,7 @@ function Finding({ f, open, onToggle }: { f: DoctorFinding; open: boolean; onTog
   const canProbe = probe !== null && port !== undefined && d?.probeable.includes(port) === true;
   const probing = d?.probing ?? null;
   return (
-    <li class={`finding ${f.severity}`} data-code={f.code}>
+    <li class={`finding sev-${f.severity}`} data-code={f.code}>
       <details open={open} onToggle={(e) => onToggle((e.currentTarget as HTMLDetailsElement).open)}>
         <summary>
           <span class="sev">{SEVERITY[f.severity]}</span>
@@ -115,11 +115,7 @@ function Finding({ f, open, onToggle }: { f: DoctorFinding; open: boolean; onTog
           {f.confirm !== null ? (
             <div class="confirm">
               {canProbe ? (
-                <button
-                  type="button"
-                  disabled={probing !== null}
-                  onClick={() => send({ type: 'diagnosis-confirm', source: port, probe })}
-                >
+                <button type="button" disabled={probing !== null} onClick={() => send({ type: 'diagnosis-confirm', source: port, probe })}>
                   {probing !== null && probing.source === port
                     ? `Listening at ${probing.baudRate} baud…`
                     : `Listen at ${f.confirm.baudRate} baud for ${f.confirm.listenUs / 1e6} s`}
