@@ -6,7 +6,7 @@
 import { existsSync, readFileSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 import { describe, expect, it } from 'vitest';
-import { Doctor, doctorCapture, type DoctorFinding, type DoctorOptions } from '../src/analysis/index.js';
+import { diagnosedHealthReport, Doctor, doctorCapture, doctorEvent, reportHtml, type DoctorFinding, type DoctorOptions } from '../src/analysis/index.js';
 import { LinkMonitor, SpektrumDecoder, USB_CHUNK_JITTER_US } from '../src/decoder/index.js';
 import { CaptureWriter, importSaleaeCsv, readCapture } from '../src/capture/index.js';
 import {
@@ -529,6 +529,50 @@ describe('doctorCapture', () => {
     }
     const r = doctorCapture(readCapture(concatBytes(parts), 'sbus.sscap'));
     expect(r.findings.map((f) => f.code)).toContain('sbus');
+  });
+});
+
+describe('what the worker and the report take from the doctor', () => {
+  it('reads recorded events the way doctorCapture does: opened (at a speed), lost, line errors', () => {
+    const s = new Session();
+    s.port(0);
+    doctorEvent(s.doctor, 0, 'port opened', 0);
+    expect(codes(s.findings(1.5 * SECOND))).toContain('nothing-arrives');
+    doctorEvent(s.doctor, 0, 'device lost', 1.6 * SECOND);
+    expect(codes(s.findings(2 * SECOND))).not.toContain('nothing-arrives');
+    doctorEvent(s.doctor, 0, 'device reconnected', 3 * SECOND);
+    doctorEvent(s.doctor, 0, 'line error: FramingError', 3.1 * SECOND);
+    doctorEvent(s.doctor, 0, 'a note that is no event', 3.2 * SECOND);
+    expect(codes(s.findings(4.5 * SECOND))).not.toContain('nothing-arrives');
+  });
+
+  it('forgets a detached port, so a remote given its number later starts clean', () => {
+    const s = new Session();
+    s.port(0, 'A');
+    s.doctor.open(0, 0);
+    expect(codes(s.findings(2 * SECOND))).toEqual(['nothing-arrives']);
+    s.doctor.detach(0);
+    expect(s.findings(3 * SECOND)).toEqual([]);
+    s.ports.delete(0);
+    s.feed(0, satellite(preset('dsmx-11ms-2048-internal'), 2 * SECOND, 3 * SECOND));
+    expect(codes(s.findings(5 * SECOND))).toEqual(['fc-settings']);
+  });
+
+  it('puts its findings into the health report, and the report\'s HTML shows them with the lines to paste', () => {
+    const w = new CaptureWriter({ baudRate: 115200, source: 'test' });
+    const ibus = receiveAs(ibusStream({ durationUs: 2 * SECOND }));
+    const parts = [w.header(), w.event('port opened', 0, 0)];
+    for (let i = 0; i < ibus.bytes.length; i += 64) parts.push(w.data(ibus.bytes.subarray(i, i + 64), ibus.timesUs[Math.min(i + 63, ibus.bytes.length - 1)]!));
+    const capture = readCapture(concatBytes(parts), 'ibus.sscap');
+    const report = diagnosedHealthReport(capture, { name: 'ibus.sscap' });
+    expect(report.diagnosis?.map((f) => f.title)).toEqual(doctorCapture(capture).findings.map((f) => f.title));
+    expect(report.diagnosis?.[0]).toMatchObject({ severity: 'problem', title: expect.stringMatching(/FlySky IBUS/) });
+    expect(JSON.parse(JSON.stringify(report))).toEqual(report);
+    const html = reportHtml(report);
+    expect(html).toContain('<h2>Diagnosis</h2>');
+    expect(html).toContain('set serialrx_provider = IBUS');
+    // Without the doctor's findings the report has no such section.
+    expect(reportHtml({ ...report, diagnosis: undefined })).not.toContain('<h2>Diagnosis</h2>');
   });
 });
 

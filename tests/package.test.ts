@@ -40,16 +40,19 @@ describe('the npm package', () => {
     expect(pkg.type).toBe('module');
     expect(pkg.sideEffects).toBe(false);
     expect(pkg.dependencies ?? {}).toEqual({});
-    const dot = (pkg.exports as Record<string, Record<string, string>>)['.']!;
-    expect(Object.keys(dot)[0]).toBe('types');
+    const exports = pkg.exports as Record<string, Record<string, string> | string>;
+    expect(Object.keys(exports)).toEqual(['.', './capture', './report', './simulator', './package.json']);
+    for (const [name, entry] of Object.entries(exports)) if (name !== './package.json') expect(Object.keys(entry)).toEqual(['types', 'default']);
+    expect((exports['./report'] as Record<string, string>).default).toBe('./dist/analysis/index.js');
     expect(pkg.bin).toEqual({ satscope: './dist/cli/main.js' });
   });
 
-  it('packs only the built library, capture files, simulator, CLI, README, LICENSE and package.json', () => {
+  it('packs only the built library, capture files, simulator, doctor, CLI, README, LICENSE and package.json', () => {
     expect(files).toContain('dist/decoder/index.js');
     expect(files).toContain('dist/capture/index.js');
     expect(files).toContain('dist/decoder/index.d.ts');
     expect(files).toContain('dist/simulator/index.js');
+    expect(files).toContain('dist/analysis/index.js');
     expect(files).toContain('dist/cli/main.js');
     expect(files).toContain('README.md');
     expect(files).toContain('LICENSE');

@@ -10,8 +10,7 @@ import { join, resolve } from 'node:path';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { servoToMicros } from '../src/decoder/index.js';
 import { CaptureWriter, encodeCapture, importRaw, importSaleaeCsv, readCapture, type Capture, type CaptureMeta, type CaptureRecordInput } from '../src/capture/index.js';
-import { healthReport, reportHtml, type HealthReport } from '../src/analysis/index.js';
-import { SPIKE_MIN_JUMP_PERCENT, escapeHtml } from '../src/analysis/index.js';
+import { diagnosedHealthReport, escapeHtml, healthReport, reportHtml, SPIKE_MIN_JUMP_PERCENT, type HealthReport } from '../src/analysis/index.js';
 import { encodeServo2048, preset, simulate, type Scenario, type SimChunk } from '../src/simulator/index.js';
 
 // ---------------------------------------------------------------------------------------------
@@ -558,13 +557,16 @@ describe('satscope report', () => {
     expect(tagProblems(r.out)).toEqual([]);
   });
 
-  it('prints the JSON report with --json, the same as the library makes', () => {
+  it('prints the JSON report with --json, the same as the library makes, with the doctor\'s findings', () => {
     const r = satscope('report', join(dir, 'run.sscap'), '--json');
     expect(r.code).toBe(0);
     const json = JSON.parse(r.out) as HealthReport;
     expect(json.source.name).toBe('run.sscap');
     expect(json.remotes[0]!.failsafes).toHaveLength(gaps);
-    expect(json).toEqual(healthReport(readCapture(new Uint8Array(readFileSync(join(dir, 'run.sscap'))), 'run.sscap'), { name: 'run.sscap' }));
+    const capture = readCapture(new Uint8Array(readFileSync(join(dir, 'run.sscap'))), 'run.sscap');
+    expect(json).toEqual(diagnosedHealthReport(capture, { name: 'run.sscap' }));
+    expect({ ...json, diagnosis: undefined }).toEqual({ ...healthReport(capture, { name: 'run.sscap' }), diagnosis: undefined });
+    expect(json.diagnosis?.map((f) => f.title)).toContain('Port 0: the link is weak: failsafe');
   });
 
   it('writes the report to --out and prints the findings', () => {

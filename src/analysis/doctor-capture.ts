@@ -167,13 +167,7 @@ export function doctorCapture(capture: Capture, options: DoctorCaptureOptions = 
       if (!(now >= t)) now = t;
     }
     if (piece.kind === 'event') {
-      const text = piece.text ?? '';
-      const error = LINE_ERROR.exec(text);
-      if (error !== null) doctor.lineError(piece.port, error[1] as string, t);
-      else if (OPENED.test(text)) {
-        const baud = BAUD.exec(text);
-        doctor.open(piece.port, t, baud !== null ? { baudRate: Number(baud[1]) } : {});
-      } else if (CLOSED.test(text)) doctor.close(piece.port);
+      doctorEvent(doctor, piece.port, piece.text ?? '', t);
       continue;
     }
     const source = sources.get(piece.port) as { decoder: SpektrumDecoder; link: LinkMonitor };
@@ -207,3 +201,18 @@ export function doctorCapture(capture: Capture, options: DoctorCaptureOptions = 
 }
 
 const SEVERITY_RANK: Record<Severity, number> = { problem: 0, warning: 1, info: 2 };
+
+/**
+ * Feeds one recorded event to a doctor: "port opened" / "device reconnected" (optionally
+ * "… at 420000 baud") opens the port, "device lost" / "port closed" closes it, and a text that
+ * names a WebSerial read error ("line error: FramingError") is that error. Other texts are
+ * ignored. The live worker and `doctorCapture` both use it, so a recording says what was seen.
+ */
+export function doctorEvent(doctor: Doctor, port: number, text: string, timeUs: number): void {
+  const error = LINE_ERROR.exec(text);
+  if (error !== null) doctor.lineError(port, error[1] as string, timeUs);
+  else if (OPENED.test(text)) {
+    const baud = BAUD.exec(text);
+    doctor.open(port, timeUs, baud !== null ? { baudRate: Number(baud[1]) } : {});
+  } else if (CLOSED.test(text)) doctor.close(port);
+}

@@ -329,6 +329,15 @@ export class Doctor {
     this.#port(port).openUs = NaN;
   }
 
+  /**
+   * Forgets a port entirely (it was removed, and its number may be given to another remote):
+   * nothing it showed carries over to whatever is attached there next.
+   */
+  detach(port: number): void {
+    this.#ports.delete(port);
+    for (const key of [...this.#since.keys()]) if (key.split(':')[1]?.split(',').includes(String(port))) this.#since.delete(key);
+  }
+
   #endProbe(p: PortState, timeUs: number): void {
     const found = (['crsf', 'sbus', 'srxl2', 'ibus', 'srxl-v1'] as const).find((k) => p.probePackets[k] >= 3);
     if (found !== undefined) p.confirmed = { protocol: found, timeUs, packets: p.probePackets[found], baudRate: p.baudRate };

@@ -19,14 +19,16 @@
  * const findings = doctor.findings(nowUs());            // a few times a second: worst first
  * ```
  *
- * A whole capture: `doctorCapture(capture)`.
+ * A whole capture: `doctorCapture(capture)`; the health report with the findings in it:
+ * `diagnosedHealthReport(capture)`.
  */
 export {
   Doctor, NOTHING_AFTER_US, NOTHING_CERTAIN_US, LINE_WINDOW_BINS,
   type Confidence, type ConfirmProbe, type DoctorCode, type DoctorFinding, type DoctorOptions, type DoctorPortSource,
   type Evidence, type Severity,
 } from './doctor.js';
-export { doctorCapture, type DoctorCaptureOptions, type DoctorReport, type DoctorTimelineEntry } from './doctor-capture.js';
+export { diagnosedHealthReport } from './doctor-report.js';
+export { doctorCapture, doctorEvent, type DoctorCaptureOptions, type DoctorReport, type DoctorTimelineEntry } from './doctor-capture.js';
 export {
   ArduPilotGuess, ARDUPILOT_GUESS_FRAMES, bindPulses, channelSetText, foreignSettings, PROTOCOL_SETTINGS, satelliteSettings,
   type FlightStack, type ForeignProtocol, type GuessTally, type StackSetting, type StreamFacts,
@@ -41,6 +43,6 @@ export {
   healthReport, formatClock, formatDuration, REPORT_BIN_US, REPORT_THRESHOLDS, SPIKE_MIN_JUMP_PERCENT,
   type FindingCode, type FindingLevel, type HealthReport, type HealthReportOptions, type RemoteReport, type ReportChannel,
   type ReportEpisode, type ReportFinding, type ReportGlitch, type ReportPeriodStats, type ReportSeries, type ReportStatus,
-  type ReportThresholds,
+  type ReportDiagnosis, type ReportThresholds,
 } from './report.js';
 export { escapeHtml, reportHtml } from './report-html.js';

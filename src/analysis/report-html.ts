@@ -360,9 +360,13 @@ h3 { font-size: 9.5pt; margin: 2mm 0 1mm; }
 .badge { font-size: 8pt; padding: 0.3mm 1.5mm; border-radius: 1mm; vertical-align: 1px; }
 ul.verdict { list-style: none; margin: 0; padding: 0; columns: 1; }
 ul.verdict li { padding: 0.25mm 0 0.25mm 5mm; text-indent: -5mm; }
-ul.verdict .mark { display: inline-block; width: 5mm; text-indent: 0; font-weight: bold; }
+ul.verdict .mark, ul.diagnosis .mark { display: inline-block; width: 5mm; text-indent: 0; font-weight: bold; }
 li.problem .mark { color: #c01818; } li.warning .mark { color: #c07a00; } li.info .mark { color: #2f6fb7; } li.ok .mark { color: #2e8b57; }
 li.problem { font-weight: bold; }
+ul.diagnosis { list-style: none; margin: 0; padding: 0; }
+ul.diagnosis > li { padding: 0.4mm 0 0.4mm 5mm; text-indent: -5mm; break-inside: avoid; }
+ul.diagnosis p { text-indent: 0; margin: 0.2mm 0 0; color: #444; font-weight: normal; }
+ul.diagnosis code { font-size: 7.5pt; background: #f1f1f1; padding: 0 1mm; border-radius: 0.6mm; }
 .graphs { margin: 3mm 0 1mm; }
 .graphs svg { display: block; }
 .cols { display: grid; grid-template-columns: 1fr 1fr; gap: 4mm; align-items: start; }
@@ -381,6 +385,20 @@ footer { margin-top: 3mm; border-top: 1px solid #ccc; padding-top: 1.5mm; color:
 section.remote { break-inside: avoid; }
 @media print { html { background: #fff; } main { margin: 0; padding: 0; max-width: none; } }
 `;
+
+/** The doctor's findings: title, first evidence, what to do first, and the lines to paste. */
+function diagnosisHtml(report: HealthReport): string {
+  const d = report.diagnosis;
+  if (d === undefined || d.length === 0) return '';
+  const e = escapeHtml;
+  const items = d.map((f) => {
+    const evidence = f.evidence[0] !== undefined ? `<p>${e(f.evidence[0].text)}</p>` : '';
+    const todo = f.todo[0] !== undefined ? `<p>→ ${e(f.todo[0])}</p>` : '';
+    const lines = f.settings.filter((s) => s.lines.length > 0).map((s) => `${e(s.stack)}: <code>${s.lines.map(e).join('</code> <code>')}</code>`);
+    return `<li class="${f.severity}"><span class="mark">${LEVEL_MARK[f.severity]}</span>${e(f.title)} <span class="muted">(${e(f.confidence)})</span>${evidence}${todo}${lines.length > 0 ? `<p>${lines.join(' · ')}</p>` : ''}</li>`;
+  });
+  return `<h2>Diagnosis</h2>\n<ul class="diagnosis">${items.join('')}</ul>`;
+}
 
 /**
  * The report as one self-contained HTML document: inline CSS and SVG, no scripts, no external
@@ -417,6 +435,7 @@ export function reportHtml(report: HealthReport): string {
 <header><div><h1>Link health report</h1><p class="file"><strong>${e(name)}</strong> · ${e(facts.join(' · '))}</p>${s.note ? `<p class="file">${e(s.note)}</p>` : ''}</div><div class="status ${report.status}">${e(STATUS_TEXT[report.status])}</div></header>
 <h2>Findings</h2>
 ${verdict}
+${diagnosisHtml(report)}
 ${graphs}
 ${detailsHtml(report)}
 <footer>${e(footer)}</footer>

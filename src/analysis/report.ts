@@ -343,6 +343,22 @@ export interface HealthReport {
   verdict: ReportFinding[];
   remotes: RemoteReport[];
   thresholds: ReportThresholds;
+  /**
+   * The doctor's findings at the end of the capture, worst first, when the caller added them
+   * (`diagnosedHealthReport`; the CLI and the page do): `reportHtml` shows
+   * them in a section of their own. The decoder does not compute them: the doctor builds on it.
+   */
+  diagnosis?: ReportDiagnosis[];
+}
+
+/** One finding of the doctor, as the report shows it (a `DoctorFinding` fits). */
+export interface ReportDiagnosis {
+  severity: 'problem' | 'warning' | 'info';
+  confidence: string;
+  title: string;
+  evidence: readonly { text: string }[];
+  todo: readonly string[];
+  settings: readonly { stack: string; lines: readonly string[]; note: string }[];
 }
 
 export interface HealthReportOptions {

@@ -8,6 +8,7 @@ import { batch, computed, signal } from '@preact/signals';
 import type { InspectEntry } from '../worker/inspector.js';
 import type { BindProgress, FromWorker, Overview, RecordingStatus, ReplayStatus, SourceStatus, ToWorker } from '../worker/protocol.js';
 import { Live } from './live.js';
+import type { DiagnosisStatus } from '../worker/protocol.js';
 
 export interface Notice {
   id: number;
@@ -28,6 +29,8 @@ export const resolutionOverride = signal<'auto' | 1024 | 2048>('auto');
 export const inspection = signal<InspectEntry[] | null>(null);
 /** The steps of the bind in progress (or the last one). */
 export const bindLog = signal<BindProgress[]>([]);
+/** The doctor's findings for the session or the replay position (null: none yet). */
+export const diagnosis = signal<DiagnosisStatus | null>(null);
 
 const IDLE: SourceStatus = {
   id: -1, label: '', kind: 'serial', state: 'idle', name: 'No receiver', clockRate: 0,
@@ -162,6 +165,9 @@ function receive(message: FromWorker): void {
       break;
     case 'bind':
       bindLog.value = message.progress.step === 'open' ? [message.progress] : [...bindLog.value, message.progress];
+      break;
+    case 'diagnosis':
+      diagnosis.value = message.diagnosis;
       break;
     default: {
       const never: never = message;

@@ -9,9 +9,8 @@
 import { readFileSync, writeFileSync } from 'node:fs';
 import { basename } from 'node:path';
 import { CaptureFormatError, captureChunks, capturePorts, readCapture, type Capture, type CaptureChunk } from '../capture/index.js';
-import { SpektrumDecoder } from '../decoder/decoder.js';
-import { healthReport, reportHtml } from '../analysis/index.js';
-import { summarizeCapture } from '../analysis/index.js';
+import { SpektrumDecoder } from '../decoder/index.js';
+import { diagnosedHealthReport, reportHtml, summarizeCapture } from '../analysis/index.js';
 import { parseCommandLine, UsageError, type Args } from './args.js';
 import { formatJsonLine, formatCsvHeader, formatCsvLine, formatReportVerdict, formatSummary } from './format.js';
 import { TextOutput } from './output.js';
@@ -179,10 +178,10 @@ async function finish(out: TextOutput, code: number): Promise<number> {
   return code;
 }
 
-/** `satscope report`: the health report of every port, as HTML or JSON, to stdout or --out. */
-function report(capture: Capture, args: Args, out: TextOutput): Promise<number> {
+/** `satscope report`: the health report of every port with the doctor's findings, as HTML or JSON, to stdout or --out. */
+async function report(capture: Capture, args: Args, out: TextOutput): Promise<number> {
   const name = basename(args.file);
-  const r = healthReport(capture, { resolution: args.resolution, name });
+  const r = diagnosedHealthReport(capture, { resolution: args.resolution, name });
   const text = args.json ? `${JSON.stringify(r, null, 2)}\n` : reportHtml(r);
   if (args.out !== null) {
     try {

@@ -8,6 +8,7 @@ import { BYTE_TIME_US, CHANNEL_COUNT, LinkMonitor, SpektrumDecoder, type LinkEpi
 import { LinkSeries } from '../analysis/index.js';
 import { InspectorLog } from './inspector.js';
 import { BUCKET_US, type Batch } from './protocol.js';
+import type { EngineTap } from './diagnosis.js';
 
 export interface EngineOptions {
   resolution: 'auto' | 1024 | 2048;
@@ -31,6 +32,8 @@ export class Engine {
   readonly decoder: SpektrumDecoder;
   /** The recent frames, discards and resyncs with their bytes, for the frame inspector. */
   readonly inspector = new InspectorLog();
+  /** The doctor's feed (diagnosis.ts): every chunk, and every frame after the link counted it. */
+  tap: EngineTap | null = null;
   readonly link: LinkMonitor;
   readonly series = new LinkSeries(BUCKET_US);
   readonly #positions = new Uint16Array(CHANNEL_COUNT);
@@ -71,6 +74,7 @@ export class Engine {
   push(bytes: Uint8Array, time: number | Float64Array | undefined, arrivedMs: number): void {
     // The log first: the decoder's events (fired in next()) take their times from these chunks.
     this.inspector.onBytes(bytes, time);
+    this.tap?.bytes(bytes, time);
     this.decoder.push(bytes, time);
     this.#pushes.push({ end: this.decoder.stats.bytes, time });
     if (this.#pushes.length > PUSHES_KEPT) this.#pushes.shift();
@@ -131,6 +135,7 @@ export class Engine {
       this.link.frame(f);
       this.series.frame(f, this.link);
       this.#frames++;
+      this.tap?.frame(f);
       for (let i = 0; i < f.count; i++) {
         const id = f.ids[i] as number;
         this.#positions[id] = f.positions[i] as number;

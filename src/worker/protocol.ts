@@ -6,6 +6,7 @@
  */
 import type { FormatInfo, LinkState, MissedBasis } from '../decoder/index.js';
 import type { InspectEntry } from './inspector.js';
+import type { ConfirmProbe, DoctorFinding } from '../analysis/index.js';
 
 /** How the page names a port it was granted: its place in getPorts() and its USB IDs. */
 export interface PortIdentity {
@@ -43,7 +44,9 @@ export type ToWorker =
   /** Playback speed; 0 = as fast as possible. */
   | { type: 'replay-speed'; speed: number }
   | { type: 'replay-seek'; timeUs: number }
-  | { type: 'set-resolution'; resolution: 'auto' | 1024 | 2048 };
+  | { type: 'set-resolution'; resolution: 'auto' | 1024 | 2048 }
+  /** Listen briefly at a finding's other line setting to confirm it, then return to 115200. */
+  | { type: 'diagnosis-confirm'; source: number; probe: ConfirmProbe };
 
 /** Low-rate state of one source (one remote), sent when it changes. */
 export interface SourceStatus {
@@ -171,4 +174,17 @@ export type FromWorker =
   | { type: 'replay'; replay: ReplayStatus | null }
   | { type: 'overview'; overview: Overview }
   | { type: 'bind'; progress: BindProgress }
-  | { type: 'inspection'; source: number; entries: InspectEntry[] };
+  | { type: 'inspection'; source: number; entries: InspectEntry[] }
+  | { type: 'diagnosis'; diagnosis: DiagnosisStatus };
+
+/** The doctor's findings (src/analysis), sent when they change, at most 4× a second. */
+export interface DiagnosisStatus {
+  /** 'live': about the session now; 'replay': at the replay position, on the capture's clock. */
+  mode: 'live' | 'replay';
+  /** Worst first. */
+  findings: DoctorFinding[];
+  /** Sources whose port can be reopened at another speed to confirm a finding (live serial ports). */
+  probeable: number[];
+  /** A listen at another speed under way. */
+  probing: { source: number; baudRate: number } | null;
+}

@@ -1,10 +1,10 @@
 /**
- * A short-lived worker that makes one health report (library: healthReport, reportHtml), so the
+ * A short-lived worker that makes one health report (diagnosedHealthReport, reportHtml), so the
  * worker reading the ports never stalls on it.
  */
 /// <reference lib="webworker" />
 import { readCapture } from '../capture/index.js';
-import { healthReport, reportHtml } from '../analysis/index.js';
+import { diagnosedHealthReport, reportHtml } from '../analysis/index.js';
 
 export interface ReportRequest {
   bytes: Uint8Array;
@@ -20,7 +20,7 @@ const scope = self as unknown as DedicatedWorkerGlobalScope;
 scope.addEventListener('message', (event: MessageEvent<ReportRequest>) => {
   const { bytes, name, format, resolution } = event.data;
   try {
-    const report = healthReport(readCapture(bytes, name), { resolution, name });
+    const report = diagnosedHealthReport(readCapture(bytes, name), { resolution, name });
     const text = format === 'html' ? reportHtml(report) : `${JSON.stringify(report, null, 2)}\n`;
     const data = new TextEncoder().encode(text).buffer as ArrayBuffer;
     const reply: ReportReply = { data };

@@ -9,6 +9,7 @@ import { FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US, FRAME_SIZE, USB_CHUNK_JITTE
 import { CaptureFormatError, capturePorts, readCapture, type Capture } from '../capture/index.js';
 import { LinkSeries, decodeCapture, resolutionKey, timingJitterUs } from '../analysis/index.js';
 import { Engine } from './engine.js';
+import { Diagnosis } from './diagnosis.js';
 import { runBind } from './bind.js';
 import { REMOTE_LABELS, type BindProgress, type FromWorker, type Overview, type PortIdentity, type SourceKind, type SourceStatus, type ToWorker } from './protocol.js';
 import { Recorder } from './recorder.js';
@@ -69,6 +70,8 @@ let replayName = '';
 /** The replayed file's bytes, for a report on it. */
 let replayBytes: Uint8Array | null = null;
 const recorder = new Recorder((recording) => post({ type: 'recording', recording }));
+/** The doctor for the session: findings to the page (diagnosis.ts). */
+const diagnosis = new Diagnosis(post, () => clockUs(), () => [...sources.values()].filter((s) => s.kind === 'serial' && s.state === 'reading').map((s) => s.id));
 
 function freeId(): number {
   let id = 0;
@@ -83,6 +86,7 @@ function defaultLabel(id: number): string {
 function addSource(kind: SourceKind, id: number, name: string, jitterUs: number): Source {
   const source: Source = { id, kind, label: defaultLabel(id), state: 'opening', name, engine: new Engine({ resolution, jitterUs }) };
   sources.set(id, source);
+  diagnosis.attach(id, source.engine, source.label);
   post({ type: 'reset', source: id });
   return source;
 }
@@ -164,6 +168,7 @@ function flush(): void {
   }
   shareResolution();
   sendSources();
+  diagnosis.tick();
 }
 
 function scheduleFlush(): void {
@@ -188,6 +193,7 @@ async function closeSource(id: number): Promise<void> {
   if (s === undefined) return;
   sources.delete(id);
   await s.serial?.close();
+  diagnosis.remove(id);
   post({ type: 'reset', source: id });
   if (sources.size === 0) stopTimers();
   sendSources();
@@ -214,6 +220,7 @@ async function closeAll(): Promise<void> {
   replay = undefined;
   for (const s of sources.values()) await s.serial?.close();
   sources.clear();
+  diagnosis.reset();
   post({ type: 'reset' });
   sendSources();
 }
@@ -260,9 +267,15 @@ async function openSerial(identity: PortIdentity, signals?: SerialOutputSignals)
   source.signals = signals;
   source.serial = new SerialSource(nowUs, {
     data: (bytes, timeUs) => onLiveData(source, bytes, timeUs),
-    lineError: (name) => notice('warning', `Line error on ${source.label}`, `${name}: some bytes may be lost; reading goes on.`),
+    lineError: (name) => {
+      // Recorded, so a recording keeps what the doctor judged the line by.
+      recorder.event(`line error: ${name}`, nowUs(), id);
+      diagnosis.lineError(id, name, nowUs());
+      notice('warning', `Line error on ${source.label}`, `${name}: some bytes may be lost; reading goes on.`);
+    },
     lost: () => {
       recorder.event('device lost', nowUs(), id);
+      diagnosis.close(id);
       setState(source, 'lost');
       notice('error', `Remote ${source.label}: the adapter was unplugged`, 'Reading stopped; everything recorded so far is kept. Plug it back in and it reconnects by itself.');
       if (reconnectTimer === undefined) reconnectTimer = setInterval(() => enqueue(reconnectLost), RECONNECT_MS);
@@ -280,6 +293,7 @@ async function openSerial(identity: PortIdentity, signals?: SerialOutputSignals)
     return false;
   }
   recorder.event('port opened', nowUs(), id);
+  diagnosis.open(id, nowUs());
   setState(source, 'reading', `${describePort(port)} at 115200 baud`);
   startTicks();
   return true;
@@ -298,6 +312,7 @@ async function reopen(s: Source, port: SerialPort): Promise<boolean> {
     return false;
   }
   recorder.event('device reconnected', nowUs(), s.id);
+  diagnosis.open(s.id, nowUs());
   setState(s, 'reading', `${describePort(port)} at 115200 baud`);
   notice('info', `Remote ${s.label} reconnected`, 'The adapter is back; reading again.');
   return true;
@@ -447,6 +462,7 @@ function replayStatus(): void {
 /** Fresh decodes for every port of the replayed capture. */
 function resetReplaySources(capture: Capture, ports: readonly number[]): void {
   sources.clear();
+  diagnosis.replayReset(replay?.startUs ?? NaN);
   post({ type: 'reset' });
   for (const port of ports) {
     const s = addSource('replay', port, `${replayName}${ports.length > 1 ? ` port ${port}` : ''}`, timingJitterUs(capture.timing));
@@ -493,6 +509,7 @@ async function openReplay(name: string, data: ArrayBuffer): Promise<void> {
     { untimedPeriodUs: periodUs },
   );
   replay = r;
+  diagnosis.replay(capture, r.startUs);
   post({ type: 'overview', overview }, [overview.t.buffer, overview.fadeRate.buffer, overview.lost.buffer]);
   if (!r.recordedTiming) {
     notice('info', `${name}: no recorded timing`, `Replayed at the receiver's pace (a frame every ${periodUs / 1000} ms). Holds, failsafes, lost frames and the frame period cannot be measured without the recorded times.`);
@@ -558,6 +575,7 @@ async function handle(message: ToWorker): Promise<void> {
       const s = sources.get(message.source);
       if (s !== undefined) {
         s.label = message.label.slice(0, 8);
+        diagnosis.relabel(s.id, s.engine, s.label);
         sendSources();
       }
       break;
@@ -613,6 +631,21 @@ async function handle(message: ToWorker): Promise<void> {
         break;
       }
       makeReport(bytes, name, message.format);
+      break;
+    }
+    case 'diagnosis-confirm': {
+      const s = sources.get(message.source);
+      if (s?.serial === undefined || s.state !== 'reading') {
+        notice('warning', 'Cannot listen at another speed', 'Only a connected serial port can (not the demo or a replay).');
+        break;
+      }
+      const problem = await diagnosis.confirm(s.id, s.serial, s.signals, message.probe, {
+        nowUs,
+        event: (text, t) => recorder.event(text, t, s.id),
+        data: (bytes, t) => recorder.data(bytes, t, s.id),
+        state: (state, name) => setState(s, state, name === undefined ? s.name.replace(/ at .*$/, ' at 115200 baud') : s.name.replace(/ at .*$/, ` ${name}`)),
+      });
+      if (problem !== null) notice('warning', `Remote ${s.label}: could not listen at ${message.probe.baudRate} baud`, problem);
       break;
     }
     case 'discard-recovered':

@@ -255,11 +255,11 @@ describe.skipIf(skip !== null)('the page on any screen', () => {
     // No text links among the buttons.
     await expect(page.locator('.toolbar > .tb-group > button.link').count()).resolves.toBe(0);
     // Resolution lives in Settings.
-    await page.getByRole('button', { name: 'Settings' }).click();
+    await page.getByRole('button', { name: 'Settings', exact: true }).click();
     await page.getByRole('combobox', { name: 'Resolution' }).waitFor();
     await page.keyboard.press('Escape');
     await expect(page.getByRole('combobox', { name: 'Resolution' }).count()).resolves.toBe(0);
-    await expect(page.getByRole('button', { name: 'Settings' }).evaluate((e) => e === document.activeElement)).resolves.toBe(true);
+    await expect(page.getByRole('button', { name: 'Settings', exact: true }).evaluate((e) => e === document.activeElement)).resolves.toBe(true);
     await page.context().close();
   });
 
@@ -314,7 +314,7 @@ describe.skipIf(skip !== null)('the page on any screen', () => {
     await page.getByTestId('empty-state').waitFor();
     await expect(page.evaluate(() => document.documentElement.dataset.theme)).resolves.toBe('dark');
     // Back to following the system, from Settings.
-    await page.getByRole('button', { name: 'Settings' }).click();
+    await page.getByRole('button', { name: 'Settings', exact: true }).click();
     await page.getByRole('combobox', { name: 'Theme' }).selectOption('system');
     await expect(page.evaluate(() => document.documentElement.dataset.theme)).resolves.toBe('light');
     await page.context().close();
@@ -386,7 +386,7 @@ describe.skipIf(skip !== null)('the page on any screen', () => {
       await demo.page.getByRole('button', { name: 'Follow' }).click();
       await demo.page.locator('.counters .help summary').click();
       found.push(...(await axe(demo.page, `demo+inspector ${scheme}`)));
-      await demo.page.getByRole('button', { name: 'Settings' }).click();
+      await demo.page.getByRole('button', { name: 'Settings', exact: true }).click();
       await demo.page.getByRole('combobox', { name: 'Resolution' }).waitFor();
       found.push(...(await axe(demo.page, `demo+settings ${scheme}`)));
       await demo.page.keyboard.press('Escape');

@@ -74,10 +74,11 @@ export class SerialSource {
 
   /**
    * Opens the port and starts reading; `signals` are set at once after opening (after a bind,
-   * the line that powers the satellite). @throws the port's own error when it cannot be opened.
+   * the line that powers the satellite). `line` is for the doctor's short listen at another
+   * setting (default 115200 8N1). @throws the port's own error when it cannot be opened.
    */
-  async open(port: SerialPort, signals?: SerialOutputSignals): Promise<void> {
-    await port.open({ baudRate: BAUD_RATE, dataBits: 8, stopBits: 1, parity: 'none', flowControl: 'none', bufferSize: 1 << 20 });
+  async open(port: SerialPort, signals?: SerialOutputSignals, line: { baudRate?: number; parity?: ParityType; stopBits?: 1 | 2 } = {}): Promise<void> {
+    await port.open({ baudRate: line.baudRate ?? BAUD_RATE, dataBits: 8, stopBits: line.stopBits ?? 1, parity: line.parity ?? 'none', flowControl: 'none', bufferSize: 1 << 20 });
     if (signals !== undefined) {
       try {
         await port.setSignals(signals);

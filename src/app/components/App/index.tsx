@@ -10,6 +10,7 @@ import { openCapture } from '../../open-file.js';
 import { replay, sources, status, xplusSeen } from '../../store.js';
 import { ChannelBars } from '../ChannelBars/index.js';
 import { Counters } from '../Counters/index.js';
+import { DiagnosisPanel } from '../Diagnosis/index.js';
 import { EmptyState } from '../EmptyState/index.js';
 import { Graphs, WINDOWS } from '../Graphs/index.js';
 import { LinkPanel } from '../LinkPanel/index.js';
@@ -79,6 +80,7 @@ export function App({ granted }: { granted: SerialPort[] }) {
           <div class="panel p-counters"><h2>Counters</h2><Counters /></div>
         </aside>
         <div class="main">
+          <div class="panel p-diagnosis" id="diagnosis"><DiagnosisPanel /></div>
           {sources.value.length > 1 ? <div class="panel p-remotes"><Remotes windowUs={windowUs} /></div> : null}
           <div class="panel p-channels"><h2>Channels{sources.value.length > 1 ? ` — remote ${status.value.label}` : ''}</h2><ChannelBars ids={NORMAL} label="Channels 0–11" /></div>
           {xplusSeen.value ? <div class="panel p-xplus"><h2>X-Plus</h2><ChannelBars ids={XPLUS} label="X-Plus channels" /></div> : null}

@@ -9,6 +9,7 @@ import { onFrame } from '../../frame-loop.js';
 import type { Live } from '../../live.js';
 import { current, linkEnded, linkMismatch, linkState, resolutionOverride } from '../../store.js';
 import { drawEpisodes } from '../../timeline.js';
+import { TopFinding } from '../Diagnosis/index.js';
 import './style.css';
 
 const LABEL = { waiting: 'Waiting', live: 'Live', hold: 'Hold', failsafe: 'Failsafe' } as const;
@@ -70,6 +71,7 @@ export function LinkPanel({ windowUs }: { windowUs: Signal<number> }) {
         <dt>Last frame</dt><dd><span ref={since}>none yet</span></dd>
         <dt>Episodes</dt><dd><span ref={counts}>none</span></dd>
       </dl>
+      <TopFinding />
       <div class="timeline" ref={strip} role="img" aria-label="No hold or failsafe in this window" />
     </section>
   );

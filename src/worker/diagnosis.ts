@@ -1,0 +1,235 @@
+/**
+ * The doctor in the worker (src/analysis): one `Doctor` per session, fed through the same path
+ * as the decoders: each engine's bytes and frames (its `tap`), each port's opening, read errors
+ * and loss. Its findings go to the page when they change, at most 4× a second.
+ *
+ * A replay gets a fresh doctor on the capture's clock (its timing, its first time as origin,
+ * memory over the whole file, as `satscope doctor` reads it), with the capture's recorded
+ * events fed in time order before the bytes they precede; a seek starts it over, as it does the
+ * decoders. Live ports can be asked to listen briefly at another line setting to confirm a
+ * finding (`confirm`), and return to 115200.
+ */
+import { Doctor, doctorEvent, type ConfirmProbe, type DoctorFinding } from '../analysis/index.js';
+import type { Capture } from '../capture/index.js';
+import type { DecodedFrame } from '../decoder/index.js';
+import type { Engine } from './engine.js';
+import type { DiagnosisStatus, FromWorker } from './protocol.js';
+import { SerialSource } from './sources/serial.js';
+
+/** What an engine hands the doctor: each chunk as it arrives, each frame after the link monitor counted it. */
+export interface EngineTap {
+  bytes(bytes: Uint8Array, time: number | Float64Array | undefined): void;
+  frame(f: DecodedFrame): void;
+}
+
+/** The page hears from the doctor at most this often. */
+const MIN_POST_MS = 250;
+/** Line settings a probe may use: anything else from the page is refused. */
+const PROBE_BAUDS = new Set([100_000, 420_000]);
+const MAX_LISTEN_US = 2_000_000;
+
+/** What the worker lends the probe. */
+export interface ProbeHooks {
+  nowUs(): number;
+  /** Recorded like any port event, so `satscope doctor` on the recording sees the probe too. */
+  event(text: string, timeUs: number): void;
+  data(bytes: Uint8Array, timeUs: number): void;
+  state(state: string, name?: string): void;
+}
+
+export class Diagnosis {
+  #doctor = new Doctor();
+  #mode: 'live' | 'replay' = 'live';
+  #capture: Capture | null = null;
+  #events: { port: number; timeUs: number; text: string }[] = [];
+  #nextEvent = 0;
+  #labels = new Map<number, string>();
+  #probing: DiagnosisStatus['probing'] = null;
+  #lastKey = '';
+  #lastPostMs = -Infinity;
+  #timer: ReturnType<typeof setTimeout> | undefined;
+
+  /**
+   * @param post sends a message to the page
+   * @param clockUs the session's clock (live: now; replay: the replay position)
+   * @param probeable the live serial sources that could listen at another speed
+   */
+  constructor(
+    readonly post: (message: FromWorker) => void,
+    readonly clockUs: () => number,
+    readonly probeable: () => number[],
+  ) {}
+
+  /** A new live session (every port closed): a fresh doctor, its sentences timed from now. */
+  reset(): void {
+    this.#mode = 'live';
+    this.#capture = null;
+    this.#events = [];
+    this.#labels.clear();
+    this.#doctor = new Doctor({ originUs: this.clockUs() });
+    this.#probing = null;
+    this.tick(true);
+  }
+
+  /** A capture opens for replay. */
+  replay(capture: Capture, startUs: number): void {
+    this.#mode = 'replay';
+    this.#capture = capture;
+    this.#events = [...capture.events].map((e) => ({ port: e.port, timeUs: e.timeUs, text: e.text })).sort((a, b) => a.timeUs - b.timeUs);
+    this.#labels.clear();
+    this.#restartReplay(startUs);
+  }
+
+  /** The replay starts over (a seek): the decoders are new, and so is the doctor. */
+  replayReset(startUs: number): void {
+    if (this.#mode === 'replay') this.#restartReplay(startUs);
+  }
+
+  #restartReplay(startUs: number): void {
+    const timing = this.#capture?.timing === 'per-byte' ? 'per-byte' : 'per-chunk';
+    this.#doctor = new Doctor({ timing, memoryUs: Infinity, originUs: Number.isFinite(startUs) ? startUs : 0 });
+    this.#nextEvent = 0;
+  }
+
+  /** Recorded events up to `timeUs`, in order. */
+  #eventsUntil(timeUs: number): void {
+    while (this.#nextEvent < this.#events.length && !((this.#events[this.#nextEvent] as { timeUs: number }).timeUs > timeUs)) {
+      const e = this.#events[this.#nextEvent++] as { port: number; timeUs: number; text: string };
+      doctorEvent(this.#doctor, e.port, e.text, e.timeUs);
+    }
+  }
+
+  /** A source's engine: its bytes and frames reach the doctor from now on. */
+  attach(id: number, engine: Engine, label: string): void {
+    if (this.#labels.has(id) && this.#mode === 'live') this.#doctor.detach(id);
+    this.#labels.set(id, label);
+    const doctor = (): Doctor => this.#doctor;
+    doctor().attach(id, { decoder: engine.decoder, link: engine.link, label });
+    engine.tap = {
+      bytes: (bytes, time) => {
+        if (this.#mode === 'replay') {
+          const t = time instanceof Float64Array ? (time[0] as number) : time;
+          if (t !== undefined) this.#eventsUntil(t);
+        }
+        doctor().bytes(id, bytes, time);
+      },
+      frame: (f) => doctor().frame(id, f),
+    };
+  }
+
+  /** A source's label changed: the findings name it. */
+  relabel(id: number, engine: Engine, label: string): void {
+    this.#labels.set(id, label);
+    this.#doctor.attach(id, { decoder: engine.decoder, link: engine.link, label });
+  }
+
+  open(id: number, timeUs: number): void {
+    this.#doctor.open(id, timeUs);
+  }
+
+  lineError(id: number, name: string, timeUs: number): void {
+    this.#doctor.lineError(id, name, timeUs);
+  }
+
+  close(id: number): void {
+    this.#doctor.close(id);
+  }
+
+  /** A source was removed: its port number may be given to another remote. */
+  remove(id: number): void {
+    this.#doctor.detach(id);
+    this.#labels.delete(id);
+  }
+
+  /**
+   * Sends the findings when they changed, at most every MIN_POST_MS (a change inside that
+   * time goes out when it is over). `force`: now, whatever changed.
+   */
+  tick(force = false): void {
+    const nowMs = performance.now();
+    const wait = this.#lastPostMs + MIN_POST_MS - nowMs;
+    if (!force && wait > 0) {
+      if (this.#timer === undefined)
+        this.#timer = setTimeout(() => {
+          this.#timer = undefined;
+          this.tick();
+        }, wait);
+      return;
+    }
+    const now = this.clockUs();
+    if (this.#mode === 'replay') this.#eventsUntil(now);
+    const findings: DoctorFinding[] = Number.isFinite(now) ? this.#doctor.findings(now) : [];
+    const diagnosis: DiagnosisStatus = {
+      mode: this.#mode,
+      findings,
+      probeable: this.#mode === 'live' ? this.probeable() : [],
+      probing: this.#probing,
+    };
+    const key = JSON.stringify(diagnosis);
+    this.#lastPostMs = nowMs;
+    if (key === this.#lastKey && !force) return;
+    this.#lastKey = key;
+    this.post({ type: 'diagnosis', diagnosis });
+  }
+
+  /**
+   * Listens at `probe`'s line setting for `probe.listenUs` to confirm a finding, then reopens
+   * the port at 115200 and reading goes on. Meanwhile the doctor gets the bytes and read errors
+   * (what it recognises there makes its finding certain); the decoder does not. Returns why it
+   * could not, or null.
+   */
+  async confirm(
+    id: number,
+    serial: SerialSource,
+    signals: SerialOutputSignals | undefined,
+    probe: ConfirmProbe,
+    hooks: ProbeHooks,
+  ): Promise<string | null> {
+    if (this.#mode !== 'live' || this.#probing !== null) return 'A listen is already under way.';
+    if (!PROBE_BAUDS.has(probe.baudRate) || !(probe.listenUs > 0) || probe.listenUs > MAX_LISTEN_US)
+      return 'Not a line setting the doctor asked for.';
+    const port = serial.port;
+    if (port === undefined) return 'The port is not open.';
+    const name = `${probe.baudRate} ${probe.parity === 'none' ? 'N' : probe.parity === 'even' ? 'E' : 'O'}${probe.stopBits}`;
+    this.#probing = { source: id, baudRate: probe.baudRate };
+    this.tick(true);
+    await serial.close();
+    const listener = new SerialSource(hooks.nowUs, {
+      data: (bytes, timeUs) => {
+        this.#doctor.bytes(id, bytes, timeUs);
+        hooks.data(bytes, timeUs);
+      },
+      lineError: (error) => {
+        const t = hooks.nowUs();
+        this.#doctor.lineError(id, error, t);
+        hooks.event(`line error: ${error}`, t);
+      },
+      lost: () => undefined,
+    });
+    let problem: string | null = null;
+    try {
+      await listener.open(port, signals, probe);
+      const t = hooks.nowUs();
+      this.#doctor.open(id, t, { baudRate: probe.baudRate });
+      hooks.event(`port opened at ${probe.baudRate} baud`, t);
+      hooks.state('probing', `listening at ${name}`);
+      await new Promise((resolve) => setTimeout(resolve, probe.listenUs / 1000));
+    } catch (error) {
+      problem = `The port could not be opened at ${name}: ${error instanceof Error ? error.message : String(error)}`;
+    }
+    await listener.close();
+    try {
+      await serial.open(port, signals);
+      const t = hooks.nowUs();
+      this.#doctor.open(id, t);
+      hooks.event('port opened at 115200 baud', t);
+      hooks.state('reading');
+    } catch (error) {
+      problem = `The port did not reopen at 115200: ${error instanceof Error ? error.message : String(error)}. Connect it again.`;
+      hooks.state('lost');
+    }
+    this.#probing = null;
+    this.tick(true);
+    return problem;
+  }
+}
