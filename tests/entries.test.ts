@@ -1,0 +1,18 @@
+/**
+ * The package's entries stay apart in a bundle: importing the core (`satscope`) pulls in neither
+ * the capture importers nor the report's HTML nor the doctor.
+ */
+import { describe, expect, it } from 'vitest';
+import { entrySizes } from '../scripts/core-size.mjs';
+
+describe('package entries in a bundle', () => {
+  it('keeps capture files, the report and the doctor out of a bundle that imports the core', async () => {
+    const sizes = await entrySizes();
+    const core = sizes.satscope.text;
+    expect(core).toContain('push() after end()');
+    expect(core).not.toMatch(/Saleae|Link health report|serialrx_provider|\.sscap/);
+    expect(sizes['satscope/report'].text).toContain('Link health report');
+    // The figure the README quotes, with room for small changes.
+    expect(sizes.satscope.gzip).toBeLessThan(14 * 1024);
+  }, 60_000);
+});
