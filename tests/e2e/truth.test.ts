@@ -115,7 +115,7 @@ describe.skipIf(skip !== null)('honest states', () => {
     await page.waitForTimeout(5500);
     const episodes = await page.locator('.link dd').nth(1).textContent();
     const missed = Number(await page.getByTestId('count-missed').textContent());
-    await page.getByRole('button', { name: 'Settings' }).click();
+    await page.getByRole('button', { name: 'Settings', exact: true }).click();
     await page.getByRole('combobox', { name: 'Resolution' }).selectOption('1024');
     await page.keyboard.press('Escape');
     await page.getByTestId('link-hint').filter({ hasText: 'Forced 1024: no frame matches; the stream looks like 2048' }).waitFor({ timeout: 5000 });
@@ -123,7 +123,7 @@ describe.skipIf(skip !== null)('honest states', () => {
     await page.waitForTimeout(2500);
     await expect(page.getByTestId('link-state').textContent()).resolves.toBe('Waiting');
     await expect(page.locator('.link dd').nth(1).textContent()).resolves.toBe(episodes);
-    await page.getByRole('button', { name: 'Settings' }).click();
+    await page.getByRole('button', { name: 'Settings', exact: true }).click();
     await page.getByRole('combobox', { name: 'Resolution' }).selectOption('auto');
     await page.keyboard.press('Escape');
     await page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor({ timeout: 5000 });
