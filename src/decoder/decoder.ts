@@ -219,23 +219,41 @@ export class SpektrumDecoder {
    */
   push(bytes: Uint8Array, time?: number | Float64Array): void {
     if (this.#ended) throw new TypeError('push() after end(): call reset() to decode a new stream');
-    const n = bytes.length;
-    if (time instanceof Float64Array && time.length !== n) {
-      throw new TypeError(`per-byte times have length ${time.length}, bytes ${n}`);
+    // push() is kept small so that it is inlined into the caller's loop, and the time is stored
+    // here rather than passed on: a double handed from there to a call that is not inlined, or
+    // to `instanceof`, is boxed (a 16-byte heap number every push).
+    if (typeof time === 'number') {
+      const i = this.#append(bytes, null);
+      if (i >= 0) this.#chunkTimes[i] = time;
+      return;
     }
-    if (n === 0) return;
+    const perByte = time instanceof Float64Array;
+    if (perByte && time.length !== bytes.length) {
+      throw new TypeError(`per-byte times have length ${time.length}, bytes ${bytes.length}`);
+    }
+    const i = this.#append(bytes, perByte ? time : null);
+    if (i >= 0) this.#chunkTimes[i] = perByte ? NaN : (time ?? NaN);
+  }
+
+  /**
+   * Copies pushed bytes (and their per-byte times) into the buffer and records the chunk.
+   * Returns the chunk's index, for the caller to store its time, or -1 for no bytes.
+   */
+  #append(bytes: Uint8Array, byteTimes: Float64Array | null): number {
+    const n = bytes.length;
+    if (n === 0) return -1;
     this.#reserve(n);
     const at = this.#tail;
     this.#buf.set(bytes, at);
-    const perByte = time instanceof Float64Array;
-    if (perByte) {
+    if (byteTimes !== null) {
       if (this.#byteTimes === null) this.#byteTimes = new Float64Array(this.#buf.length);
-      this.#byteTimes.set(time, at);
+      this.#byteTimes.set(byteTimes, at);
     }
-    this.#addChunk(this.#base + at + n, perByte ? NaN : (time ?? NaN), perByte);
+    const i = this.#addChunk(this.#base + at + n, byteTimes !== null);
     this.#tail = at + n;
     this.#stats.bytes += n;
     this.#stats.pendingBytes += n;
+    return i;
   }
 
   /**
@@ -921,8 +939,8 @@ export class SpektrumDecoder {
     if (this.#onEvent !== undefined) this.#onEvent(event);
   }
 
-  /** Records a pushed chunk's end (stream offset) and time. */
-  #addChunk(end: number, time: number, perByte: boolean): void {
+  /** Records a pushed chunk's end (stream offset); returns its index, for the caller to store its time. */
+  #addChunk(end: number, perByte: boolean): number {
     if (this.#chunkTail === this.#chunkEnds.length) {
       const live = this.#chunkTail - this.#chunkHead;
       if (this.#chunkHead >= live) {
@@ -946,8 +964,8 @@ export class SpektrumDecoder {
     }
     const i = this.#chunkTail++;
     this.#chunkEnds[i] = end;
-    this.#chunkTimes[i] = time;
     this.#chunkPerByte[i] = perByte ? 1 : 0;
+    return i;
   }
 
   /**
