@@ -119,8 +119,8 @@ function whole(s) {
   return frames + drain(d);
 }
 
-function chunkTimes(s) {
-  const d = new SpektrumDecoder();
+function chunkTimes(s, options = undefined) {
+  const d = new SpektrumDecoder(options);
   const { views, chunkTimes: times } = s;
   let frames = 0;
   for (let k = 0; k < views.length; k++) {
@@ -202,6 +202,7 @@ const CASES = [
   { name: 'whole buffer, no times', stream: '2048', run: whole, base: 'baseline JS loop, 2048 internal' },
   { name: '64-byte chunks, chunk times', stream: '2048', run: chunkTimes, base: 'baseline JS loop, 2048 internal' },
   { name: '64-byte chunks, per-byte times', stream: '2048', run: perByteTimes, base: 'baseline JS loop, 2048 internal' },
+  { name: '64-byte chunks, chunk times, general path', stream: '2048', run: (s) => chunkTimes(s, { fastPath: false }), base: 'baseline JS loop, 2048 internal' },
   { name: 'baseline JS loop, 1024 internal', stream: '1024', run: (s) => baseline(s.bytes, s.resolution), base: null },
   { name: '1024 mode, 64-byte chunks, chunk times', stream: '1024', run: chunkTimes, base: 'baseline JS loop, 1024 internal' },
   { name: 'baseline JS loop, 2048 external', stream: 'external', run: (s) => baseline(s.bytes, s.resolution), base: null },
