@@ -29,7 +29,12 @@ const fresh = args.includes('--fresh');
 
 /** Writes the capture of `durationUs` to `path` (through a temporary file: a cut-off run leaves no half file). */
 function makeCapture(path, durationUs) {
-  const writer = new CaptureWriter({ source: 'simulator', baudRate: 115200, note: 'bench/day.mjs', ports: [{ name: 'internal DSMX 11 ms' }, { name: 'external DSMX 11 ms' }] });
+  const writer = new CaptureWriter({
+    source: 'simulator',
+    baudRate: 115200,
+    note: 'bench/day.mjs',
+    ports: [{ name: 'internal DSMX 11 ms' }, { name: 'external DSMX 11 ms' }],
+  });
   const sims = [
     new Simulator({ ...preset('dsmx-11ms-2048-internal'), seed: 11 }),
     new Simulator({ ...preset('dsmx-11ms-2048-external'), seed: 12 }),
@@ -39,7 +44,10 @@ function makeCapture(path, durationUs) {
   const out = new Uint8Array(8 << 20);
   let used = 0;
   const put = (record) => {
-    if (used + record.length > out.length) { writeSync(fd, out, 0, used); used = 0; }
+    if (used + record.length > out.length) {
+      writeSync(fd, out, 0, used);
+      used = 0;
+    }
     out.set(record, used);
     used += record.length;
   };
@@ -84,12 +92,17 @@ function measure(argv) {
   };
 }
 
-const load = () => loadavg().map((x) => x.toFixed(2)).join(' ');
+const load = () =>
+  loadavg()
+    .map((x) => x.toFixed(2))
+    .join(' ');
 console.log(`satscope on day-long captures: node ${process.version}, ${cpus().length} CPUs, load average ${load()}`);
 // What node itself takes, to read the peak memory figures against.
 const idle = measure(['--version']);
 console.log(`node + satscope --version alone: ${idle.wallS.toFixed(2)} s, peak ${idle.peakMB.toFixed(0)} MB\n`);
-console.log(`${'capture'.padEnd(8)} ${'file MB'.padStart(8)} ${'command'.padEnd(8)} ${'wall s'.padStart(7)} ${'cpu s'.padStart(7)} ${'peak MB'.padStart(8)} ${'peak/file'.padStart(9)} ${'s per file GB'.padStart(13)}`);
+console.log(
+  `${'capture'.padEnd(8)} ${'file MB'.padStart(8)} ${'command'.padEnd(8)} ${'wall s'.padStart(7)} ${'cpu s'.padStart(7)} ${'peak MB'.padStart(8)} ${'peak/file'.padStart(9)} ${'s per file GB'.padStart(13)}`,
+);
 const rows = [];
 for (const name of only) {
   const durationUs = DURATIONS[name];
@@ -102,13 +115,20 @@ for (const name of only) {
   }
   const fileMB = statSync(path).size / 2 ** 20;
   const html = join(tmpdir(), `satscope-bench-day-${name}.html`);
-  for (const [command, argv] of [['info', ['info', path]], ['report', ['report', path, '--out', html]]]) {
+  for (const [command, argv] of [
+    ['info', ['info', path]],
+    ['report', ['report', path, '--out', html]],
+  ]) {
     const r = measure(argv);
     if (r.status !== 0) console.log(`  ${command} exited with ${r.status}: ${r.stderr.trim().split('\n').slice(-3).join(' / ')}`);
     rows.push({ name, command, fileMB, ...r });
-    console.log(`${name.padEnd(8)} ${fileMB.toFixed(1).padStart(8)} ${command.padEnd(8)} ${r.wallS.toFixed(2).padStart(7)} ${r.cpuS.toFixed(2).padStart(7)} ${r.peakMB.toFixed(0).padStart(8)} ${(r.peakMB / fileMB).toFixed(2).padStart(9)} ${(r.wallS / (fileMB / 1024)).toFixed(1).padStart(13)}`);
+    console.log(
+      `${name.padEnd(8)} ${fileMB.toFixed(1).padStart(8)} ${command.padEnd(8)} ${r.wallS.toFixed(2).padStart(7)} ${r.cpuS.toFixed(2).padStart(7)} ${r.peakMB.toFixed(0).padStart(8)} ${(r.peakMB / fileMB).toFixed(2).padStart(9)} ${(r.wallS / (fileMB / 1024)).toFixed(1).padStart(13)}`,
+    );
   }
   if (!args.includes('--keep-html')) rmSync(html, { force: true });
 }
 console.log(`\nload average after: ${load()}`);
-console.log('Targets (issue 12): info and report under 5 s with peak memory under 3× the file size on the 24-hour capture; cost linear in the file size (s per file GB flat).');
+console.log(
+  'Targets (issue 12): info and report under 5 s with peak memory under 3× the file size on the 24-hour capture; cost linear in the file size (s per file GB flat).',
+);

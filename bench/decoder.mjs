@@ -28,8 +28,8 @@ const FRAME_SIZE = 16;
 
 /** The streams: about 5.2 MB each (an hour at 11 ms, two at 22 ms). */
 const STREAMS = {
-  '2048': { preset: 'dsmx-11ms-2048-internal', hours: 1, resolution: 2048, label: 'DSMX 11 ms 2048, internal remote, 1 h' },
-  '1024': { preset: 'dsm2-22ms-1024-internal', hours: 2, resolution: 1024, label: 'DSM2 22 ms 1024, internal remote, 2 h' },
+  2048: { preset: 'dsmx-11ms-2048-internal', hours: 1, resolution: 2048, label: 'DSMX 11 ms 2048, internal remote, 1 h' },
+  1024: { preset: 'dsm2-22ms-1024-internal', hours: 2, resolution: 1024, label: 'DSM2 22 ms 1024, internal remote, 2 h' },
   external: { preset: 'dsmx-11ms-2048-external', hours: 1, resolution: 2048, label: 'DSMX 11 ms 2048, external remote, 1 h' },
 };
 
@@ -87,22 +87,31 @@ function baseline(bytes, resolution) {
         }
       } else {
         id = word >> 10;
-        if (id > 11) { ok = false; break; }
+        if (id > 11) {
+          ok = false;
+          break;
+        }
         position = word & 0x3ff;
       }
       const bit = 1 << id;
-      if ((seen & bit) !== 0) { ok = false; break; }
+      if ((seen & bit) !== 0) {
+        ok = false;
+        break;
+      }
       seen |= bit;
       ids[count] = id;
       positions[count] = position;
       count++;
     }
-    if (!ok) { invalid++; continue; }
+    if (!ok) {
+      invalid++;
+      continue;
+    }
     frames++;
     sum += positions[0] + ids[count - 1];
   }
   if (sum < 0) throw new Error('unreachable: keeps the loop from being optimised away');
-  return frames;
+  return frames + invalid; // every aligned 16 bytes, like the decoder's frame count on a clean stream
 }
 
 function drain(d) {
@@ -114,7 +123,7 @@ function drain(d) {
 function whole(s) {
   const d = new SpektrumDecoder();
   d.push(s.bytes);
-  let frames = drain(d);
+  const frames = drain(d);
   d.end();
   return frames + drain(d);
 }
@@ -158,15 +167,38 @@ if (process.argv[2] === '--alloc') {
   // time gets boxed depends on what the JIT inlines into the caller.
   const { views, chunkTimes: times, byteTimes } = s;
   const run = {
-    chunk: (d, from, to) => { let n = 0; for (let k = from; k < to; k++) { d.push(views[k], times[k]); n += drain(d); } return n; },
-    'per-byte': (d, from, to) => { let n = 0; for (let k = from; k < to; k++) { d.push(views[k], byteTimes[k]); n += drain(d); } return n; },
-    none: (d, from, to) => { let n = 0; for (let k = from; k < to; k++) { d.push(views[k]); n += drain(d); } return n; },
+    chunk: (d, from, to) => {
+      let n = 0;
+      for (let k = from; k < to; k++) {
+        d.push(views[k], times[k]);
+        n += drain(d);
+      }
+      return n;
+    },
+    'per-byte': (d, from, to) => {
+      let n = 0;
+      for (let k = from; k < to; k++) {
+        d.push(views[k], byteTimes[k]);
+        n += drain(d);
+      }
+      return n;
+    },
+    none: (d, from, to) => {
+      let n = 0;
+      for (let k = from; k < to; k++) {
+        d.push(views[k]);
+        n += drain(d);
+      }
+      return n;
+    },
   }[mode];
   run(new SpektrumDecoder(), 0, s.views.length);
   run(new SpektrumDecoder(), 0, s.views.length);
   const { PerformanceObserver } = await import('node:perf_hooks');
   let gcs = 0;
-  const obs = new PerformanceObserver((list) => { gcs += list.getEntries().length; });
+  const obs = new PerformanceObserver((list) => {
+    gcs += list.getEntries().length;
+  });
   obs.observe({ entryTypes: ['gc'] });
   const runs = [];
   for (let r = 0; r < 3; r++) {
@@ -202,7 +234,12 @@ const CASES = [
   { name: 'whole buffer, no times', stream: '2048', run: whole, base: 'baseline JS loop, 2048 internal' },
   { name: '64-byte chunks, chunk times', stream: '2048', run: chunkTimes, base: 'baseline JS loop, 2048 internal' },
   { name: '64-byte chunks, per-byte times', stream: '2048', run: perByteTimes, base: 'baseline JS loop, 2048 internal' },
-  { name: '64-byte chunks, chunk times, general path', stream: '2048', run: (s) => chunkTimes(s, { fastPath: false }), base: 'baseline JS loop, 2048 internal' },
+  {
+    name: '64-byte chunks, chunk times, general path',
+    stream: '2048',
+    run: (s) => chunkTimes(s, { fastPath: false }),
+    base: 'baseline JS loop, 2048 internal',
+  },
   { name: 'baseline JS loop, 1024 internal', stream: '1024', run: (s) => baseline(s.bytes, s.resolution), base: null },
   { name: '1024 mode, 64-byte chunks, chunk times', stream: '1024', run: chunkTimes, base: 'baseline JS loop, 1024 internal' },
   { name: 'baseline JS loop, 2048 external', stream: 'external', run: (s) => baseline(s.bytes, s.resolution), base: null },
@@ -210,9 +247,15 @@ const CASES = [
 ].filter((c, _i, all) => only === '' || c.name.includes(only) || all.some((x) => x.base === c.name && x.name.includes(only)));
 // (A baseline stays in whenever a case compared with it does.)
 
-const load = () => loadavg().map((x) => x.toFixed(2)).join(' ');
+const load = () =>
+  loadavg()
+    .map((x) => x.toFixed(2))
+    .join(' ');
 console.log(`SatScope decoder benchmark: node ${process.version}, ${cpus().length} CPUs, load average ${load()} (1, 5, 15 min)`);
-for (const s of Object.values(streams)) console.log(`  stream ${s.key.padEnd(8)} ${s.label}: ${(s.bytes.length / 1e6).toFixed(2)} MB, ${s.views.length} chunks of ${CHUNK} bytes`);
+for (const s of Object.values(streams))
+  console.log(
+    `  stream ${s.key.padEnd(8)} ${s.label}: ${(s.bytes.length / 1e6).toFixed(2)} MB, ${s.views.length} chunks of ${CHUNK} bytes`,
+  );
 console.log(`${ROUNDS} rounds interleaving ${CASES.length} cases after ${WARMUP} warm-up rounds; min / median / max`);
 
 const ms = new Map(CASES.map((c) => [c.name, []]));
@@ -230,7 +273,10 @@ for (let r = 0; r < WARMUP + ROUNDS; r++) {
 }
 
 const sorted = (xs) => [...xs].sort((a, b) => a - b);
-const stats = (xs) => { const v = sorted(xs); return [v[0], v[v.length >> 1], v[v.length - 1]]; };
+const stats = (xs) => {
+  const v = sorted(xs);
+  return [v[0], v[v.length >> 1], v[v.length - 1]];
+};
 const fmt = (v, digits) => v.map((x) => x.toFixed(digits).padStart(digits === 0 ? 5 : 5)).join(' /');
 console.log(`\n${'case'.padEnd(46)} ${'MB/s min / median / max'.padEnd(24)} ${'× baseline (same round)'.padEnd(24)} frames`);
 for (const c of CASES) {
@@ -249,9 +295,21 @@ console.log(`load average after: ${load()}`);
 
 const self = fileURLToPath(import.meta.url);
 console.log('\nheap growth in steady state (no GC during the run; locked decoder, the least of 3 runs after 2 warm-up runs):');
-for (const [mode, stream] of [['chunk', '2048'], ['per-byte', '2048'], ['none', '2048'], ['chunk', '1024'], ['chunk', 'external']]) {
+for (const [mode, stream] of [
+  ['chunk', '2048'],
+  ['per-byte', '2048'],
+  ['none', '2048'],
+  ['chunk', '1024'],
+  ['chunk', 'external'],
+]) {
   if (only !== '' && !['heap', stream, mode].some((w) => only.includes(w))) continue;
-  const alloc = JSON.parse(execFileSync(process.execPath, ['--expose-gc', '--max-semi-space-size=1024', self, '--alloc', mode, stream], { encoding: 'utf8' }));
-  const what = { chunk: '64-byte chunks, chunk times', 'per-byte': '64-byte chunks, per-byte times', none: '64-byte chunks, no times' }[mode];
-  console.log(`  ${`${stream}, ${what}`.padEnd(44)} ${(alloc.bytes / alloc.frames).toFixed(2).padStart(6)} bytes/frame = ${(alloc.bytes / alloc.pushes).toFixed(2).padStart(6)} bytes/push over ${alloc.frames} frames in ${alloc.pushes} pushes (${alloc.gcs} GCs; bytes in 3 runs: ${alloc.all.join(', ')})`);
+  const alloc = JSON.parse(
+    execFileSync(process.execPath, ['--expose-gc', '--max-semi-space-size=1024', self, '--alloc', mode, stream], { encoding: 'utf8' }),
+  );
+  const what = { chunk: '64-byte chunks, chunk times', 'per-byte': '64-byte chunks, per-byte times', none: '64-byte chunks, no times' }[
+    mode
+  ];
+  console.log(
+    `  ${`${stream}, ${what}`.padEnd(44)} ${(alloc.bytes / alloc.frames).toFixed(2).padStart(6)} bytes/frame = ${(alloc.bytes / alloc.pushes).toFixed(2).padStart(6)} bytes/push over ${alloc.frames} frames in ${alloc.pushes} pushes (${alloc.gcs} GCs; bytes in 3 runs: ${alloc.all.join(', ')})`,
+  );
 }

@@ -23,10 +23,21 @@ function trace(bytes: Uint8Array, times: Float64Array, options: DecoderOptions, 
   const drain = () => {
     for (let f = d.next(); f; f = d.next()) {
       seen.push({
-        index: f.index, offset: f.offset, timeUs: Number.isNaN(f.timeUs) ? 'NaN' : f.timeUs, remote: f.remote, system: f.system,
-        resolution: f.resolution, fades: f.fades, fadesDelta: f.fadesDelta, rssi: f.rssi, count: f.count,
-        ids: Array.from(f.ids.subarray(0, f.count)), positions: Array.from(f.positions.subarray(0, f.count)),
-        words: Array.from(f.words), vtx: f.vtx && { ...f.vtx }, bytes: hex(f.bytes),
+        index: f.index,
+        offset: f.offset,
+        timeUs: Number.isNaN(f.timeUs) ? 'NaN' : f.timeUs,
+        remote: f.remote,
+        system: f.system,
+        resolution: f.resolution,
+        fades: f.fades,
+        fadesDelta: f.fadesDelta,
+        rssi: f.rssi,
+        count: f.count,
+        ids: Array.from(f.ids.subarray(0, f.count)),
+        positions: Array.from(f.positions.subarray(0, f.count)),
+        words: Array.from(f.words),
+        vtx: f.vtx && { ...f.vtx },
+        bytes: hex(f.bytes),
       });
       seen.push({ ...d.stats });
     }
@@ -43,9 +54,9 @@ function trace(bytes: Uint8Array, times: Float64Array, options: DecoderOptions, 
     }
   } else {
     let seed = bytes.length;
-    for (let i = 0; i < bytes.length;) {
+    for (let i = 0; i < bytes.length; ) {
       seed = (Math.imul(seed, 1103515245) + 12345) >>> 0;
-      const end = Math.min(bytes.length, i + 1 + (seed >>> 16) % 97);
+      const end = Math.min(bytes.length, i + 1 + ((seed >>> 16) % 97));
       d.push(bytes.subarray(i, end));
       drain();
       i = end;
@@ -65,7 +76,8 @@ function expectSame(bytes: Uint8Array, times: Float64Array, options: DecoderOpti
     expect(fast.seen.length, `${feed}: frames and stats snapshots`).toBe(general.seen.length);
     expect(fast.seen.at(-1), `${feed}: stats at the end`).toEqual(general.seen.at(-1));
     for (let i = 0; i < general.seen.length; i++) {
-      if (JSON.stringify(fast.seen[i]) !== JSON.stringify(general.seen[i])) expect(fast.seen[i], `${feed}: entry ${i}`).toEqual(general.seen[i]);
+      if (JSON.stringify(fast.seen[i]) !== JSON.stringify(general.seen[i]))
+        expect(fast.seen[i], `${feed}: entry ${i}`).toEqual(general.seen[i]);
     }
     expect(fast.events, `${feed}: events`).toEqual(general.events);
     expect(fast.format, `${feed}: format`).toEqual(general.format);
@@ -81,7 +93,9 @@ for (const resolution of ['auto', 1024, 2048] as const) {
 }
 
 const fixtureDir = join(import.meta.dirname, 'fixtures');
-const fixtures = readdirSync(fixtureDir).filter((f) => f.endsWith('.bin')).map((f) => f.replace('.bin', ''));
+const fixtures = readdirSync(fixtureDir)
+  .filter((f) => f.endsWith('.bin'))
+  .map((f) => f.replace('.bin', ''));
 
 describe('the fast path gives what the general path gives', () => {
   it.each(fixtures)('fixture %s, every option, every feed', (name) => {
@@ -110,7 +124,13 @@ describe('the fast path gives what the general path gives', () => {
       };
       const edits: Edit[] = [];
       for (let k = 0; k < clean.length / 300; k++) {
-        edits.push({ at: rand(clean.length), kind: rand(2) === 0 ? 'delete' : 'insert', length: 1 + rand(40), seed: rand(1 << 30), copy: rand(3) === 0 });
+        edits.push({
+          at: rand(clean.length),
+          kind: rand(2) === 0 ? 'delete' : 'insert',
+          length: 1 + rand(40),
+          seed: rand(1 << 30),
+          copy: rand(3) === 0,
+        });
       }
       const damaged = damage(clean, edits);
       const bytes = damaged.bytes;
