@@ -14,7 +14,7 @@ import { closeSync, existsSync, openSync, renameSync, rmSync, statSync, writeSyn
 import { cpus, loadavg, tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { CaptureWriter } from '../dist/decoder/index.js';
+import { CaptureWriter } from '../dist/capture/index.js';
 import { Simulator, preset } from '../dist/simulator/index.js';
 
 const VERSION = 1; // bump when the generated stream changes, so old files are not reused

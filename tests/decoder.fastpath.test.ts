@@ -8,7 +8,8 @@
 import { existsSync, readdirSync, readFileSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 import { describe, expect, it } from 'vitest';
-import { SpektrumDecoder, importSaleaeCsv, type DecoderEvent, type DecoderOptions } from '../src/decoder/index.js';
+import { importSaleaeCsv } from '../src/capture/index.js';
+import { type DecoderEvent, type DecoderOptions, SpektrumDecoder } from '../src/decoder/index.js';
 import { preset, simulate } from '../src/simulator/index.js';
 import { CLEAN_PRESETS, damage, hex, type Edit } from './damage.js';
 
