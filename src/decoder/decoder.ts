@@ -25,7 +25,7 @@
  * (emitted unconditionally): so `next()` always returns after bounded work.
  */
 import { BYTE_TIME_US, FRAME_SIZE, systemInfo, type Resolution } from './spec.js';
-import { createFrame, createVtx, countZeroWords, INVALID, isVtxFrame, layoutChannels, readSlots, slotLayout } from './frame.js';
+import { createFrame, createVtx, countZeroWords, decodeSlots, INVALID, isVtxFrame, layoutChannels, readSlots, slotLayout } from './frame.js';
 import type {
   DecodedFrame, DecoderEvent, DecoderStats, FormatInfo, HeaderMode, HeaderReading, RemoteKind, ResolutionReason,
 } from './types.js';
@@ -41,6 +41,12 @@ export interface DecoderOptions {
   headerMode?: 'auto' | HeaderMode;
   /** Called synchronously for locks, discards, resyncs, format changes and fade jumps. */
   onEvent?: (event: DecoderEvent) => void;
+  /**
+   * Whether the locked decoder takes its one-pass path for frames that continue the stream
+   * (default true). false decodes everything through the general path: the same frames, stats
+   * and events, only slower (tests compare the two; benchmarks show the difference).
+   */
+  fastPath?: boolean;
 }
 
 /** Frames looked at before a lock. */
@@ -116,10 +122,13 @@ function countFollows(prev: number, next: number, step = FADE_STEP): boolean {
 }
 
 export class SpektrumDecoder {
-  #options: Required<Omit<DecoderOptions, 'onEvent' | 'resolutionFrom'>>;
+  #options: Required<Omit<DecoderOptions, 'onEvent' | 'resolutionFrom' | 'fastPath'>>;
+  readonly #fastPath: boolean;
   readonly #onEvent: ((event: DecoderEvent) => void) | undefined;
 
   #buf = new Uint8Array(INITIAL_CAPACITY);
+  /** #buf as 32-bit words: the fast path copies a frame that starts at a multiple of 4 in four moves. */
+  #buf32 = new Uint32Array(this.#buf.buffer);
   /**
    * Times are kept per pushed chunk, not per byte (filling a time for every byte cost a third of
    * the decoder's throughput): each chunk's end offset in the stream and its time, or NaN. Only
@@ -167,6 +176,7 @@ export class SpektrumDecoder {
   #layoutNext = 0;
 
   readonly #frame = createFrame();
+  readonly #frameBytes32 = new Uint32Array(this.#frame.bytes.buffer, this.#frame.bytes.byteOffset, FRAME_SIZE / 4);
   readonly #vtx = createVtx();
   readonly #stats: DecoderStats = {
     bytes: 0, frames: 0, frameBytes: 0, discardedBytes: 0, pendingBytes: 0,
@@ -202,6 +212,10 @@ export class SpektrumDecoder {
     if (options.onEvent !== undefined && typeof options.onEvent !== 'function') {
       throw new TypeError('onEvent must be a function');
     }
+    if (options.fastPath !== undefined && typeof options.fastPath !== 'boolean') {
+      throw new TypeError(`fastPath must be a boolean, not ${String(options.fastPath)}`);
+    }
+    this.#fastPath = options.fastPath ?? true;
     this.#options = { resolution, remote, headerMode };
     this.#fixedBy = options.resolutionFrom === 'internal-remote' ? 'internal-remote' : 'user';
     this.#onEvent = options.onEvent;
@@ -219,23 +233,41 @@ export class SpektrumDecoder {
    */
   push(bytes: Uint8Array, time?: number | Float64Array): void {
     if (this.#ended) throw new TypeError('push() after end(): call reset() to decode a new stream');
-    const n = bytes.length;
-    if (time instanceof Float64Array && time.length !== n) {
-      throw new TypeError(`per-byte times have length ${time.length}, bytes ${n}`);
+    // push() is kept small so that it is inlined into the caller's loop, and the time is stored
+    // here rather than passed on: a double handed from there to a call that is not inlined, or
+    // to `instanceof`, is boxed (a 16-byte heap number every push).
+    if (typeof time === 'number') {
+      const i = this.#append(bytes, null);
+      if (i >= 0) this.#chunkTimes[i] = time;
+      return;
     }
-    if (n === 0) return;
+    const perByte = time instanceof Float64Array;
+    if (perByte && time.length !== bytes.length) {
+      throw new TypeError(`per-byte times have length ${time.length}, bytes ${bytes.length}`);
+    }
+    const i = this.#append(bytes, perByte ? time : null);
+    if (i >= 0) this.#chunkTimes[i] = perByte ? NaN : (time ?? NaN);
+  }
+
+  /**
+   * Copies pushed bytes (and their per-byte times) into the buffer and records the chunk.
+   * Returns the chunk's index, for the caller to store its time, or -1 for no bytes.
+   */
+  #append(bytes: Uint8Array, byteTimes: Float64Array | null): number {
+    const n = bytes.length;
+    if (n === 0) return -1;
     this.#reserve(n);
     const at = this.#tail;
     this.#buf.set(bytes, at);
-    const perByte = time instanceof Float64Array;
-    if (perByte) {
+    if (byteTimes !== null) {
       if (this.#byteTimes === null) this.#byteTimes = new Float64Array(this.#buf.length);
-      this.#byteTimes.set(time, at);
+      this.#byteTimes.set(byteTimes, at);
     }
-    this.#addChunk(this.#base + at + n, perByte ? NaN : (time ?? NaN), perByte);
+    const i = this.#addChunk(this.#base + at + n, byteTimes !== null);
     this.#tail = at + n;
     this.#stats.bytes += n;
     this.#stats.pendingBytes += n;
+    return i;
   }
 
   /**
@@ -323,6 +355,10 @@ export class SpektrumDecoder {
    * or `reset()`.
    */
   next(): DecodedFrame | undefined {
+    if (this.#fastPath && this.#locked) {
+      const frame = this.#nextFast();
+      if (frame !== null) return frame;
+    }
     for (;;) {
       if (!this.#locked) {
         if (!this.#acquire()) return undefined;
@@ -393,6 +429,104 @@ export class SpektrumDecoder {
   }
 
   // ---- locked path -------------------------------------------------------------------------
+
+  /**
+   * The common locked case in one pass: the frame at the head has the layout read while
+   * confirming the one before it (#nextAt), a known one; acquisition's confirmed frames are
+   * behind; its header continues the last frame's with a fade step the general path would count
+   * without an event; and the whole next frame is in, valid, and continues it. Then it is
+   * emitted exactly as the general path would emit it. Anything else returns null and the
+   * general path decides (it finds the same state: nothing here is changed before emitting).
+   */
+  #nextFast(): DecodedFrame | null {
+    const o = this.#head;
+    if (this.#tail - o < 2 * FRAME_SIZE) return null;
+    const at = this.#base + o;
+    if (at !== this.#nextAt || at < this.#confirmedUntil || !this.#haveLast) return null;
+    const layout = this.#nextLayout;
+    if (layout === INVALID) return null;
+    const buf = this.#buf;
+    const b0 = buf[o] as number;
+    const b1 = buf[o + 1] as number;
+    const n = o + FRAME_SIZE;
+    let delta = 0;
+    if (this.#remote === 'internal') {
+      const mode = this.#b0Mode;
+      const system = this.#system;
+      if (b1 !== system || buf[n + 1] !== system) return null;
+      if (mode === B0_FADES) {
+        // #fitsLast and #follows with FADE_STEP, and #fadeDelta's rise without an event.
+        delta = (b0 - this.#last0) & 0xff;
+        if (delta >= FADE_STEP || (((buf[n] as number) - b0) & 0xff) >= FADE_STEP) return null;
+      } else if (mode === B0_RSSI) {
+        if (!plausibleRssi(b0) || !plausibleRssi(buf[n] as number)) return null;
+      } else if (mode !== B0_RSSI_FORCED) {
+        return null; // B0_UNKNOWN: emitting may decide byte 0 (an event), the general path's job.
+      }
+    } else {
+      const count = (b0 << 8) | b1;
+      delta = (count - ((this.#last0 << 8) | this.#last1)) & 0xffff;
+      if (delta >= FADE_STEP || ((((buf[n] as number) << 8) | (buf[n + 1] as number)) - count & 0xffff) >= FADE_STEP) return null;
+    }
+    const next = slotLayout(buf, n, this.#resolution as Resolution);
+    if (next === INVALID || !this.#knownLayout(layout)) return null;
+    this.#nextAt = at + FRAME_SIZE;
+    this.#nextLayout = next;
+    return this.#emitFast(o, b0, b1, delta);
+  }
+
+  /** #emit for a frame #nextFast vouched for: a known layout, a fade step without an event, byte 0's reading settled. */
+  #emitFast(o: number, b0: number, b1: number, delta: number): DecodedFrame {
+    const buf = this.#buf;
+    const frame = this.#frame;
+    const resolution = this.#resolution as Resolution;
+    frame.index++;
+    frame.offset = this.#base + o;
+    this.#stampTime(frame, o);
+    frame.resolution = resolution;
+    if (this.#remote === 'internal') {
+      frame.remote = 'internal';
+      frame.system = b1;
+      if (this.#b0Mode === B0_FADES) {
+        frame.rssi = null;
+        frame.fades = b0;
+      } else {
+        frame.rssi = b0 >= 0x80 ? b0 - 0x100 : b0;
+        frame.fades = null;
+      }
+    } else {
+      frame.remote = 'external';
+      frame.system = null;
+      frame.rssi = null;
+      frame.fades = (b0 << 8) | b1;
+    }
+    frame.fadesDelta = delta;
+    this.#last0 = b0;
+    this.#last1 = b1;
+    this.#jumpTrusted = false;
+    if ((o & 3) === 0) {
+      // A raw copy in the platform's byte order both ways: the same 16 bytes.
+      const from = this.#buf32;
+      const to = this.#frameBytes32;
+      const k = o >> 2;
+      to[0] = from[k] as number;
+      to[1] = from[k + 1] as number;
+      to[2] = from[k + 2] as number;
+      to[3] = from[k + 3] as number;
+    } else {
+      const bytes = frame.bytes;
+      for (let i = 0; i < FRAME_SIZE; i++) bytes[i] = buf[o + i] as number;
+    }
+    const empty = decodeSlots(frame, buf, o, resolution, isVtxFrame(buf, o), this.#vtx);
+    const s = this.#stats;
+    s.frames++;
+    s.frameBytes += FRAME_SIZE;
+    s.pendingBytes -= FRAME_SIZE;
+    s.emptySlots += empty;
+    if (frame.vtx !== null) s.vtxFrames++;
+    this.#head = o + FRAME_SIZE;
+    return frame;
+  }
 
   /** Whether the header at `o` continues the last emitted frame under the lock's model. */
   #fitsLast(o: number): boolean {
@@ -921,8 +1055,8 @@ export class SpektrumDecoder {
     if (this.#onEvent !== undefined) this.#onEvent(event);
   }
 
-  /** Records a pushed chunk's end (stream offset) and time. */
-  #addChunk(end: number, time: number, perByte: boolean): void {
+  /** Records a pushed chunk's end (stream offset); returns its index, for the caller to store its time. */
+  #addChunk(end: number, perByte: boolean): number {
     if (this.#chunkTail === this.#chunkEnds.length) {
       const live = this.#chunkTail - this.#chunkHead;
       if (this.#chunkHead >= live) {
@@ -946,8 +1080,8 @@ export class SpektrumDecoder {
     }
     const i = this.#chunkTail++;
     this.#chunkEnds[i] = end;
-    this.#chunkTimes[i] = time;
     this.#chunkPerByte[i] = perByte ? 1 : 0;
+    return i;
   }
 
   /**
@@ -986,6 +1120,7 @@ export class SpektrumDecoder {
     const buf = new Uint8Array(capacity);
     buf.set(this.#buf.subarray(0, this.#tail));
     this.#buf = buf;
+    this.#buf32 = new Uint32Array(buf.buffer);
     if (byteTimes !== null) {
       const times = new Float64Array(capacity);
       times.set(byteTimes.subarray(0, this.#tail));

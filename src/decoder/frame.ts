@@ -16,6 +16,34 @@ const CODE_BITS = 4;
 /** Bit 28 of a layout: the phase bit of the first slot (frames of a pair differ there). */
 const LAYOUT_PHASE_BIT = 1 << 28;
 
+/**
+ * A slot's channel and layout code depend on its high byte alone (the ID bits, and for X-Plus
+ * the two extra ID bits and the phase bit, all lie in bits 15–9), so each resolution has a
+ * table: the channel 0–19 the high byte names, or -1 for an impossible ID (§8.5, §8.6), and its
+ * code in a layout. 0xFFFF (both bytes) is an empty slot and is tested before the table.
+ */
+const CHANNEL_2048 = new Int8Array(256);
+const CODE_2048 = new Int8Array(256);
+const CHANNEL_1024 = new Int8Array(256);
+const CODE_1024 = new Int8Array(256);
+for (let hi = 0; hi < 256; hi++) {
+  const word = hi << 8;
+  const id = (word >> 11) & 0x0f;
+  if (id <= MAX_NORMAL_CHANNEL) {
+    CHANNEL_2048[hi] = id;
+    CODE_2048[hi] = id;
+  } else if (id === XPLUS_CHANNEL_ID) {
+    CHANNEL_2048[hi] = XPLUS_FIRST + ((word >> 9) & 0x03) + ((word & MASK_2048_PHASE) !== 0 ? 4 : 0);
+    CODE_2048[hi] = CODE_XPLUS;
+  } else {
+    CHANNEL_2048[hi] = -1;
+    CODE_2048[hi] = -1;
+  }
+  const id1024 = word >> 10;
+  CHANNEL_1024[hi] = id1024 <= MAX_NORMAL_CHANNEL ? id1024 : -1;
+  CODE_1024[hi] = id1024 <= MAX_NORMAL_CHANNEL ? id1024 : -1;
+}
+
 /** A layout that is not one: the slots do not form a valid frame. */
 export const INVALID = -1;
 
@@ -41,37 +69,22 @@ export function isVtxFrame(b: Uint8Array, o: number): boolean {
 export function slotLayout(b: Uint8Array, o: number, resolution: Resolution): number {
   const vtx = isVtxFrame(b, o);
   const slots = vtx ? SLOTS_PER_FRAME - 2 : SLOTS_PER_FRAME;
+  const channels = resolution === 2048 ? CHANNEL_2048 : CHANNEL_1024;
+  const codes = resolution === 2048 ? CODE_2048 : CODE_1024;
   let seen = 0;
   let layout = 0;
   for (let i = 0; i < slots; i++) {
-    const word = ((b[o + 2 + 2 * i] as number) << 8) | (b[o + 3 + 2 * i] as number);
-    let code: number;
-    let channel: number;
-    if (word === EMPTY_SLOT) {
-      layout |= CODE_EMPTY << (CODE_BITS * i);
+    const hi = b[o + 2 + 2 * i] as number;
+    if (hi === 0xff && b[o + 3 + 2 * i] === 0xff) {
+      layout |= CODE_EMPTY << (CODE_BITS * i); // EMPTY_SLOT
       continue;
     }
-    if (resolution === 2048) {
-      const id = (word >> 11) & 0x0f;
-      if (id <= MAX_NORMAL_CHANNEL) {
-        code = id;
-        channel = id;
-      } else if (id === XPLUS_CHANNEL_ID) {
-        code = CODE_XPLUS;
-        channel = XPLUS_FIRST + ((word >> 9) & 0x03) + ((word & MASK_2048_PHASE) !== 0 ? 4 : 0);
-      } else {
-        return INVALID;
-      }
-    } else {
-      const id = word >> 10;
-      if (id > MAX_NORMAL_CHANNEL) return INVALID;
-      code = id;
-      channel = id;
-    }
+    const channel = channels[hi] as number;
+    if (channel < 0) return INVALID;
     const bit = 1 << channel;
     if ((seen & bit) !== 0) return INVALID;
     seen |= bit;
-    layout |= code << (CODE_BITS * i);
+    layout |= (codes[hi] as number) << (CODE_BITS * i);
   }
   if (vtx) layout |= (CODE_VTX << (CODE_BITS * 5)) | (CODE_VTX << (CODE_BITS * 6));
   if (((b[o + 2] as number) & 0x80) !== 0) layout |= LAYOUT_PHASE_BIT;
@@ -113,42 +126,43 @@ export function createVtx(): VtxControl {
 /**
  * Fills the slots of `frame` from the 16 bytes at `o` of `b` (header fields are the caller's).
  * The slots must have passed `slotLayout` under the same resolution; `vtx` is what
- * `isVtxFrame` said. Returns the number of empty slots. This is the decoder's hottest function:
- * plain byte arithmetic on the Uint8Array, no DataView calls.
+ * `isVtxFrame` said. Returns the number of empty slots.
  */
 export function readSlots(frame: DecodedFrame, b: Uint8Array, o: number, resolution: Resolution, vtx: boolean, vtxStore: VtxControl): number {
-  const { ids, positions, words, bytes } = frame;
+  const bytes = frame.bytes;
   for (let i = 0; i < 16; i++) bytes[i] = b[o + i] as number;
+  return decodeSlots(frame, b, o, resolution, vtx, vtxStore);
+}
+
+/**
+ * `readSlots` without copying the raw bytes to `frame.bytes` (the caller has). This is the
+ * decoder's hottest function: plain byte arithmetic on the Uint8Array and table lookups, no
+ * DataView calls.
+ */
+export function decodeSlots(frame: DecodedFrame, b: Uint8Array, o: number, resolution: Resolution, vtx: boolean, vtxStore: VtxControl): number {
+  const { ids, positions, words } = frame;
+  const channels = resolution === 2048 ? CHANNEL_2048 : CHANNEL_1024;
   const slots = vtx ? SLOTS_PER_FRAME - 2 : SLOTS_PER_FRAME;
   let count = 0;
   let empty = 0;
   for (let i = 0; i < SLOTS_PER_FRAME; i++) {
-    const word = ((bytes[2 + 2 * i] as number) << 8) | (bytes[3 + 2 * i] as number);
+    const hi = b[o + 2 + 2 * i] as number;
+    const word = (hi << 8) | (b[o + 3 + 2 * i] as number);
     words[i] = word;
     if (i >= slots) continue;
     if (word === EMPTY_SLOT) {
       empty++;
       continue;
     }
-    if (resolution === 2048) {
-      const id = (word >> 11) & 0x0f;
-      if (id === XPLUS_CHANNEL_ID) {
-        // §8.6: two position bits extend the ID, the phase adds 4, 9 bits scale to 11.
-        ids[count] = XPLUS_FIRST + ((word >> 9) & 0x03) + ((word & MASK_2048_PHASE) !== 0 ? 4 : 0);
-        positions[count] = (word & 0x01ff) << 2;
-      } else {
-        ids[count] = id;
-        positions[count] = word & MASK_2048_SXPOS;
-      }
-    } else {
-      ids[count] = word >> 10;
-      positions[count] = word & MASK_1024_SXPOS;
-    }
+    const channel = channels[hi] as number;
+    ids[count] = channel;
+    // §8.6: an X-Plus slot's 9 bits scale to 11; otherwise the position is the low 10 or 11 bits.
+    positions[count] = resolution === 1024 ? word & MASK_1024_SXPOS : channel >= XPLUS_FIRST ? (word & 0x01ff) << 2 : word & MASK_2048_SXPOS;
     count++;
   }
   frame.count = count;
   if (vtx) {
-    const raw = (((bytes[12] as number) << 24) | ((bytes[13] as number) << 16) | ((bytes[14] as number) << 8) | (bytes[15] as number)) >>> 0;
+    const raw = (((b[o + 12] as number) << 24) | ((b[o + 13] as number) << 16) | ((b[o + 14] as number) << 8) | (b[o + 15] as number)) >>> 0;
     vtxStore.raw = raw;
     vtxStore.band = (raw >>> 21) & 0x07;
     vtxStore.channel = (raw >>> 16) & 0x0f;
