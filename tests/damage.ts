@@ -109,7 +109,7 @@ export interface Verdict {
  * or the frame before or after it (the bar: "no frame lost beyond those the damage touches plus
  * one"), or within the first `settle` frames (acquisition).
  */
-export function judge(sent: readonly SentFrame[], got: readonly SentFrame[], d: Damaged, settle = 5): Verdict {
+export function judge(sent: readonly SentFrame[], got: readonly SentFrame[], d: Damaged, settle = 5, starts?: ReadonlySet<number>): Verdict {
   const byOffset = new Map(sent.map((f) => [f.offset, f]));
   const invented: string[] = [];
   let rssiSwaps = 0;
@@ -124,6 +124,9 @@ export function judge(sent: readonly SentFrame[], got: readonly SentFrame[], d: 
     }
     // The same bytes and reading as a frame sent elsewhere (a lost byte equal to the one beside it).
     if (sent.some((x) => x.bytes === f.bytes && sameReading(x.reading, f.reading))) continue;
+    // A frame the clean decode did not give (it started elsewhere), but the receiver sent: its
+    // bytes stand unbroken in the clean stream from where the simulator started a frame.
+    if (s === undefined && starts?.has(start) === true && end === start + 15) continue;
     // A stray byte just before an SPM4649T frame's system byte reads as its RSSI: RSSI wanders
     // from frame to frame, so nothing can tell it from the receiver's own (as with a flipped bit).
     // Where the decoder does not yet know fades from RSSI it claims nothing from byte 0.

@@ -49,18 +49,20 @@ function aligned(es: readonly Edit[], streamLength: number): boolean {
 }
 
 const stream = (name: string, seed: number) => simulate({ ...preset(name), seed }, 1_200_000).bytes;
+/** Where the simulator started each frame of that stream (its ground truth). */
+const frameStarts = (name: string, seed: number) => new Set(simulate({ ...preset(name), seed }, 1_200_000, { truth: true }).truth!.frames.map((f) => f.offset));
 
-function check(clean: Uint8Array, es: Edit[]) {
+function check(clean: Uint8Array, es: Edit[], starts?: ReadonlySet<number>) {
   const sent = framesOf(clean);
   const d = damage(clean, es);
-  return judge(sent, framesOf(d.bytes), d);
+  return judge(sent, framesOf(d.bytes), d, 5, starts);
 }
 
 describe('lost and stray bytes', () => {
   it('emits only frames the receiver sent, loses none beyond the damage plus one, adds no fades (simulator, every system type)', () => {
     fc.assert(fc.property(fc.constantFrom(...CLEAN_PRESETS), fc.integer({ min: 1, max: 1e6 }), edits, (name, seed, es) => {
       const clean = stream(name, seed);
-      const v = check(clean, es);
+      const v = check(clean, es, frameStarts(name, seed));
       if (!aligned(es, clean.length)) expect(v.invented).toEqual([]);
       expect(v.lost).toEqual([]);
       expect(v.extraFades).toBe(0);

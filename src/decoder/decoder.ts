@@ -415,9 +415,16 @@ export class SpektrumDecoder {
       // The frame at o does not continue the stream (or the next one does not continue it).
       const q = this.#search(o + 1, o + MAX_RESYNC_BYTES);
       if (q === NEED_MORE) return undefined;
-      if (fits && (q === NOT_FOUND ? this.#lastOfItsKind(o, layout) : this.#standsAlone(o, layout, q))) {
+      // A chain of frames that starts right after this one (or at it) is a stream of its own, not
+      // noise to skip on the way to a frame that happens to fit the old count further on.
+      const newAfter = q !== NOT_FOUND && q > o + FRAME_SIZE && this.#chainStartsAt(o + FRAME_SIZE);
+      if (fits && (q === NOT_FOUND || newAfter ? this.#lastOfItsKind(o, layout) : this.#standsAlone(o, layout, q))) {
         // This frame is whole: what follows it up to q is noise, or something new starts after it.
         return this.#emit(o, layout);
+      }
+      if (!fits && layout !== INVALID && q !== NOT_FOUND && q >= o + FRAME_SIZE && this.#chainStartsAt(o)) {
+        this.#unlock();
+        continue;
       }
       if (q !== NOT_FOUND) {
         this.#resync(o, q);
@@ -616,15 +623,21 @@ export class SpektrumDecoder {
    */
   #lastOfItsKind(o: number, layout: number): boolean {
     if (!this.#knownLayout(layout)) return false;
-    const buf = this.#buf;
     const a = o + FRAME_SIZE;
-    const b = a + FRAME_SIZE;
-    if (b + FRAME_SIZE > this.#tail) return false;
-    if (this.#haveLast && slotLayout(buf, a, this.#resolution as Resolution) !== INVALID && this.#fitsLast(a)) return false;
-    const valid = (f: number) => slotLayout(buf, f, 2048) !== INVALID || slotLayout(buf, f, 1024) !== INVALID;
-    if (!valid(a) || !valid(b)) return false;
-    return buf[a + 1] === buf[b + 1] ||
-      countFollows(((buf[a] as number) << 8) | (buf[a + 1] as number), ((buf[b] as number) << 8) | (buf[b + 1] as number));
+    if (this.#haveLast && a + FRAME_SIZE <= this.#tail && slotLayout(this.#buf, a, this.#resolution as Resolution) !== INVALID && this.#fitsLast(a)) return false;
+    return this.#chainStartsAt(a);
+  }
+
+  /**
+   * Whether a stream starts at `a` as acquisition would lock on it: a chain of frames of one
+   * remote at either resolution (two frames that parse are common in slot bytes read as
+   * headers, so it takes the same evidence as a lock).
+   */
+  #chainStartsAt(a: number): boolean {
+    const frames = Math.min(ACQUIRE_FRAMES, Math.floor((this.#tail - a) / FRAME_SIZE));
+    if (frames < MIN_CHAIN) return false;
+    const forced = this.#options.resolution;
+    return (forced !== 1024 && this.#score(a, 2048, frames) >= 0) || (forced !== 2048 && this.#score(a, 1024, frames) >= 0);
   }
 
   /** Discards the bytes from `o` up to `q`, where frames continue. */
