@@ -417,14 +417,19 @@ export class SpektrumDecoder {
       if (q === NEED_MORE) return undefined;
       // A chain of frames that starts right after this one (or at it) is a stream of its own, not
       // noise to skip on the way to a frame that happens to fit the old count further on.
-      const newAfter = q !== NOT_FOUND && q > o + FRAME_SIZE && this.#chainStartsAt(o + FRAME_SIZE);
-      if (fits && (q === NOT_FOUND || newAfter ? this.#lastOfItsKind(o, layout) : this.#standsAlone(o, layout, q))) {
+      const newAfter = q !== NOT_FOUND && q > o + FRAME_SIZE ? this.#chainStartsAt(o + FRAME_SIZE) : NOT_FOUND;
+      if (newAfter === NEED_MORE) return undefined;
+      if (fits && (q === NOT_FOUND || newAfter === 1 ? this.#lastOfItsKind(o, layout) : this.#standsAlone(o, layout, q))) {
         // This frame is whole: what follows it up to q is noise, or something new starts after it.
         return this.#emit(o, layout);
       }
-      if (!fits && layout !== INVALID && q !== NOT_FOUND && q >= o + FRAME_SIZE && this.#chainStartsAt(o)) {
-        this.#unlock();
-        continue;
+      if (!fits && layout !== INVALID && q !== NOT_FOUND && q >= o + FRAME_SIZE) {
+        const here = this.#chainStartsAt(o);
+        if (here === NEED_MORE) return undefined;
+        if (here === 1) {
+          this.#unlock();
+          continue;
+        }
       }
       if (q !== NOT_FOUND) {
         this.#resync(o, q);
@@ -625,7 +630,7 @@ export class SpektrumDecoder {
     if (!this.#knownLayout(layout)) return false;
     const a = o + FRAME_SIZE;
     if (this.#haveLast && a + FRAME_SIZE <= this.#tail && slotLayout(this.#buf, a, this.#resolution as Resolution) !== INVALID && this.#fitsLast(a)) return false;
-    return this.#chainStartsAt(a);
+    return this.#chainStartsAt(a) === 1;
   }
 
   /**
@@ -633,11 +638,13 @@ export class SpektrumDecoder {
    * remote at either resolution (two frames that parse are common in slot bytes read as
    * headers, so it takes the same evidence as a lock).
    */
-  #chainStartsAt(a: number): boolean {
+  #chainStartsAt(a: number): 0 | 1 | typeof NEED_MORE {
+    // The answer must not depend on how the bytes were chunked: wait for a whole window.
+    if (this.#tail - a < ACQUIRE_FRAMES * FRAME_SIZE && !this.#ended) return NEED_MORE;
     const frames = Math.min(ACQUIRE_FRAMES, Math.floor((this.#tail - a) / FRAME_SIZE));
-    if (frames < MIN_CHAIN) return false;
+    if (frames < MIN_CHAIN) return 0;
     const forced = this.#options.resolution;
-    return (forced !== 1024 && this.#score(a, 2048, frames) >= 0) || (forced !== 2048 && this.#score(a, 1024, frames) >= 0);
+    return (forced !== 1024 && this.#score(a, 2048, frames) >= 0) || (forced !== 2048 && this.#score(a, 1024, frames) >= 0) ? 1 : 0;
   }
 
   /** Discards the bytes from `o` up to `q`, where frames continue. */
