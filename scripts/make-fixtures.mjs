@@ -57,8 +57,8 @@ const FIXTURES = [
 
 /** JSON with one array element per line, so diffs of regenerated fixtures stay readable. */
 function lines(key, items, last = false) {
-  const body = items.map((x) => '    ' + JSON.stringify(x)).join(',\n');
-  return `  ${JSON.stringify(key)}: [${items.length ? '\n' + body + '\n  ' : ''}]${last ? '' : ','}\n`;
+  const body = items.map((x) => `    ${JSON.stringify(x)}`).join(',\n');
+  return `  ${JSON.stringify(key)}: [${items.length ? `\n${body}\n  ` : ''}]${last ? '' : ','}\n`;
 }
 
 mkdirSync(outDir, { recursive: true });

@@ -13,7 +13,7 @@
 import { existsSync, readdirSync, readFileSync, statSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 import { describe, expect, it } from 'vitest';
-import { type FormatInfo, type LinkEpisode, type LinkStats } from '../src/decoder/index.js';
+import type { FormatInfo, LinkEpisode, LinkStats } from '../src/decoder/index.js';
 import { encodeCapture, importRaw, readCapture, type Capture, type CaptureRecordInput } from '../src/capture/index.js';
 import { captureSpan, healthReport, summarizeCapture, timingJitterUs } from '../src/analysis/index.js';
 import { preset, simulate } from '../src/simulator/index.js';

@@ -177,8 +177,12 @@ describe('the UART line model', () => {
       const s = pulsesOf(simulateLine(bytes, baud, stop, (i) => gaps[i]!).edges);
       expect(m.edges).toBe(s.falls);
       expect(m.lowUs.length).toBe(s.lows.length);
-      m.lowUs.forEach((w, i) => expect(w).toBeCloseTo(s.lows[i]!, 6));
-      m.highUs.forEach((w, i) => expect(w).toBeCloseTo(s.highs[i]!, 6));
+      m.lowUs.forEach((w, i) => {
+        expect(w).toBeCloseTo(s.lows[i]!, 6);
+      });
+      m.highUs.forEach((w, i) => {
+        expect(w).toBeCloseTo(s.highs[i]!, 6);
+      });
     }
   });
 });
@@ -233,8 +237,12 @@ describe('planPulses', () => {
         }
         // The plan's own numbers are the nominal (requested-rate) simulation.
         const nominal = pulsesOf(simulateLine(plan.bytes, plan.baudRate, plan.stopBits).edges);
-        plan.lowUs.forEach((w, i) => expect(w).toBeCloseTo(nominal.lows[i]!, 6));
-        plan.highUs.forEach((w, i) => expect(w).toBeCloseTo(nominal.highs[i]!, 6));
+        plan.lowUs.forEach((w, i) => {
+          expect(w).toBeCloseTo(nominal.lows[i]!, 6);
+        });
+        plan.highUs.forEach((w, i) => {
+          expect(w).toBeCloseTo(nominal.highs[i]!, 6);
+        });
         expect(plan.totalUs).toBeCloseTo((plan.bytes.length * plan.frameBits * 1e6) / plan.baudRate, 6);
 
         // In the window: after power-on, the last pulse done well before 200 ms.
@@ -259,7 +267,9 @@ describe('planPulses', () => {
           const { edges } = simulateLine(plan.bytes, plan.baudRate, plan.stopBits, (i) => gaps[i]!);
           const { falls, lows, highs } = pulsesOf(edges);
           expect(falls, label).toBe(n);
-          lows.forEach((w, i) => expect(w, label).toBeCloseTo(nominal.lows[i]!, 9));
+          lows.forEach((w, i) => {
+            expect(w, label).toBeCloseTo(nominal.lows[i]!, 9);
+          });
           // Gaps only lengthen highs, each by at most one gap.
           highs.forEach((w, i) => {
             expect(w).toBeGreaterThanOrEqual(nominal.highs[i]! - 1e-9);
@@ -268,7 +278,9 @@ describe('planPulses', () => {
           // The library's own waveform says the same.
           const m = measurePulses(uartWaveform(plan.bytes, plan.baudRate, plan.stopBits, 0, 0, gaps));
           expect(m.edges).toBe(n);
-          m.lowUs.forEach((w, i) => expect(w).toBeCloseTo(lows[i]!, 6));
+          m.lowUs.forEach((w, i) => {
+            expect(w).toBeCloseTo(lows[i]!, 6);
+          });
         }
       }
     });

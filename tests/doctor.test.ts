@@ -524,7 +524,7 @@ describe('doctorCapture', () => {
     const parts = [w.header(), w.event('port opened', 0, 0)];
     let e = 0;
     for (let i = 0; i < sbus.bytes.length; i++) {
-      while (e < sbus.errors.length && sbus.errors[e]!.offset <= i) parts.push(w.event(`line error: ${sbus.errors[e]!.kind}`, sbus.errors[e]!.timeUs, 0)), e++;
+      for (; e < sbus.errors.length && sbus.errors[e]!.offset <= i; e++) parts.push(w.event(`line error: ${sbus.errors[e]!.kind}`, sbus.errors[e]!.timeUs, 0));
       parts.push(w.data(sbus.bytes.subarray(i, i + 1), sbus.timesUs[i]!));
     }
     const r = doctorCapture(readCapture(concatBytes(parts), 'sbus.sscap'));

@@ -30,7 +30,9 @@ function usbDelivered(slots: number, periodUs: number, lost: Set<number>, stallU
     // A chunk held back holds back the ones after it: they come in one burst.
     const arrival = Math.max(tick + stallUs(k), last);
     last = arrival;
-    chunk.forEach((_, j) => times.push(arrival - (chunk.length - 1 - j) * 16 * BYTE_TIME_US - 15 * BYTE_TIME_US));
+    chunk.forEach((_, j) => {
+      times.push(arrival - (chunk.length - 1 - j) * 16 * BYTE_TIME_US - 15 * BYTE_TIME_US);
+    });
     k++;
   }
   return times;
@@ -138,7 +140,9 @@ describe('LinkMonitor: missed means missed', () => {
     // Slots 27–40 never sent (154 ms), and the counter says so.
     const lost = new Set(Array.from({ length: 14 }, (_, i) => 27 + i));
     const times = usbDelivered(300, 11_000, lost, () => 0);
-    times.forEach((t, i) => real.frame(frame(t, i === 27 ? 14 : 0, 0xb2, i >= 27 ? 54 : 40)));
+    times.forEach((t, i) => {
+      real.frame(frame(t, i === 27 ? 14 : 0, 0xb2, i >= 27 ? 54 : 40));
+    });
     expect(real.stats).toMatchObject({ holds: 1, missedFrames: 14 });
     expect(real.takeRetracted()).toEqual([]);
   });

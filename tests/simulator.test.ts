@@ -93,7 +93,7 @@ function run(s: Scenario, durationUs?: number): { sim: Simulator; chunk: SimChun
 }
 
 const intact = (frames: TruthFrame[]) => frames.filter((f) => f.damage === null);
-const hex = (w: number) => '0x' + w.toString(16).toUpperCase().padStart(4, '0');
+const hex = (w: number) => `0x${w.toString(16).toUpperCase().padStart(4, '0')}`;
 
 // ---------------------------------------------------------------------------------------------
 

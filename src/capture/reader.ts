@@ -379,7 +379,7 @@ export function parseCaptureCounting(bytes: Uint8Array): { capture: ParsedCaptur
 }
 
 /** `array`, or a view of its first `length` elements when that wastes little, else a trimmed copy. */
-function fit<T extends Uint8Array | Uint32Array | Float64Array>(array: T, length: number): T {
+function trimTo<T extends Uint8Array | Uint32Array | Float64Array>(array: T, length: number): T {
   // A view avoids holding the file's data twice at the peak; a copy frees a mostly empty buffer.
   return (length >= array.length * 0.75 ? array.subarray(0, length) : array.slice(0, length)) as T;
 }
@@ -464,7 +464,7 @@ function readSscap(bytes: Uint8Array, work: CaptureReaderWork): ParsedCapture {
         chunkTimes[chunks] = timeUs;
         chunkPorts[chunks] = port;
         chunks++;
-        if (timeUs === timeUs) anyTime = true; // not NaN
+        if (!Number.isNaN(timeUs)) anyTime = true;
       } else {
         events.push({ timeUs, port, text: utf8Decode(bytes, payload, payload + len), chunkIndex: chunks });
       }
@@ -500,10 +500,10 @@ function readSscap(bytes: Uint8Array, work: CaptureReaderWork): ParsedCapture {
     kind: 'sscap',
     meta,
     timing: anyTime ? 'per-chunk' : 'none',
-    bytes: fit(data, dataLength),
-    chunkEnds: fit(chunkEnds, chunks),
-    chunkTimesUs: fit(chunkTimes, chunks),
-    chunkPorts: fit(chunkPorts, chunks),
+    bytes: trimTo(data, dataLength),
+    chunkEnds: trimTo(chunkEnds, chunks),
+    chunkTimesUs: trimTo(chunkTimes, chunks),
+    chunkPorts: trimTo(chunkPorts, chunks),
     events,
     issues,
     version,

@@ -44,7 +44,7 @@ function firstLine(bytes: Uint8Array): [number, number] {
 }
 
 function hasExtension(fileName: string | undefined, ext: string): boolean {
-  return fileName !== undefined && fileName.toLowerCase().endsWith(ext);
+  return fileName?.toLowerCase().endsWith(ext) === true;
 }
 
 /**

@@ -110,7 +110,9 @@ export function formatDoctorReport(r: DoctorReport, name: string): string {
     for (const e of f.evidence) lines.push(`  - ${e.text}`);
     if (f.todo.length > 0) {
       lines.push('  What to do:');
-      f.todo.forEach((t, i) => lines.push(`    ${i + 1}. ${t}`));
+      f.todo.forEach((t, i) => {
+        lines.push(`    ${i + 1}. ${t}`);
+      });
     }
     const withLines = f.settings.filter((s) => s.lines.length > 0 || s.note !== '');
     if (withLines.length > 0) {

@@ -7,7 +7,7 @@
 /// <reference lib="webworker" />
 import { FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US, FRAME_SIZE, USB_CHUNK_JITTER_US, systemInfo } from '../decoder/index.js';
 import { CaptureFormatError, capturePorts, readCapture, type Capture } from '../capture/index.js';
-import { LinkSeries, decodeCapture, resolutionKey, timingJitterUs } from '../analysis/index.js';
+import { type LinkSeries, decodeCapture, resolutionKey, timingJitterUs } from '../analysis/index.js';
 import { Engine } from './engine.js';
 import { Diagnosis } from './diagnosis.js';
 import { runBind } from './bind.js';

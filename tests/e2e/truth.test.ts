@@ -47,7 +47,9 @@ function saleaeFile(): string {
   if (existsSync(real)) return real;
   const sim = simulate(preset('dsmx-11ms-2048-internal'), 5_000_000);
   const lines = ['Time [s],Value,Parity Error,Framing Error'];
-  sim.bytes.forEach((b, i) => lines.push(`${(sim.timesUs[i]! / 1e6).toFixed(9)},0x${b.toString(16).toUpperCase().padStart(2, '0')},,`));
+  sim.bytes.forEach((b, i) => {
+    lines.push(`${(sim.timesUs[i]! / 1e6).toFixed(9)},0x${b.toString(16).toUpperCase().padStart(2, '0')},,`);
+  });
   const path = join(dir, 'sim-saleae.txt');
   writeFileSync(path, `${lines.join('\n')}\n`);
   return path;

@@ -106,7 +106,8 @@ async function axe(page: Page, label: string): Promise<string[]> {
     const r = await w.axe.run(document, { resultTypes: ['violations'] });
     return { violations: r.violations.map((v) => ({ id: v.id, impact: v.impact, targets: v.nodes.map((n) => n.target.join(' ')) })), passes: r.passes.length };
   });
-  const byImpact = result.violations.reduce<Record<string, number>>((acc, v) => ({ ...acc, [v.impact]: (acc[v.impact] ?? 0) + v.targets.length }), {});
+  const byImpact: Record<string, number> = {};
+  for (const v of result.violations) byImpact[v.impact] = (byImpact[v.impact] ?? 0) + v.targets.length;
   console.log(`axe ${label} (${Date.now() - t0} ms): ${JSON.stringify(byImpact)} ${result.violations.map((v) => `${v.id}(${v.impact})`).join(' ')}`);
   return result.violations.filter((v) => v.impact === 'serious' || v.impact === 'critical').map((v) => `${v.id}: ${v.targets.slice(0, 3).join(', ')}`);
 }

@@ -231,8 +231,14 @@ export async function openFakeSerialPort(options: FakeSerialPortOptions = {}): P
       if (exited) return reject(exitError ?? new Error('pty helper exited'));
       const w = {
         match,
-        resolve: (e: Ev) => (clearTimeout(timer), resolve(e)),
-        reject: (e: Error) => (clearTimeout(timer), reject(e)),
+        resolve: (e: Ev) => {
+          clearTimeout(timer);
+          resolve(e);
+        },
+        reject: (e: Error) => {
+          clearTimeout(timer);
+          reject(e);
+        },
       };
       const timer = setTimeout(() => {
         eventWaiters.splice(eventWaiters.indexOf(w), 1);
@@ -370,7 +376,10 @@ export async function openFakeSerialPort(options: FakeSerialPortOptions = {}): P
       if (left <= 0) throw new Error(`fake serial port: timed out waiting for ${n} bytes from the page (have ${pending()})`);
       await new Promise<void>((r) => {
         const t = setTimeout(r, left);
-        receivedWake = () => (clearTimeout(t), r());
+        receivedWake = () => {
+          clearTimeout(t);
+          r();
+        };
       });
       receivedWake = undefined;
     }

@@ -4,7 +4,7 @@
 import { spawn } from 'node:child_process';
 import type { Socket } from 'node:net';
 
-const REAPER = String.raw`
+const REAPER = `
 import json, os, sys, time
 pid, lock_dir, registry, policy_file, policy_dir = sys.argv[1:6]
 sys.stdin.buffer.read()  # returns at EOF: our parent is gone

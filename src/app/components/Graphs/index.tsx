@@ -105,7 +105,9 @@ export function Graphs({ windowUs }: { windowUs: Signal<number> }) {
       return makeChart(box, spec, width(), sync);
     });
     const keys = charts.map((c) => keyboardCursor(c, c.root.parentElement as HTMLElement));
-    const resize = new ResizeObserver(() => charts.forEach((c) => c.setSize({ width: width(), height: HEIGHT })));
+    const resize = new ResizeObserver(() => charts.forEach((c) => {
+      c.setSize({ width: width(), height: HEIGHT });
+    }));
     resize.observe(el);
     let version = -1;
     let drawnAt = 0;
@@ -139,8 +141,12 @@ export function Graphs({ windowUs }: { windowUs: Signal<number> }) {
     return () => {
       stop();
       resize.disconnect();
-      keys.forEach((off) => off());
-      charts.forEach((c) => c.destroy());
+      keys.forEach((off) => {
+        off();
+      });
+      charts.forEach((c) => {
+        c.destroy();
+      });
       el.replaceChildren();
     };
   }, [rssi, windowUs, palette]);
