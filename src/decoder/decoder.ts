@@ -25,9 +25,26 @@
  * (emitted unconditionally): so `next()` always returns after bounded work.
  */
 import { BYTE_TIME_US, FRAME_SIZE, systemInfo, type Resolution } from './spec.js';
-import { createFrame, createVtx, countZeroWords, decodeSlots, INVALID, isVtxFrame, layoutChannels, readSlots, slotLayout } from './frame.js';
+import {
+  createFrame,
+  createVtx,
+  countZeroWords,
+  decodeSlots,
+  INVALID,
+  isVtxFrame,
+  layoutChannels,
+  readSlots,
+  slotLayout,
+} from './frame.js';
 import type {
-  DecodedFrame, DecoderEvent, DecoderStats, FormatInfo, HeaderMode, HeaderReading, RemoteKind, ResolutionReason,
+  DecodedFrame,
+  DecoderEvent,
+  DecoderStats,
+  FormatInfo,
+  HeaderMode,
+  HeaderReading,
+  RemoteKind,
+  ResolutionReason,
 } from './types.js';
 
 export interface DecoderOptions {
@@ -179,8 +196,16 @@ export class SpektrumDecoder {
   readonly #frameBytes32 = new Uint32Array(this.#frame.bytes.buffer, this.#frame.bytes.byteOffset, FRAME_SIZE / 4);
   readonly #vtx = createVtx();
   readonly #stats: DecoderStats = {
-    bytes: 0, frames: 0, frameBytes: 0, discardedBytes: 0, pendingBytes: 0,
-    resyncs: 0, badFrames: 0, emptySlots: 0, vtxFrames: 0, fadeJumps: 0,
+    bytes: 0,
+    frames: 0,
+    frameBytes: 0,
+    discardedBytes: 0,
+    pendingBytes: 0,
+    resyncs: 0,
+    badFrames: 0,
+    emptySlots: 0,
+    vtxFrames: 0,
+    fadeJumps: 0,
   };
 
   /** Acquisition scratch: the best candidate's header reading. */
@@ -383,7 +408,10 @@ export class SpektrumDecoder {
           if (!this.#ended) return undefined;
           // The stream's last frame: whole when the stream ends with it, or when what is left
           // after it starts with a header that continues it (a truncated last frame).
-          if (this.#knownLayout(layout) && (avail === FRAME_SIZE || (avail >= FRAME_SIZE + 2 && this.#standsAlone(o, layout, o + FRAME_SIZE)))) {
+          if (
+            this.#knownLayout(layout) &&
+            (avail === FRAME_SIZE || (avail >= FRAME_SIZE + 2 && this.#standsAlone(o, layout, o + FRAME_SIZE)))
+          ) {
             return this.#emit(o, layout);
           }
           this.#discard(o, avail, 'end-of-stream');
@@ -415,21 +443,18 @@ export class SpektrumDecoder {
       // The frame at o does not continue the stream (or the next one does not continue it).
       const q = this.#search(o + 1, o + MAX_RESYNC_BYTES);
       if (q === NEED_MORE) return undefined;
-      // A chain of frames that starts right after this one (or at it) is a stream of its own, not
-      // noise to skip on the way to a frame that happens to fit the old count further on.
-      const newAfter = q !== NOT_FOUND && q > o + FRAME_SIZE ? this.#chainStartsAt(o + FRAME_SIZE) : NOT_FOUND;
-      if (newAfter === NEED_MORE) return undefined;
-      if (fits && (q === NOT_FOUND || newAfter === 1 ? this.#lastOfItsKind(o, layout) : this.#standsAlone(o, layout, q))) {
+      // This remote's own chain that starts right after this frame (or at it) is the remote going
+      // on after its count fell (a restart), not noise to skip on the way to a frame that
+      // happens to fit the old count further on.
+      const internal = this.#remote === 'internal';
+      const restartAfter = internal && q !== NOT_FOUND && q > o + FRAME_SIZE && this.#ownChainAt(o + FRAME_SIZE);
+      if (fits && (q === NOT_FOUND ? this.#lastOfItsKind(o, layout) : (restartAfter && this.#knownLayout(layout)) || this.#standsAlone(o, layout, q))) {
         // This frame is whole: what follows it up to q is noise, or something new starts after it.
         return this.#emit(o, layout);
       }
-      if (!fits && layout !== INVALID && q !== NOT_FOUND && q >= o + FRAME_SIZE) {
-        const here = this.#chainStartsAt(o);
-        if (here === NEED_MORE) return undefined;
-        if (here === 1) {
-          this.#unlock();
-          continue;
-        }
+      if (!fits && internal && q !== NOT_FOUND && q >= o + FRAME_SIZE && this.#ownChainAt(o)) {
+        this.#unlock();
+        continue;
       }
       if (q !== NOT_FOUND) {
         this.#resync(o, q);
@@ -478,7 +503,7 @@ export class SpektrumDecoder {
     } else {
       const count = (b0 << 8) | b1;
       delta = (count - ((this.#last0 << 8) | this.#last1)) & 0xffff;
-      if (delta >= FADE_STEP || ((((buf[n] as number) << 8) | (buf[n + 1] as number)) - count & 0xffff) >= FADE_STEP) return null;
+      if (delta >= FADE_STEP || (((((buf[n] as number) << 8) | (buf[n + 1] as number)) - count) & 0xffff) >= FADE_STEP) return null;
     }
     const next = slotLayout(buf, n, this.#resolution as Resolution);
     if (next === INVALID || !this.#knownLayout(layout)) return null;
@@ -629,8 +654,27 @@ export class SpektrumDecoder {
   #lastOfItsKind(o: number, layout: number): boolean {
     if (!this.#knownLayout(layout)) return false;
     const a = o + FRAME_SIZE;
-    if (this.#haveLast && a + FRAME_SIZE <= this.#tail && slotLayout(this.#buf, a, this.#resolution as Resolution) !== INVALID && this.#fitsLast(a)) return false;
+    if (
+      this.#haveLast &&
+      a + FRAME_SIZE <= this.#tail &&
+      slotLayout(this.#buf, a, this.#resolution as Resolution) !== INVALID &&
+      this.#fitsLast(a)
+    )
+      return false;
     return this.#chainStartsAt(a) === 1;
+  }
+
+  /**
+   * Whether two valid frames of this internal remote start at `a`: its system byte in both and
+   * a byte 0 that goes on from one to the other. Needs only bytes the search has already seen.
+   */
+  #ownChainAt(a: number): boolean {
+    const buf = this.#buf;
+    const b = a + FRAME_SIZE;
+    if (b + FRAME_SIZE > this.#tail) return false;
+    const resolution = this.#resolution as Resolution;
+    return buf[a + 1] === this.#system && buf[b + 1] === this.#system && slotLayout(buf, a, resolution) !== INVALID &&
+      slotLayout(buf, b, resolution) !== INVALID && byte0Follows(buf[a] as number, buf[b] as number, this.#b0Mode);
   }
 
   /**
@@ -797,11 +841,15 @@ export class SpektrumDecoder {
       frames++;
       if (skipped >= 0) skipped++;
     }
-    const sameRemote = this.#haveLast && this.#remote === (internal ? 'internal' : 'external') &&
-      (internal ? this.#system === system : true) && this.#resolution === resolution;
+    const sameRemote =
+      this.#haveLast &&
+      this.#remote === (internal ? 'internal' : 'external') &&
+      (internal ? this.#system === system : true) &&
+      this.#resolution === resolution;
     let b0Mode = this.#candB0;
     // The same remote going on keeps what its byte 0 was shown to be, if byte 0 goes on too.
-    if (internal && b0Mode === B0_UNKNOWN && sameRemote && byte0Follows(this.#last0, this.#buf[o] as number, this.#b0Mode)) b0Mode = this.#b0Mode;
+    if (internal && b0Mode === B0_UNKNOWN && sameRemote && byte0Follows(this.#last0, this.#buf[o] as number, this.#b0Mode))
+      b0Mode = this.#b0Mode;
     if (internal && b0Mode === B0_UNKNOWN) {
       // Byte 0 has only been a plausible RSSI and never fallen: read further along the chain before deciding.
       const evidence = this.#byte0Evidence(o, resolution, system);
@@ -814,8 +862,11 @@ export class SpektrumDecoder {
     // with layouts it used before (a shifted reading of the stream makes layouts of its own).
     this.#jumpTrusted = sameRemote && this.#chainKnown(o, resolution, frames);
     if (!sameRemote) this.#haveLast = false;
-    const changed = this.#everLocked && (this.#remote !== (internal ? 'internal' : 'external') || this.#system !== (internal ? system : null) ||
-      this.#resolution !== resolution);
+    const changed =
+      this.#everLocked &&
+      (this.#remote !== (internal ? 'internal' : 'external') ||
+        this.#system !== (internal ? system : null) ||
+        this.#resolution !== resolution);
     this.#locked = true;
     this.#nextAt = -1;
     this.#everLocked = true;
@@ -847,12 +898,20 @@ export class SpektrumDecoder {
   #chainsInto(a: number, b: number, resolution: Resolution, internal: boolean, system: number): boolean {
     const buf = this.#buf;
     const layout = slotLayout(buf, a, resolution);
-    if (layout === INVALID || !this.#layoutInChain(layout, b, Math.min(ACQUIRE_FRAMES, Math.floor((this.#tail - b) / FRAME_SIZE)), resolution)) return false;
+    if (
+      layout === INVALID ||
+      !this.#layoutInChain(layout, b, Math.min(ACQUIRE_FRAMES, Math.floor((this.#tail - b) / FRAME_SIZE)), resolution)
+    )
+      return false;
     if (internal) {
       const mode = this.#options.headerMode === 'rssi' ? B0_RSSI_FORCED : this.#options.headerMode === 'fades' ? B0_FADES : B0_UNKNOWN;
       return buf[a + 1] === system && buf[b + 1] === system && byte0Follows(buf[a] as number, buf[b] as number, mode, ACQUIRE_FADE_STEP);
     }
-    return countFollows(((buf[a] as number) << 8) | (buf[a + 1] as number), ((buf[b] as number) << 8) | (buf[b + 1] as number), ACQUIRE_FADE_STEP);
+    return countFollows(
+      ((buf[a] as number) << 8) | (buf[a + 1] as number),
+      ((buf[b] as number) << 8) | (buf[b + 1] as number),
+      ACQUIRE_FADE_STEP,
+    );
   }
 
   /** The best-scoring start among the next ACQUIRE_SHIFTS offsets, at one resolution or (0) both. */
@@ -865,11 +924,19 @@ export class SpektrumDecoder {
       if (frames < 1) break;
       if (only !== 1024) {
         const v = this.#score(p + s, 2048, frames);
-        if (v > score) { score = v; shift = s; resolution = 2048; }
+        if (v > score) {
+          score = v;
+          shift = s;
+          resolution = 2048;
+        }
       }
       if (only !== 2048) {
         const v = this.#score(p + s, 1024, frames);
-        if (v > score) { score = v; shift = s; resolution = 1024; }
+        if (v > score) {
+          score = v;
+          shift = s;
+          resolution = 1024;
+        }
       }
     }
     return { score, shift, resolution };
@@ -893,7 +960,8 @@ export class SpektrumDecoder {
       const f = o + k * FRAME_SIZE;
       if (f + FRAME_SIZE > this.#tail) return this.#ended ? B0_UNKNOWN : NEED_MORE;
       const b0 = buf[f] as number;
-      if (buf[f + 1] !== system || slotLayout(buf, f, resolution) === INVALID || !byte0Follows(prev, b0, B0_UNKNOWN, ACQUIRE_FADE_STEP)) return B0_UNKNOWN;
+      if (buf[f + 1] !== system || slotLayout(buf, f, resolution) === INVALID || !byte0Follows(prev, b0, B0_UNKNOWN, ACQUIRE_FADE_STEP))
+        return B0_UNKNOWN;
       if (!plausibleRssi(b0)) return B0_FADES;
       if (b0 < prev) return B0_RSSI;
       prev = b0;
@@ -937,7 +1005,15 @@ export class SpektrumDecoder {
         else if (damaged < 0 && info !== undefined && k < frames - 1) damaged = k;
         else chainI = k;
       }
-      if (chainE > k && !countFollows(((buf[p] as number) << 8) | (buf[p + 1] as number), ((buf[f] as number) << 8) | (buf[f + 1] as number), ACQUIRE_FADE_STEP)) chainE = k;
+      if (
+        chainE > k &&
+        !countFollows(
+          ((buf[p] as number) << 8) | (buf[p + 1] as number),
+          ((buf[f] as number) << 8) | (buf[f + 1] as number),
+          ACQUIRE_FADE_STEP,
+        )
+      )
+        chainE = k;
       if (chainI <= k && chainE <= k) break;
     }
     // A skipped frame counts only when good frames follow it.
@@ -947,9 +1023,12 @@ export class SpektrumDecoder {
     // was internal and byte 0 is never zero (`03 55`): then it is a system byte to ignore
     // (§8.3). `00 xx` is a count below 256, the header of an external remote (or a clone).
     // A header that continues the last one as a rising count is that count moving, though.
-    const countGoesOn = this.#haveLast && countFollows((this.#last0 << 8) | this.#last1, ((buf[o] as number) << 8) | s) &&
-      ((buf[o] as number) << 8 | s) !== ((this.#last0 << 8) | this.#last1);
-    const preferInternal = remote === 'internal' || info !== undefined || (s !== 0 && !zeroByte0 && !countGoesOn && this.#remote === 'internal');
+    const countGoesOn =
+      this.#haveLast &&
+      countFollows((this.#last0 << 8) | this.#last1, ((buf[o] as number) << 8) | s) &&
+      (((buf[o] as number) << 8) | s) !== ((this.#last0 << 8) | this.#last1);
+    const preferInternal =
+      remote === 'internal' || info !== undefined || (s !== 0 && !zeroByte0 && !countGoesOn && this.#remote === 'internal');
     const internal = chainI > chainE || (chainI === chainE && preferInternal);
     const length = internal ? chainI : chainE;
     const skipped = internal && damaged >= 0 && damaged < length ? damaged : -1;
@@ -990,11 +1069,11 @@ export class SpektrumDecoder {
       // A §8.3 system byte in every frame is strong evidence of an internal remote.
       if (info !== undefined) score += 8;
       if (info?.resolution === resolution) score += 2;
-    } else if (((buf[o] as number) << 8 | s) < 256) {
+    } else if ((((buf[o] as number) << 8) | s) < 256) {
       score += 1;
     }
     // A header of 0xFFFF is an empty slot's filler more often than a fade count at its limit.
-    if (((buf[o] as number) << 8 | s) === 0xffff) score -= 3;
+    if ((((buf[o] as number) << 8) | s) === 0xffff) score -= 3;
     // Transmitters send channels 0…N-1: a contiguous set is the signature of the right reading.
     if ((channels & (channels + 1)) === 0) score += 2;
     this.#candInternal = internal;
@@ -1054,20 +1133,27 @@ export class SpektrumDecoder {
     const hex = (v: number) => `0x${v.toString(16).padStart(2, '0').toUpperCase()}`;
     let remote = 'external remote (or a receiver that sends no system byte): bytes 0–1 are a UINT16 fade count';
     if (this.#remote === 'internal') {
-      const b0 = this.#b0Mode === B0_UNKNOWN
-        ? '; byte 0 has stayed at values that are fades above 155 or SPM4649T RSSI, without falling: not yet known which'
-        : this.#b0Mode === B0_FADES ? '' : '; byte 0 is SPM4649T RSSI';
+      const b0 =
+        this.#b0Mode === B0_UNKNOWN
+          ? '; byte 0 has stayed at values that are fades above 155 or SPM4649T RSSI, without falling: not yet known which'
+          : this.#b0Mode === B0_FADES
+            ? ''
+            : '; byte 0 is SPM4649T RSSI';
       remote = sys
         ? `internal remote (system byte ${hex(this.#system ?? 0)}, ${sys.name})${b0}`
         : `internal remote (system byte ${hex(this.#system ?? 0)} is none of the four in §8.3: ignored)${b0}`;
     }
     switch (this.#reason) {
-      case 'override': return `${res} resolution set by the user; ${remote}.`;
-      case 'internal-remote': return `${res} resolution from the internal remote's system byte (on another port: it holds the key for every remote); ${remote}.`;
-      case 'system-byte': return `${res} resolution from the system byte, confirmed by the channel IDs; ${remote}.`;
+      case 'override':
+        return `${res} resolution set by the user; ${remote}.`;
+      case 'internal-remote':
+        return `${res} resolution from the internal remote's system byte (on another port: it holds the key for every remote); ${remote}.`;
+      case 'system-byte':
+        return `${res} resolution from the system byte, confirmed by the channel IDs; ${remote}.`;
       case 'system-byte-contradicted':
         return `${res} resolution inferred from the channel IDs: the system byte says ${sys?.resolution ?? '?'} but its channel IDs only make sense at ${res}; ${remote}.`;
-      default: return `${res} resolution inferred from the channel IDs (no valid system byte); ${remote}.`;
+      default:
+        return `${res} resolution inferred from the channel IDs (no valid system byte); ${remote}.`;
     }
   }
 
