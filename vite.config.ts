@@ -25,7 +25,10 @@ function contentSecurityPolicy(): Plugin {
     name: 'satscope-csp',
     apply: 'build',
     transformIndexHtml(html) {
-      return html.replace('<meta charset="utf-8" />', `<meta charset="utf-8" />\n    <meta http-equiv="Content-Security-Policy" content="${CSP}" />`);
+      return html.replace(
+        '<meta charset="utf-8" />',
+        `<meta charset="utf-8" />\n    <meta http-equiv="Content-Security-Policy" content="${CSP}" />`,
+      );
     },
   };
 }
@@ -39,8 +42,19 @@ function serviceWorker(): Plugin {
     name: 'satscope-sw',
     apply: 'build',
     generateBundle(_options, bundle) {
-      const files = ['./', ...Object.keys(bundle).map((f) => `./${f}`), './icon.svg', './icon-192.png', './icon-512.png', './manifest.webmanifest'];
-      const version = createHash('sha256').update(files.join('\n')).update(JSON.stringify(Object.values(bundle).map((b) => ('code' in b ? b.code.length : 0)))).digest('hex').slice(0, 12);
+      const files = [
+        './',
+        ...Object.keys(bundle).map((f) => `./${f}`),
+        './icon.svg',
+        './icon-192.png',
+        './icon-512.png',
+        './manifest.webmanifest',
+      ];
+      const version = createHash('sha256')
+        .update(files.join('\n'))
+        .update(JSON.stringify(Object.values(bundle).map((b) => ('code' in b ? b.code.length : 0))))
+        .digest('hex')
+        .slice(0, 12);
       const source = readFileSync(resolve(import.meta.dirname, 'src/sw/sw.js'), 'utf8')
         .replace('__CACHE__', `satscope-${version}`)
         .replace('__FILES__', JSON.stringify(files));

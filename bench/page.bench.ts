@@ -70,110 +70,136 @@ function summarize(name: string, m: { longTasks: number[]; latencies: number[] }
   };
 }
 
-it('measures the page', async () => {
-  const skip = browserUnavailable();
-  if (skip !== null) {
-    console.warn(`page benchmark skipped: ${skip}`);
-    return;
-  }
-  const results: Record<string, unknown> = {};
-  const server = await startStaticServer(APP_DIR);
-  const tmp = mkdtempSync(join(tmpdir(), 'satscope-bench-'));
-  const serialSkip = fakeSerialUnsupportedReason();
-  const policy = serialSkip === null ? await installSerialPolicy(server.origin) : null;
-  const fake = serialSkip === null ? await openFakeSerialPort() : null;
-  const browser = await launchChromium({ args: ['--enable-precise-memory-info'] });
-  try {
-    // 1. A receiver on the serial stack at real pace, recording the whole time.
-    if (fake !== null) {
-      const page = await browser.newPage({ viewport: { width: 1400, height: 1000 } });
-      await observeLongTasks(page);
-      await page.goto(server.url('/?bench'));
-      await page.getByRole('button', { name: 'Serial port' }).click();
-      await page.getByTestId('source-status').filter({ hasText: 'at 115200 baud' }).waitFor();
-      const sim = new Simulator({ ...preset('dsmx-11ms-2048-internal'), seed: 5 });
-      const stream = sim.generate(sim.scenario.timing.startUs + SECONDS * 1e6 + 2e6);
-      await page.getByRole('button', { name: '● Record' }).click();
-      const heapBefore = await heapMB(page);
-      await collect(page);
-      await fake.writePaced(stream.bytes, stream.timesUs);
-      const serial = summarize('serial (pty, real WebSerial), recording', await collect(page));
-      const heapAfter = await heapMB(page);
-      await page.getByRole('button', { name: 'Stop recording' }).click();
-      results.serial = { ...serial, heapMBBefore: Number(heapBefore.toFixed(2)), heapMBAfter: Number(heapAfter.toFixed(2)), heapGrowthMB: Number((heapAfter - heapBefore).toFixed(2)) };
-      await page.close();
-    } else {
-      results.serial = `skipped: ${serialSkip}`;
+it(
+  'measures the page',
+  async () => {
+    const skip = browserUnavailable();
+    if (skip !== null) {
+      console.warn(`page benchmark skipped: ${skip}`);
+      return;
     }
-
-    // 2. The demo source.
-    {
-      const page = await browser.newPage({ viewport: { width: 1400, height: 1000 } });
-      await observeLongTasks(page);
-      await page.goto(server.url('/?bench'));
-      if (fake !== null) await page.getByRole('button', { name: 'Demo', exact: true }).click();
-      await page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor({ timeout: 10_000 });
-      await collect(page);
-      await page.waitForTimeout(SECONDS * 1000);
-      results.demo = summarize('demo (simulator in the worker)', await collect(page));
-      await page.close();
-    }
-
-    // 3. Open and plot a 1-hour capture (USB-batched, as the recorder writes them).
-    {
-      const sim = new Simulator({ ...preset('dsmx-11ms-2048-internal'), seed: 6 });
-      const hour = sim.generate(sim.scenario.timing.startUs + 3600e6);
-      const file = join(tmp, 'hour.sscap');
-      writeCapture(file, usbChunks(hour.bytes, hour.timesUs));
-      const size = readFileSync(file).length;
-      const times: number[] = [];
-      for (let run = 0; run < 3; run++) {
+    const results: Record<string, unknown> = {};
+    const server = await startStaticServer(APP_DIR);
+    const tmp = mkdtempSync(join(tmpdir(), 'satscope-bench-'));
+    const serialSkip = fakeSerialUnsupportedReason();
+    const policy = serialSkip === null ? await installSerialPolicy(server.origin) : null;
+    const fake = serialSkip === null ? await openFakeSerialPort() : null;
+    const browser = await launchChromium({ args: ['--enable-precise-memory-info'] });
+    try {
+      // 1. A receiver on the serial stack at real pace, recording the whole time.
+      if (fake !== null) {
         const page = await browser.newPage({ viewport: { width: 1400, height: 1000 } });
-        await page.goto(server.url('/?demo=0'));
-        // Timed in the page, from the file input's change to the overview drawn and the first
-        // frames shown (the test's own upload of the file through CDP is not counted).
-        await page.evaluate(() => {
-          const w = window as unknown as { __open: { start: number; plotted: number } };
-          w.__open = { start: 0, plotted: 0 };
-          document.querySelector('input[type=file]')?.addEventListener('change', () => { w.__open.start = performance.now(); }, { capture: true });
-          new MutationObserver((_, obs) => {
-            const counted = document.querySelector('[data-testid="count-frames"]')?.textContent !== '—';
-            if (document.querySelector('section.replay .overview canvas') !== null && counted) {
-              w.__open.plotted = performance.now();
-              obs.disconnect();
-            }
-          }).observe(document.body, { subtree: true, childList: true, characterData: true });
-        });
-        await page.setInputFiles('input[type=file]', file);
-        await page.waitForFunction(() => (window as unknown as { __open: { plotted: number } }).__open.plotted > 0, undefined, { timeout: 30_000 });
-        times.push(Math.round(await page.evaluate(() => {
-          const o = (window as unknown as { __open: { start: number; plotted: number } }).__open;
-          return o.plotted - o.start;
-        })));
+        await observeLongTasks(page);
+        await page.goto(server.url('/?bench'));
+        await page.getByRole('button', { name: 'Serial port' }).click();
+        await page.getByTestId('source-status').filter({ hasText: 'at 115200 baud' }).waitFor();
+        const sim = new Simulator({ ...preset('dsmx-11ms-2048-internal'), seed: 5 });
+        const stream = sim.generate(sim.scenario.timing.startUs + SECONDS * 1e6 + 2e6);
+        await page.getByRole('button', { name: '● Record' }).click();
+        const heapBefore = await heapMB(page);
+        await collect(page);
+        await fake.writePaced(stream.bytes, stream.timesUs);
+        const serial = summarize('serial (pty, real WebSerial), recording', await collect(page));
+        const heapAfter = await heapMB(page);
+        await page.getByRole('button', { name: 'Stop recording' }).click();
+        results.serial = {
+          ...serial,
+          heapMBBefore: Number(heapBefore.toFixed(2)),
+          heapMBAfter: Number(heapAfter.toFixed(2)),
+          heapGrowthMB: Number((heapAfter - heapBefore).toFixed(2)),
+        };
+        await page.close();
+      } else {
+        results.serial = `skipped: ${serialSkip}`;
+      }
+
+      // 2. The demo source.
+      {
+        const page = await browser.newPage({ viewport: { width: 1400, height: 1000 } });
+        await observeLongTasks(page);
+        await page.goto(server.url('/?bench'));
+        if (fake !== null) await page.getByRole('button', { name: 'Demo', exact: true }).click();
+        await page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor({ timeout: 10_000 });
+        await collect(page);
+        await page.waitForTimeout(SECONDS * 1000);
+        results.demo = summarize('demo (simulator in the worker)', await collect(page));
         await page.close();
       }
-      results.openHourCapture = { fileMB: Number((size / (1 << 20)).toFixed(1)), frames: sim.framesGenerated, msRuns: times, msMedian: pct(times, 50) };
-    }
 
-    // 4. What the browser downloads first.
-    const assets = join(APP_DIR, 'assets');
-    const files = readdirSync(assets);
-    const gz = (f: string) => gzipSync(readFileSync(join(assets, f)), { level: 9 }).length;
-    const entry = files.filter((f) => f.startsWith('index-') && f.endsWith('.js'));
-    const worker = files.filter((f) => f.startsWith('worker-'));
-    results.bundle = {
-      initialJsGzipKB: Number((entry.reduce((n, f) => n + gz(f), 0) / 1024).toFixed(1)),
-      workerJsGzipKB: Number((worker.reduce((n, f) => n + gz(f), 0) / 1024).toFixed(1)),
-      cssGzipKB: Number((files.filter((f) => f.endsWith('.css')).reduce((n, f) => n + gz(f), 0) / 1024).toFixed(1)),
-    };
-  } finally {
-    await browser.close();
-    await fake?.close();
-    await policy?.remove();
-    await server.close();
-    rmSync(tmp, { recursive: true, force: true });
-  }
-  mkdirSync(join(ROOT, 'bench-results'), { recursive: true });
-  writeFileSync(join(ROOT, 'bench-results/page.json'), `${JSON.stringify(results, null, 2)}\n`);
-  console.log(JSON.stringify(results, null, 2));
-}, 15 * 60_000);
+      // 3. Open and plot a 1-hour capture (USB-batched, as the recorder writes them).
+      {
+        const sim = new Simulator({ ...preset('dsmx-11ms-2048-internal'), seed: 6 });
+        const hour = sim.generate(sim.scenario.timing.startUs + 3600e6);
+        const file = join(tmp, 'hour.sscap');
+        writeCapture(file, usbChunks(hour.bytes, hour.timesUs));
+        const size = readFileSync(file).length;
+        const times: number[] = [];
+        for (let run = 0; run < 3; run++) {
+          const page = await browser.newPage({ viewport: { width: 1400, height: 1000 } });
+          await page.goto(server.url('/?demo=0'));
+          // Timed in the page, from the file input's change to the overview drawn and the first
+          // frames shown (the test's own upload of the file through CDP is not counted).
+          await page.evaluate(() => {
+            const w = window as unknown as { __open: { start: number; plotted: number } };
+            w.__open = { start: 0, plotted: 0 };
+            document.querySelector('input[type=file]')?.addEventListener(
+              'change',
+              () => {
+                w.__open.start = performance.now();
+              },
+              { capture: true },
+            );
+            new MutationObserver((_, obs) => {
+              const counted = document.querySelector('[data-testid="count-frames"]')?.textContent !== '—';
+              if (document.querySelector('section.replay .overview canvas') !== null && counted) {
+                w.__open.plotted = performance.now();
+                obs.disconnect();
+              }
+            }).observe(document.body, { subtree: true, childList: true, characterData: true });
+          });
+          await page.setInputFiles('input[type=file]', file);
+          await page.waitForFunction(() => (window as unknown as { __open: { plotted: number } }).__open.plotted > 0, undefined, {
+            timeout: 30_000,
+          });
+          times.push(
+            Math.round(
+              await page.evaluate(() => {
+                const o = (window as unknown as { __open: { start: number; plotted: number } }).__open;
+                return o.plotted - o.start;
+              }),
+            ),
+          );
+          await page.close();
+        }
+        results.openHourCapture = {
+          fileMB: Number((size / (1 << 20)).toFixed(1)),
+          frames: sim.framesGenerated,
+          msRuns: times,
+          msMedian: pct(times, 50),
+        };
+      }
+
+      // 4. What the browser downloads first.
+      const assets = join(APP_DIR, 'assets');
+      const files = readdirSync(assets);
+      const gz = (f: string) => gzipSync(readFileSync(join(assets, f)), { level: 9 }).length;
+      const entry = files.filter((f) => f.startsWith('index-') && f.endsWith('.js'));
+      const worker = files.filter((f) => f.startsWith('worker-'));
+      results.bundle = {
+        initialJsGzipKB: Number((entry.reduce((n, f) => n + gz(f), 0) / 1024).toFixed(1)),
+        workerJsGzipKB: Number((worker.reduce((n, f) => n + gz(f), 0) / 1024).toFixed(1)),
+        cssGzipKB: Number((files.filter((f) => f.endsWith('.css')).reduce((n, f) => n + gz(f), 0) / 1024).toFixed(1)),
+      };
+    } finally {
+      await browser.close();
+      await fake?.close();
+      await policy?.remove();
+      await server.close();
+      rmSync(tmp, { recursive: true, force: true });
+    }
+    mkdirSync(join(ROOT, 'bench-results'), { recursive: true });
+    writeFileSync(join(ROOT, 'bench-results/page.json'), `${JSON.stringify(results, null, 2)}\n`);
+    console.log(JSON.stringify(results, null, 2));
+  },
+  15 * 60_000,
+);

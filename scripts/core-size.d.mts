@@ -1,2 +1,4 @@
 /** Each package entry bundled alone, minified and gzipped: sizes in bytes and the minified code. */
-export function entrySizes(): Promise<Record<'satscope' | 'satscope/capture' | 'satscope/report', { min: number; gzip: number; text: string }>>;
+export function entrySizes(): Promise<
+  Record<'satscope' | 'satscope/capture' | 'satscope/report', { min: number; gzip: number; text: string }>
+>;

@@ -10,7 +10,11 @@ import { join } from 'node:path';
 import { gzipSync } from 'node:zlib';
 import { build } from 'vite';
 
-const ENTRIES = { satscope: 'src/decoder/index.ts', 'satscope/capture': 'src/capture/index.ts', 'satscope/report': 'src/analysis/index.ts' };
+const ENTRIES = {
+  satscope: 'src/decoder/index.ts',
+  'satscope/capture': 'src/capture/index.ts',
+  'satscope/report': 'src/analysis/index.ts',
+};
 
 export async function entrySizes() {
   const sizes = {};
@@ -18,7 +22,8 @@ export async function entrySizes() {
     const out = mkdtempSync(join(tmpdir(), 'satscope-size-'));
     try {
       await build({
-        configFile: false, logLevel: 'silent',
+        configFile: false,
+        logLevel: 'silent',
         build: { outDir: out, minify: true, lib: { entry, formats: ['es'], fileName: 'entry' }, rollupOptions: { treeshake: true } },
       });
       const file = readdirSync(out).find((f) => f.endsWith('.js'));
@@ -32,5 +37,6 @@ export async function entrySizes() {
 }
 
 if (import.meta.url === `file://${process.argv[1]}`) {
-  for (const [name, s] of Object.entries(await entrySizes())) console.log(`${name.padEnd(17)} ${(s.min / 1024).toFixed(1)} kB minified, ${(s.gzip / 1024).toFixed(1)} kB gzipped`);
+  for (const [name, s] of Object.entries(await entrySizes()))
+    console.log(`${name.padEnd(17)} ${(s.min / 1024).toFixed(1)} kB minified, ${(s.gzip / 1024).toFixed(1)} kB gzipped`);
 }

@@ -73,11 +73,13 @@ function decode(SpektrumDecoder, input, chunked) {
   const out = [];
   const drain = () => {
     for (let f = d.next(); f; f = d.next()) {
-      out.push(`${f.offset}|${f.remote}|${f.system}|${f.resolution}|${f.fades}|${f.fadesDelta}|${f.rssi}|${f.ids.subarray(0, f.count)}|${f.positions.subarray(0, f.count)}|${f.vtx?.raw ?? ''}`);
+      out.push(
+        `${f.offset}|${f.remote}|${f.system}|${f.resolution}|${f.fades}|${f.fadesDelta}|${f.rssi}|${f.ids.subarray(0, f.count)}|${f.positions.subarray(0, f.count)}|${f.vtx?.raw ?? ''}`,
+      );
     }
   };
   let k = 0;
-  for (let i = 0; i < bytes.length;) {
+  for (let i = 0; i < bytes.length; ) {
     const end = chunked ? Math.min(bytes.length, i + splits[k++ % splits.length]) : bytes.length;
     const part = bytes.subarray(i, end);
     const time = timing === 'chunk' ? end * 87 : timing === 'per-byte' ? Float64Array.from(part, (_, j) => (i + j) * 87) : undefined;
@@ -106,7 +108,8 @@ function check(SpektrumDecoder, input) {
     const i = whole.frames.findIndex((f, j) => f !== chunked.frames[j]);
     return `chunking changed frame ${i}: ${whole.frames[i]} vs ${chunked.frames[i]}`;
   }
-  if (JSON.stringify(s) !== JSON.stringify(chunked.stats)) return `chunking changed the counters: ${JSON.stringify(s)} vs ${JSON.stringify(chunked.stats)}`;
+  if (JSON.stringify(s) !== JSON.stringify(chunked.stats))
+    return `chunking changed the counters: ${JSON.stringify(s)} vs ${JSON.stringify(chunked.stats)}`;
   return null;
 }
 
@@ -136,34 +139,43 @@ async function workerMain() {
  */
 export function runFuzz({ from = 0, count = 1_000_000, workers = Math.max(1, availableParallelism()), hangMs = 10_000 } = {}) {
   const file = fileURLToPath(import.meta.url);
-  return Promise.all(Array.from({ length: workers }, (_, w) => new Promise((resolve, reject) => {
-    const progress = new SharedArrayBuffer(4);
-    const at = new Int32Array(progress);
-    const worker = new Worker(file, { workerData: { from: from + w, count: count - w, step: workers, progress } });
-    let last = -1;
-    let still = 0;
-    const timer = setInterval(() => {
-      const n = Atomics.load(at, 0);
-      if (n !== last) {
-        last = n;
-        still = 0;
-        return;
-      }
-      still += 500;
-      if (still >= hangMs) {
-        clearInterval(timer);
-        void worker.terminate();
-        reject(new Error(`input ${n} made no progress for ${hangMs} ms (replay: node scripts/fuzz.mjs --from ${n} --count 1)`));
-      }
-    }, 500);
-    worker.on('message', (m) => {
-      if (m.type !== 'done') return;
-      clearInterval(timer);
-      resolve(m.failures);
-      void worker.terminate();
-    });
-    worker.on('error', (e) => { clearInterval(timer); reject(e); });
-  }))).then((all) => all.flat());
+  return Promise.all(
+    Array.from(
+      { length: workers },
+      (_, w) =>
+        new Promise((resolve, reject) => {
+          const progress = new SharedArrayBuffer(4);
+          const at = new Int32Array(progress);
+          const worker = new Worker(file, { workerData: { from: from + w, count: count - w, step: workers, progress } });
+          let last = -1;
+          let still = 0;
+          const timer = setInterval(() => {
+            const n = Atomics.load(at, 0);
+            if (n !== last) {
+              last = n;
+              still = 0;
+              return;
+            }
+            still += 500;
+            if (still >= hangMs) {
+              clearInterval(timer);
+              void worker.terminate();
+              reject(new Error(`input ${n} made no progress for ${hangMs} ms (replay: node scripts/fuzz.mjs --from ${n} --count 1)`));
+            }
+          }, 500);
+          worker.on('message', (m) => {
+            if (m.type !== 'done') return;
+            clearInterval(timer);
+            resolve(m.failures);
+            void worker.terminate();
+          });
+          worker.on('error', (e) => {
+            clearInterval(timer);
+            reject(e);
+          });
+        }),
+    ),
+  ).then((all) => all.flat());
 }
 
 if (!isMainThread) {
@@ -184,7 +196,9 @@ if (!isMainThread) {
       console.error(`${failures.length} failing inputs in ${count} (${s} s)`);
       process.exitCode = 1;
     } else {
-      console.log(`${count} inputs from ${from}, every option and timing: 0 throws, 0 hangs, every byte accounted for, same frames however chunked (${s} s)`);
+      console.log(
+        `${count} inputs from ${from}, every option and timing: 0 throws, 0 hangs, every byte accounted for, same frames however chunked (${s} s)`,
+      );
     }
   } catch (e) {
     console.error(String(e instanceof Error ? e.message : e));

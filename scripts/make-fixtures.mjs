@@ -24,14 +24,7 @@
 import { mkdirSync, writeFileSync } from 'node:fs';
 import { dirname, join } from 'node:path';
 import { fileURLToPath } from 'node:url';
-import {
-  Simulator,
-  describeLayout,
-  preset,
-  toFixtureFrame,
-  toFixtureGap,
-  toFixtureNoise,
-} from '../dist/simulator/index.js';
+import { Simulator, describeLayout, preset, toFixtureFrame, toFixtureGap, toFixtureNoise } from '../dist/simulator/index.js';
 
 const root = join(dirname(fileURLToPath(import.meta.url)), '..');
 const outDir = join(root, 'tests', 'fixtures');

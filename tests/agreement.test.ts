@@ -38,9 +38,16 @@ function captureFiles(dir: string): string[] {
 /** A capture with the time of every byte, as a logic analyser records it. */
 function perByte(sim: { bytes: Uint8Array; timesUs: Float64Array }): Capture {
   return {
-    kind: 'saleae-csv', meta: {}, timing: 'per-byte', bytes: sim.bytes,
-    chunkEnds: Uint32Array.of(sim.bytes.length), chunkTimesUs: Float64Array.of(sim.timesUs[sim.timesUs.length - 1]!),
-    chunkPorts: new Uint8Array(1), byteTimesUs: sim.timesUs, events: [], issues: [],
+    kind: 'saleae-csv',
+    meta: {},
+    timing: 'per-byte',
+    bytes: sim.bytes,
+    chunkEnds: Uint32Array.of(sim.bytes.length),
+    chunkTimesUs: Float64Array.of(sim.timesUs[sim.timesUs.length - 1]!),
+    chunkPorts: new Uint8Array(1),
+    byteTimesUs: sim.timesUs,
+    events: [],
+    issues: [],
   };
 }
 
@@ -97,12 +104,27 @@ function fromReport(capture: Capture): Story {
   const origin = report.timeline.originUs ?? 0;
   // Every failsafe began as a hold, which ends where the failsafe starts.
   const episodes = [
-    ...r.holds.episodes.map((e) => ({ kind: 'hold', startUs: e.startUs + origin, endUs: e.ongoing ? null : e.endUs + origin, lastFrameUs: e.lastFrameUs + origin })),
-    ...r.failsafes.map((e) => ({ kind: 'failsafe', startUs: e.startUs + origin, endUs: e.ongoing ? null : e.endUs + origin, lastFrameUs: e.lastFrameUs + origin })),
+    ...r.holds.episodes.map((e) => ({
+      kind: 'hold',
+      startUs: e.startUs + origin,
+      endUs: e.ongoing ? null : e.endUs + origin,
+      lastFrameUs: e.lastFrameUs + origin,
+    })),
+    ...r.failsafes.map((e) => ({
+      kind: 'failsafe',
+      startUs: e.startUs + origin,
+      endUs: e.ongoing ? null : e.endUs + origin,
+      lastFrameUs: e.lastFrameUs + origin,
+    })),
   ].sort((a, b) => a.startUs - b.startUs || (a.kind === 'hold' ? -1 : 1));
   return {
-    frames: r.frames, missedFrames: r.missedFrames, holds: r.holds.count, failsafes: r.failsafes.length, episodes,
-    resolution: r.resolution.value, reason: r.resolution.reason,
+    frames: r.frames,
+    missedFrames: r.missedFrames,
+    holds: r.holds.count,
+    failsafes: r.failsafes.length,
+    episodes,
+    resolution: r.resolution.value,
+    reason: r.resolution.reason,
   };
 }
 
@@ -175,7 +197,7 @@ function fromReplay(capture: Capture, speed: number, seekAtUs?: number): Story {
  */
 function stalled(chunks: { bytes: Uint8Array; timeUs: number }[], maxUs: number, seed = 7): { bytes: Uint8Array; timeUs: number }[] {
   let x = seed;
-  const random = () => ((x = (x * 1_103_515_245 + 12_345) % 2_147_483_648) / 2_147_483_648);
+  const random = () => (x = (x * 1_103_515_245 + 12_345) % 2_147_483_648) / 2_147_483_648;
   let last = 0;
   return chunks.map((c) => {
     const at = Math.max(last, c.timeUs + (random() < 0.05 ? random() * maxUs : 0));
@@ -227,10 +249,30 @@ interface Case {
 const sim = (name: string, seed: number, durationUs: number) => simulate({ ...preset(name), seed }, durationUs, { truth: true });
 
 const CASES: Case[] = [
-  { name: 'simulator dropouts-failsafe (per-byte times)', capture: () => perByte(sim('dropouts-failsafe', 3, 4_000_000)), live: true, expect: { holds: 2, failsafes: 1 } },
-  { name: 'simulator dropouts-and-damage (per-byte times)', capture: () => perByte(sim('dropouts-and-damage', 5, 4_000_000)), live: true, expect: { holds: 2, failsafes: 1 } },
-  { name: 'simulator damaged-line, 00 00 header: missed frames by count (per-byte times)', capture: () => perByte(sim('damaged-line', 7, 4_000_000)), live: true, expect: { failsafes: 0 } },
-  { name: 'simulator dsm2-22ms-1024-external (per-byte times)', capture: () => perByte(sim('dsm2-22ms-1024-external', 9, 3_000_000)), live: true, expect: { holds: 0, failsafes: 0 } },
+  {
+    name: 'simulator dropouts-failsafe (per-byte times)',
+    capture: () => perByte(sim('dropouts-failsafe', 3, 4_000_000)),
+    live: true,
+    expect: { holds: 2, failsafes: 1 },
+  },
+  {
+    name: 'simulator dropouts-and-damage (per-byte times)',
+    capture: () => perByte(sim('dropouts-and-damage', 5, 4_000_000)),
+    live: true,
+    expect: { holds: 2, failsafes: 1 },
+  },
+  {
+    name: 'simulator damaged-line, 00 00 header: missed frames by count (per-byte times)',
+    capture: () => perByte(sim('damaged-line', 7, 4_000_000)),
+    live: true,
+    expect: { failsafes: 0 },
+  },
+  {
+    name: 'simulator dsm2-22ms-1024-external (per-byte times)',
+    capture: () => perByte(sim('dsm2-22ms-1024-external', 9, 3_000_000)),
+    live: true,
+    expect: { holds: 0, failsafes: 0 },
+  },
   {
     name: 'simulator dropouts-failsafe recorded through a USB adapter (.sscap, chunk times)',
     capture: () => {
@@ -240,7 +282,12 @@ const CASES: Case[] = [
     live: false,
     expect: { holds: 2, failsafes: 1 },
   },
-  { name: 'simulator dropouts-failsafe as a raw .bin (no timing)', capture: () => importRaw(sim('dropouts-failsafe', 3, 4_000_000).bytes), live: false, expect: { holds: 0, failsafes: 0, episodes: [] } },
+  {
+    name: 'simulator dropouts-failsafe as a raw .bin (no timing)',
+    capture: () => importRaw(sim('dropouts-failsafe', 3, 4_000_000).bytes),
+    live: false,
+    expect: { holds: 0, failsafes: 0, episodes: [] },
+  },
 ];
 
 if (present) {
@@ -248,7 +295,12 @@ if (present) {
     const name = path.slice(CAPTURES.length + 1);
     // The PX4 DX9 captures are clean links (0 gaps, 0 fades): nothing may be made up from their timing.
     const clean = /dx9/.test(name) ? { holds: 0, failsafes: 0, missedFrames: 0 } : undefined;
-    CASES.push({ name: `real capture ${name}`, capture: () => readCapture(new Uint8Array(readFileSync(path)), path), live: true, expect: clean });
+    CASES.push({
+      name: `real capture ${name}`,
+      capture: () => readCapture(new Uint8Array(readFileSync(path)), path),
+      live: true,
+      expect: clean,
+    });
   }
 }
 
@@ -272,7 +324,7 @@ describe('every surface tells the same story about the same bytes', () => {
         ['1×', 1],
         ['4×', 4],
         ['full speed', 0],
-      ])('replay at %s agrees, on the capture\'s clock', (_label, speed) => {
+      ])("replay at %s agrees, on the capture's clock", (_label, speed) => {
         expectAgree(fromReplay(capture, speed), reference, 0);
       });
 
@@ -285,8 +337,13 @@ describe('every surface tells the same story about the same bytes', () => {
         const { story: live, holdAfterUs } = fromLive(capture);
         // A silence shorter than the USB delivery jitter explains is no hold through an adapter
         // (on a logic analyser it is): those, and only those, the live view may not show.
-        const unseen = reference.episodes.filter((e) => e.kind === 'hold' && e.endUs !== null && e.endUs - e.lastFrameUs <= holdAfterUs + 16_000 &&
-          !reference.episodes.some((f) => f.kind === 'failsafe' && f.lastFrameUs === e.lastFrameUs));
+        const unseen = reference.episodes.filter(
+          (e) =>
+            e.kind === 'hold' &&
+            e.endUs !== null &&
+            e.endUs - e.lastFrameUs <= holdAfterUs + 16_000 &&
+            !reference.episodes.some((f) => f.kind === 'failsafe' && f.lastFrameUs === e.lastFrameUs),
+        );
         if (unseen.length > 0) {
           const shown = live.episodes.filter((e) => !unseen.some((u) => Math.abs(u.lastFrameUs - e.lastFrameUs) <= 20_000));
           expect(live.holds).toBeGreaterThanOrEqual(reference.holds - unseen.length);
@@ -304,10 +361,13 @@ describe('every surface tells the same story about the same bytes', () => {
         expectAgree(live, reference, 20_000);
       });
 
-      it.runIf(c.live && c.expect?.holds === 0)('on a loaded host (chunks held back up to 80 ms now and then), the live engine still shows no hold and no missed frame that is not there', () => {
-        const { story: live } = fromLive(capture, 80_000);
-        expect(live).toMatchObject({ holds: 0, failsafes: 0, missedFrames: reference.missedFrames, episodes: [] });
-      });
+      it.runIf(c.live && c.expect?.holds === 0)(
+        'on a loaded host (chunks held back up to 80 ms now and then), the live engine still shows no hold and no missed frame that is not there',
+        () => {
+          const { story: live } = fromLive(capture, 80_000);
+          expect(live).toMatchObject({ holds: 0, failsafes: 0, missedFrames: reference.missedFrames, episodes: [] });
+        },
+      );
     });
   }
 });

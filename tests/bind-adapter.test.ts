@@ -9,7 +9,12 @@ import { runBind } from '../src/worker/bind.js';
 
 /** A SerialPort with these USB IDs that records what a driver does to it. */
 function fakePort(usb: UsbIds) {
-  const calls: { open: SerialOptions[]; signals: SerialOutputSignals[]; written: number[]; closes: number } = { open: [], signals: [], written: [], closes: 0 };
+  const calls: { open: SerialOptions[]; signals: SerialOutputSignals[]; written: number[]; closes: number } = {
+    open: [],
+    signals: [],
+    written: [],
+    closes: 0,
+  };
   let writable: WritableStream<Uint8Array> | null = null;
   const port = {
     getInfo: () => ({ ...usb }),
@@ -62,11 +67,13 @@ describe('the USB-serial adapter table', () => {
 
 describe('the Bind panel preview', () => {
   it('is the plan the worker runs on the same adapter: same rate, same bytes, same power signals', async () => {
-    const runs = await Promise.all(ADAPTERS.map(async ({ label, usb }) => {
-      const { port, calls } = fakePort(usb);
-      await runBind(port, { pulses: 9, powerLine: 'rts', polarity: 'asserted' }, () => {});
-      return { label, usb, calls };
-    }));
+    const runs = await Promise.all(
+      ADAPTERS.map(async ({ label, usb }) => {
+        const { port, calls } = fakePort(usb);
+        await runBind(port, { pulses: 9, powerLine: 'rts', polarity: 'asserted' }, () => {});
+        return { label, usb, calls };
+      }),
+    );
     for (const { label, usb, calls } of runs) {
       const preview = bindPreview(9, usb, 'rts', 'asserted');
       const shown = preview.steps.flatMap((s) => ('signals' in s && s.action !== 'reopen' ? [s.signals] : []));

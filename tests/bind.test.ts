@@ -1,18 +1,41 @@
 import { describe, expect, it } from 'vitest';
 import {
-  BIND_MODES, BIND_WINDOW, DEFAULT_CHIPS, BIND_PULSE_MAX_US, BIND_PULSE_MIN_US, USB_SERIAL_CHIPS,
-  bindMode, bindPulsesFor, bindTimeline, chipBaudRate, chipsForUsbId, countFallingEdges, measurePulses,
-  planPulses, powerSignals, uartWaveform, validatePlan,
-  type PulsePlan, type UsbSerialChip,
+  BIND_MODES,
+  BIND_WINDOW,
+  DEFAULT_CHIPS,
+  BIND_PULSE_MAX_US,
+  BIND_PULSE_MIN_US,
+  USB_SERIAL_CHIPS,
+  bindMode,
+  bindPulsesFor,
+  bindTimeline,
+  chipBaudRate,
+  chipsForUsbId,
+  countFallingEdges,
+  measurePulses,
+  planPulses,
+  powerSignals,
+  uartWaveform,
+  validatePlan,
+  type PulsePlan,
+  type UsbSerialChip,
 } from '../src/bind/index.js';
 
 // ---------------------------------------------------------------------------------------------
 // An independent line model: every bit is its own step, nothing merged, gaps in µs.
 
-interface Edge { t: number; level: 0 | 1 }
+interface Edge {
+  t: number;
+  level: 0 | 1;
+}
 
 /** Level changes on the TX line (idle high before t = 0), bit by bit. */
-function simulateLine(bytes: ArrayLike<number>, baud: number, stopBits: 1 | 2, gapAfterUs: (i: number) => number = () => 0): { edges: Edge[]; endUs: number } {
+function simulateLine(
+  bytes: ArrayLike<number>,
+  baud: number,
+  stopBits: 1 | 2,
+  gapAfterUs: (i: number) => number = () => 0,
+): { edges: Edge[]; endUs: number } {
   const bitUs = 1e6 / baud;
   const edges: Edge[] = [];
   let level: 0 | 1 = 1;
@@ -73,12 +96,25 @@ const hex = (p: PulsePlan) => [...p.bytes].map((b) => `0x${b.toString(16).padSta
 function plansFor(n: number): { label: string; plan: PulsePlan }[] {
   const out = [{ label: 'default chips', plan: planPulses(n) }];
   for (const chip of USB_SERIAL_CHIPS) out.push({ label: chip, plan: planPulses(n, { chips: [chip] }) });
-  for (const [vid, pid] of [[0x0403, 0x6001], [0x10c4, 0xea60], [0x1a86, 0x7523], [0x067b, 0x2303], [0x067b, 0x23a3], [0x2341, 0x0043]] as const) {
+  for (const [vid, pid] of [
+    [0x0403, 0x6001],
+    [0x10c4, 0xea60],
+    [0x1a86, 0x7523],
+    [0x067b, 0x2303],
+    [0x067b, 0x23a3],
+    [0x2341, 0x0043],
+  ] as const) {
     out.push({ label: `usb ${vid.toString(16)}:${pid.toString(16)}`, plan: planPulses(n, { chips: chipsForUsbId(vid, pid) }) });
   }
-  out.push({ label: 'one pulse per byte, ft232r+ch340+pl2303', plan: planPulses(n, { chips: ['ft232r', 'ch340', 'pl2303'], maxPulsesPerByte: 1 }) });
+  out.push({
+    label: 'one pulse per byte, ft232r+ch340+pl2303',
+    plan: planPulses(n, { chips: ['ft232r', 'ch340', 'pl2303'], maxPulsesPerByte: 1 }),
+  });
   out.push({ label: 'forced 9600 (several pulses per byte)', plan: planPulses(n, { baudRates: [9600] }) });
-  out.push({ label: 'forced 45833 8N2 (5 bits low, 6 high)', plan: planPulses(n, { baudRates: [45833], stopBits: [2], chips: ['ft232r'] }) });
+  out.push({
+    label: 'forced 45833 8N2 (5 bits low, 6 high)',
+    plan: planPulses(n, { baudRates: [45833], stopBits: [2], chips: ['ft232r'] }),
+  });
   return out;
 }
 
@@ -87,8 +123,14 @@ function plansFor(n: number): { label: string; plan: PulsePlan }[] {
 describe('§7.2 bind modes', () => {
   it('match the spec tables', () => {
     const spec: [number, 'internal' | 'external', 'DSM2' | 'DSMX', 11 | 22][] = [
-      [3, 'internal', 'DSM2', 22], [4, 'external', 'DSM2', 22], [5, 'internal', 'DSM2', 11], [6, 'external', 'DSM2', 11],
-      [7, 'internal', 'DSMX', 22], [8, 'external', 'DSMX', 22], [9, 'internal', 'DSMX', 11], [10, 'external', 'DSMX', 11],
+      [3, 'internal', 'DSM2', 22],
+      [4, 'external', 'DSM2', 22],
+      [5, 'internal', 'DSM2', 11],
+      [6, 'external', 'DSM2', 11],
+      [7, 'internal', 'DSMX', 22],
+      [8, 'external', 'DSMX', 22],
+      [9, 'internal', 'DSMX', 11],
+      [10, 'external', 'DSMX', 11],
     ];
     expect(BIND_MODES.map((m) => [m.pulses, m.remote, m.protocol, m.periodMs])).toEqual(spec);
     // "we recommend that 11ms DSMX be used (9 ("internal") or 10 ("external") pulses)"
@@ -152,7 +194,11 @@ describe('the UART line model', () => {
     expect(countFallingEdges(w)).toBe(5);
     // 0x00: start + 8 zeros = 9 bits low, then the stop bit.
     const z = uartWaveform([0x00], 10_000, 2, 50, 70);
-    expect(z).toEqual([{ level: 1, durationUs: 50 }, { level: 0, durationUs: 900 }, { level: 1, durationUs: 270 }]);
+    expect(z).toEqual([
+      { level: 1, durationUs: 50 },
+      { level: 0, durationUs: 900 },
+      { level: 1, durationUs: 270 },
+    ]);
     // 0xFF: only the start bit is low.
     expect(measurePulses(uartWaveform([0xff], 10_000)).lowUs).toEqual([100]);
     // 0xF0: five bits low, five high.

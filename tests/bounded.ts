@@ -51,11 +51,18 @@ import(workerData.dist).then(({ SpektrumDecoder }) => {
 export async function runBounded(inputs: readonly BoundedInput[], perInputMs: number): Promise<BoundedResult[]> {
   const worker = new Worker(WORKER, { eval: true, workerData: { dist: DIST } });
   try {
-    const next = (): Promise<unknown> => new Promise((resolve, reject) => {
-      const timer = setTimeout(() => reject(new Error('timeout')), perInputMs);
-      worker.once('message', (m) => { clearTimeout(timer); resolve(m); });
-      worker.once('error', (e) => { clearTimeout(timer); reject(e); });
-    });
+    const next = (): Promise<unknown> =>
+      new Promise((resolve, reject) => {
+        const timer = setTimeout(() => reject(new Error('timeout')), perInputMs);
+        worker.once('message', (m) => {
+          clearTimeout(timer);
+          resolve(m);
+        });
+        worker.once('error', (e) => {
+          clearTimeout(timer);
+          reject(e);
+        });
+      });
     await next();
     const results: BoundedResult[] = [];
     for (const [i, input] of inputs.entries()) {
@@ -65,7 +72,9 @@ export async function runBounded(inputs: readonly BoundedInput[], perInputMs: nu
         results.push((await reply) as BoundedResult);
       } catch (e) {
         const head = Array.from(input.bytes.subarray(0, 64), (b) => b.toString(16).padStart(2, '0')).join('');
-        throw new Error(`input ${i} (${input.bytes.length} bytes, options ${JSON.stringify(input.options)}, starts ${head}) did not finish in ${perInputMs} ms: ${String(e)}`);
+        throw new Error(
+          `input ${i} (${input.bytes.length} bytes, options ${JSON.stringify(input.options)}, starts ${head}) did not finish in ${perInputMs} ms: ${String(e)}`,
+        );
       }
     }
     return results;

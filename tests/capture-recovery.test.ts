@@ -38,7 +38,18 @@ function record(capture: Capture, note: string): Uint8Array {
 
 function simulated(): Capture {
   const sim = simulate({ ...preset('dsmx-11ms-2048-internal'), seed: 8 }, 2_000_000);
-  return { kind: 'raw', meta: {}, timing: 'per-byte', bytes: sim.bytes, byteTimesUs: sim.timesUs, chunkEnds: Uint32Array.of(sim.bytes.length), chunkTimesUs: Float64Array.of(NaN), chunkPorts: new Uint8Array(1), events: [], issues: [] };
+  return {
+    kind: 'raw',
+    meta: {},
+    timing: 'per-byte',
+    bytes: sim.bytes,
+    byteTimesUs: sim.timesUs,
+    chunkEnds: Uint32Array.of(sim.bytes.length),
+    chunkTimesUs: Float64Array.of(NaN),
+    chunkPorts: new Uint8Array(1),
+    events: [],
+    issues: [],
+  };
 }
 
 const sources: [string, () => Capture][] = [['a simulated recording', simulated]];
@@ -55,8 +66,13 @@ const sameArray = (a: ArrayBufferView, b: ArrayBufferView): boolean =>
 
 /** The same data chunks (bytes, times, ports) and events: compared as arrays, since it runs thousands of times. */
 function sameRecords(a: Capture, b: Capture): boolean {
-  return sameArray(a.bytes, b.bytes) && sameArray(a.chunkEnds, b.chunkEnds) && sameArray(a.chunkTimesUs, b.chunkTimesUs) &&
-    sameArray(a.chunkPorts, b.chunkPorts) && JSON.stringify(a.events) === JSON.stringify(b.events);
+  return (
+    sameArray(a.bytes, b.bytes) &&
+    sameArray(a.chunkEnds, b.chunkEnds) &&
+    sameArray(a.chunkTimesUs, b.chunkTimesUs) &&
+    sameArray(a.chunkPorts, b.chunkPorts) &&
+    JSON.stringify(a.events) === JSON.stringify(b.events)
+  );
 }
 
 describe.each(sources)('a .sscap of %s with one bit of its header flipped', (_, source) => {
@@ -82,7 +98,10 @@ describe.each(sources)('a .sscap of %s with one bit of its header flipped', (_, 
       expect(sameRecords(parsed, whole), `bit ${bit}: the records`).toBe(true);
       expect(parsed.issues[0], `bit ${bit}`).toMatchObject({ kind: 'bad-header', offset: 0, length: whole.headerLength });
       // Only the header is reported (and, at most, a metadata field a flip turned into the wrong type).
-      expect(parsed.issues.slice(1).every((i) => i.kind === 'bad-meta'), `bit ${bit}`).toBe(true);
+      expect(
+        parsed.issues.slice(1).every((i) => i.kind === 'bad-meta'),
+        `bit ${bit}`,
+      ).toBe(true);
       // Damage in the fixed fields (signature, version, flags, length) or the CRC loses no metadata.
       const inMetadata = bit >> 3 >= 16 && bit >> 3 < whole.headerLength - 4;
       if (!inMetadata) expect(parsed.meta, `bit ${bit}`).toEqual(whole.meta);
@@ -129,7 +148,11 @@ describe.each(sources)('a .sscap of %s with one bit of its header flipped', (_, 
       }
       const recovered = new Set(parsed.chunkTimesUs);
       for (const t of untouched) expect(recovered.has(t), `run ${run}: the record at ${t} µs`).toBe(true);
-      if (damaged.subarray(0, whole.headerLength).some((b, i) => b !== file[i])) expect(parsed.issues.some((i) => i.kind === 'bad-header'), `run ${run}`).toBe(true);
+      if (damaged.subarray(0, whole.headerLength).some((b, i) => b !== file[i]))
+        expect(
+          parsed.issues.some((i) => i.kind === 'bad-header'),
+          `run ${run}`,
+        ).toBe(true);
     }
     // A signature beyond repair alone is recovered too (the header CRC or the first record proves the file).
     expect(refused).toBe(0);
@@ -217,7 +240,15 @@ describe('reading a crafted .sscap', () => {
     const large = work(make(1024 * 1024));
     for (const { capture } of [small, large]) {
       // The genuine records at the end are found behind the crafted ones.
-      expect(chunksOf(capture).slice(-3).map((c) => [c.timeUs, c.bytes.length, c.bytes[0]])).toEqual([[1, 1000, 1], [2, 1000, 2], [3, 1000, 3]]);
+      expect(
+        chunksOf(capture)
+          .slice(-3)
+          .map((c) => [c.timeUs, c.bytes.length, c.bytes[0]]),
+      ).toEqual([
+        [1, 1000, 1],
+        [2, 1000, 2],
+        [3, 1000, 3],
+      ]);
     }
     // 16 times the size: linear work grows 16 times, quadratic 256 times.
     expect(large.total / small.total).toBeLessThan(20);

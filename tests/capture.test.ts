@@ -160,7 +160,10 @@ describe('.sscap round trip', () => {
 
   it('costs RECORD_OVERHEAD bytes per record on top of the payload', () => {
     const header = new CaptureWriter(META).header();
-    const payload = DATA_RECORDS.reduce((n, r) => n + r.bytes.length, 0) + new TextEncoder().encode('port opened').length + new TextEncoder().encode('device lost 🔌').length;
+    const payload =
+      DATA_RECORDS.reduce((n, r) => n + r.bytes.length, 0) +
+      new TextEncoder().encode('port opened').length +
+      new TextEncoder().encode('device lost 🔌').length;
     expect(file.length).toBe(header.length + payload + RECORDS.length * RECORD_OVERHEAD);
   });
 });
@@ -225,7 +228,10 @@ describe('.sscap damage recovery', () => {
       if (tailStart === cut) {
         expect(parsed.issues, `cut at ${cut}`).toEqual([]);
       } else {
-        expect(parsed.issues.map((i) => [i.kind, i.offset, i.length]), `cut at ${cut}`).toEqual([['truncated-record', tailStart, cut - tailStart]]);
+        expect(
+          parsed.issues.map((i) => [i.kind, i.offset, i.length]),
+          `cut at ${cut}`,
+        ).toEqual([['truncated-record', tailStart, cut - tailStart]]);
         expect(parsed.issues[0]?.message).toMatch(/ends inside a record/);
       }
     }
@@ -249,7 +255,10 @@ describe('.sscap damage recovery', () => {
       const parsed = parseCapture(damaged);
       expect(chunksOf(parsed), `byte ${at - start} damaged`).toEqual([whole[0], ...whole.slice(2)]);
       expect(parsed.events).toHaveLength(2);
-      expect(parsed.issues.map((i) => [i.offset, i.length]), `byte ${at - start} damaged`).toEqual([[start, end - start]]);
+      expect(
+        parsed.issues.map((i) => [i.offset, i.length]),
+        `byte ${at - start} damaged`,
+      ).toEqual([[start, end - start]]);
       // A damaged sync marker looks like stray bytes; any other damaged byte is a damaged record.
       expect(parsed.issues[0]?.kind).toBe(at - start < 2 ? 'garbage' : 'bad-checksum');
     }
@@ -260,7 +269,9 @@ describe('.sscap damage recovery', () => {
     const damaged = file.slice();
     new DataView(damaged.buffer).setUint32((starts[1] as number) + 4, 100_000, true);
     const parsed = parseCapture(damaged);
-    expect(parsed.issues.map((i) => [i.kind, i.offset, i.length])).toEqual([['bad-checksum', starts[1], (starts[2] as number) - (starts[1] as number)]]);
+    expect(parsed.issues.map((i) => [i.kind, i.offset, i.length])).toEqual([
+      ['bad-checksum', starts[1], (starts[2] as number) - (starts[1] as number)],
+    ]);
     expect(parsed.chunkEnds).toHaveLength(3);
   });
 
@@ -333,7 +344,10 @@ describe('.sscap damage recovery', () => {
       expect(parsed.meta, `bit ${bit}`).toEqual(parseCapture(file).meta);
       expect(chunksOf(parsed), `bit ${bit}`).toEqual(chunksOf(parseCapture(file)));
       expect(parsed.headerLength).toBe(headerLength);
-      expect(parsed.issues.map((i) => [i.kind, i.offset, i.length]), `bit ${bit}`).toEqual([['bad-header', 0, headerLength]]);
+      expect(
+        parsed.issues.map((i) => [i.kind, i.offset, i.length]),
+        `bit ${bit}`,
+      ).toEqual([['bad-header', 0, headerLength]]);
       expect(parsed.issues[0]?.message).toMatch(/metadata length \(\d+, not \d+\) is wrong; repaired/);
     }
   });
@@ -409,7 +423,7 @@ describe('.sscap damage recovery', () => {
       const damaged = file.slice();
       const hits = 1 + ((noise[0] ?? 0) % 4);
       for (let k = 0; k < hits; k++) {
-        const at = headerLength + (((noise[1 + k] ?? 0) << 8) | (noise[5 + k] ?? 0)) % (file.length - headerLength);
+        const at = headerLength + ((((noise[1 + k] ?? 0) << 8) | (noise[5 + k] ?? 0)) % (file.length - headerLength));
         damaged[at] = noise[9 + k] ?? 0;
       }
       const touched = (r: number): boolean => damaged.subarray(starts[r], ends[r]).some((b, i) => b !== file[(starts[r] as number) + i]);
@@ -626,7 +640,8 @@ describe('Saleae CSV: inline exports', () => {
   });
 
   it('reads a Logic 2 export by column name, with quoted headers and analyser names', () => {
-    const csv = 'name,type,start_time,duration,"data"\n"Async Serial","data",0.00123,8.68e-05,0x3E\n"Async Serial","data",1.5e-3,8.68e-05,0xB2\n';
+    const csv =
+      'name,type,start_time,duration,"data"\n"Async Serial","data",0.00123,8.68e-05,0x3E\n"Async Serial","data",1.5e-3,8.68e-05,0xB2\n';
     const capture = importSaleaeCsv(csv);
     expect([...capture.bytes]).toEqual([0x3e, 0xb2]);
     expect([...(capture.byteTimesUs ?? [])]).toEqual([1230, 1500]);
@@ -685,7 +700,10 @@ describe('Saleae CSV: inline exports', () => {
 
   it('refuses a file with a header but no usable row, saying why', () => {
     expectFormatError(() => importSaleaeCsv('Time [s],Value\n'), /no usable bytes: there are no rows/);
-    expectFormatError(() => importSaleaeCsv('Time [s],Value\n0.1,hello\n'), /no usable bytes: all 1 row\(s\) were rejected \(first: line 2/);
+    expectFormatError(
+      () => importSaleaeCsv('Time [s],Value\n0.1,hello\n'),
+      /no usable bytes: all 1 row\(s\) were rejected \(first: line 2/,
+    );
   });
 
   it('refuses text without a recognisable header', () => {
@@ -726,7 +744,10 @@ describe('readCapture', () => {
   });
 
   it('refuses text that is not a Saleae export, quoting its first line', () => {
-    expectFormatError(() => readCapture(ascii('{"hello": 1}\n'), 'settings.json'), /settings\.json.*looks like text but not a Saleae async-serial CSV.*"\{\\"hello\\": 1\}"/);
+    expectFormatError(
+      () => readCapture(ascii('{"hello": 1}\n'), 'settings.json'),
+      /settings\.json.*looks like text but not a Saleae async-serial CSV.*"\{\\"hello\\": 1\}"/,
+    );
     expectFormatError(() => readCapture(ascii('# SatScope\n\nA decoder.\n')), /looks like text but not a Saleae async-serial CSV/);
   });
 

@@ -85,7 +85,14 @@ describe('satscope decode into a pipe', () => {
   });
 
   it('ends cleanly, with exit code 0 and no message, when the reader stops early (| head)', () => {
-    const r = spawnSync('sh', ['-c', `("${process.execPath}" "${join(dir, 'peak.mjs')}" decode "${big}" 2>"${dir}/err"; echo $? >"${dir}/rc") | head -n 3; cat "${dir}/rc" "${dir}/err"`], { encoding: 'utf8' });
+    const r = spawnSync(
+      'sh',
+      [
+        '-c',
+        `("${process.execPath}" "${join(dir, 'peak.mjs')}" decode "${big}" 2>"${dir}/err"; echo $? >"${dir}/rc") | head -n 3; cat "${dir}/rc" "${dir}/err"`,
+      ],
+      { encoding: 'utf8' },
+    );
     const out = r.stdout.split('\n');
     expect(out.slice(0, 3).every((l) => l.startsWith('{"t": null, "remote": "internal"'))).toBe(true);
     expect(out[3]).toBe('0');

@@ -39,7 +39,10 @@ beforeAll(() => {
   writeFileSync(join(dir, 'run.sscap'), file);
   writeFileSync(join(dir, 'cut.sscap'), file.subarray(0, file.length - 30));
   writeFileSync(join(dir, 'run.bin'), sim.bytes);
-  const csv = ['Time [s],Value,Parity Error,Framing Error', ...Array.from(sim.bytes, (b, i) => `${(sim.timesUs[i]! / 1e6).toFixed(9)},0x${b.toString(16).toUpperCase().padStart(2, '0')},,`)];
+  const csv = [
+    'Time [s],Value,Parity Error,Framing Error',
+    ...Array.from(sim.bytes, (b, i) => `${(sim.timesUs[i]! / 1e6).toFixed(9)},0x${b.toString(16).toUpperCase().padStart(2, '0')},,`),
+  ];
   writeFileSync(join(dir, 'run.csv'), csv.join('\n'));
   // The same bytes with one bit of the header's metadata length flipped.
   const damaged = file.slice();
@@ -47,11 +50,17 @@ beforeAll(() => {
   writeFileSync(join(dir, 'damaged-header.sscap'), damaged);
   // Two satellites on ports 1 and 2, none on port 0.
   const two = new CaptureWriter({ source: 'test' });
-  writeFileSync(join(dir, 'two.sscap'), concatBytes([two.header(), two.data(sim.bytes, NaN, 1), two.data(sim.bytes.subarray(0, 800), NaN, 2)]));
+  writeFileSync(
+    join(dir, 'two.sscap'),
+    concatBytes([two.header(), two.data(sim.bytes, NaN, 1), two.data(sim.bytes.subarray(0, 800), NaN, 2)]),
+  );
   writeFileSync(join(dir, '-dash.bin'), sim.bytes);
   writeFileSync(join(dir, 'notes.txt'), 'these are my notes\nnot a capture\n');
   writeFileSync(join(dir, 'empty.bin'), new Uint8Array(0));
-  writeFileSync(join(dir, 'noise.bin'), Uint8Array.from({ length: 500 }, (_, i) => (i * 37 + 11) & 0xff));
+  writeFileSync(
+    join(dir, 'noise.bin'),
+    Uint8Array.from({ length: 500 }, (_, i) => (i * 37 + 11) & 0xff),
+  );
 });
 
 afterAll(() => rmSync(dir, { recursive: true, force: true }));
@@ -62,7 +71,9 @@ describe('satscope decode', () => {
     expect(r.code).toBe(0);
     const lines = r.out.trim().split('\n');
     expect(lines).toHaveLength(intact.length);
-    expect(lines[0]).toMatch(/^\{"t": [\d.]+, "remote": "internal", "system": 178, "resolution": 2048, "fades": \d+, "rssi": null, "channels": \[\{"id": \d+, "pos": \d+, "us": \d+\}/);
+    expect(lines[0]).toMatch(
+      /^\{"t": [\d.]+, "remote": "internal", "system": 178, "resolution": 2048, "fades": \d+, "rssi": null, "channels": \[\{"id": \d+, "pos": \d+, "us": \d+\}/,
+    );
     const first = JSON.parse(lines[0]!);
     expect(Object.keys(first)).toEqual(['t', 'remote', 'system', 'resolution', 'fades', 'rssi', 'channels']);
     expect(first.channels.map((c: { id: number; pos: number }) => [c.id, c.pos])).toEqual(intact[0]!.channels.map((c) => [c.id, c.pos]));
@@ -74,9 +85,18 @@ describe('satscope decode', () => {
   });
 
   it('decodes the same frames from a raw .bin (t is null) and a Saleae CSV (exact t)', () => {
-    const fromSscap = satscope('decode', join(dir, 'run.sscap')).out.trim().split('\n').map((l) => JSON.parse(l));
-    const bin = satscope('decode', join(dir, 'run.bin')).out.trim().split('\n').map((l) => JSON.parse(l));
-    const csv = satscope('decode', join(dir, 'run.csv')).out.trim().split('\n').map((l) => JSON.parse(l));
+    const fromSscap = satscope('decode', join(dir, 'run.sscap'))
+      .out.trim()
+      .split('\n')
+      .map((l) => JSON.parse(l));
+    const bin = satscope('decode', join(dir, 'run.bin'))
+      .out.trim()
+      .split('\n')
+      .map((l) => JSON.parse(l));
+    const csv = satscope('decode', join(dir, 'run.csv'))
+      .out.trim()
+      .split('\n')
+      .map((l) => JSON.parse(l));
     expect(bin.map((f) => f.channels)).toEqual(fromSscap.map((f) => f.channels));
     expect(csv.map((f) => f.channels)).toEqual(fromSscap.map((f) => f.channels));
     expect(bin.every((f) => f.t === null)).toBe(true);
@@ -155,7 +175,10 @@ describe('satscope decode', () => {
 
   it('refuses options a command does not take, missing and repeated values, with exit code 2', () => {
     const cases: [string[], RegExp][] = [
-      [['info', 'x', '--format', 'csv'], /unknown option '--format' for info: info prints a summary; --format \(jsonl or csv\) is for decode/],
+      [
+        ['info', 'x', '--format', 'csv'],
+        /unknown option '--format' for info: info prints a summary; --format \(jsonl or csv\) is for decode/,
+      ],
       [['decode', 'x', '--json'], /unknown option '--json' for decode: .*--json is for info and report/],
       [['report', 'x', '--port', '1'], /report covers every port/],
       [['decode', 'x', '--out', 'y'], /unknown option '--out' for decode \(decode takes --format, --resolution, --port\)/],
@@ -204,7 +227,7 @@ describe('satscope info', () => {
     expect(r.out).toMatch(/ 0 Throttle/);
   });
 
-  it('prints the summary as JSON with --json: the library\'s summary, and the figures the text shows', () => {
+  it("prints the summary as JSON with --json: the library's summary, and the figures the text shows", () => {
     const r = satscope('info', join(dir, 'run.csv'), '--json');
     expect(r.code).toBe(0);
     const s = JSON.parse(r.out);

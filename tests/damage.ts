@@ -21,7 +21,8 @@ export function framesOf(bytes: Uint8Array, options: DecoderOptions = {}, chunk 
   const d = new SpektrumDecoder(options);
   const out: SentFrame[] = [];
   const drain = () => {
-    for (let f = d.next(); f; f = d.next()) out.push({ offset: f.offset, bytes: hex(f.bytes), reading: reading(f), fadesDelta: f.fadesDelta });
+    for (let f = d.next(); f; f = d.next())
+      out.push({ offset: f.offset, bytes: hex(f.bytes), reading: reading(f), fadesDelta: f.fadesDelta });
   };
   const step = chunk > 0 ? chunk : bytes.length;
   for (let i = 0; i < bytes.length; i += step) {
@@ -61,7 +62,10 @@ export function damage(clean: Uint8Array, edits: readonly Edit[]): Damaged {
   let i = 0;
   for (const e of sorted) {
     if (e.at < i) continue;
-    for (; i < e.at; i++) { bytes.push(clean[i] as number); origin.push(i); }
+    for (; i < e.at; i++) {
+      bytes.push(clean[i] as number);
+      origin.push(i);
+    }
     if (e.kind === 'delete') {
       i = Math.min(clean.length, e.at + e.length);
       places.push([e.at, i]);
@@ -75,7 +79,10 @@ export function damage(clean: Uint8Array, edits: readonly Edit[]): Damaged {
       }
     }
   }
-  for (; i < clean.length; i++) { bytes.push(clean[i] as number); origin.push(i); }
+  for (; i < clean.length; i++) {
+    bytes.push(clean[i] as number);
+    origin.push(i);
+  }
   return { bytes: Uint8Array.from(bytes), origin: Int32Array.from(origin), places };
 }
 
@@ -109,7 +116,13 @@ export interface Verdict {
  * or the frame before or after it (the bar: "no frame lost beyond those the damage touches plus
  * one"), or within the first `settle` frames (acquisition).
  */
-export function judge(sent: readonly SentFrame[], got: readonly SentFrame[], d: Damaged, settle = 5, starts?: ReadonlySet<number>): Verdict {
+export function judge(
+  sent: readonly SentFrame[],
+  got: readonly SentFrame[],
+  d: Damaged,
+  settle = 5,
+  starts?: ReadonlySet<number>,
+): Verdict {
   const byOffset = new Map(sent.map((f) => [f.offset, f]));
   const invented: string[] = [];
   let rssiSwaps = 0;
@@ -132,7 +145,12 @@ export function judge(sent: readonly SentFrame[], got: readonly SentFrame[], d: 
     // Where the decoder does not yet know fades from RSSI it claims nothing from byte 0.
     const [, , , fades, rssiValue] = f.reading.split('|');
     const rssi = rssiValue !== 'null' || fades === 'null';
-    if (rssi && sent.some((x) => x.bytes.slice(2) === f.bytes.slice(2) && x.reading.split('|').slice(5).join() === f.reading.split('|').slice(5).join())) {
+    if (
+      rssi &&
+      sent.some(
+        (x) => x.bytes.slice(2) === f.bytes.slice(2) && x.reading.split('|').slice(5).join() === f.reading.split('|').slice(5).join(),
+      )
+    ) {
       rssiSwaps++;
       continue;
     }
@@ -150,9 +168,23 @@ export function judge(sent: readonly SentFrame[], got: readonly SentFrame[], d: 
 
 /** Clean streams of every system type, both remotes, X-Plus, VTX, RSSI, empty slots, lying system bytes. */
 export const CLEAN_PRESETS: readonly string[] = [
-  'dsm2-22ms-1024-internal', 'dsm2-22ms-1024-external', 'dsm2-11ms-2048-internal', 'dsm2-11ms-2048-external',
-  'dsmx-22ms-2048-internal', 'dsmx-22ms-2048-external', 'dsmx-11ms-2048-internal', 'dsmx-11ms-2048-external',
-  'clone-zero-header', 'lying-b2-with-1024-data', 'lying-01-with-2048-data', 'rssi-spm4649t', 'xplus-dx9', 'xplus-8',
-  'vtx', 'empty-slots-12ch', 'empty-slots-22ms-5ch', 'fade-wrap-internal', 'fade-wrap-external',
+  'dsm2-22ms-1024-internal',
+  'dsm2-22ms-1024-external',
+  'dsm2-11ms-2048-internal',
+  'dsm2-11ms-2048-external',
+  'dsmx-22ms-2048-internal',
+  'dsmx-22ms-2048-external',
+  'dsmx-11ms-2048-internal',
+  'dsmx-11ms-2048-external',
+  'clone-zero-header',
+  'lying-b2-with-1024-data',
+  'lying-01-with-2048-data',
+  'rssi-spm4649t',
+  'xplus-dx9',
+  'xplus-8',
+  'vtx',
+  'empty-slots-12ch',
+  'empty-slots-22ms-5ch',
+  'fade-wrap-internal',
+  'fade-wrap-external',
 ];
-

@@ -15,7 +15,9 @@ import { CLEAN_PRESETS, damage, framesOf, judge, sameReading, type Edit } from '
 
 const captureDir = resolve(import.meta.dirname, '../../shared/captures/px4');
 const captures = existsSync(captureDir)
-  ? ['dsm_x_data.txt', 'dsm_x_dx9_data.txt', 'dsm_x_dx9_px4_binding_data.txt'].map((n) => importSaleaeCsv(new Uint8Array(readFileSync(join(captureDir, n)))).bytes)
+  ? ['dsm_x_data.txt', 'dsm_x_dx9_data.txt', 'dsm_x_dx9_px4_binding_data.txt'].map(
+      (n) => importSaleaeCsv(new Uint8Array(readFileSync(join(captureDir, n)))).bytes,
+    )
   : [];
 if (captures.length === 0) console.warn(`skipping the real captures in the damage tests: ${captureDir} is not here`);
 
@@ -50,7 +52,8 @@ function aligned(es: readonly Edit[], streamLength: number): boolean {
 
 const stream = (name: string, seed: number) => simulate({ ...preset(name), seed }, 1_200_000).bytes;
 /** Where the simulator started each frame of that stream (its ground truth). */
-const frameStarts = (name: string, seed: number) => new Set(simulate({ ...preset(name), seed }, 1_200_000, { truth: true }).truth!.frames.map((f) => f.offset));
+const frameStarts = (name: string, seed: number) =>
+  new Set(simulate({ ...preset(name), seed }, 1_200_000, { truth: true }).truth!.frames.map((f) => f.offset));
 
 function check(clean: Uint8Array, es: Edit[], starts?: ReadonlySet<number>) {
   const sent = framesOf(clean);
@@ -60,23 +63,32 @@ function check(clean: Uint8Array, es: Edit[], starts?: ReadonlySet<number>) {
 
 describe('lost and stray bytes', () => {
   it('emits only frames the receiver sent, loses none beyond the damage plus one, adds no fades (simulator, every system type)', () => {
-    fc.assert(fc.property(fc.constantFrom(...CLEAN_PRESETS), fc.integer({ min: 1, max: 1e6 }), edits, (name, seed, es) => {
-      const clean = stream(name, seed);
-      const v = check(clean, es, frameStarts(name, seed));
-      if (!aligned(es, clean.length)) expect(v.invented).toEqual([]);
-      expect(v.lost).toEqual([]);
-      expect(v.extraFades).toBe(0);
-    }), { numRuns: 400 });
+    fc.assert(
+      fc.property(fc.constantFrom(...CLEAN_PRESETS), fc.integer({ min: 1, max: 1e6 }), edits, (name, seed, es) => {
+        const clean = stream(name, seed);
+        const v = check(clean, es, frameStarts(name, seed));
+        if (!aligned(es, clean.length)) expect(v.invented).toEqual([]);
+        expect(v.lost).toEqual([]);
+        expect(v.extraFades).toBe(0);
+      }),
+      { numRuns: 400 },
+    );
   });
 
-  it.skipIf(captures.length === 0)('emits only frames the receiver sent, loses none beyond the damage plus one, adds no fades (real PX4 captures)', () => {
-    fc.assert(fc.property(fc.constantFrom(...captures.keys()), edits, (k, es) => {
-      const v = check(captures[k]!, es);
-      if (!aligned(es, captures[k]!.length)) expect(v.invented).toEqual([]);
-      expect(v.lost).toEqual([]);
-      expect(v.extraFades).toBe(0);
-    }), { numRuns: 150 });
-  });
+  it.skipIf(captures.length === 0)(
+    'emits only frames the receiver sent, loses none beyond the damage plus one, adds no fades (real PX4 captures)',
+    () => {
+      fc.assert(
+        fc.property(fc.constantFrom(...captures.keys()), edits, (k, es) => {
+          const v = check(captures[k]!, es);
+          if (!aligned(es, captures[k]!.length)) expect(v.invented).toEqual([]);
+          expect(v.lost).toEqual([]);
+          expect(v.extraFades).toBe(0);
+        }),
+        { numRuns: 150 },
+      );
+    },
+  );
 
   it('never glues the front of a frame to the back of the next, for every single deletion of 1–40 bytes across a frame boundary', () => {
     const clean = stream('dsmx-11ms-2048-external', 5);
@@ -93,9 +105,8 @@ describe('lost and stray bytes', () => {
 
 describe('transitions', () => {
   it('follows a change of remote kind, system byte or resolution within three frames', () => {
-    fc.assert(fc.property(
-      fc.constantFrom(...CLEAN_PRESETS), fc.constantFrom(...CLEAN_PRESETS), fc.integer({ min: 1, max: 1e6 }),
-      (a, b, seed) => {
+    fc.assert(
+      fc.property(fc.constantFrom(...CLEAN_PRESETS), fc.constantFrom(...CLEAN_PRESETS), fc.integer({ min: 1, max: 1e6 }), (a, b, seed) => {
         // An external remote whose count is above 255 right after an internal remote reads as
         // that internal remote with an ignored system byte until its count moves (its low byte
         // stays still between fades): the one ambiguity §8.3 leaves. Its own test says so.
@@ -113,12 +124,15 @@ describe('transitions', () => {
         for (const f of after) {
           const r = reading.get(first.length + f.offset);
           // A re-acquired byte 0 may still be unsure (fades or RSSI): the rest of the reading must match.
-          expect(r !== undefined && sameReading(f.reading, r), `${a} → ${b}: frame at ${f.offset} reads ${r}, sent ${f.reading}`).toBe(true);
+          expect(r !== undefined && sameReading(f.reading, r), `${a} → ${b}: frame at ${f.offset} reads ${r}, sent ${f.reading}`).toBe(
+            true,
+          );
         }
         // Nothing is read across the seam as a frame neither stream sent.
         const sent = new Set([...framesOf(first), ...framesOf(second)].map((f) => f.bytes));
         expect(got.filter((f) => !sent.has(f.bytes))).toEqual([]);
-      },
-    ), { numRuns: 200 });
+      }),
+      { numRuns: 200 },
+    );
   });
 });

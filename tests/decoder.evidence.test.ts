@@ -11,9 +11,18 @@ import { encodeExternalFrame, encodeInternalFrame, encodeServo2048 } from '../sr
 import { concatBytes as join } from './bytes.js';
 import { runBounded } from './bounded.js';
 
-const hex = (s: string) => Uint8Array.from(s.replace(/\s+/g, '').match(/../g)!.map((h) => parseInt(h, 16)));
+const hex = (s: string) =>
+  Uint8Array.from(
+    s
+      .replace(/\s+/g, '')
+      .match(/../g)!
+      .map((h) => parseInt(h, 16)),
+  );
 
-function decodeAll(bytes: Uint8Array, options: DecoderOptions = {}): { frames: FrameSnapshot[]; decoder: SpektrumDecoder; events: DecoderEvent[] } {
+function decodeAll(
+  bytes: Uint8Array,
+  options: DecoderOptions = {},
+): { frames: FrameSnapshot[]; decoder: SpektrumDecoder; events: DecoderEvent[] } {
   const events: DecoderEvent[] = [];
   const decoder = new SpektrumDecoder({ ...options, onEvent: (e) => events.push(e) });
   decoder.push(bytes);
@@ -27,8 +36,24 @@ function decodeAll(bytes: Uint8Array, options: DecoderOptions = {}): { frames: F
 function slots(i: number, t: number): number[] {
   const p = (x: number) => 1024 + Math.round(300 * Math.sin(t + x));
   return i % 2 === 0
-    ? [encodeServo2048(1, p(1), 1), encodeServo2048(5, p(5)), encodeServo2048(2, p(2)), encodeServo2048(3, p(3)), encodeServo2048(0, p(0)), encodeServo2048(7, p(7)), encodeServo2048(6, p(6))]
-    : [encodeServo2048(1, p(1)), encodeServo2048(5, p(5)), encodeServo2048(2, p(2)), encodeServo2048(3, p(3)), encodeServo2048(4, p(4)), encodeServo2048(8, p(8)), encodeServo2048(9, p(9))];
+    ? [
+        encodeServo2048(1, p(1), 1),
+        encodeServo2048(5, p(5)),
+        encodeServo2048(2, p(2)),
+        encodeServo2048(3, p(3)),
+        encodeServo2048(0, p(0)),
+        encodeServo2048(7, p(7)),
+        encodeServo2048(6, p(6)),
+      ]
+    : [
+        encodeServo2048(1, p(1)),
+        encodeServo2048(5, p(5)),
+        encodeServo2048(2, p(2)),
+        encodeServo2048(3, p(3)),
+        encodeServo2048(4, p(4)),
+        encodeServo2048(8, p(8)),
+        encodeServo2048(9, p(9)),
+      ];
 }
 const internal = (i: number, fades: number, system = 0xb2) => encodeInternalFrame({ fades, system }, slots(i, i / 10));
 const external = (i: number, fades: number) => encodeExternalFrame(fades, slots(i, i / 10));
@@ -39,7 +64,8 @@ describe('progress', () => {
     const inputs = [];
     for (const resolution of ['auto', 1024, 2048] as const) {
       for (const remote of ['auto', 'internal', 'external'] as const) {
-        for (const headerMode of ['auto', 'fades', 'rssi'] as const) inputs.push({ bytes: stream, options: { resolution, remote, headerMode } });
+        for (const headerMode of ['auto', 'fades', 'rssi'] as const)
+          inputs.push({ bytes: stream, options: { resolution, remote, headerMode } });
       }
     }
     const results = await runBounded(inputs, 2_000);
@@ -55,8 +81,14 @@ describe('fade counts', () => {
       for (const stray of [0x3e, 0x00, 0xb2, 0xff]) {
         const bytes = join([clean.subarray(0, at), Uint8Array.of(stray), clean.subarray(at)]);
         const { frames: out } = decodeAll(bytes);
-        expect(out.reduce((n, f) => n + f.fadesDelta, 0), `stray 0x${stray.toString(16)} at ${at}`).toBe(0);
-        expect(out.every((f) => f.fades === 0), `stray 0x${stray.toString(16)} at ${at}`).toBe(true);
+        expect(
+          out.reduce((n, f) => n + f.fadesDelta, 0),
+          `stray 0x${stray.toString(16)} at ${at}`,
+        ).toBe(0);
+        expect(
+          out.every((f) => f.fades === 0),
+          `stray 0x${stray.toString(16)} at ${at}`,
+        ).toBe(true);
       }
     }
   });
@@ -116,7 +148,10 @@ describe('remote kind and system byte', () => {
   });
 
   it('reads 03 55 after B2 frames as 3 fades under an ignored system byte, never as 853 fades', () => {
-    const frames = [...Array.from({ length: 6 }, (_, i) => internal(i, 3)), ...Array.from({ length: 12 }, (_, i) => internal(6 + i, 3, 0x55))];
+    const frames = [
+      ...Array.from({ length: 6 }, (_, i) => internal(i, 3)),
+      ...Array.from({ length: 12 }, (_, i) => internal(6 + i, 3, 0x55)),
+    ];
     const { frames: out, decoder } = decodeAll(join(frames));
     expect(out.map((f) => [f.remote, f.fades])).toEqual(Array(18).fill(['internal', 3]));
     expect(decoder.format.systemValid).toBe(false);
@@ -125,7 +160,10 @@ describe('remote kind and system byte', () => {
   });
 
   it('after an internal remote, reads an external count above 255 as an ignored system byte until the count moves', () => {
-    const frames = [...Array.from({ length: 8 }, (_, i) => internal(i, 3)), ...Array.from({ length: 16 }, (_, i) => external(8 + i, 300 + (i >> 3)))];
+    const frames = [
+      ...Array.from({ length: 8 }, (_, i) => internal(i, 3)),
+      ...Array.from({ length: 16 }, (_, i) => external(8 + i, 300 + (i >> 3))),
+    ];
     const { frames: out } = decodeAll(join(frames));
     expect(out.slice(8, 16).every((f) => f.remote === 'internal' && f.system === 300 % 256 && f.fades === 1)).toBe(true);
     // The count moves at frame 16 (byte 1 changes): from there on it is the external remote it is.

@@ -1,10 +1,23 @@
 import { describe, expect, it } from 'vitest';
-import { SpektrumDecoder, copyFrame, decodeStream, servoToMicros, servoToPercent, channelName, type DecoderEvent, type FrameSnapshot } from '../src/decoder/index.js';
 import {
-  encodeExternalFrame, encodeInternalFrame, encodeServo1024, encodeServo2048, encodeXPlus, vtxWords,
+  SpektrumDecoder,
+  copyFrame,
+  decodeStream,
+  servoToMicros,
+  servoToPercent,
+  channelName,
+  type DecoderEvent,
+  type FrameSnapshot,
+} from '../src/decoder/index.js';
+import {
+  encodeExternalFrame,
+  encodeInternalFrame,
+  encodeServo1024,
+  encodeServo2048,
+  encodeXPlus,
+  vtxWords,
 } from '../src/simulator/encode.js';
 import { concatBytes as join } from './bytes.js';
-
 
 /** Decodes bytes fed in one piece, then end(): owned snapshots. */
 function decodeAll(bytes: Uint8Array, decoder = new SpektrumDecoder(), time?: number | Float64Array): FrameSnapshot[] {
@@ -22,12 +35,22 @@ function dsmxPair(fades: number, system: number, t: number): Uint8Array[] {
   const p = (x: number) => 1024 + Math.round(300 * Math.sin(t + x));
   return [
     encodeInternalFrame({ fades, system }, [
-      encodeServo2048(1, p(1), 1), encodeServo2048(5, p(5)), encodeServo2048(2, p(2)), encodeServo2048(3, p(3)),
-      encodeServo2048(0, p(0)), encodeServo2048(7, p(7)), encodeServo2048(6, p(6)),
+      encodeServo2048(1, p(1), 1),
+      encodeServo2048(5, p(5)),
+      encodeServo2048(2, p(2)),
+      encodeServo2048(3, p(3)),
+      encodeServo2048(0, p(0)),
+      encodeServo2048(7, p(7)),
+      encodeServo2048(6, p(6)),
     ]),
     encodeInternalFrame({ fades, system }, [
-      encodeServo2048(1, p(1)), encodeServo2048(5, p(5)), encodeServo2048(2, p(2)), encodeServo2048(3, p(3)),
-      encodeServo2048(4, p(4)), encodeServo2048(8, p(8)), encodeServo2048(9, p(9)),
+      encodeServo2048(1, p(1)),
+      encodeServo2048(5, p(5)),
+      encodeServo2048(2, p(2)),
+      encodeServo2048(3, p(3)),
+      encodeServo2048(4, p(4)),
+      encodeServo2048(8, p(8)),
+      encodeServo2048(9, p(9)),
     ]),
   ];
 }
@@ -155,10 +178,17 @@ describe('slots beyond channels 0–11', () => {
     for (let i = 0; i < 8; i++) {
       const x = 12 + i;
       // X+5 … X+8 (phase 1) travel in the phase-1 frame of a pair.
-      frames.push(encodeInternalFrame({ fades: 0, system: 0xb2 }, [
-        encodeServo2048(0, 300, x >= 16), encodeServo2048(1, 1024), encodeServo2048(2, 1024), encodeServo2048(3, 1024),
-        encodeServo2048(4, 1706), encodeServo2048(5, 1706), encodeXPlus(x, 400 + 100 * i),
-      ]));
+      frames.push(
+        encodeInternalFrame({ fades: 0, system: 0xb2 }, [
+          encodeServo2048(0, 300, x >= 16),
+          encodeServo2048(1, 1024),
+          encodeServo2048(2, 1024),
+          encodeServo2048(3, 1024),
+          encodeServo2048(4, 1706),
+          encodeServo2048(5, 1706),
+          encodeXPlus(x, 400 + 100 * i),
+        ]),
+      );
     }
     const out = decodeAll(join(frames));
     expect(out.map((f) => f.channels[6]!.id)).toEqual([12, 13, 14, 15, 16, 17, 18, 19]);
@@ -167,7 +197,13 @@ describe('slots beyond channels 0–11', () => {
   });
 
   it('skips 0xFFFF slots and counts them', () => {
-    const words = [encodeServo2048(0, 300), encodeServo2048(1, 1024), encodeServo2048(2, 1024), encodeServo2048(3, 1024), encodeServo2048(4, 1706)];
+    const words = [
+      encodeServo2048(0, 300),
+      encodeServo2048(1, 1024),
+      encodeServo2048(2, 1024),
+      encodeServo2048(3, 1024),
+      encodeServo2048(4, 1706),
+    ];
     const decoder = new SpektrumDecoder();
     const out = decodeAll(join(Array.from({ length: 5 }, () => encodeInternalFrame({ fades: 0, system: 0xa2 }, words))), decoder);
     expect(out).toHaveLength(5);
@@ -177,8 +213,19 @@ describe('slots beyond channels 0–11', () => {
 
   it('reads Spektrum VTX control from the last two slots and never as channels', () => {
     const vtx = { band: 4, channel: 7, power: 3, region: 1, pit: true };
-    const base = [encodeServo2048(0, 300), encodeServo2048(1, 1024), encodeServo2048(2, 1024), encodeServo2048(3, 1024), encodeServo2048(4, 1706)];
-    const frames = [0, 1, 2, 3, 4, 5].map((i) => encodeInternalFrame({ fades: 0, system: 0xb2 }, i === 3 ? [...base, ...vtxWords(vtx)] : [...base, encodeServo2048(5, 1024), encodeServo2048(6, 1024)]));
+    const base = [
+      encodeServo2048(0, 300),
+      encodeServo2048(1, 1024),
+      encodeServo2048(2, 1024),
+      encodeServo2048(3, 1024),
+      encodeServo2048(4, 1706),
+    ];
+    const frames = [0, 1, 2, 3, 4, 5].map((i) =>
+      encodeInternalFrame(
+        { fades: 0, system: 0xb2 },
+        i === 3 ? [...base, ...vtxWords(vtx)] : [...base, encodeServo2048(5, 1024), encodeServo2048(6, 1024)],
+      ),
+    );
     const decoder = new SpektrumDecoder();
     const out = decodeAll(join(frames), decoder);
     expect(out).toHaveLength(6);
@@ -189,13 +236,23 @@ describe('slots beyond channels 0–11', () => {
   });
 
   it('reads two X+5…X+8 words in a phase-1 frame as channels, not VTX', () => {
-    const frames = [0, 1, 2, 3, 4, 5].map(() => encodeInternalFrame({ fades: 0, system: 0xb2 }, [
-      encodeServo2048(0, 300, 1), encodeServo2048(1, 1024), encodeServo2048(2, 1024), encodeServo2048(3, 1024),
-      encodeServo2048(4, 1706), encodeXPlus(16, 1024), encodeXPlus(17, 2000),
-    ]));
+    const frames = [0, 1, 2, 3, 4, 5].map(() =>
+      encodeInternalFrame({ fades: 0, system: 0xb2 }, [
+        encodeServo2048(0, 300, 1),
+        encodeServo2048(1, 1024),
+        encodeServo2048(2, 1024),
+        encodeServo2048(3, 1024),
+        encodeServo2048(4, 1706),
+        encodeXPlus(16, 1024),
+        encodeXPlus(17, 2000),
+      ]),
+    );
     const out = decodeAll(join(frames));
     expect(out[0]!.vtx).toBeNull();
-    expect(out[0]!.channels.slice(5)).toEqual([{ id: 16, pos: 1024, us: 1500 }, { id: 17, pos: 2000, us: servoToMicros(2000, 2048) }]);
+    expect(out[0]!.channels.slice(5)).toEqual([
+      { id: 16, pos: 1024, us: 1500 },
+      { id: 17, pos: 2000, us: servoToMicros(2000, 2048) },
+    ]);
   });
 
   it('names channels as the spec does', () => {

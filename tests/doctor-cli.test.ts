@@ -43,7 +43,10 @@ beforeAll(() => {
   const ibus = receiveAs(ibusStream({ durationUs: 3 * SECOND, startUs: 50_000 }));
   writeFileSync(join(dir, 'ibus.sscap'), recording(ibus.bytes, ibus.timesUs));
   writeFileSync(join(dir, 'ibus.bin'), ibus.bytes);
-  const dsm2 = simulate({ ...preset('dsm2-22ms-1024-internal'), fades: { lossRate: 0, randomRate: 0 }, timing: { startUs: 50_000 } }, 3 * SECOND);
+  const dsm2 = simulate(
+    { ...preset('dsm2-22ms-1024-internal'), fades: { lossRate: 0, randomRate: 0 }, timing: { startUs: 50_000 } },
+    3 * SECOND,
+  );
   writeFileSync(join(dir, 'dsm2.sscap'), recording(dsm2.bytes, dsm2.timesUs));
   const w = new CaptureWriter({ baudRate: 115200, source: 'test' });
   writeFileSync(join(dir, 'silent.sscap'), concatBytes([w.header(), w.event('port opened', 0, 0), w.event('device lost', 5 * SECOND, 0)]));

@@ -6,12 +6,31 @@
 import { existsSync, readFileSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 import { describe, expect, it } from 'vitest';
-import { diagnosedHealthReport, Doctor, doctorCapture, doctorEvent, reportHtml, type DoctorFinding, type DoctorOptions } from '../src/analysis/index.js';
+import {
+  diagnosedHealthReport,
+  Doctor,
+  doctorCapture,
+  doctorEvent,
+  reportHtml,
+  type DoctorFinding,
+  type DoctorOptions,
+} from '../src/analysis/index.js';
 import { LinkMonitor, SpektrumDecoder, USB_CHUNK_JITTER_US } from '../src/decoder/index.js';
 import { CaptureWriter, importSaleaeCsv, readCapture } from '../src/capture/index.js';
 import {
-  crsfStream, ibusStream, noiseSignal, preset, receiveAs, sbusStream, simulate, spektrumTransmission, srxl2Stream, srxlV1Stream, uartReceive,
-  type Scenario, type UartResult,
+  crsfStream,
+  ibusStream,
+  noiseSignal,
+  preset,
+  receiveAs,
+  sbusStream,
+  simulate,
+  spektrumTransmission,
+  srxl2Stream,
+  srxlV1Stream,
+  uartReceive,
+  type Scenario,
+  type UartResult,
 } from '../src/simulator/index.js';
 import { concatBytes } from './bytes.js';
 
@@ -28,7 +47,10 @@ class Session {
   port(port: number, label?: string): { decoder: SpektrumDecoder; link: LinkMonitor } {
     let p = this.ports.get(port);
     if (p === undefined) {
-      p = { decoder: new SpektrumDecoder(), link: new LinkMonitor({ jitterUs: this.options.timing === 'per-byte' ? 0 : USB_CHUNK_JITTER_US }) };
+      p = {
+        decoder: new SpektrumDecoder(),
+        link: new LinkMonitor({ jitterUs: this.options.timing === 'per-byte' ? 0 : USB_CHUNK_JITTER_US }),
+      };
       this.ports.set(port, p);
       this.doctor.attach(port, { ...p, ...(label !== undefined ? { label } : {}) });
     }
@@ -243,7 +265,14 @@ describe('bytes that are not a satellite stream', () => {
   });
 
   it('never takes a satellite for something else, from its first bytes on, even on a damaged line', () => {
-    for (const name of ['dsmx-11ms-2048-internal', 'dsm2-22ms-1024-external', 'clone-zero-header', 'damaged-line', 'dropouts-and-damage', 'rssi-spm4649t']) {
+    for (const name of [
+      'dsmx-11ms-2048-internal',
+      'dsm2-22ms-1024-external',
+      'clone-zero-header',
+      'damaged-line',
+      'dropouts-and-damage',
+      'rssi-spm4649t',
+    ]) {
       const s = new Session();
       s.doctor.open(0, 0);
       const sim = satellite(preset(name), 3 * SECOND, 20_000);
@@ -254,13 +283,28 @@ describe('bytes that are not a satellite stream', () => {
         let start = 0;
         while (start < sim.bytes.length && sim.timesUs[start]! < fed) start++;
         s.feed(0, { bytes: sim.bytes.subarray(start, end), timesUs: sim.timesUs.subarray(start, end) });
-        const wrong = s.findings(t).filter((f) => ['inverted-line', 'srxl-v1', 'srxl2', 'ibus', 'sbus', 'crsf', 'wrong-speed', 'noise', 'unknown-stream', 'nothing-arrives'].includes(f.code));
+        const wrong = s
+          .findings(t)
+          .filter((f) =>
+            [
+              'inverted-line',
+              'srxl-v1',
+              'srxl2',
+              'ibus',
+              'sbus',
+              'crsf',
+              'wrong-speed',
+              'noise',
+              'unknown-stream',
+              'nothing-arrives',
+            ].includes(f.code),
+          );
         expect(wrong.map((f) => `${name} at ${t}: ${f.code}`)).toEqual([]);
       }
     }
   });
 
-  it('clears a line finding once the satellite\'s own frames have filled the window', () => {
+  it("clears a line finding once the satellite's own frames have filled the window", () => {
     const s = new Session();
     s.feed(0, receiveAs(ibusStream({ durationUs: 2 * SECOND })));
     expect(codes(s.findings(2 * SECOND))).toContain('ibus');
@@ -298,7 +342,9 @@ describe('a satellite stream the flight controller will read wrong', () => {
   it('names the bind pulses of the mode it is in now (DSM2 22 ms internal: 3)', () => {
     const s = new Session();
     s.feed(0, satellite(preset('dsm2-22ms-1024-internal'), 3 * SECOND));
-    expect(find(s.findings(3 * SECOND), 'fc-settings').settings.find((x) => x.stack === 'Betaflight')!.note).toMatch(/bound now as DSM2 22 ms 1024 internal \(3 pulses\)/);
+    expect(find(s.findings(3 * SECOND), 'fc-settings').settings.find((x) => x.stack === 'Betaflight')!.note).toMatch(
+      /bound now as DSM2 22 ms 1024 internal \(3 pulses\)/,
+    );
   });
 
   it('suggests 11 ms for a DSMX 22 ms stream, as information: SPEK2048 already reads it right', () => {
@@ -341,7 +387,7 @@ describe('a satellite stream the flight controller will read wrong', () => {
     expect(find(s.findings(3 * SECOND), 'vtx-frames').evidence[0]!.text).toMatch(/bytes 12–15/);
   });
 
-  it('predicts that ArduPilot\'s guess never settles on 1024 frames of 10 channels, whose 11-bit reading also looks right', () => {
+  it("predicts that ArduPilot's guess never settles on 1024 frames of 10 channels, whose 11-bit reading also looks right", () => {
     const s = new Session();
     s.feed(0, satellite({ ...preset('dsm2-22ms-1024-internal'), channels: 10 }, 3 * SECOND));
     const f = find(s.findings(3 * SECOND), 'autopilot-detection');
@@ -421,7 +467,13 @@ describe('a weak link', () => {
     const s = new Session();
     const shared = [1, 3, 5].map((at) => ({ atUs: at * SECOND, durationUs: 0.1 * SECOND }));
     const alone = [0.5, 1.6, 2.2, 2.6, 3.6, 4.2, 4.6, 5.6, 6.2, 6.6, 7.2].map((at) => ({ atUs: at * SECOND, durationUs: 0.1 * SECOND }));
-    s.feed(0, satellite({ ...preset('dsmx-11ms-2048-internal'), dropouts: [...shared, ...alone], fades: { lossRate: 0, randomRate: 0 } }, 8 * SECOND));
+    s.feed(
+      0,
+      satellite(
+        { ...preset('dsmx-11ms-2048-internal'), dropouts: [...shared, ...alone], fades: { lossRate: 0, randomRate: 0 } },
+        8 * SECOND,
+      ),
+    );
     s.feed(1, satellite({ ...preset('dsmx-11ms-2048-external'), dropouts: shared, fades: { lossRate: 0, randomRate: 0 } }, 8 * SECOND));
     expect(codes(s.findings(8 * SECOND))).not.toContain('fades-together');
     expect(find(s.findings(8 * SECOND), 'weakest-remote').ports).toEqual([0]);
@@ -429,8 +481,28 @@ describe('a weak link', () => {
 
   it('does not say remotes fade together when they fade at different times', () => {
     const s = new Session();
-    s.feed(0, satellite({ ...preset('dsmx-11ms-2048-internal'), dropouts: [1, 3, 5].map((at) => ({ atUs: at * SECOND, durationUs: 0.1 * SECOND })), fades: { lossRate: 0, randomRate: 0 } }, 8 * SECOND));
-    s.feed(1, satellite({ ...preset('dsmx-11ms-2048-external'), dropouts: [2, 4, 6].map((at) => ({ atUs: at * SECOND, durationUs: 0.1 * SECOND })), fades: { lossRate: 0, randomRate: 0 } }, 8 * SECOND));
+    s.feed(
+      0,
+      satellite(
+        {
+          ...preset('dsmx-11ms-2048-internal'),
+          dropouts: [1, 3, 5].map((at) => ({ atUs: at * SECOND, durationUs: 0.1 * SECOND })),
+          fades: { lossRate: 0, randomRate: 0 },
+        },
+        8 * SECOND,
+      ),
+    );
+    s.feed(
+      1,
+      satellite(
+        {
+          ...preset('dsmx-11ms-2048-external'),
+          dropouts: [2, 4, 6].map((at) => ({ atUs: at * SECOND, durationUs: 0.1 * SECOND })),
+          fades: { lossRate: 0, randomRate: 0 },
+        },
+        8 * SECOND,
+      ),
+    );
     expect(codes(s.findings(8 * SECOND))).not.toContain('fades-together');
   });
 });
@@ -483,13 +555,23 @@ describe('a wrong setup', () => {
   it('does not take a fade counter that wraps during a dropout for a restart', () => {
     const s = new Session({ timing: 'per-byte' });
     // 120 + ~164 missed frames: the 8-bit counter wraps to ~28 while nothing is sent.
-    s.feed(0, satellite({ ...preset('dsmx-11ms-2048-internal'), fades: { start: 120, lossRate: 0, randomRate: 0 }, dropouts: [{ atUs: 1 * SECOND, durationUs: 1.8 * SECOND }] }, 4 * SECOND));
+    s.feed(
+      0,
+      satellite(
+        {
+          ...preset('dsmx-11ms-2048-internal'),
+          fades: { start: 120, lossRate: 0, randomRate: 0 },
+          dropouts: [{ atUs: 1 * SECOND, durationUs: 1.8 * SECOND }],
+        },
+        4 * SECOND,
+      ),
+    );
     const last = s.ports.get(0)!.decoder;
     expect(last.format.headerMode).toBe('fades');
     expect(codes(s.findings(4 * SECOND))).not.toContain('receiver-restart');
   });
 
-  it('explains an SPM4649T\'s RSSI byte', () => {
+  it("explains an SPM4649T's RSSI byte", () => {
     const s = new Session();
     s.feed(0, satellite(preset('rssi-spm4649t'), 3 * SECOND));
     const f = find(s.findings(3 * SECOND), 'rssi-receiver');
@@ -511,7 +593,8 @@ describe('doctorCapture', () => {
     const w = new CaptureWriter({ baudRate: 115200, source: 'test' });
     const ibus = receiveAs(ibusStream({ durationUs: 3 * SECOND }));
     const parts = [w.header(), w.event('port opened', 0, 0)];
-    for (let i = 0; i < ibus.bytes.length; i += 64) parts.push(w.data(ibus.bytes.subarray(i, i + 64), ibus.timesUs[Math.min(i + 63, ibus.bytes.length - 1)]!));
+    for (let i = 0; i < ibus.bytes.length; i += 64)
+      parts.push(w.data(ibus.bytes.subarray(i, i + 64), ibus.timesUs[Math.min(i + 63, ibus.bytes.length - 1)]!));
     const r = doctorCapture(readCapture(concatBytes(parts), 'ibus.sscap'));
     expect(r.findings.map((f) => f.code)).toContain('ibus');
     expect(r.timeline.find((e) => e.code === 'ibus')).toMatchObject({ toUs: null });
@@ -524,7 +607,8 @@ describe('doctorCapture', () => {
     const parts = [w.header(), w.event('port opened', 0, 0)];
     let e = 0;
     for (let i = 0; i < sbus.bytes.length; i++) {
-      for (; e < sbus.errors.length && sbus.errors[e]!.offset <= i; e++) parts.push(w.event(`line error: ${sbus.errors[e]!.kind}`, sbus.errors[e]!.timeUs, 0));
+      for (; e < sbus.errors.length && sbus.errors[e]!.offset <= i; e++)
+        parts.push(w.event(`line error: ${sbus.errors[e]!.kind}`, sbus.errors[e]!.timeUs, 0));
       parts.push(w.data(sbus.bytes.subarray(i, i + 1), sbus.timesUs[i]!));
     }
     const r = doctorCapture(readCapture(concatBytes(parts), 'sbus.sscap'));
@@ -558,11 +642,12 @@ describe('what the worker and the report take from the doctor', () => {
     expect(codes(s.findings(5 * SECOND))).toEqual(['fc-settings']);
   });
 
-  it('puts its findings into the health report, and the report\'s HTML shows them with the lines to paste', () => {
+  it("puts its findings into the health report, and the report's HTML shows them with the lines to paste", () => {
     const w = new CaptureWriter({ baudRate: 115200, source: 'test' });
     const ibus = receiveAs(ibusStream({ durationUs: 2 * SECOND }));
     const parts = [w.header(), w.event('port opened', 0, 0)];
-    for (let i = 0; i < ibus.bytes.length; i += 64) parts.push(w.data(ibus.bytes.subarray(i, i + 64), ibus.timesUs[Math.min(i + 63, ibus.bytes.length - 1)]!));
+    for (let i = 0; i < ibus.bytes.length; i += 64)
+      parts.push(w.data(ibus.bytes.subarray(i, i + 64), ibus.timesUs[Math.min(i + 63, ibus.bytes.length - 1)]!));
     const capture = readCapture(concatBytes(parts), 'ibus.sscap');
     const report = diagnosedHealthReport(capture, { name: 'ibus.sscap' });
     expect(report.diagnosis?.map((f) => f.title)).toEqual(doctorCapture(capture).findings.map((f) => f.title));

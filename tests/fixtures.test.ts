@@ -8,20 +8,48 @@ import { describe, expect, it } from 'vitest';
 import { SpektrumDecoder, type DecodedFrame } from '../src/decoder/index.js';
 
 const dir = join(import.meta.dirname, 'fixtures');
-const names = readdirSync(dir).filter((f) => f.endsWith('.expected.json')).map((f) => f.replace('.expected.json', ''));
+const names = readdirSync(dir)
+  .filter((f) => f.endsWith('.expected.json'))
+  .map((f) => f.replace('.expected.json', ''));
 
 interface ExpectedFrame {
-  offset: number; timeUs: number; remote: string; system: number | null; resolution: number;
-  fades: number | null; rssi: number | null; ids: number[]; positions: number[];
-  vtx: Record<string, unknown> | null; damage: { kind: string } | null;
+  offset: number;
+  timeUs: number;
+  remote: string;
+  system: number | null;
+  resolution: number;
+  fades: number | null;
+  rssi: number | null;
+  ids: number[];
+  positions: number[];
+  vtx: Record<string, unknown> | null;
+  damage: { kind: string } | null;
 }
 
-interface Seen { offset: number; timeUs: number; remote: string; system: number | null; resolution: number; fades: number | null; rssi: number | null; ids: number[]; positions: number[]; vtx: Record<string, unknown> | null }
+interface Seen {
+  offset: number;
+  timeUs: number;
+  remote: string;
+  system: number | null;
+  resolution: number;
+  fades: number | null;
+  rssi: number | null;
+  ids: number[];
+  positions: number[];
+  vtx: Record<string, unknown> | null;
+}
 
 function see(f: DecodedFrame): Seen {
   return {
-    offset: f.offset, timeUs: f.timeUs, remote: f.remote, system: f.system, resolution: f.resolution, fades: f.fades,
-    rssi: f.rssi, ids: Array.from(f.ids.subarray(0, f.count)), positions: Array.from(f.positions.subarray(0, f.count)),
+    offset: f.offset,
+    timeUs: f.timeUs,
+    remote: f.remote,
+    system: f.system,
+    resolution: f.resolution,
+    fades: f.fades,
+    rssi: f.rssi,
+    ids: Array.from(f.ids.subarray(0, f.count)),
+    positions: Array.from(f.positions.subarray(0, f.count)),
     vtx: f.vtx && { ...f.vtx },
   };
 }
@@ -33,21 +61,32 @@ const drain = (d: SpektrumDecoder, out: Seen[]) => {
 
 /** Ways live or recorded data reaches the decoder. */
 const feeds: Record<string, Feed> = {
-  'whole, per-byte times': (d, b, t, out) => { d.push(b, t); drain(d, out); },
-  'one byte at a time, no times': (d, b, _t, out) => { for (let i = 0; i < b.length; i++) { d.push(b.subarray(i, i + 1)); drain(d, out); } },
+  'whole, per-byte times': (d, b, t, out) => {
+    d.push(b, t);
+    drain(d, out);
+  },
+  'one byte at a time, no times': (d, b, _t, out) => {
+    for (let i = 0; i < b.length; i++) {
+      d.push(b.subarray(i, i + 1));
+      drain(d, out);
+    }
+  },
   'USB batches every 16 ms, chunk times': (d, b, t, out) => {
     let start = 0;
     for (let i = 0; i <= b.length; i++) {
       const deadline = Math.floor((t[start] ?? 0) / 16_000) * 16_000 + 16_000;
       if (i === b.length || (t[i] as number) >= deadline) {
-        if (i > start) { d.push(b.subarray(start, i), deadline); drain(d, out); }
+        if (i > start) {
+          d.push(b.subarray(start, i), deadline);
+          drain(d, out);
+        }
         start = i;
       }
     }
   },
   'random splits, chunk times': (d, b, t, out) => {
     let seed = 7;
-    for (let i = 0; i < b.length;) {
+    for (let i = 0; i < b.length; ) {
       seed = (seed * 1103515245 + 12345) >>> 0;
       const n = 1 + (seed % 61);
       const end = Math.min(b.length, i + n);
@@ -62,7 +101,10 @@ describe.each(names)('fixture %s', (name) => {
   const bytes = new Uint8Array(readFileSync(join(dir, `${name}.bin`)));
   const raw = readFileSync(join(dir, `${name}.times.f64`));
   const times = new Float64Array(raw.buffer.slice(raw.byteOffset, raw.byteOffset + raw.byteLength));
-  const expected = JSON.parse(readFileSync(join(dir, `${name}.expected.json`), 'utf8')) as { frames: ExpectedFrame[]; noise?: { offset: number }[] };
+  const expected = JSON.parse(readFileSync(join(dir, `${name}.expected.json`), 'utf8')) as {
+    frames: ExpectedFrame[];
+    noise?: { offset: number }[];
+  };
   const intact = expected.frames.filter((f) => f.damage === null);
   const flipped = new Set(expected.frames.filter((f) => f.damage?.kind === 'bit-flip').map((f) => f.offset));
   /** Intact frames followed by noise or by a frame that lost bytes. */
@@ -70,7 +112,11 @@ describe.each(names)('fixture %s', (name) => {
   for (const [i, f] of expected.frames.entries()) {
     const next = expected.frames[i + 1];
     const end = f.offset + 16;
-    if (f.damage === null && ((next !== undefined && next.damage?.kind === 'truncated') || (expected.noise ?? []).some((n) => n.offset === end))) besideDamage.add(f.offset);
+    if (
+      f.damage === null &&
+      ((next !== undefined && next.damage?.kind === 'truncated') || (expected.noise ?? []).some((n) => n.offset === end))
+    )
+      besideDamage.add(f.offset);
   }
 
   it.each(Object.keys(feeds))('decodes every intact frame and nothing else when fed %s', (feedName) => {
@@ -84,10 +130,19 @@ describe.each(names)('fixture %s', (name) => {
     // The frame right before damage (noise, a frame that lost bytes) may go with it: its end
     // cannot be told from the damage (a frame that lost bytes reads as whole).
     const expectedFrames = intact.filter((f) => decoded.some((d) => d.offset === f.offset) || !besideDamage.has(f.offset));
-    expect(decoded.map(({ timeUs: _t, ...f }) => f)).toEqual(expectedFrames.map((f) => ({
-      offset: f.offset, remote: f.remote, system: f.system, resolution: f.resolution, fades: f.fades, rssi: f.rssi,
-      ids: f.ids, positions: f.positions, vtx: f.vtx,
-    })));
+    expect(decoded.map(({ timeUs: _t, ...f }) => f)).toEqual(
+      expectedFrames.map((f) => ({
+        offset: f.offset,
+        remote: f.remote,
+        system: f.system,
+        resolution: f.resolution,
+        fades: f.fades,
+        rssi: f.rssi,
+        ids: f.ids,
+        positions: f.positions,
+        vtx: f.vtx,
+      })),
+    );
     expect(intact.length - expectedFrames.length).toBeLessThanOrEqual(besideDamage.size);
     if (feedName.startsWith('whole')) {
       // The fixture stores times to the ns.

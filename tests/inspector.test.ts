@@ -2,23 +2,37 @@ import { describe, expect, it } from 'vitest';
 import { describeFrame } from '../src/app/inspect.js';
 import { SpektrumDecoder, copyFrame, servoToMicros, type FrameSnapshot } from '../src/decoder/index.js';
 import {
-  encodeExternalFrame, encodeInternalFrame, encodeServo1024, encodeServo2048, encodeXPlus, vtxWords,
+  encodeExternalFrame,
+  encodeInternalFrame,
+  encodeServo1024,
+  encodeServo2048,
+  encodeXPlus,
+  vtxWords,
 } from '../src/simulator/encode.js';
 import { DISCARD_BYTES_CAP, InspectorLog, type InspectEntry } from '../src/worker/inspector.js';
 import { concatBytes as join } from './bytes.js';
-
 
 /** A DSMX 11 ms frame pair: phase bit on the first slot of the first frame. */
 function pair(t: number, fades = 3): Uint8Array[] {
   const p = (x: number) => 1024 + Math.round(300 * Math.sin(t + x));
   return [
     encodeInternalFrame({ fades, system: 0xb2 }, [
-      encodeServo2048(1, p(1), 1), encodeServo2048(5, p(5)), encodeServo2048(2, p(2)), encodeServo2048(3, p(3)),
-      encodeServo2048(0, p(0)), encodeServo2048(7, p(7)), encodeServo2048(6, p(6)),
+      encodeServo2048(1, p(1), 1),
+      encodeServo2048(5, p(5)),
+      encodeServo2048(2, p(2)),
+      encodeServo2048(3, p(3)),
+      encodeServo2048(0, p(0)),
+      encodeServo2048(7, p(7)),
+      encodeServo2048(6, p(6)),
     ]),
     encodeInternalFrame({ fades, system: 0xb2 }, [
-      encodeServo2048(1, p(1)), encodeServo2048(5, p(5)), encodeServo2048(2, p(2)), encodeServo2048(3, p(3)),
-      encodeServo2048(4, p(4)), encodeServo2048(8, p(8)), encodeServo2048(9, p(9)),
+      encodeServo2048(1, p(1)),
+      encodeServo2048(5, p(5)),
+      encodeServo2048(2, p(2)),
+      encodeServo2048(3, p(3)),
+      encodeServo2048(4, p(4)),
+      encodeServo2048(8, p(8)),
+      encodeServo2048(9, p(9)),
     ]),
   ];
 }
@@ -65,7 +79,7 @@ function run(stream: Uint8Array, log = new InspectorLog(), chunk = 37, chunkTime
 const bytesOf = (e: InspectEntry) => (e.bytes === null ? null : Array.from(e.bytes));
 
 describe('InspectorLog', () => {
-  it('logs frames, discards and resyncs in stream order with the frames\' bytes', () => {
+  it("logs frames, discards and resyncs in stream order with the frames' bytes", () => {
     const good = frames(10); // 20 frames
     const truncated = (good[3] as Uint8Array).subarray(0, 11);
     const stream = join([noise(40), ...good.slice(0, 6), noise(21), ...good.slice(6), truncated, ...frames(6, 10)]);
@@ -139,7 +153,13 @@ describe('InspectorLog', () => {
   it('shows a frame that noise follows discarded with the noise, in stream order', () => {
     // A frame with a layout not seen before, then noise: nothing confirms where it ends.
     const odd = encodeInternalFrame({ fades: 3, system: 0xb2 }, [
-      encodeServo2048(10, 500), encodeServo2048(11, 600), encodeServo2048(0, 700), 0xffff, 0xffff, 0xffff, 0xffff,
+      encodeServo2048(10, 500),
+      encodeServo2048(11, 600),
+      encodeServo2048(0, 700),
+      0xffff,
+      0xffff,
+      0xffff,
+      0xffff,
     ]);
     const stream = join([...frames(6), odd, noise(21), ...frames(6, 6)]);
     const log = new InspectorLog();
@@ -151,7 +171,11 @@ describe('InspectorLog', () => {
     const o = 12 * 16;
     const entries = log.snapshot(100);
     const i = entries.findIndex((e) => e.offset === o && e.kind === 'discarded');
-    expect(entries.slice(i, i + 3).map((e) => [e.kind, e.offset])).toEqual([['discarded', o], ['resync', o + 37], ['frame', o + 37]]);
+    expect(entries.slice(i, i + 3).map((e) => [e.kind, e.offset])).toEqual([
+      ['discarded', o],
+      ['resync', o + 37],
+      ['frame', o + 37],
+    ]);
     expect(bytesOf(entries[i] as InspectEntry)?.slice(0, 16)).toEqual(Array.from(odd));
   });
 
@@ -199,7 +223,7 @@ describe('InspectorLog', () => {
     expect(locked).toMatchObject({ kind: 'locked', offset: 1000 });
   });
 
-  it('a huge chunk keeps only the ring\'s worth of bytes; reset() starts over', () => {
+  it("a huge chunk keeps only the ring's worth of bytes; reset() starts over", () => {
     const stream = join(frames(20));
     const log = new InspectorLog(4096, 128);
     run(stream, log, stream.length);
@@ -210,17 +234,28 @@ describe('InspectorLog', () => {
     expect(log.size).toBe(0);
     expect(log.streamBytes).toBe(0);
     run(join(frames(3)), log);
-    expect(log.snapshot(100).filter((e) => e.kind === 'frame').map((e) => e.offset)).toEqual([0, 16, 32, 48, 64, 80]);
+    expect(
+      log
+        .snapshot(100)
+        .filter((e) => e.kind === 'frame')
+        .map((e) => e.offset),
+    ).toEqual([0, 16, 32, 48, 64, 80]);
   });
 
-  it('logs an external remote\'s and an RSSI remote\'s frames with their header mode', () => {
+  it("logs an external remote's and an RSSI remote's frames with their header mode", () => {
     const ext: Uint8Array[] = [];
-    for (let i = 0; i < 8; i++) ext.push(encodeExternalFrame(300 + i, [encodeServo2048(0, 1000 + i), encodeServo2048(1, 900), encodeServo2048(2, 800)]));
-    const e = run(join(ext)).log.snapshot(100).filter((x) => x.kind === 'frame');
+    for (let i = 0; i < 8; i++)
+      ext.push(encodeExternalFrame(300 + i, [encodeServo2048(0, 1000 + i), encodeServo2048(1, 900), encodeServo2048(2, 800)]));
+    const e = run(join(ext))
+      .log.snapshot(100)
+      .filter((x) => x.kind === 'frame');
     expect(e[0]).toMatchObject({ remote: 'external', headerMode: 'fades', system: null, resolution: 2048 });
     const rssi: Uint8Array[] = [];
-    for (let i = 0; i < 8; i++) rssi.push(encodeInternalFrame({ rssi: -60 - (i % 3), system: 0xb2 }, [encodeServo2048(0, 1000 + i), encodeServo2048(1, 900)]));
-    const r = run(join(rssi)).log.snapshot(100).filter((x) => x.kind === 'frame');
+    for (let i = 0; i < 8; i++)
+      rssi.push(encodeInternalFrame({ rssi: -60 - (i % 3), system: 0xb2 }, [encodeServo2048(0, 1000 + i), encodeServo2048(1, 900)]));
+    const r = run(join(rssi))
+      .log.snapshot(100)
+      .filter((x) => x.kind === 'frame');
     expect(r[0]).toMatchObject({ remote: 'internal', headerMode: 'rssi', system: 0xb2 });
   });
 
@@ -241,12 +276,26 @@ describe('describeFrame', () => {
     expect(d.phase).toBe(1);
     expect(d.slots).toHaveLength(7);
     expect(d.slots[0]).toMatchObject({
-      index: 0, first: 2, last: 3, word: 0x8bff, hex: '8BFF', kind: 'channel', phase: 1, id: 1, channel: 1,
-      position: 1023, us: servoToMicros(1023, 2048), name: 'Aileron', label: '1p', problem: null,
+      index: 0,
+      first: 2,
+      last: 3,
+      word: 0x8bff,
+      hex: '8BFF',
+      kind: 'channel',
+      phase: 1,
+      id: 1,
+      channel: 1,
+      position: 1023,
+      us: servoToMicros(1023, 2048),
+      name: 'Aileron',
+      label: '1p',
+      problem: null,
     });
     expect(d.slots[1]).toMatchObject({ kind: 'channel', phase: 0, channel: 5, position: 1024, name: 'Aux 1', label: '5' });
     expect(d.slots.slice(2).every((s) => s.kind === 'empty' && s.word === 0xffff && s.label === 'empty')).toBe(true);
-    expect(d.summary).toBe(`fades 62 · 0xB2 DSMX 11 ms · 1p Aileron 1023 ${servoToMicros(1023, 2048)}\u00a0µs · 5 Aux 1 1024 ${servoToMicros(1024, 2048)}\u00a0µs · 5 empty`);
+    expect(d.summary).toBe(
+      `fades 62 · 0xB2 DSMX 11 ms · 1p Aileron 1023 ${servoToMicros(1023, 2048)}\u00a0µs · 5 Aux 1 1024 ${servoToMicros(1024, 2048)}\u00a0µs · 5 empty`,
+    );
     expect(d.vtx).toBeNull();
   });
 
@@ -259,7 +308,7 @@ describe('describeFrame', () => {
     expect(g.header[0]).toMatchObject({ value: -56, text: 'RSSI -56\u00a0dBm' });
   });
 
-  it('reads an external remote\'s bytes 0–1 as one UINT16 fade count', () => {
+  it("reads an external remote's bytes 0–1 as one UINT16 fade count", () => {
     const f = encodeExternalFrame(0x1234, [encodeServo2048(2, 2047)]);
     const d = describeFrame(f, 2048, 'external', 'fades');
     expect(d.header).toHaveLength(1);
@@ -273,7 +322,16 @@ describe('describeFrame', () => {
     const d = describeFrame(f, 1024, 'internal', 'fades');
     expect(d.header[1]).toMatchObject({ text: '0x01 DSM2 22 ms', valid: true });
     expect(d.phase).toBeNull();
-    expect(d.slots[0]).toMatchObject({ kind: 'channel', phase: null, id: 3, channel: 3, position: 700, us: servoToMicros(700, 1024), name: 'Rudder', label: '3' });
+    expect(d.slots[0]).toMatchObject({
+      kind: 'channel',
+      phase: null,
+      id: 3,
+      channel: 3,
+      position: 700,
+      us: servoToMicros(700, 1024),
+      name: 'Rudder',
+      label: '3',
+    });
     expect(d.slots[1]).toMatchObject({ kind: 'channel', channel: 0, position: 1023, name: 'Throttle' });
     expect(d.slots[2]).toMatchObject({ kind: 'invalid', id: 12, channel: null, label: '!' });
     expect(d.slots[2]?.problem).toMatch(/does not exist/);
@@ -282,13 +340,26 @@ describe('describeFrame', () => {
   it('reads X-Plus X+1 and X+8 (sub-ID, phase, 9 bits scaled to 11)', () => {
     // Phase-1 frame: the X+8 and X+5 words start with 0xE but are not VTX.
     const f = encodeInternalFrame({ fades: 1, system: 0xb2 }, [
-      encodeServo2048(0, 1000, 1), encodeXPlus(12, 1001), encodeServo2048(1, 900), encodeServo2048(2, 900),
-      encodeServo2048(3, 900), encodeXPlus(19, 2047), encodeXPlus(16, 4),
+      encodeServo2048(0, 1000, 1),
+      encodeXPlus(12, 1001),
+      encodeServo2048(1, 900),
+      encodeServo2048(2, 900),
+      encodeServo2048(3, 900),
+      encodeXPlus(19, 2047),
+      encodeXPlus(16, 4),
     ]);
     const d = describeFrame(f, 2048, 'internal', 'fades');
     expect(d.vtx).toBeNull();
     expect(d.slots[1]).toMatchObject({
-      kind: 'xplus', phase: 0, id: 12, subId: 0, value9: 250, channel: 12, position: 1000, name: 'X+1', label: 'X+1',
+      kind: 'xplus',
+      phase: 0,
+      id: 12,
+      subId: 0,
+      value9: 250,
+      channel: 12,
+      position: 1000,
+      name: 'X+1',
+      label: 'X+1',
       us: servoToMicros(1000, 2048),
     });
     expect(d.slots[5]).toMatchObject({ kind: 'xplus', phase: 1, id: 12, subId: 3, value9: 511, channel: 19, position: 2044, name: 'X+8' });
@@ -301,7 +372,13 @@ describe('describeFrame', () => {
   it('reads VTX control from bytes 12–15 in a phase-0 frame', () => {
     const [hi, lo] = vtxWords({ band: 2, channel: 5, power: 3, region: 1, pit: true });
     const f = encodeInternalFrame({ fades: 0, system: 0xb2 }, [
-      encodeServo2048(0, 1000), encodeServo2048(1, 1000), 0xffff, 0xffff, 0xffff, hi, lo,
+      encodeServo2048(0, 1000),
+      encodeServo2048(1, 1000),
+      0xffff,
+      0xffff,
+      0xffff,
+      hi,
+      lo,
     ]);
     const d = describeFrame(f, 2048, 'internal', 'fades');
     expect(d.vtx).toMatchObject({ band: 2, channel: 5, power: 3, region: 1, pit: true });
@@ -309,18 +386,40 @@ describe('describeFrame', () => {
     expect(d.slots[6]).toMatchObject({ kind: 'vtx', first: 14, label: 'VTX', text: '' });
     expect(d.slots[5]?.title).toMatch(/band 2, channel 5, power 3, region EU, pit mode on/);
     expect(d.slots[6]?.title).toMatch(/^bytes 14–15, slot 7, word 0xE01B: .*band 2, channel 5, power 3, region EU, pit mode on/);
-    expect(d.summary).toBe(`fades 0 · 0xB2 DSMX 11 ms · 0 Throttle 1000 ${servoToMicros(1000, 2048)}\u00a0µs · 1 Aileron 1000 ${servoToMicros(1000, 2048)}\u00a0µs · VTX band 2 ch 5 power 3 EU pit · 3 empty`);
+    expect(d.summary).toBe(
+      `fades 0 · 0xB2 DSMX 11 ms · 0 Throttle 1000 ${servoToMicros(1000, 2048)}\u00a0µs · 1 Aileron 1000 ${servoToMicros(1000, 2048)}\u00a0µs · VTX band 2 ch 5 power 3 EU pit · 3 empty`,
+    );
     // The same words in a phase-1 frame are not VTX (they read as X-Plus words, or invalid).
-    const g = encodeInternalFrame({ fades: 0, system: 0xb2 }, [encodeServo2048(0, 1000, 1), encodeServo2048(1, 1000), 0xffff, 0xffff, 0xffff, hi, lo]);
+    const g = encodeInternalFrame({ fades: 0, system: 0xb2 }, [
+      encodeServo2048(0, 1000, 1),
+      encodeServo2048(1, 1000),
+      0xffff,
+      0xffff,
+      0xffff,
+      hi,
+      lo,
+    ]);
     expect(describeFrame(g, 2048, 'internal', 'fades').vtx).toBeNull();
   });
 
   it('marks impossible channel IDs, repeated channels and bad system bytes', () => {
-    const f = encodeInternalFrame({ fades: 0, system: 0x55 }, [encodeServo2048(0, 10), encodeServo2048(14, 100), encodeServo2048(0, 20), 0x7fff]);
+    const f = encodeInternalFrame({ fades: 0, system: 0x55 }, [
+      encodeServo2048(0, 10),
+      encodeServo2048(14, 100),
+      encodeServo2048(0, 20),
+      0x7fff,
+    ]);
     const d = describeFrame(f, 2048, 'internal', 'fades');
     expect(d.header[1]).toMatchObject({ valid: false, value: 0x55, text: '0x55 not a valid system byte' });
     expect(d.header[1]?.title).toMatch(/not a valid system byte/);
-    expect(d.slots[1]).toMatchObject({ kind: 'invalid', id: 14, channel: null, position: null, label: '!', text: 'invalid 0x7064 (ID 14)' });
+    expect(d.slots[1]).toMatchObject({
+      kind: 'invalid',
+      id: 14,
+      channel: null,
+      position: null,
+      label: '!',
+      text: 'invalid 0x7064 (ID 14)',
+    });
     expect(d.slots[1]?.problem).toMatch(/channel ID 14 does not exist/);
     expect(d.slots[2]).toMatchObject({ kind: 'invalid', channel: 0, position: 20, text: 'invalid 0x0014 (Throttle again)' });
     expect(d.slots[2]?.problem).toMatch(/Throttle again \(slot 1 has it\)/);

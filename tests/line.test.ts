@@ -4,8 +4,22 @@
  */
 import { describe, expect, it } from 'vitest';
 import {
-  CRSF_FORMAT, SBUS_FORMAT, UART_115200_8N1, characterTimeUs, crsfStream, ibusStream, lineSignal, noiseSignal, preset, receiveAs,
-  sbusStream, simulate, spektrumTransmission, srxl2Stream, uartReceive, type Transmission,
+  CRSF_FORMAT,
+  SBUS_FORMAT,
+  UART_115200_8N1,
+  characterTimeUs,
+  crsfStream,
+  ibusStream,
+  lineSignal,
+  noiseSignal,
+  preset,
+  receiveAs,
+  sbusStream,
+  simulate,
+  spektrumTransmission,
+  srxl2Stream,
+  uartReceive,
+  type Transmission,
 } from '../src/simulator/index.js';
 
 const count = (r: ReturnType<typeof uartReceive>, kind: string): number => r.errors.filter((e) => e.kind === kind).length;

@@ -57,7 +57,7 @@ describe('LinkMonitor: hold and failsafe', () => {
     ]);
   });
 
-  it('a real 1.5 s dropout gives one hold and one failsafe at the right capture times, and the counter\'s missed frames', () => {
+  it("a real 1.5 s dropout gives one hold and one failsafe at the right capture times, and the counter's missed frames", () => {
     const link = new LinkMonitor();
     let t = 5_000_000;
     for (let i = 0; i < 200; i++, t += 11_000) link.frame(frame(t, 0, 0xb2, 7));

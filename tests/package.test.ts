@@ -25,7 +25,10 @@ beforeAll(() => {
   // dist/ was built by npm test; --ignore-scripts keeps prepack from rebuilding it under the tests that read it.
   if (!existsSync(join(root, 'dist/decoder/index.js'))) throw new Error('dist/ is missing: run `npm run build:lib` first (npm test does)');
   scratch = mkdtempSync(join(tmpdir(), 'satscope-pack-'));
-  const out = JSON.parse(run('npm', ['pack', '--json', '--ignore-scripts', '--pack-destination', scratch], root)) as { filename: string; files: { path: string }[] }[];
+  const out = JSON.parse(run('npm', ['pack', '--json', '--ignore-scripts', '--pack-destination', scratch], root)) as {
+    filename: string;
+    files: { path: string }[];
+  }[];
   tarball = join(scratch, out[0]!.filename);
   files = out[0]!.files.map((f) => f.path).sort();
 });
@@ -42,7 +45,8 @@ describe('the npm package', () => {
     expect(pkg.dependencies ?? {}).toEqual({});
     const exports = pkg.exports as Record<string, Record<string, string> | string>;
     expect(Object.keys(exports)).toEqual(['.', './capture', './report', './simulator', './package.json']);
-    for (const [name, entry] of Object.entries(exports)) if (name !== './package.json') expect(Object.keys(entry)).toEqual(['types', 'default']);
+    for (const [name, entry] of Object.entries(exports))
+      if (name !== './package.json') expect(Object.keys(entry)).toEqual(['types', 'default']);
     expect((exports['./report'] as Record<string, string>).default).toBe('./dist/analysis/index.js');
     expect(pkg.bin).toEqual({ satscope: './dist/cli/main.js' });
   });
@@ -56,7 +60,9 @@ describe('the npm package', () => {
     expect(files).toContain('dist/cli/main.js');
     expect(files).toContain('README.md');
     expect(files).toContain('LICENSE');
-    const stray = files.filter((f) => !/^(dist\/(decoder|capture|analysis|simulator|cli)\/.+\.(js|d\.ts)|README\.md|LICENSE|package\.json)$/.test(f));
+    const stray = files.filter(
+      (f) => !/^(dist\/(decoder|capture|analysis|simulator|cli)\/.+\.(js|d\.ts)|README\.md|LICENSE|package\.json)$/.test(f),
+    );
     expect(stray).toEqual([]);
   });
 
@@ -75,7 +81,9 @@ describe('the npm package', () => {
     }
     // An ESM-only package: CommonJS and node10 resolution are out of scope (the esm-only profile).
     const report = JSON.parse(output) as { analysis: { problems: { resolutionKind?: string }[] } };
-    const relevant = report.analysis.problems.filter((p) => p.resolutionKind === undefined || p.resolutionKind === 'node16-esm' || p.resolutionKind === 'bundler');
+    const relevant = report.analysis.problems.filter(
+      (p) => p.resolutionKind === undefined || p.resolutionKind === 'node16-esm' || p.resolutionKind === 'bundler',
+    );
     expect(relevant).toEqual([]);
   });
 
@@ -84,7 +92,9 @@ describe('the npm package', () => {
     run('mkdir', ['-p', app], scratch);
     writeFileSync(join(app, 'package.json'), JSON.stringify({ name: 'consumer', private: true, type: 'module' }));
     run('npm', ['install', '--no-audit', '--no-fund', '--offline', tarball], app);
-    writeFileSync(join(app, 'use.mjs'), `
+    writeFileSync(
+      join(app, 'use.mjs'),
+      `
       import { SpektrumDecoder, channelName } from 'satscope';
       import { encodeInternalFrame, encodeServo2048 } from 'satscope/simulator';
       const d = new SpektrumDecoder();
@@ -92,7 +102,8 @@ describe('the npm package', () => {
       d.end();
       const f = d.next();
       console.log(JSON.stringify({ system: f.system, first: channelName(f.ids[0]), pos: f.positions[1] }));
-    `);
+    `,
+    );
     expect(JSON.parse(run('node', ['use.mjs'], app))).toEqual({ system: 0xb2, first: 'Throttle', pos: 341 });
     expect(run(join(app, 'node_modules/.bin/satscope'), ['--help'], app)).toMatch(/satscope decode FILE/);
   });

@@ -13,12 +13,24 @@ import { importSaleaeCsv } from '../src/capture/index.js';
 
 const dir = resolve(import.meta.dirname, '../../shared/captures/px4');
 const present = existsSync(dir);
-if (!present) console.warn(`skipping the PX4 capture tests: ${dir} is not here (it sits beside the repository on development machines and in CI)`);
+if (!present)
+  console.warn(`skipping the PX4 capture tests: ${dir} is not here (it sits beside the repository on development machines and in CI)`);
 
-interface Frame { offset: number; remote: string; system: number | null; fades: number | null; ids: number[]; positions: number[] }
+interface Frame {
+  offset: number;
+  remote: string;
+  system: number | null;
+  fades: number | null;
+  ids: number[];
+  positions: number[];
+}
 const see = (f: DecodedFrame): Frame => ({
-  offset: f.offset, remote: f.remote, system: f.system, fades: f.fades,
-  ids: Array.from(f.ids.subarray(0, f.count)), positions: Array.from(f.positions.subarray(0, f.count)),
+  offset: f.offset,
+  remote: f.remote,
+  system: f.system,
+  fades: f.fades,
+  ids: Array.from(f.ids.subarray(0, f.count)),
+  positions: Array.from(f.positions.subarray(0, f.count)),
 });
 
 function load(name: string) {
@@ -33,7 +45,12 @@ function load(name: string) {
       start = i;
     }
   }
-  return { bytes: capture.bytes, times, full: bursts.filter(([, n]) => n === 16).map(([o]) => o), short: bursts.filter(([, n]) => n !== 16) };
+  return {
+    bytes: capture.bytes,
+    times,
+    full: bursts.filter(([, n]) => n === 16).map(([o]) => o),
+    short: bursts.filter(([, n]) => n !== 16),
+  };
 }
 
 function decode(bytes: Uint8Array, feed: (d: SpektrumDecoder, out: Frame[]) => void) {
@@ -46,17 +63,30 @@ function decode(bytes: Uint8Array, feed: (d: SpektrumDecoder, out: Frame[]) => v
 }
 
 function allFeeds(bytes: Uint8Array, times: Float64Array) {
-  const drain = (d: SpektrumDecoder, out: Frame[]) => { for (let f = d.next(); f; f = d.next()) out.push(see(f)); };
+  const drain = (d: SpektrumDecoder, out: Frame[]) => {
+    for (let f = d.next(); f; f = d.next()) out.push(see(f));
+  };
   return {
-    perByte: decode(bytes, (d, out) => { d.push(bytes, times); drain(d, out); }),
-    noTiming: decode(bytes, (d, out) => { for (let i = 0; i < bytes.length; i += 5) { d.push(bytes.subarray(i, i + 5)); drain(d, out); } }),
+    perByte: decode(bytes, (d, out) => {
+      d.push(bytes, times);
+      drain(d, out);
+    }),
+    noTiming: decode(bytes, (d, out) => {
+      for (let i = 0; i < bytes.length; i += 5) {
+        d.push(bytes.subarray(i, i + 5));
+        drain(d, out);
+      }
+    }),
     usb16ms: decode(bytes, (d, out) => {
       // What a browser sees through an FTDI adapter: whatever arrived in each 16 ms window, one time per chunk.
       let start = 0;
       for (let i = 0; i <= bytes.length; i++) {
         const deadline = Math.floor((times[start] as number) / 16_000) * 16_000 + 16_000;
         if (i === bytes.length || (times[i] as number) >= deadline) {
-          if (i > start) { d.push(bytes.subarray(start, i), deadline); drain(d, out); }
+          if (i > start) {
+            d.push(bytes.subarray(start, i), deadline);
+            drain(d, out);
+          }
           start = i;
         }
       }
@@ -65,7 +95,8 @@ function allFeeds(bytes: Uint8Array, times: Float64Array) {
 }
 
 const channelSet = (frames: Frame[]) => [...new Set(frames.flatMap((f) => f.ids))].sort((a, b) => a - b);
-const valuesOf = (frames: Frame[], id: number) => [...new Set(frames.flatMap((f) => f.positions.filter((_, k) => f.ids[k] === id)))].sort((a, b) => a - b);
+const valuesOf = (frames: Frame[], id: number) =>
+  [...new Set(frames.flatMap((f) => f.positions.filter((_, k) => f.ids[k] === id)))].sort((a, b) => a - b);
 
 describe.skipIf(!present)('real PX4 captures', () => {
   it('dsm_x_data.txt: frames only at the 66 full bursts, all but those right before a truncated one, 10 channels, 00 00 header', () => {

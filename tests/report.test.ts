@@ -9,8 +9,24 @@ import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { servoToMicros } from '../src/decoder/index.js';
-import { CaptureWriter, encodeCapture, importRaw, importSaleaeCsv, readCapture, type Capture, type CaptureMeta, type CaptureRecordInput } from '../src/capture/index.js';
-import { diagnosedHealthReport, escapeHtml, healthReport, reportHtml, SPIKE_MIN_JUMP_PERCENT, type HealthReport } from '../src/analysis/index.js';
+import {
+  CaptureWriter,
+  encodeCapture,
+  importRaw,
+  importSaleaeCsv,
+  readCapture,
+  type Capture,
+  type CaptureMeta,
+  type CaptureRecordInput,
+} from '../src/capture/index.js';
+import {
+  diagnosedHealthReport,
+  escapeHtml,
+  healthReport,
+  reportHtml,
+  SPIKE_MIN_JUMP_PERCENT,
+  type HealthReport,
+} from '../src/analysis/index.js';
 import { encodeServo2048, preset, simulate, type Scenario, type SimChunk } from '../src/simulator/index.js';
 
 // ---------------------------------------------------------------------------------------------
@@ -20,9 +36,16 @@ import { encodeServo2048, preset, simulate, type Scenario, type SimChunk } from 
 /** A capture with the time of every byte, as a logic analyser records it. */
 function perByte(sim: { bytes: Uint8Array; timesUs: Float64Array }): Capture {
   return {
-    kind: 'saleae-csv', meta: {}, timing: 'per-byte', bytes: sim.bytes,
-    chunkEnds: Uint32Array.of(sim.bytes.length), chunkTimesUs: Float64Array.of(sim.timesUs[sim.timesUs.length - 1]!),
-    chunkPorts: new Uint8Array(1), byteTimesUs: sim.timesUs, events: [], issues: [],
+    kind: 'saleae-csv',
+    meta: {},
+    timing: 'per-byte',
+    bytes: sim.bytes,
+    chunkEnds: Uint32Array.of(sim.bytes.length),
+    chunkTimesUs: Float64Array.of(sim.timesUs[sim.timesUs.length - 1]!),
+    chunkPorts: new Uint8Array(1),
+    byteTimesUs: sim.timesUs,
+    events: [],
+    issues: [],
   };
 }
 
@@ -101,11 +124,23 @@ describe('healthReport: failsafe, holds and lost frames against the simulator', 
 
   it('covers the one port, with time zero at the first byte and one bin a second', () => {
     expect(report.format).toBe('satscope-health-report');
-    expect(report.source).toMatchObject({ name: 'dropouts.csv', kind: 'saleae-csv', timing: 'per-byte', ports: [0], bytes: sim.bytes.length });
+    expect(report.source).toMatchObject({
+      name: 'dropouts.csv',
+      kind: 'saleae-csv',
+      timing: 'per-byte',
+      ports: [0],
+      bytes: sim.bytes.length,
+    });
     expect(report.remotes).toHaveLength(1);
     expect(origin).toBeCloseTo(sim.timesUs[0]!, 0);
     expect(report.timeline.bins).toBe(Math.ceil(report.timeline.durationUs! / 1e6));
-    expect(r).toMatchObject({ port: 0, label: 'Port 0', remote: 'internal', headerMode: 'fades', system: { byte: 0xb2, name: 'DSMX 11 ms 2048', valid: true } });
+    expect(r).toMatchObject({
+      port: 0,
+      label: 'Port 0',
+      remote: 'internal',
+      headerMode: 'fades',
+      system: { byte: 0xb2, name: 'DSMX 11 ms 2048', valid: true },
+    });
     expect(r.resolution).toMatchObject({ value: 2048, reason: 'system-byte' });
     expect(r.resolution.explanation).toMatch(/system byte/);
   });
@@ -125,7 +160,9 @@ describe('healthReport: failsafe, holds and lost frames against the simulator', 
     const longest = r.failsafes[0]!;
     const at = `${Math.floor(longest.startUs / 60e6)}:${((longest.startUs / 1e6) % 60).toFixed(1).padStart(4, '0')}`;
     expect(report.verdict[0]).toMatchObject({ level: 'problem', code: 'failsafe' });
-    expect(report.verdict[0]!.text).toBe(`1 failsafe episode, ${Math.round(longest.durationUs / 1000)} ms at ${at} (1.3 s without frames from 0:01.2)`);
+    expect(report.verdict[0]!.text).toBe(
+      `1 failsafe episode, ${Math.round(longest.durationUs / 1000)} ms at ${at} (1.3 s without frames from 0:01.2)`,
+    );
     expect(report.status).toBe('poor');
   });
 
@@ -140,7 +177,9 @@ describe('healthReport: failsafe, holds and lost frames against the simulator', 
     expect(r.holds.longestUs).toBeCloseTo(longest.endUs - longest.lastFrameUs! - 11_000, 0);
     expect(r.holds.longestAtUs! + origin).toBeCloseTo(longest.lastFrameUs! + 11_000, 0);
     expect(r.longestGapUs).toBeCloseTo(Math.max(...truth.gaps.map((g) => g.endUs - g.lastFrameUs!)), 0);
-    expect(report.verdict.find((f) => f.code === 'holds')!.text).toMatch(/^1 hold \(last values held, recovered before failsafe\), \d+ ms at 0:00\.5$/);
+    expect(report.verdict.find((f) => f.code === 'holds')!.text).toMatch(
+      /^1 hold \(last values held, recovered before failsafe\), \d+ ms at 0:00\.5$/,
+    );
   });
 
   it('counts the lost frames as the truth does, and the lost ratio and fades per minute from them', () => {
@@ -192,7 +231,10 @@ describe('healthReport: timing', () => {
     const sim = run(preset('dsmx-11ms-2048-internal'), 5_000_000);
     const r = healthReport(perByte(sim)).remotes[0]!;
     const times = intactOf(sim).map((f) => f.timeUs);
-    const gapFree = times.slice(1).map((t, i) => t - times[i]!).filter((d) => d < 16_500);
+    const gapFree = times
+      .slice(1)
+      .map((t, i) => t - times[i]!)
+      .filter((d) => d < 16_500);
     const mean = gapFree.reduce((a, b) => a + b, 0) / gapFree.length;
     const sd = Math.sqrt(gapFree.reduce((a, b) => a + (b - mean) ** 2, 0) / gapFree.length);
     const sorted = gapFree.slice().sort((a, b) => a - b);
@@ -217,13 +259,15 @@ describe('healthReport: timing', () => {
     // Late frames are not missed ones: only what the receiver's counter says it missed.
     expect(r.missedBasis).toBe('fade-counter');
     expect(r.missedFrames).toBe(r.fades!.total);
-    expect(r.missedFrames).toBeLessThanOrEqual(sum(sim.truth!.gaps.map((g) => g.missedFrames)) + sum(intactOf(sim).map((f) => f.fadesDelta)));
+    expect(r.missedFrames).toBeLessThanOrEqual(
+      sum(sim.truth!.gaps.map((g) => g.missedFrames)) + sum(intactOf(sim).map((f) => f.fadesDelta)),
+    );
     expect(r.holds.count).toBe(0);
     expect(r.findings.find((f) => f.code === 'jitter')).toMatchObject({ level: 'warning' });
     expect(r.findings.find((f) => f.code === 'jitter')!.text).toMatch(/jitter 3\.0\d ms \(over 10 % of the period\)/);
   });
 
-  it('finds the same failsafe from 16 ms USB chunks, within the batching, and says the jitter is the adapter\'s', () => {
+  it("finds the same failsafe from 16 ms USB chunks, within the batching, and says the jitter is the adapter's", () => {
     const sim = run({ ...preset('dropouts-failsafe'), seed: 3 }, 4_000_000);
     const report = healthReport(sscap(usbRecords(sim)));
     const r = report.remotes[0]!;
@@ -273,8 +317,11 @@ describe('healthReport: RSSI', () => {
     expect(r.headerMode).toBe('rssi');
     expect(r.fades).toBeNull();
     expect(r.rssi).toEqual({
-      minDbm: Math.min(...real), maxDbm: Math.max(...real), meanDbm: Math.round((real.reduce((a, b) => a + b, 0) / real.length) * 10) / 10,
-      frames: real.length, lossReports: levels.length - real.length,
+      minDbm: Math.min(...real),
+      maxDbm: Math.max(...real),
+      meanDbm: Math.round((real.reduce((a, b) => a + b, 0) / real.length) * 10) / 10,
+      frames: real.length,
+      lossReports: levels.length - real.length,
     });
     expect(r.rssi!.lossReports).toBeGreaterThan(0);
     expect(r.series.fades).toBeNull();
@@ -295,7 +342,14 @@ describe('healthReport: glitches', () => {
   const twoFrames = carrying(sim, 5, 120).slice(0, 2);
   const small = carrying(sim, 7, 140)[0]!;
   const step = carrying(sim, 9, 200);
-  const before = (id: number, at: number) => positionOf(sim, carrying(sim, id, 0).filter((i) => i < at).at(-1)!, id)!;
+  const before = (id: number, at: number) =>
+    positionOf(
+      sim,
+      carrying(sim, id, 0)
+        .filter((i) => i < at)
+        .at(-1)!,
+      id,
+    )!;
   const expected = [
     { frame: gear, id: 4, pos: positionOf(sim, gear, 4)! + 800 },
     { frame: aileron, id: 1, pos: positionOf(sim, aileron, 1)! - 700 },
@@ -303,7 +357,7 @@ describe('healthReport: glitches', () => {
   for (const g of expected) setChannel(sim, g.frame, g.id, g.pos);
   // Not glitches: the same wrong value twice running, a 20 % spike, and a switch that stays.
   for (const i of twoFrames) setChannel(sim, i, 5, 1500);
-  setChannel(sim, small, 7, positionOf(sim, small, 7)! + Math.round(0.2 * 2048 / 3));
+  setChannel(sim, small, 7, positionOf(sim, small, 7)! + Math.round((0.2 * 2048) / 3));
   for (const i of step) setChannel(sim, i, 9, 1707);
 
   it('finds the single-frame spikes that come back, and nothing else', () => {
@@ -313,7 +367,9 @@ describe('healthReport: glitches', () => {
     expect(r.glitches.frames).toBe(2);
     const truth = sim.truth!.frames;
     const origin = report.timeline.originUs!;
-    expect(r.glitches.listed.map((g) => [g.channel, g.frameIndex])).toEqual(expected.map((g) => [g.id, g.frame]).sort((a, b) => a[1]! - b[1]!));
+    expect(r.glitches.listed.map((g) => [g.channel, g.frameIndex])).toEqual(
+      expected.map((g) => [g.id, g.frame]).sort((a, b) => a[1]! - b[1]!),
+    );
     for (const g of r.glitches.listed) {
       const e = expected.find((x) => x.id === g.channel)!;
       expect(g.kind).toBe('spike');
@@ -324,13 +380,18 @@ describe('healthReport: glitches', () => {
       expect(Math.abs(g.jumpPercent)).toBeGreaterThanOrEqual(SPIKE_MIN_JUMP_PERCENT);
     }
     expect(r.findings.find((f) => f.code === 'glitches')).toMatchObject({ level: 'warning' });
-    expect(r.findings.find((f) => f.code === 'glitches')!.text).toMatch(/^2 glitches: single-frame spikes .* \(first on Gear at 0:01\.\d\)$/);
+    expect(r.findings.find((f) => f.code === 'glitches')!.text).toMatch(
+      /^2 glitches: single-frame spikes .* \(first on Gear at 0:01\.\d\)$/,
+    );
     expect(reportHtml(report)).toMatch(/<h3>Glitches<\/h3>/);
   });
 
   it('finds them by frame count in a capture without timing', () => {
     const r = healthReport(importRaw(sim.bytes)).remotes[0]!;
-    expect(r.glitches.listed.map((g) => [g.channel, g.frameIndex, g.timeUs])).toEqual([[4, gear, null], [1, aileron, null]]);
+    expect(r.glitches.listed.map((g) => [g.channel, g.frameIndex, g.timeUs])).toEqual([
+      [4, gear, null],
+      [1, aileron, null],
+    ]);
   });
 
   it('finds none in clean streams of every preset without damage', () => {
@@ -357,7 +418,9 @@ describe('healthReport: glitches', () => {
     expect(r.fades!.total).toBe(0);
     expect(r.decoder.badFrames).toBeGreaterThan(0);
     expect(r.decoder.discardedBytes).toBeGreaterThan(0);
-    expect(r.findings.find((f) => f.code === 'line-damage')!.text).toMatch(/^Line damage: \d+ bad frames, \d+ resyncs, \d+ bytes discarded$/);
+    expect(r.findings.find((f) => f.code === 'line-damage')!.text).toMatch(
+      /^Line damage: \d+ bad frames, \d+ resyncs, \d+ bytes discarded$/,
+    );
   });
 });
 
@@ -368,13 +431,17 @@ describe('healthReport: several ports on one clock', () => {
   const b = run({ ...preset('dropouts-failsafe'), seed: 5, timing: { startUs: 300_000 } }, 3_600_000);
   const c = run(preset('dsm2-22ms-1024-external'), 1_500_000);
   const records = [...usbRecords(a, 0), ...usbRecords(b, 1), ...usbRecords(c, 2)].sort((x, y) => x.timeUs - y.timeUs);
-  const report = healthReport(sscap(records, { source: 'test', ports: [{ name: 'left wing' }, { name: 'tail <b>' }, { name: 'belly' }] }), { name: 'three.sscap' });
+  const report = healthReport(sscap(records, { source: 'test', ports: [{ name: 'left wing' }, { name: 'tail <b>' }, { name: 'belly' }] }), {
+    name: 'three.sscap',
+  });
   const [r0, r1, r2] = report.remotes as [HealthReport['remotes'][0], HealthReport['remotes'][0], HealthReport['remotes'][0]];
 
   it('reports one remote per port, named from the metadata, on one time axis', () => {
     expect(report.source.ports).toEqual([0, 1, 2]);
     expect(report.remotes.map((r) => [r.port, r.label, r.system.name, r.remote])).toEqual([
-      [0, 'left wing', 'DSMX 11 ms 2048', 'internal'], [1, 'tail <b>', 'DSMX 11 ms 2048', 'internal'], [2, 'belly', null, 'external'],
+      [0, 'left wing', 'DSMX 11 ms 2048', 'internal'],
+      [1, 'tail <b>', 'DSMX 11 ms 2048', 'internal'],
+      [2, 'belly', null, 'external'],
     ]);
     for (const r of report.remotes) {
       for (const xs of [r.series.frames, r.series.lost, r.series.fades!]) expect(xs).toHaveLength(report.timeline.bins);
@@ -386,7 +453,7 @@ describe('healthReport: several ports on one clock', () => {
     expect(r2.resolution.value).toBe(1024);
   });
 
-  it('keeps each port\'s episodes apart, and sees the port that went silent for good', () => {
+  it("keeps each port's episodes apart, and sees the port that went silent for good", () => {
     expect(r0.failsafes).toEqual([]);
     expect(r1.failsafes).toHaveLength(b.truth!.gaps.filter((g) => g.failsafe).length);
     expect(r2.failsafes).toHaveLength(1);
@@ -399,14 +466,21 @@ describe('healthReport: several ports on one clock', () => {
     expect(Math.abs(r2.missedFrames! - silent / 22_000)).toBeLessThan(3);
   });
 
-  it('puts every port\'s findings in the verdict under its label, worst first', () => {
+  it("puts every port's findings in the verdict under its label, worst first", () => {
     expect(report.status).toBe('poor');
     expect(report.verdict.filter((f) => f.code === 'failsafe' && f.level === 'problem').map((f) => f.port)).toEqual([1, 2]);
-    expect(report.verdict.find((f) => f.port === 2 && f.code === 'failsafe')!.text).toMatch(/^belly: 1 failsafe episode, .*; the capture ends in failsafe$/);
+    expect(report.verdict.find((f) => f.port === 2 && f.code === 'failsafe')!.text).toMatch(
+      /^belly: 1 failsafe episode, .*; the capture ends in failsafe$/,
+    );
     expect(report.verdict.find((f) => f.port === 1)!.text).toMatch(/^tail <b>: /);
     // What every port shares is said once.
     expect(report.verdict.filter((f) => f.code === 'chunk-timing')).toEqual([
-      { level: 'info', code: 'chunk-timing', port: null, text: expect.stringMatching(/^All ports: Frame times are USB chunk arrival times/) },
+      {
+        level: 'info',
+        code: 'chunk-timing',
+        port: null,
+        text: expect.stringMatching(/^All ports: Frame times are USB chunk arrival times/),
+      },
     ]);
     const levels = report.verdict.map((f) => ['problem', 'warning', 'info', 'ok'].indexOf(f.level));
     expect(levels).toEqual(levels.slice().sort((x, y) => x - y));
@@ -540,10 +614,16 @@ describe('satscope report', () => {
     const parts = [writer.header(), ...usbRecords(sim).map((r) => (r.type === 'data' ? writer.data(r.bytes, r.timeUs) : new Uint8Array()))];
     const file = new Uint8Array(parts.reduce((n, p) => n + p.length, 0));
     let at = 0;
-    for (const p of parts) { file.set(p, at); at += p.length; }
+    for (const p of parts) {
+      file.set(p, at);
+      at += p.length;
+    }
     writeFileSync(join(dir, 'run.sscap'), file);
     writeFileSync(join(dir, 'notes.txt'), 'these are my notes\nnot a capture\n');
-    writeFileSync(join(dir, 'noise.bin'), Uint8Array.from({ length: 500 }, (_, i) => (i * 37 + 11) & 0xff));
+    writeFileSync(
+      join(dir, 'noise.bin'),
+      Uint8Array.from({ length: 500 }, (_, i) => (i * 37 + 11) & 0xff),
+    );
   });
   afterAll(() => rmSync(dir, { recursive: true, force: true }));
 
@@ -557,7 +637,7 @@ describe('satscope report', () => {
     expect(tagProblems(r.out)).toEqual([]);
   });
 
-  it('prints the JSON report with --json, the same as the library makes, with the doctor\'s findings', () => {
+  it("prints the JSON report with --json, the same as the library makes, with the doctor's findings", () => {
     const r = satscope('report', join(dir, 'run.sscap'), '--json');
     expect(r.code).toBe(0);
     const json = JSON.parse(r.out) as HealthReport;
@@ -573,7 +653,9 @@ describe('satscope report', () => {
     const out = join(dir, 'run.report.html');
     const r = satscope('report', join(dir, 'run.sscap'), '--out', out);
     expect(r.code).toBe(0);
-    expect(r.out).toMatch(new RegExp(`^Report written to .*run\\.report\\.html: link poor \\(1 port\\)\\n  PROBLEM  ${gaps} failsafe episode`));
+    expect(r.out).toMatch(
+      new RegExp(`^Report written to .*run\\.report\\.html: link poor \\(1 port\\)\\n  PROBLEM  ${gaps} failsafe episode`),
+    );
     expect(readFileSync(out, 'utf8')).toBe(satscope('report', join(dir, 'run.sscap')).out);
     const json = join(dir, 'run.report.json');
     expect(satscope('report', join(dir, 'run.sscap'), '--json', '--out', json).code).toBe(0);

@@ -62,7 +62,7 @@ function refDecode(bytes: Uint8Array, at: number, resolution: 1024 | 2048): RefF
   const raw = ((words[5]! << 16) | words[6]!) >>> 0;
   let vtx: RefFrame['vtx'] = null;
   let n = 7;
-  if (((raw & 0xf000f000) >>> 0) === 0xe000e000 && (words[0]! & 0x8000) === 0) {
+  if ((raw & 0xf000f000) >>> 0 === 0xe000e000 && (words[0]! & 0x8000) === 0) {
     vtx = {
       raw,
       band: (raw >> 21) & 7,
@@ -190,7 +190,11 @@ describe('channel layouts', () => {
 
   it('carries every channel at least once per pair for 1–12 channels', () => {
     for (let n = 1; n <= 12; n++) {
-      for (const [res, ms] of [[2048, 11], [2048, 22], [1024, 22]] as const) {
+      for (const [res, ms] of [
+        [2048, 11],
+        [2048, 22],
+        [1024, 22],
+      ] as const) {
         const ids = new Set(channelLayout(res, ms, n).flatMap((f) => f.slots.filter((s) => typeof s === 'number')));
         expect([...ids].sort((a, b) => a - b)).toEqual(Array.from({ length: n }, (_, i) => i));
       }
@@ -580,7 +584,7 @@ describe('demo scenario', () => {
 
   it('keeps going: a long bench-style run without ground truth is cheap', () => {
     const sim = new Simulator(demoScenario());
-    const c = sim.generate(60 * 60 * 1_000_000 / 12); // five minutes
+    const c = sim.generate((60 * 60 * 1_000_000) / 12); // five minutes
     // 27,272 slots, less lost frames and two dropouts per 40 s.
     expect(c.bytes.length).toBeGreaterThan(25_000 * 16);
     expect(sim.framesGenerated).toBe(c.bytes.length / 16);
@@ -594,7 +598,15 @@ describe('golden fixtures', () => {
     .map((f) => f.slice(0, -'.expected.json'.length));
 
   it('exist for every important scenario', () => {
-    for (const n of ['dsm2-22ms-1024-internal', 'dsmx-11ms-2048-external', 'clone-zero-header', 'rssi-spm4649t', 'xplus-dx9', 'vtx', 'dropouts-and-damage']) {
+    for (const n of [
+      'dsm2-22ms-1024-internal',
+      'dsmx-11ms-2048-external',
+      'clone-zero-header',
+      'rssi-spm4649t',
+      'xplus-dx9',
+      'vtx',
+      'dropouts-and-damage',
+    ]) {
       expect(names).toContain(n);
     }
   });

@@ -29,9 +29,16 @@ function usbChunks(bytes: Uint8Array, times: Float64Array): { bytes: Uint8Array;
 /** A capture with the time of every byte in one chunk, as `readCapture` returns a Saleae export. */
 function saleae(sim: { bytes: Uint8Array; timesUs: Float64Array }): Capture {
   return {
-    kind: 'saleae-csv', meta: {}, timing: 'per-byte', bytes: sim.bytes,
-    chunkEnds: Uint32Array.of(sim.bytes.length), chunkTimesUs: Float64Array.of(sim.timesUs[sim.timesUs.length - 1]!),
-    chunkPorts: new Uint8Array(1), byteTimesUs: sim.timesUs, events: [], issues: [],
+    kind: 'saleae-csv',
+    meta: {},
+    timing: 'per-byte',
+    bytes: sim.bytes,
+    chunkEnds: Uint32Array.of(sim.bytes.length),
+    chunkTimesUs: Float64Array.of(sim.timesUs[sim.timesUs.length - 1]!),
+    chunkPorts: new Uint8Array(1),
+    byteTimesUs: sim.timesUs,
+    events: [],
+    issues: [],
   };
 }
 
@@ -239,7 +246,7 @@ function replayOf(capture: Capture, options: { untimedPeriodUs?: number } = {}) 
   return { r, clock, positions, engine, ended: () => ended };
 }
 
-describe('replay runs on the capture\'s clock', () => {
+describe("replay runs on the capture's clock", () => {
   const sim = simulate({ ...preset('dropouts-failsafe'), seed: 3 }, 4_000_000);
 
   it('gives a Saleae export (one chunk, per-byte times) its timeline: start, end, 1× pace, seeking and full speed', () => {
@@ -281,7 +288,7 @@ describe('replay runs on the capture\'s clock', () => {
     expect(engine.link.stats.holds).toBe(0);
   });
 
-  it('plays a raw .bin at the receiver\'s pace, decoded without times: a timeline, but nothing measured from it', () => {
+  it("plays a raw .bin at the receiver's pace, decoded without times: a timeline, but nothing measured from it", () => {
     const capture = importRaw(sim.bytes);
     expect(captureSpan(capture).startUs).toBeNaN();
     const { r, clock, engine, ended } = replayOf(capture, { untimedPeriodUs: 11_000 });
@@ -302,7 +309,13 @@ describe('replay runs on the capture\'s clock', () => {
 
   it('plays a chunk-timed recording (.sscap) from its first chunk to its last', () => {
     const chunks = usbChunks(sim.bytes, sim.timesUs);
-    const capture = readCapture(encodeCapture({ baudRate: 115200 }, chunks.map((c) => ({ type: 'data', bytes: c.bytes, timeUs: c.timeUs, port: 0 }))), 'x.sscap');
+    const capture = readCapture(
+      encodeCapture(
+        { baudRate: 115200 },
+        chunks.map((c) => ({ type: 'data', bytes: c.bytes, timeUs: c.timeUs, port: 0 })),
+      ),
+      'x.sscap',
+    );
     const { r } = replayOf(capture);
     expect(r.endUs).toBe(chunks.at(-1)!.timeUs);
     expect(r.startUs).toBeLessThan(chunks[0]!.timeUs);

@@ -91,7 +91,15 @@ export function doctorCapture(capture: Capture, options: DoctorCaptureOptions = 
     if (chunk.byteTimesUs !== undefined) {
       for (let s = 0; s < chunk.bytes.length; s += SLICE_BYTES) {
         const times = chunk.byteTimesUs.subarray(s, s + SLICE_BYTES);
-        pieces.push({ kind: 'data', port: chunk.port, order: order++, timeUs: times[times.length - 1] as number, firstUs: times[0] as number, bytes: chunk.bytes.subarray(s, s + SLICE_BYTES), time: times });
+        pieces.push({
+          kind: 'data',
+          port: chunk.port,
+          order: order++,
+          timeUs: times[times.length - 1] as number,
+          firstUs: times[0] as number,
+          bytes: chunk.bytes.subarray(s, s + SLICE_BYTES),
+          time: times,
+        });
       }
     } else {
       // Untimed: as if the bytes came back to back at 115200.
@@ -99,17 +107,30 @@ export function doctorCapture(capture: Capture, options: DoctorCaptureOptions = 
       const t = timed ? chunk.timeUs : offset * BYTE_TIME_US;
       // A decoder dates a chunk's frames back from its arrival at 115200: none is earlier than this.
       const first = t - (chunk.bytes.length - 1) * BYTE_TIME_US;
-      pieces.push({ kind: 'data', port: chunk.port, order: order++, timeUs: t, firstUs: first, bytes: chunk.bytes, time: timed ? chunk.time : t });
+      pieces.push({
+        kind: 'data',
+        port: chunk.port,
+        order: order++,
+        timeUs: t,
+        firstUs: first,
+        bytes: chunk.bytes,
+        time: timed ? chunk.time : t,
+      });
     }
   }
   pushEvents(Infinity);
   // Per-byte captures hold one chunk per port: put the ports' slices back in time order.
-  if (capture.timing === 'per-byte') pieces.sort((a, b) => (Number.isFinite(a.timeUs) && Number.isFinite(b.timeUs) ? a.timeUs - b.timeUs : 0) || a.order - b.order);
+  if (capture.timing === 'per-byte')
+    pieces.sort((a, b) => (Number.isFinite(a.timeUs) && Number.isFinite(b.timeUs) ? a.timeUs - b.timeUs : 0) || a.order - b.order);
 
   // Time zero of the evidence sentences: the capture's first time, as in the health report.
   let origin = Infinity;
   for (const piece of pieces) if (piece.firstUs < origin) origin = piece.firstUs;
-  const doctor = new Doctor({ timing: capture.timing === 'per-byte' ? 'per-byte' : 'per-chunk', memoryUs: Infinity, originUs: Number.isFinite(origin) ? origin : 0 });
+  const doctor = new Doctor({
+    timing: capture.timing === 'per-byte' ? 'per-byte' : 'per-chunk',
+    memoryUs: Infinity,
+    originUs: Number.isFinite(origin) ? origin : 0,
+  });
   const names = capture.meta.ports;
   const sources = new Map<number, { decoder: SpektrumDecoder; link: LinkMonitor }>();
   for (const port of sorted) {
@@ -130,7 +151,14 @@ export function doctorCapture(capture: Capture, options: DoctorCaptureOptions = 
       seen.add(key);
       const entry = open.get(key);
       if (entry === undefined) {
-        const e: DoctorTimelineEntry = { code: f.code, ports: f.ports, severity: f.severity, title: f.title, fromUs: f.sinceUs, toUs: null };
+        const e: DoctorTimelineEntry = {
+          code: f.code,
+          ports: f.ports,
+          severity: f.severity,
+          title: f.title,
+          fromUs: f.sinceUs,
+          toUs: null,
+        };
         open.set(key, e);
         timeline.push(e);
       } else {
@@ -194,7 +222,14 @@ export function doctorCapture(capture: Capture, options: DoctorCaptureOptions = 
   return {
     format: 'satscope-doctor',
     version: 1,
-    source: { kind: capture.kind, timing: capture.timing, ports: sorted, bytes, startUs: Number.isFinite(origin) && real ? origin : null, endUs: Number.isFinite(now) && real ? now : null },
+    source: {
+      kind: capture.kind,
+      timing: capture.timing,
+      ports: sorted,
+      bytes,
+      startUs: Number.isFinite(origin) && real ? origin : null,
+      endUs: Number.isFinite(now) && real ? now : null,
+    },
     findings,
     timeline,
   };

@@ -215,15 +215,28 @@ export function classifyLine(c: LineCounts): LineVerdict {
     const periodUs = 1e6 / breaksPerSecond;
     if (bytesPerBreak < 3) return { kind: 'noise', breaksPerSecond, errorRatio };
     if (bytesPerBreak >= 13) {
-      return { kind: 'sbus', periodUs, breaksPerSecond, bytesPerBreak, confident: near(periodUs, 14_000) || near(periodUs, 7_000) || near(periodUs, 9_000, 0.08) || near(periodUs, 10_000, 0.08) };
+      return {
+        kind: 'sbus',
+        periodUs,
+        breaksPerSecond,
+        bytesPerBreak,
+        confident: near(periodUs, 14_000) || near(periodUs, 7_000) || near(periodUs, 9_000, 0.08) || near(periodUs, 10_000, 0.08),
+      };
     }
     if (bytesPerBreak >= 6) {
-      return { kind: 'inverted-satellite', periodUs, breaksPerSecond, bytesPerBreak, confident: near(periodUs, 11_000) || near(periodUs, 22_000) };
+      return {
+        kind: 'inverted-satellite',
+        periodUs,
+        breaksPerSecond,
+        bytesPerBreak,
+        confident: near(periodUs, 11_000) || near(periodUs, 22_000),
+      };
     }
     return { kind: 'idle-low', breaksPerSecond, bytesPerBreak };
   }
   if (errorRatio >= ERROR_RATIO) {
-    if (Number.isFinite(c.burstPeriodUs) && CRSF_PERIODS_US.some((p) => near(c.burstPeriodUs, p, 0.05))) return { kind: 'crsf', periodUs: c.burstPeriodUs };
+    if (Number.isFinite(c.burstPeriodUs) && CRSF_PERIODS_US.some((p) => near(c.burstPeriodUs, p, 0.05)))
+      return { kind: 'crsf', periodUs: c.burstPeriodUs };
     return { kind: 'other-speed', errorRatio };
   }
   return { kind: 'unknown-115200', bytes: c.bytes };

@@ -40,38 +40,64 @@ export interface StackSetting {
 export type ForeignProtocol = 'srxl-v1' | 'srxl2' | 'ibus' | 'sbus' | 'crsf';
 
 /** The provider to select for a protocol in each stack: `null` where the stack has none. */
-export const PROTOCOL_SETTINGS: Readonly<Record<ForeignProtocol, { name: string; betaflight: string | null; inav: string | null; ardupilot: boolean; px4: boolean }>> = {
+export const PROTOCOL_SETTINGS: Readonly<
+  Record<ForeignProtocol, { name: string; betaflight: string | null; inav: string | null; ardupilot: boolean; px4: boolean }>
+> = {
   // Betaflight "SRXL": its Spektrum reader (src/main/rx/spektrum.c) takes the 16 bytes after a
   // gap, and bytes 2–15 of an 0xA5 SRXL frame are the same seven channel words; iNav's serial_rx
   // table has no SRXL. ArduPilot reads 0xA5 frames ("Spk AR7700 etc.", SRXL_HEADER_V5 in
   // AP_RCProtocol_SRXL.h); PX4's rc_input list has none.
   'srxl-v1': { name: 'Spektrum SRXL (v1)', betaflight: 'SRXL', inav: null, ardupilot: true, px4: false },
-  'srxl2': { name: 'Spektrum SRXL2', betaflight: 'SRXL2', inav: 'SRXL2', ardupilot: true, px4: false },
-  'ibus': { name: 'FlySky IBUS', betaflight: 'IBUS', inav: 'IBUS', ardupilot: true, px4: false },
-  'sbus': { name: 'SBUS', betaflight: 'SBUS', inav: 'SBUS', ardupilot: true, px4: true },
-  'crsf': { name: 'CRSF (Crossfire / ExpressLRS)', betaflight: 'CRSF', inav: 'CRSF', ardupilot: true, px4: true },
+  srxl2: { name: 'Spektrum SRXL2', betaflight: 'SRXL2', inav: 'SRXL2', ardupilot: true, px4: false },
+  ibus: { name: 'FlySky IBUS', betaflight: 'IBUS', inav: 'IBUS', ardupilot: true, px4: false },
+  sbus: { name: 'SBUS', betaflight: 'SBUS', inav: 'SBUS', ardupilot: true, px4: true },
+  crsf: { name: 'CRSF (Crossfire / ExpressLRS)', betaflight: 'CRSF', inav: 'CRSF', ardupilot: true, px4: true },
 };
 
 /** The settings for a flight controller that should read `protocol` instead of a satellite. */
 export function foreignSettings(protocol: ForeignProtocol): StackSetting[] {
   const p = PROTOCOL_SETTINGS[protocol];
-  const bf: StackSetting = p.betaflight !== null
-    ? { stack: 'Betaflight', lines: [`set serialrx_provider = ${p.betaflight}`, 'save'], note: `Ports tab: Serial RX on the receiver's UART; Receiver tab: ${p.betaflight}.` }
-    : { stack: 'Betaflight', lines: [], note: `Betaflight has no ${p.name} provider.` };
-  const inav: StackSetting = p.inav !== null
-    ? { stack: 'iNav', lines: ['set receiver_type = SERIAL', `set serialrx_provider = ${p.inav}`, 'save'], note: `Ports tab: Serial RX on the receiver's UART.` }
-    : { stack: 'iNav', lines: [], note: `iNav has no ${p.name} provider (its serial_rx table lists none): use SRXL2 or a satellite output instead.` };
+  const bf: StackSetting =
+    p.betaflight !== null
+      ? {
+          stack: 'Betaflight',
+          lines: [`set serialrx_provider = ${p.betaflight}`, 'save'],
+          note: `Ports tab: Serial RX on the receiver's UART; Receiver tab: ${p.betaflight}.`,
+        }
+      : { stack: 'Betaflight', lines: [], note: `Betaflight has no ${p.name} provider.` };
+  const inav: StackSetting =
+    p.inav !== null
+      ? {
+          stack: 'iNav',
+          lines: ['set receiver_type = SERIAL', `set serialrx_provider = ${p.inav}`, 'save'],
+          note: `Ports tab: Serial RX on the receiver's UART.`,
+        }
+      : {
+          stack: 'iNav',
+          lines: [],
+          note: `iNav has no ${p.name} provider (its serial_rx table lists none): use SRXL2 or a satellite output instead.`,
+        };
   return [
     bf,
     inav,
-    { stack: 'ArduPilot', lines: [], note: p.ardupilot ? `Detected by itself on the RC input (RC_PROTOCOLS left to detect all).` : `Not among ArduPilot's RC protocols.` },
-    { stack: 'PX4', lines: [], note: p.px4 ? `rc_input selects ${p.name} by itself.` : `PX4's rc_input does not read ${p.name} (it reads PPM, SBUS, DSM, SUMD, ST24, CRSF).` },
+    {
+      stack: 'ArduPilot',
+      lines: [],
+      note: p.ardupilot ? `Detected by itself on the RC input (RC_PROTOCOLS left to detect all).` : `Not among ArduPilot's RC protocols.`,
+    },
+    {
+      stack: 'PX4',
+      lines: [],
+      note: p.px4
+        ? `rc_input selects ${p.name} by itself.`
+        : `PX4's rc_input does not read ${p.name} (it reads PPM, SBUS, DSM, SUMD, ST24, CRSF).`,
+    },
   ];
 }
 
 /** The §7.2 bind pulses for a mode: DSMX 22 ms 7/8, DSMX 11 ms 9/10, DSM2 22 ms 3/4, DSM2 11 ms 5/6 (internal/external). */
 export function bindPulses(protocol: 'DSM2' | 'DSMX', periodMs: 11 | 22, remote: 'internal' | 'external'): number {
-  const base = protocol === 'DSMX' ? (periodMs === 11 ? 9 : 7) : (periodMs === 11 ? 5 : 3);
+  const base = protocol === 'DSMX' ? (periodMs === 11 ? 9 : 7) : periodMs === 11 ? 5 : 3;
   return base + (remote === 'external' ? 1 : 0);
 }
 
@@ -100,7 +126,11 @@ export function satelliteSettings(s: StreamFacts): StackSetting[] {
   const lines = [`set serialrx_provider = ${provider}`, 'save'];
   return [
     { stack: 'Betaflight', lines, note: `${provider} reads ${s.resolution}-resolution frames.${now} ${rebind}` },
-    { stack: 'iNav', lines: ['set receiver_type = SERIAL', ...lines], note: `${provider} reads ${s.resolution}-resolution frames.${now} ${rebind}` },
+    {
+      stack: 'iNav',
+      lines: ['set receiver_type = SERIAL', ...lines],
+      note: `${provider} reads ${s.resolution}-resolution frames.${now} ${rebind}`,
+    },
   ];
 }
 
@@ -150,7 +180,9 @@ export class ArduPilotGuess {
 
   /** One frame's 16 bytes. */
   frame(b: ArrayLike<number>): void {
-    const vtx = (((((b[12] as number) << 24) | ((b[13] as number) << 16) | ((b[14] as number) << 8) | (b[15] as number)) & VTX_MASK) >>> 0) === VTX_MARKER && ((b[2] as number) & 0x80) === 0;
+    const vtx =
+      ((((b[12] as number) << 24) | ((b[13] as number) << 16) | ((b[14] as number) << 8) | (b[15] as number)) & VTX_MASK) >>> 0 ===
+        VTX_MARKER && ((b[2] as number) & 0x80) === 0;
     const slots = vtx ? 5 : 7;
     for (let i = 0; i < slots; i++) {
       const raw = ((b[2 + 2 * i] as number) << 8) | (b[3 + 2 * i] as number);

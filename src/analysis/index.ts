@@ -23,26 +23,67 @@
  * `diagnosedHealthReport(capture)`.
  */
 export {
-  Doctor, NOTHING_AFTER_US, NOTHING_CERTAIN_US, LINE_WINDOW_BINS,
-  type Confidence, type ConfirmProbe, type DoctorCode, type DoctorFinding, type DoctorOptions, type DoctorPortSource,
-  type Evidence, type Severity,
+  Doctor,
+  NOTHING_AFTER_US,
+  NOTHING_CERTAIN_US,
+  LINE_WINDOW_BINS,
+  type Confidence,
+  type ConfirmProbe,
+  type DoctorCode,
+  type DoctorFinding,
+  type DoctorOptions,
+  type DoctorPortSource,
+  type Evidence,
+  type Severity,
 } from './doctor.js';
 export { diagnosedHealthReport } from './doctor-report.js';
 export { doctorCapture, doctorEvent, type DoctorCaptureOptions, type DoctorReport, type DoctorTimelineEntry } from './doctor-capture.js';
 export {
-  ArduPilotGuess, ARDUPILOT_GUESS_FRAMES, bindPulses, channelSetText, foreignSettings, PROTOCOL_SETTINGS, satelliteSettings,
-  type FlightStack, type ForeignProtocol, type GuessTally, type StackSetting, type StreamFacts,
+  ArduPilotGuess,
+  ARDUPILOT_GUESS_FRAMES,
+  bindPulses,
+  channelSetText,
+  foreignSettings,
+  PROTOCOL_SETTINGS,
+  satelliteSettings,
+  type FlightStack,
+  type ForeignProtocol,
+  type GuessTally,
+  type StackSetting,
+  type StreamFacts,
 } from './doctor-stacks.js';
 export { classifyLine, PacketScanner, PACKET_KINDS, type LineCounts, type LineVerdict, type PacketKind } from './doctor-line.js';
 export {
-  captureSpan, decodeCapture, resolutionKey, summarizeCapture, timingJitterUs,
-  type CaptureSummary, type ChannelSummary, type DecodeCaptureOptions,
+  captureSpan,
+  decodeCapture,
+  resolutionKey,
+  summarizeCapture,
+  timingJitterUs,
+  type CaptureSummary,
+  type ChannelSummary,
+  type DecodeCaptureOptions,
 } from './summary.js';
 export { LinkSeries, monitorWithSeries } from './series.js';
 export {
-  healthReport, formatClock, formatDuration, REPORT_BIN_US, REPORT_THRESHOLDS, SPIKE_MIN_JUMP_PERCENT,
-  type FindingCode, type FindingLevel, type HealthReport, type HealthReportOptions, type RemoteReport, type ReportChannel,
-  type ReportEpisode, type ReportFinding, type ReportGlitch, type ReportPeriodStats, type ReportSeries, type ReportStatus,
-  type ReportDiagnosis, type ReportThresholds,
+  healthReport,
+  formatClock,
+  formatDuration,
+  REPORT_BIN_US,
+  REPORT_THRESHOLDS,
+  SPIKE_MIN_JUMP_PERCENT,
+  type FindingCode,
+  type FindingLevel,
+  type HealthReport,
+  type HealthReportOptions,
+  type RemoteReport,
+  type ReportChannel,
+  type ReportEpisode,
+  type ReportFinding,
+  type ReportGlitch,
+  type ReportPeriodStats,
+  type ReportSeries,
+  type ReportStatus,
+  type ReportDiagnosis,
+  type ReportThresholds,
 } from './report.js';
 export { escapeHtml, reportHtml } from './report-html.js';

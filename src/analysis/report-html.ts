@@ -94,7 +94,15 @@ function graphsSvg(report: HealthReport): string {
     const prefix = report.remotes.length > 1 ? `${r.label}: ` : '';
     panels.push({ title: `${prefix}lost frames /s`, kind: 'bars', color: COLORS.lost, values: r.series.lost, remote: r });
     if (r.series.fades) panels.push({ title: `${prefix}fades /s`, kind: 'bars', color: COLORS.fades, values: r.series.fades, remote: r });
-    if (r.series.rssiMean) panels.push({ title: `${prefix}RSSI dBm (mean, lowest)`, kind: 'rssi', color: COLORS.rssi, values: r.series.rssiMean, low: r.series.rssiMin ?? undefined, remote: r });
+    if (r.series.rssiMean)
+      panels.push({
+        title: `${prefix}RSSI dBm (mean, lowest)`,
+        kind: 'rssi',
+        color: COLORS.rssi,
+        values: r.series.rssiMean,
+        low: r.series.rssiMin ?? undefined,
+        remote: r,
+      });
   }
   if (panels.length === 0) return '';
   const W = 720;
@@ -111,7 +119,9 @@ function graphsSvg(report: HealthReport): string {
   const colUs = binUs * group;
   const ticks = timeTicks(duration);
   const parts: string[] = [];
-  parts.push(`<svg viewBox="0 0 ${W} ${H}" width="100%" role="img" aria-label="Link quality over time" font-family="Helvetica, Arial, sans-serif" font-size="10">`);
+  parts.push(
+    `<svg viewBox="0 0 ${W} ${H}" width="100%" role="img" aria-label="Link quality over time" font-family="Helvetica, Arial, sans-serif" font-size="10">`,
+  );
   // Legend.
   const legend: [string, string][] = [['Lost frames', COLORS.lost]];
   if (panels.some((p) => p.color === COLORS.fades)) legend.push(['Fades', COLORS.fades]);
@@ -119,10 +129,13 @@ function graphsSvg(report: HealthReport): string {
   legend.push(['Hold', COLORS.hold], ['Failsafe', COLORS.failsafe]);
   let lx = left;
   for (const [name, color] of legend) {
-    parts.push(`<rect x="${lx}" y="4" width="10" height="10" fill="${color}"/><text x="${lx + 14}" y="13" fill="${COLORS.text}">${escapeHtml(name)}</text>`);
+    parts.push(
+      `<rect x="${lx}" y="4" width="10" height="10" fill="${color}"/><text x="${lx + 14}" y="13" fill="${COLORS.text}">${escapeHtml(name)}</text>`,
+    );
     lx += 24 + name.length * 5.6;
   }
-  if (group > 1) parts.push(`<text x="${W - right}" y="13" text-anchor="end" fill="${COLORS.axis}">each column: the highest of ${group} s</text>`);
+  if (group > 1)
+    parts.push(`<text x="${W - right}" y="13" text-anchor="end" fill="${COLORS.axis}">each column: the highest of ${group} s</text>`);
   panels.forEach((p, k) => {
     const top = legendH + k * (panelH + gapH);
     const bottom = top + panelH;
@@ -194,7 +207,9 @@ function graphsSvg(report: HealthReport): string {
       const dm = line(mean);
       if (dm !== '') parts.push(`<path d="${dm}" fill="none" stroke="${p.color}" stroke-width="1.6"/>`);
       if (RSSI_LOW_DBM > lo && RSSI_LOW_DBM < hi) {
-        parts.push(`<line x1="${left}" y1="${f1(y(RSSI_LOW_DBM))}" x2="${left + plotW}" y2="${f1(y(RSSI_LOW_DBM))}" stroke="${COLORS.failsafeEdge}" stroke-dasharray="3 3" stroke-width="0.8"/>`);
+        parts.push(
+          `<line x1="${left}" y1="${f1(y(RSSI_LOW_DBM))}" x2="${left + plotW}" y2="${f1(y(RSSI_LOW_DBM))}" stroke="${COLORS.failsafeEdge}" stroke-dasharray="3 3" stroke-width="0.8"/>`,
+        );
       }
       parts.push(`<text x="${left - 4}" y="${top + pad + 4}" text-anchor="end" fill="${COLORS.axis}">${hi}</text>`);
       parts.push(`<text x="${left - 4}" y="${bottom}" text-anchor="end" fill="${COLORS.axis}">${lo}</text>`);
@@ -222,45 +237,90 @@ const hex2 = (v: number): string => `0x${v.toString(16).toUpperCase().padStart(2
 
 /** Short forms of the decoder's resolution reasons (the reason code itself for any other). */
 const REASON_SHORT: Partial<Record<ResolutionReason, string>> = {
-  override: 'set by the user', 'system-byte': 'system byte', 'channel-ids': 'from the channel IDs',
+  override: 'set by the user',
+  'system-byte': 'system byte',
+  'channel-ids': 'from the channel IDs',
   'internal-remote': 'from the internal remote',
-  'system-byte-contradicted': 'system byte contradicted', unknown: 'undecided',
+  'system-byte-contradicted': 'system byte contradicted',
+  unknown: 'undecided',
 };
 
 /** The metrics of one remote as label/value rows; `compact` for the side-by-side table of several remotes. */
 function metricRows(r: RemoteReport, timed: boolean, compact: boolean): [string, string][] {
   const rows: [string, string][] = [];
-  const sys = r.system.byte === null ? (compact ? 'none' : 'none (external remote or no system byte)') : `${hex2(r.system.byte)} ${r.system.name ?? '(not a valid system byte)'}`;
+  const sys =
+    r.system.byte === null
+      ? compact
+        ? 'none'
+        : 'none (external remote or no system byte)'
+      : `${hex2(r.system.byte)} ${r.system.name ?? '(not a valid system byte)'}`;
   rows.push(['System', sys]);
-  rows.push(['Remote', r.remote === null ? '?' : `${r.remote}${r.headerMode === 'rssi' ? (compact ? ', RSSI' : ', RSSI in byte 0 (SPM4649T)') : ''}`]);
+  rows.push([
+    'Remote',
+    r.remote === null ? '?' : `${r.remote}${r.headerMode === 'rssi' ? (compact ? ', RSSI' : ', RSSI in byte 0 (SPM4649T)') : ''}`,
+  ]);
   rows.push(['Resolution', `${r.resolution.value ?? '?'} (${REASON_SHORT[r.resolution.reason] ?? r.resolution.reason})`]);
-  rows.push(['Duration', r.durationUs === null ? '–' : `${formatDuration(r.durationUs)} (${formatClock(r.firstFrameUs ?? 0)}–${formatClock(r.lastFrameUs ?? 0)})`]);
+  rows.push([
+    'Duration',
+    r.durationUs === null
+      ? '–'
+      : `${formatDuration(r.durationUs)} (${formatClock(r.firstFrameUs ?? 0)}–${formatClock(r.lastFrameUs ?? 0)})`,
+  ]);
   rows.push(['Frames', r.expectedFrames !== null ? `${r.frames} of ${r.expectedFrames}${compact ? '' : ' expected'}` : String(r.frames)]);
   if (timed) rows.push(['Lost frames', r.lostRatio === null ? '–' : `${r.missedFrames} (${pctText(r.lostRatio)})`]);
-  rows.push(['Fades', r.fades === null ? '–' : `${r.fades.total}${r.fades.perMinute !== null ? ` (${rate(r.fades.perMinute)}/min)` : ''}${r.fades.implausibleJumps ? `; ${plural(r.fades.implausibleJumps, 'counter jump')} ignored` : ''}`]);
+  rows.push([
+    'Fades',
+    r.fades === null
+      ? '–'
+      : `${r.fades.total}${r.fades.perMinute !== null ? ` (${rate(r.fades.perMinute)}/min)` : ''}${r.fades.implausibleJumps ? `; ${plural(r.fades.implausibleJumps, 'counter jump')} ignored` : ''}`,
+  ]);
   if (r.rssi || !compact) {
-    if (r.rssi) rows.push(['RSSI', r.rssi.minDbm === null ? 'no level reported' : `${r.rssi.minDbm} / ${r.rssi.meanDbm} / ${r.rssi.maxDbm} dBm${compact ? '' : ' (min / mean / max)'}${r.rssi.lossReports ? `, ${r.rssi.lossReports} loss reports` : ''}`]);
+    if (r.rssi)
+      rows.push([
+        'RSSI',
+        r.rssi.minDbm === null
+          ? 'no level reported'
+          : `${r.rssi.minDbm} / ${r.rssi.meanDbm} / ${r.rssi.maxDbm} dBm${compact ? '' : ' (min / mean / max)'}${r.rssi.lossReports ? `, ${r.rssi.lossReports} loss reports` : ''}`,
+      ]);
   } else {
     rows.push(['RSSI', '–']);
   }
   if (timed) {
     const hd = r.holds;
     const became = hd.count - hd.recovered - hd.episodes.filter((h) => h.ongoing).length;
-    rows.push(['Holds', `${hd.count}${became > 0 ? ` (${became} became ${became === 1 ? 'a failsafe' : 'failsafes'})` : ''}${hd.longestUs !== null ? `; longest recovered ${formatDuration(hd.longestUs)} at ${formatClock(hd.longestAtUs ?? 0)}` : ''}`]);
-    rows.push(['Failsafes', r.failsafes.length === 0 ? '0' : `${r.failsafes.length}, ${formatDuration(r.failsafes.reduce((a, x) => a + x.durationUs, 0))} in all`]);
+    rows.push([
+      'Holds',
+      `${hd.count}${became > 0 ? ` (${became} became ${became === 1 ? 'a failsafe' : 'failsafes'})` : ''}${hd.longestUs !== null ? `; longest recovered ${formatDuration(hd.longestUs)} at ${formatClock(hd.longestAtUs ?? 0)}` : ''}`,
+    ]);
+    rows.push([
+      'Failsafes',
+      r.failsafes.length === 0 ? '0' : `${r.failsafes.length}, ${formatDuration(r.failsafes.reduce((a, x) => a + x.durationUs, 0))} in all`,
+    ]);
     rows.push(['Longest gap', r.longestGapUs === null ? '–' : formatDuration(r.longestGapUs)]);
     const fp = r.framePeriod;
     const chunk = fp?.basis === 'per-chunk' ? ' (USB chunk times)' : '';
-    const pcts = fp === null ? '–' : `p50 ${(fp.p50Us / 1000).toFixed(2)} · p95 ${(fp.p95Us / 1000).toFixed(2)} · p99 ${(fp.p99Us / 1000).toFixed(2)} ms`;
+    const pcts =
+      fp === null
+        ? '–'
+        : `p50 ${(fp.p50Us / 1000).toFixed(2)} · p95 ${(fp.p95Us / 1000).toFixed(2)} · p99 ${(fp.p99Us / 1000).toFixed(2)} ms`;
     if (compact) {
-      rows.push(['Frame period', fp === null ? '–' : `${(fp.meanUs / 1000).toFixed(3)} ms, jitter ${formatDuration(fp.stdDevUs)}; ${pcts}${chunk}`]);
+      rows.push([
+        'Frame period',
+        fp === null ? '–' : `${(fp.meanUs / 1000).toFixed(3)} ms, jitter ${formatDuration(fp.stdDevUs)}; ${pcts}${chunk}`,
+      ]);
     } else {
-      rows.push(['Frame period', fp === null ? '–' : `${(fp.meanUs / 1000).toFixed(3)} ms mean, jitter ${formatDuration(fp.stdDevUs)}${chunk}`]);
+      rows.push([
+        'Frame period',
+        fp === null ? '–' : `${(fp.meanUs / 1000).toFixed(3)} ms mean, jitter ${formatDuration(fp.stdDevUs)}${chunk}`,
+      ]);
       rows.push(['Intervals', fp === null ? '–' : `${pcts} (${fp.intervals}, gaps excluded)`]);
     }
   }
   const d = r.decoder;
-  rows.push(['Decoder', `${d.bytes} bytes, ${d.discardedBytes} discarded, ${d.resyncs} resyncs, ${d.badFrames} bad frames${d.formatChanges ? `, ${d.formatChanges} format changes` : ''}`]);
+  rows.push([
+    'Decoder',
+    `${d.bytes} bytes, ${d.discardedBytes} discarded, ${d.resyncs} resyncs, ${d.badFrames} bad frames${d.formatChanges ? `, ${d.formatChanges} format changes` : ''}`,
+  ]);
   rows.push(['Glitches', r.glitches.count === 0 ? 'none' : `${r.glitches.count} spikes in ${r.glitches.frames} frames`]);
   if (compact) rows.push(['Channels', channelList(r)]);
   return rows;
@@ -271,9 +331,14 @@ function channelList(r: RemoteReport): string {
   if (r.channels.length === 0) return 'none';
   const runs: string[] = [];
   const ids = r.channels.map((c) => c.id);
-  for (let i = 0; i < ids.length;) {
+  for (let i = 0; i < ids.length; ) {
     let j = i;
-    while (j + 1 < ids.length && ids[j + 1] === (ids[j] as number) + 1 && ((ids[j + 1] as number) < XPLUS_FIRST) === ((ids[i] as number) < XPLUS_FIRST)) j++;
+    while (
+      j + 1 < ids.length &&
+      ids[j + 1] === (ids[j] as number) + 1 &&
+      (ids[j + 1] as number) < XPLUS_FIRST === (ids[i] as number) < XPLUS_FIRST
+    )
+      j++;
     const a = ids[i] as number;
     const b = ids[j] as number;
     const name = (id: number): string => (id >= XPLUS_FIRST ? channelName(id) : String(id));
@@ -296,7 +361,13 @@ function failsafeTable(report: HealthReport): string {
   const many = report.remotes.length > 1;
   const all = report.remotes.flatMap((r) => r.failsafes.map((x) => ({ r, x }))).sort((a, b) => a.x.startUs - b.x.startUs);
   if (all.length === 0) return '';
-  const rows = all.slice(0, LIST_ROWS).map(({ r, x }, i) => `<tr>${many ? `<td>${e(r.label)}</td>` : `<td class="n">${i + 1}</td>`}<td class="n">${formatClock(x.lastFrameUs)}</td><td class="n">${formatClock(x.startUs)}</td><td class="n">${x.ongoing ? 'end of capture' : formatClock(x.endUs)}</td><td class="n">${e(formatDuration(x.durationUs))}</td></tr>`).join('');
+  const rows = all
+    .slice(0, LIST_ROWS)
+    .map(
+      ({ r, x }, i) =>
+        `<tr>${many ? `<td>${e(r.label)}</td>` : `<td class="n">${i + 1}</td>`}<td class="n">${formatClock(x.lastFrameUs)}</td><td class="n">${formatClock(x.startUs)}</td><td class="n">${x.ongoing ? 'end of capture' : formatClock(x.endUs)}</td><td class="n">${e(formatDuration(x.durationUs))}</td></tr>`,
+    )
+    .join('');
   return `<div><h3>Failsafe episodes</h3><table class="grid"><thead><tr>${many ? '<th>Port</th>' : '<th class="n">#</th>'}<th class="n">Last frame</th><th class="n">Failsafe from</th><th class="n">Until</th><th class="n">Duration</th></tr></thead><tbody>${rows}</tbody></table>${moreNote(Math.min(LIST_ROWS, all.length), all.length)}</div>`;
 }
 
@@ -307,7 +378,13 @@ function glitchTable(report: HealthReport): string {
   const all = report.remotes.flatMap((r) => r.glitches.listed.map((g) => ({ r, g })));
   const total = report.remotes.reduce((n, r) => n + r.glitches.count, 0);
   if (total === 0) return '';
-  const rows = all.slice(0, LIST_ROWS).map(({ r, g }) => `<tr>${many ? `<td>${e(r.label)}</td>` : ''}<td class="n">${g.timeUs === null ? `frame ${g.frameIndex}` : formatClock(g.timeUs)}</td><td>${e(g.name)}</td><td class="n">${g.beforeUs}</td><td class="n">${g.spikeUs}</td><td class="n">${g.afterUs}</td></tr>`).join('');
+  const rows = all
+    .slice(0, LIST_ROWS)
+    .map(
+      ({ r, g }) =>
+        `<tr>${many ? `<td>${e(r.label)}</td>` : ''}<td class="n">${g.timeUs === null ? `frame ${g.frameIndex}` : formatClock(g.timeUs)}</td><td>${e(g.name)}</td><td class="n">${g.beforeUs}</td><td class="n">${g.spikeUs}</td><td class="n">${g.afterUs}</td></tr>`,
+    )
+    .join('');
   return `<div><h3>Glitches</h3><table class="grid"><thead><tr>${many ? '<th>Port</th>' : ''}<th class="n">Time</th><th>Channel</th><th class="n">Before</th><th class="n">Spike</th><th class="n">After µs</th></tr></thead><tbody>${rows}</tbody></table>${moreNote(Math.min(LIST_ROWS, all.length), total)}</div>`;
 }
 
@@ -328,7 +405,9 @@ function detailsHtml(report: HealthReport): string {
   const extraHtml = extra.length === 0 ? '' : `<div class="cols">${extra.join('')}</div>`;
   if (remotes.length === 1) {
     const r = remotes[0] as RemoteReport;
-    const kv = metricRows(r, timed, false).map(([k, v]) => `<tr><th>${e(k)}</th><td>${e(v)}</td></tr>`).join('');
+    const kv = metricRows(r, timed, false)
+      .map(([k, v]) => `<tr><th>${e(k)}</th><td>${e(v)}</td></tr>`)
+      .join('');
     const title = `${r.label}${r.system.name ? ` · ${r.system.name}` : ''}${r.remote ? ` · ${r.remote} remote` : ''}`;
     return `<section class="remote"><h2><span class="badge ${r.status}">${e(STATUS_TEXT[r.status])}</span> ${e(title)}</h2><p class="why">${e(r.resolution.explanation)}</p><div class="cols"><table class="kv">${kv}</table>${channelTable(r)}</div>${extraHtml}</section>`;
   }
@@ -337,8 +416,10 @@ function detailsHtml(report: HealthReport): string {
   const head = remotes.map((r) => `<th>${e(r.label)} <span class="badge ${r.status}">${e(STATUS_TEXT[r.status])}</span></th>`).join('');
   const body = labels.map((k, i) => `<tr><th>${e(k)}</th>${columns.map((c) => `<td>${e(c[i]?.[1] ?? '')}</td>`).join('')}</tr>`).join('');
   const why = remotes.map((r) => `<li>${e(r.label)}: ${e(r.resolution.explanation)}</li>`).join('');
-  return `<section class="remote"><h2>Remotes</h2><table class="grid compare"><thead><tr><th></th>${head}</tr></thead><tbody>${body}</tbody></table>` +
-    `<ul class="why">${why}</ul>${extraHtml}</section>`;
+  return (
+    `<section class="remote"><h2>Remotes</h2><table class="grid compare"><thead><tr><th></th>${head}</tr></thead><tbody>${body}</tbody></table>` +
+    `<ul class="why">${why}</ul>${extraHtml}</section>`
+  );
 }
 
 const CSS = `
@@ -394,7 +475,9 @@ function diagnosisHtml(report: HealthReport): string {
   const items = d.map((f) => {
     const evidence = f.evidence[0] !== undefined ? `<p>${e(f.evidence[0].text)}</p>` : '';
     const todo = f.todo[0] !== undefined ? `<p>→ ${e(f.todo[0])}</p>` : '';
-    const lines = f.settings.filter((s) => s.lines.length > 0).map((s) => `${e(s.stack)}: <code>${s.lines.map(e).join('</code> <code>')}</code>`);
+    const lines = f.settings
+      .filter((s) => s.lines.length > 0)
+      .map((s) => `${e(s.stack)}: <code>${s.lines.map(e).join('</code> <code>')}</code>`);
     return `<li class="${f.severity}"><span class="mark">${LEVEL_MARK[f.severity]}</span>${e(f.title)} <span class="muted">(${e(f.confidence)})</span>${evidence}${todo}${lines.length > 0 ? `<p>${lines.join(' · ')}</p>` : ''}</li>`;
   });
   return `<h2>Diagnosis</h2>\n<ul class="diagnosis">${items.join('')}</ul>`;
@@ -412,13 +495,20 @@ export function reportHtml(report: HealthReport): string {
   if (report.timeline.durationUs !== null) facts.push(formatDuration(report.timeline.durationUs));
   if (s.createdAt) facts.push(`recorded ${s.createdAt}`);
   if (s.recordedFrom && s.recordedFrom !== s.kind) facts.push(`from ${s.recordedFrom}`);
-  const verdict = report.verdict.length === 0 ? '<p class="muted">Nothing to report.</p>'
-    : `<ul class="verdict">${report.verdict.map((f) => `<li class="${f.level}"><span class="mark">${LEVEL_MARK[f.level]}</span>${e(f.text)}</li>`).join('')}</ul>`;
+  const verdict =
+    report.verdict.length === 0
+      ? '<p class="muted">Nothing to report.</p>'
+      : `<ul class="verdict">${report.verdict.map((f) => `<li class="${f.level}"><span class="mark">${LEVEL_MARK[f.level]}</span>${e(f.text)}</li>`).join('')}</ul>`;
   const svg = graphsSvg(report);
-  const graphs = svg !== '' ? `<section class="graphs">${svg}</section>`
-    : report.timeline.bins === 0 && report.remotes.some((r) => r.frames > 0) ? '<p class="muted">No timing in this file: no graphs over time.</p>' : '';
+  const graphs =
+    svg !== ''
+      ? `<section class="graphs">${svg}</section>`
+      : report.timeline.bins === 0 && report.remotes.some((r) => r.frames > 0)
+        ? '<p class="muted">No timing in this file: no graphs over time.</p>'
+        : '';
   const t = report.thresholds;
-  const footer = `Thresholds: fade rate high above ${t.fadeRateHighPerMin}/min; lost frames warning from ${t.lostRatioWarn * 100} %, problem from ${t.lostRatioProblem * 100} %; ` +
+  const footer =
+    `Thresholds: fade rate high above ${t.fadeRateHighPerMin}/min; lost frames warning from ${t.lostRatioWarn * 100} %, problem from ${t.lostRatioProblem * 100} %; ` +
     `jitter warning above ${t.jitterWarnFraction * 100} % of the period (per-byte timing only); RSSI low below ${t.rssiLowDbm} dBm; ` +
     `glitch = a channel value ${t.spikeMinJumpPercent} % travel or more away from both neighbouring appearances, which come back within ${t.spikeReturnPercent} % of each other inside ${t.spikeWindowUs / 1000} ms. ` +
     `Times are m:ss.s from the start of the capture. Made by SatScope (satscope report).`;

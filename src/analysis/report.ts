@@ -11,7 +11,16 @@
 import type { Capture, CaptureKind, CaptureTiming } from '../capture/index.js';
 import { captureChunks, capturePorts } from '../capture/index.js';
 import type { LinkEpisode, MissedBasis } from '../decoder/index.js';
-import { CHANNEL_COUNT, channelResolution, channelName, servoToMicros, servoToPercent, systemInfo, type Resolution, USB_CHUNK_JITTER_US } from '../decoder/index.js';
+import {
+  CHANNEL_COUNT,
+  channelResolution,
+  channelName,
+  servoToMicros,
+  servoToPercent,
+  systemInfo,
+  type Resolution,
+  USB_CHUNK_JITTER_US,
+} from '../decoder/index.js';
 import { captureSpan, decodeCapture, resolutionKey } from './summary.js';
 import type { HeaderReading, RemoteKind, ResolutionReason } from '../decoder/index.js';
 
@@ -151,8 +160,20 @@ export type FindingLevel = 'ok' | 'info' | 'warning' | 'problem';
 
 /** What a finding is about (stable, for programs; `text` is for people). */
 export type FindingCode =
-  | 'no-frames' | 'failsafe' | 'holds' | 'lost-frames' | 'fade-rate' | 'rssi' | 'jitter'
-  | 'glitches' | 'line-damage' | 'resolution' | 'format-changes' | 'no-timing' | 'chunk-timing' | 'file-issues';
+  | 'no-frames'
+  | 'failsafe'
+  | 'holds'
+  | 'lost-frames'
+  | 'fade-rate'
+  | 'rssi'
+  | 'jitter'
+  | 'glitches'
+  | 'line-damage'
+  | 'resolution'
+  | 'format-changes'
+  | 'no-timing'
+  | 'chunk-timing'
+  | 'file-issues';
 
 /** One plain-English finding. */
 export interface ReportFinding {
@@ -304,8 +325,14 @@ export interface RemoteReport {
   glitches: { count: number; frames: number; listed: ReportGlitch[] };
   /** The decoder's counters. */
   decoder: {
-    bytes: number; frames: number; discardedBytes: number; resyncs: number; badFrames: number;
-    emptySlots: number; vtxFrames: number; formatChanges: number;
+    bytes: number;
+    frames: number;
+    discardedBytes: number;
+    resyncs: number;
+    badFrames: number;
+    emptySlots: number;
+    vtxFrames: number;
+    formatChanges: number;
   };
   series: ReportSeries;
   findings: ReportFinding[];
@@ -427,7 +454,12 @@ interface PortData {
 }
 
 /** Decodes one port, keeping what the report needs per frame, and finds spikes as it goes. */
-function decodePort(capture: Capture, port: number, resolution: 'auto' | Resolution, resolutionFrom: 'user' | 'internal-remote' = 'user'): PortData {
+function decodePort(
+  capture: Capture,
+  port: number,
+  resolution: 'auto' | Resolution,
+  resolutionFrom: 'user' | 'internal-remote' = 'user',
+): PortData {
   const times = new Column();
   const intervals = new Column();
   const rssi = new Column();
@@ -447,71 +479,101 @@ function decodePort(capture: Capture, port: number, resolution: 'auto' | Resolut
   let lastGlitchFrame = -1;
   let formatChanges = 0;
   let fadeCounterMoved = false;
-  const remote = decodeCapture(capture, {
-    port,
-    resolution,
-    resolutionFrom,
-    binUs: REPORT_BIN_US,
-    onEvent: (e) => {
-      if (e.type === 'format-changed') formatChanges++;
+  const remote = decodeCapture(
+    capture,
+    {
+      port,
+      resolution,
+      resolutionFrom,
+      binUs: REPORT_BIN_US,
+      onEvent: (e) => {
+        if (e.type === 'format-changed') formatChanges++;
+      },
     },
-  }, (f, link) => {
-    times.push(f.timeUs);
-    if (Number.isFinite(link.lastIntervalUs)) intervals.push(link.lastIntervalUs);
-    rssi.push(f.rssi ?? NaN);
-    if (f.fades !== null && f.fades !== 0) fadeCounterMoved = true;
-    for (let i = 0; i < f.count; i++) {
-      const id = f.ids[i] as number;
-      const res: Resolution = channelResolution(id, f.resolution);
-      const pos = f.positions[i] as number;
-      const u = servoToMicros(pos, res);
-      const p = servoToPercent(pos, res);
-      channelFrames[id] = (channelFrames[id] as number) + 1;
-      if (u < (channelMin[id] as number)) channelMin[id] = u;
-      if (u > (channelMax[id] as number)) channelMax[id] = u;
-      channelSum[id] = (channelSum[id] as number) + u;
-      const a = 2 * id; // [a] is the older appearance (A), [a + 1] the newer (B); C is this one.
-      const n = seen[id] as number;
-      if (n >= 2) {
-        const pA = pct[a] as number;
-        const pB = pct[a + 1] as number;
-        const up = pB - pA;
-        const down = pB - p;
-        const span = Number.isFinite(f.timeUs) && Number.isFinite(at[a] as number)
-          ? f.timeUs - (at[a] as number) <= SPIKE_WINDOW_US
-          : f.index - (idx[a] as number) <= SPIKE_WINDOW_FRAMES;
-        if (span && Math.abs(up) >= SPIKE_MIN_JUMP_PERCENT && Math.abs(down) >= SPIKE_MIN_JUMP_PERCENT &&
-          Math.sign(up) === Math.sign(down) && Math.abs(p - pA) <= SPIKE_RETURN_PERCENT) {
-          glitchCount++;
-          const frameIndex = idx[a + 1] as number;
-          if (frameIndex !== lastGlitchFrame) glitchFrames++;
-          lastGlitchFrame = frameIndex;
-          if (glitchesRaw.length < MAX_LISTED_GLITCHES) {
-            glitchesRaw.push({
-              kind: 'spike', absUs: at[a + 1] as number, frameIndex, channel: id, name: channelName(id),
-              beforeUs: us[a] as number, spikeUs: us[a + 1] as number, afterUs: u, jumpPercent: r1(up),
-            });
+    (f, link) => {
+      times.push(f.timeUs);
+      if (Number.isFinite(link.lastIntervalUs)) intervals.push(link.lastIntervalUs);
+      rssi.push(f.rssi ?? NaN);
+      if (f.fades !== null && f.fades !== 0) fadeCounterMoved = true;
+      for (let i = 0; i < f.count; i++) {
+        const id = f.ids[i] as number;
+        const res: Resolution = channelResolution(id, f.resolution);
+        const pos = f.positions[i] as number;
+        const u = servoToMicros(pos, res);
+        const p = servoToPercent(pos, res);
+        channelFrames[id] = (channelFrames[id] as number) + 1;
+        if (u < (channelMin[id] as number)) channelMin[id] = u;
+        if (u > (channelMax[id] as number)) channelMax[id] = u;
+        channelSum[id] = (channelSum[id] as number) + u;
+        const a = 2 * id; // [a] is the older appearance (A), [a + 1] the newer (B); C is this one.
+        const n = seen[id] as number;
+        if (n >= 2) {
+          const pA = pct[a] as number;
+          const pB = pct[a + 1] as number;
+          const up = pB - pA;
+          const down = pB - p;
+          const span =
+            Number.isFinite(f.timeUs) && Number.isFinite(at[a] as number)
+              ? f.timeUs - (at[a] as number) <= SPIKE_WINDOW_US
+              : f.index - (idx[a] as number) <= SPIKE_WINDOW_FRAMES;
+          if (
+            span &&
+            Math.abs(up) >= SPIKE_MIN_JUMP_PERCENT &&
+            Math.abs(down) >= SPIKE_MIN_JUMP_PERCENT &&
+            Math.sign(up) === Math.sign(down) &&
+            Math.abs(p - pA) <= SPIKE_RETURN_PERCENT
+          ) {
+            glitchCount++;
+            const frameIndex = idx[a + 1] as number;
+            if (frameIndex !== lastGlitchFrame) glitchFrames++;
+            lastGlitchFrame = frameIndex;
+            if (glitchesRaw.length < MAX_LISTED_GLITCHES) {
+              glitchesRaw.push({
+                kind: 'spike',
+                absUs: at[a + 1] as number,
+                frameIndex,
+                channel: id,
+                name: channelName(id),
+                beforeUs: us[a] as number,
+                spikeUs: us[a + 1] as number,
+                afterUs: u,
+                jumpPercent: r1(up),
+              });
+            }
           }
         }
+        if (n >= 1) {
+          pct[a] = pct[a + 1] as number;
+          us[a] = us[a + 1] as number;
+          at[a] = at[a + 1] as number;
+          idx[a] = idx[a + 1] as number;
+        }
+        pct[a + 1] = p;
+        us[a + 1] = u;
+        at[a + 1] = f.timeUs;
+        idx[a + 1] = f.index;
+        seen[id] = n + 1;
       }
-      if (n >= 1) {
-        pct[a] = pct[a + 1] as number;
-        us[a] = us[a + 1] as number;
-        at[a] = at[a + 1] as number;
-        idx[a] = idx[a + 1] as number;
-      }
-      pct[a + 1] = p;
-      us[a + 1] = u;
-      at[a + 1] = f.timeUs;
-      idx[a + 1] = f.index;
-      seen[id] = n + 1;
-    }
-  });
+    },
+  );
   let bytes = 0;
   for (const chunk of captureChunks(capture, port)) bytes += chunk.bytes.length;
   return {
-    port, times: times.view(), rssi: rssi.view(), intervals: intervals.view(), remote,
-    channelFrames, channelMin, channelMax, channelSum, glitchesRaw, glitchCount, glitchFrames, formatChanges, bytes, fadeCounterMoved,
+    port,
+    times: times.view(),
+    rssi: rssi.view(),
+    intervals: intervals.view(),
+    remote,
+    channelFrames,
+    channelMin,
+    channelMax,
+    channelSum,
+    glitchesRaw,
+    glitchCount,
+    glitchFrames,
+    formatChanges,
+    bytes,
+    fadeCounterMoved,
   };
 }
 
@@ -562,7 +624,11 @@ function remoteFindings(r: RemoteReport, timing: CaptureTiming): ReportFinding[]
     out.push({ level, code, port: r.port, text });
   };
   if (r.frames === 0) {
-    add('problem', 'no-frames', `No Spektrum frames found in ${plural(r.decoder.bytes, 'byte')} (is this the satellite's DATA line at 115200 baud?)`);
+    add(
+      'problem',
+      'no-frames',
+      `No Spektrum frames found in ${plural(r.decoder.bytes, 'byte')} (is this the satellite's DATA line at 115200 baud?)`,
+    );
     return out;
   }
   const timed = timing !== 'none';
@@ -572,14 +638,24 @@ function remoteFindings(r: RemoteReport, timing: CaptureTiming): ReportFinding[]
       for (const e of r.failsafes) if (e.durationUs > longest.durationUs) longest = e;
       const n = r.failsafes.length;
       const ongoing = r.failsafes.some((e) => e.ongoing) ? '; the capture ends in failsafe' : '';
-      const outage = longest.ongoing ? '' : ` (${formatDuration(longest.endUs - longest.lastFrameUs)} without frames from ${formatClock(longest.lastFrameUs)})`;
-      add('problem', 'failsafe', `${plural(n, 'failsafe episode')}, ${n > 1 ? 'longest ' : ''}${formatDuration(longest.durationUs)} at ${formatClock(longest.startUs)}${outage}${ongoing}`);
+      const outage = longest.ongoing
+        ? ''
+        : ` (${formatDuration(longest.endUs - longest.lastFrameUs)} without frames from ${formatClock(longest.lastFrameUs)})`;
+      add(
+        'problem',
+        'failsafe',
+        `${plural(n, 'failsafe episode')}, ${n > 1 ? 'longest ' : ''}${formatDuration(longest.durationUs)} at ${formatClock(longest.startUs)}${outage}${ongoing}`,
+      );
     } else {
       add('ok', 'failsafe', 'No failsafe');
     }
     const h = r.holds;
     if (h.recovered > 0 && h.longestUs !== null && h.longestAtUs !== null) {
-      add('warning', 'holds', `${plural(h.recovered, 'hold')} (last values held, recovered before failsafe), ${h.recovered > 1 ? 'longest ' : ''}${formatDuration(h.longestUs)} at ${formatClock(h.longestAtUs)}`);
+      add(
+        'warning',
+        'holds',
+        `${plural(h.recovered, 'hold')} (last values held, recovered before failsafe), ${h.recovered > 1 ? 'longest ' : ''}${formatDuration(h.longestUs)} at ${formatClock(h.longestAtUs)}`,
+      );
     }
     if (r.lostRatio !== null && r.missedFrames !== null && r.expectedFrames !== null) {
       const level: FindingLevel = r.lostRatio >= LOST_RATIO_PROBLEM ? 'problem' : r.lostRatio >= LOST_RATIO_WARN ? 'warning' : 'ok';
@@ -587,23 +663,48 @@ function remoteFindings(r: RemoteReport, timing: CaptureTiming): ReportFinding[]
       add(level, 'lost-frames', `${pctText(r.lostRatio)} of frames lost (${r.missedFrames} of ${r.expectedFrames})${judged}`);
     }
     if (r.fades !== null && !r.fades.counterMoved && (r.missedFrames ?? 0) > 0) {
-      add('info', 'fade-rate', `The fade counter stayed at 0 although ${plural(r.missedFrames ?? 0, 'frame was', 'frames were')} lost: this receiver does not seem to count fades (a 00 00 header?)`);
+      add(
+        'info',
+        'fade-rate',
+        `The fade counter stayed at 0 although ${plural(r.missedFrames ?? 0, 'frame was', 'frames were')} lost: this receiver does not seem to count fades (a 00 00 header?)`,
+      );
     } else if (r.fades !== null && r.fades.perMinute !== null) {
       const high = r.fades.perMinute > FADE_RATE_HIGH_PER_MIN;
-      add(high ? 'warning' : 'ok', 'fade-rate', `Fade rate ${rate(r.fades.perMinute)}/min${high ? ` is high (over ${FADE_RATE_HIGH_PER_MIN}/min)` : ''} (${plural(r.fades.total, 'fade')})`);
+      add(
+        high ? 'warning' : 'ok',
+        'fade-rate',
+        `Fade rate ${rate(r.fades.perMinute)}/min${high ? ` is high (over ${FADE_RATE_HIGH_PER_MIN}/min)` : ''} (${plural(r.fades.total, 'fade')})`,
+      );
     }
     if (r.framePeriod !== null && r.nominalPeriodUs !== null) {
       const fp = r.framePeriod;
       if (fp.basis === 'per-byte') {
         const high = fp.stdDevUs > JITTER_WARN_FRACTION * r.nominalPeriodUs;
-        add(high ? 'warning' : 'ok', 'jitter', `Frame period ${formatDuration(fp.meanUs)}, jitter ${formatDuration(fp.stdDevUs)}${high ? ` (over ${JITTER_WARN_FRACTION * 100} % of the period)` : ''}`);
+        add(
+          high ? 'warning' : 'ok',
+          'jitter',
+          `Frame period ${formatDuration(fp.meanUs)}, jitter ${formatDuration(fp.stdDevUs)}${high ? ` (over ${JITTER_WARN_FRACTION * 100} % of the period)` : ''}`,
+        );
       } else {
-        add('info', 'chunk-timing', 'Frame times are USB chunk arrival times: the jitter shown is mostly the adapter\'s batching, and a single missed frame cannot be told from it');
+        add(
+          'info',
+          'chunk-timing',
+          "Frame times are USB chunk arrival times: the jitter shown is mostly the adapter's batching, and a single missed frame cannot be told from it",
+        );
       }
     }
   } else {
-    add('info', 'no-timing', `No timing in this file: no rates, holds, failsafes or jitter${r.missedFrames === null ? ', and no lost frames' : ''}`);
-    if (r.fades !== null) add('info', 'fade-rate', `${plural(r.fades.total, 'fade')} counted by the receiver${r.missedFrames !== null ? ' (its count of frames lost)' : ''}`);
+    add(
+      'info',
+      'no-timing',
+      `No timing in this file: no rates, holds, failsafes or jitter${r.missedFrames === null ? ', and no lost frames' : ''}`,
+    );
+    if (r.fades !== null)
+      add(
+        'info',
+        'fade-rate',
+        `${plural(r.fades.total, 'fade')} counted by the receiver${r.missedFrames !== null ? ' (its count of frames lost)' : ''}`,
+      );
   }
   if (r.rssi !== null) {
     if (r.rssi.minDbm !== null && r.rssi.minDbm < RSSI_LOW_DBM) {
@@ -614,20 +715,33 @@ function remoteFindings(r: RemoteReport, timing: CaptureTiming): ReportFinding[]
     if (r.rssi.lossReports > 0) add('info', 'rssi', `${plural(r.rssi.lossReports, 'frame')} reported a loss (RSSI −128)`);
   }
   if (r.fades !== null && r.fades.implausibleJumps > 0) {
-    add('warning', 'glitches', `${plural(r.fades.implausibleJumps, 'implausible jump')} of the fade counter left out (corrupted frame headers)`);
+    add(
+      'warning',
+      'glitches',
+      `${plural(r.fades.implausibleJumps, 'implausible jump')} of the fade counter left out (corrupted frame headers)`,
+    );
   }
   if (r.glitches.count > 0) {
     const first = r.glitches.listed[0];
     const where = first ? ` (first on ${first.name}${first.timeUs !== null ? ` at ${formatClock(first.timeUs)}` : ''})` : '';
-    add('warning', 'glitches', `${plural(r.glitches.count, 'glitch', 'glitches')}: single-frame spikes of ${SPIKE_MIN_JUMP_PERCENT} % travel or more that return the next time${where}`);
+    add(
+      'warning',
+      'glitches',
+      `${plural(r.glitches.count, 'glitch', 'glitches')}: single-frame spikes of ${SPIKE_MIN_JUMP_PERCENT} % travel or more that return the next time${where}`,
+    );
   }
   const d = r.decoder;
   if (d.badFrames > 0 || d.resyncs > 0) {
     const ratio = d.badFrames / Math.max(1, d.frames + d.badFrames);
-    add(ratio > BAD_FRAME_WARN_RATIO ? 'warning' : 'info', 'line-damage', `Line damage: ${plural(d.badFrames, 'bad frame')}, ${plural(d.resyncs, 'resync')}, ${plural(d.discardedBytes, 'byte')} discarded`);
+    add(
+      ratio > BAD_FRAME_WARN_RATIO ? 'warning' : 'info',
+      'line-damage',
+      `Line damage: ${plural(d.badFrames, 'bad frame')}, ${plural(d.resyncs, 'resync')}, ${plural(d.discardedBytes, 'byte')} discarded`,
+    );
   }
   if (r.resolution.reason === 'system-byte-contradicted') add('warning', 'resolution', r.resolution.explanation);
-  if (d.formatChanges > 0) add('info', 'format-changes', `The decoder changed its reading of the format ${plural(d.formatChanges, 'time')}`);
+  if (d.formatChanges > 0)
+    add('info', 'format-changes', `The decoder changed its reading of the format ${plural(d.formatChanges, 'time')}`);
   return out;
 }
 
@@ -755,7 +869,11 @@ export function healthReport(capture: Capture, options: HealthReportOptions = {}
       const c = d.channelFrames[id] as number;
       if (c > 0) {
         channels.push({
-          id, name: channelName(id), frames: c, minUs: d.channelMin[id] as number, maxUs: d.channelMax[id] as number,
+          id,
+          name: channelName(id),
+          frames: c,
+          minUs: d.channelMin[id] as number,
+          maxUs: d.channelMax[id] as number,
           meanUs: r1((d.channelSum[id] as number) / c),
         });
       }
@@ -783,16 +901,24 @@ export function healthReport(capture: Capture, options: HealthReportOptions = {}
       delivery: { delayUs: hasClock ? r1n(ls.deliveryDelayUs) : null, jitterUs: hasClock ? r1n(ls.deliveryJitterUs) : null },
       lostRatio: haveMissed ? Math.round((missed / Math.max(1, stats.frames + missed)) * 1e6) / 1e6 : null,
       nominalPeriodUs: havePeriod ? period : null,
-      fades: rssiMode ? null : {
-        total: fadesTotal,
-        perMinute: Number.isFinite(duration) && duration > 0 ? r3(fadesTotal / (duration / 60e6)) : null,
-        counterMoved: d.fadeCounterMoved,
-        implausibleJumps: fadeJumps,
-      },
-      rssi: rssiMode || rssiFrames > 0 ? {
-        minDbm: finite(rssiLo), maxDbm: finite(rssiHi), meanDbm: rssiFrames > 0 ? Math.round((rssiTotal / rssiFrames) * 10) / 10 : null,
-        frames: rssiFrames, lossReports: rssiLoss,
-      } : null,
+      fades: rssiMode
+        ? null
+        : {
+            total: fadesTotal,
+            perMinute: Number.isFinite(duration) && duration > 0 ? r3(fadesTotal / (duration / 60e6)) : null,
+            counterMoved: d.fadeCounterMoved,
+            implausibleJumps: fadeJumps,
+          },
+      rssi:
+        rssiMode || rssiFrames > 0
+          ? {
+              minDbm: finite(rssiLo),
+              maxDbm: finite(rssiHi),
+              meanDbm: rssiFrames > 0 ? Math.round((rssiTotal / rssiFrames) * 10) / 10 : null,
+              frames: rssiFrames,
+              lossReports: rssiLoss,
+            }
+          : null,
       holds: {
         count: holdEpisodes.length,
         recovered: recovered.length,
@@ -810,8 +936,14 @@ export function healthReport(capture: Capture, options: HealthReportOptions = {}
         listed: d.glitchesRaw.map(({ absUs, ...g }) => ({ ...g, timeUs: hasClock ? r1n(absUs - origin) : null })),
       },
       decoder: {
-        bytes: d.bytes, frames: stats.frames, discardedBytes: stats.discardedBytes, resyncs: stats.resyncs,
-        badFrames: stats.badFrames, emptySlots: stats.emptySlots, vtxFrames: stats.vtxFrames, formatChanges: d.formatChanges,
+        bytes: d.bytes,
+        frames: stats.frames,
+        discardedBytes: stats.discardedBytes,
+        resyncs: stats.resyncs,
+        badFrames: stats.badFrames,
+        emptySlots: stats.emptySlots,
+        vtxFrames: stats.vtxFrames,
+        formatChanges: d.formatChanges,
       },
       series: {
         frames: framesS,
@@ -829,7 +961,12 @@ export function healthReport(capture: Capture, options: HealthReportOptions = {}
 
   const verdict: ReportFinding[] = [];
   if (capture.issues.length > 0) {
-    verdict.push({ level: 'info', code: 'file-issues', port: null, text: `The file is damaged: ${plural(capture.issues.length, 'part')} skipped (${capture.issues[0]?.message ?? ''})` });
+    verdict.push({
+      level: 'info',
+      code: 'file-issues',
+      port: null,
+      text: `The file is damaged: ${plural(capture.issues.length, 'part')} skipped (${capture.issues[0]?.message ?? ''})`,
+    });
   }
   if (ports.length === 0) {
     verdict.push({ level: 'problem', code: 'no-frames', port: null, text: 'The capture holds no data' });

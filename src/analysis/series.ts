@@ -123,9 +123,15 @@ export class LinkSeries {
     return this.#origin + i * this.binUs;
   }
 
-  frames(i: number): number { return this.#frames.data[i] ?? 0; }
-  fades(i: number): number { return this.#fades.data[i] ?? 0; }
-  lost(i: number): number { return this.#lost.data[i] ?? 0; }
+  frames(i: number): number {
+    return this.#frames.data[i] ?? 0;
+  }
+  fades(i: number): number {
+    return this.#fades.data[i] ?? 0;
+  }
+  lost(i: number): number {
+    return this.#lost.data[i] ?? 0;
+  }
   /** Mean RSSI of bin `i` (loss reports of −128 left out), NaN without. */
   rssiMean(i: number): number {
     const n = this.#rssiN.data[i] ?? 0;

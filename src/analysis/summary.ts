@@ -7,7 +7,16 @@ import { captureChunks } from '../capture/index.js';
 import { SpektrumDecoder, type DecoderOptions } from '../decoder/index.js';
 import type { LinkEpisode, LinkMonitor, LinkStats } from '../decoder/index.js';
 import { LinkSeries, monitorWithSeries } from './series.js';
-import { BYTE_TIME_US, channelName, channelResolution, CHANNEL_COUNT, servoToMicros, systemInfo, USB_CHUNK_JITTER_US, type Resolution } from '../decoder/index.js';
+import {
+  BYTE_TIME_US,
+  channelName,
+  channelResolution,
+  CHANNEL_COUNT,
+  servoToMicros,
+  systemInfo,
+  USB_CHUNK_JITTER_US,
+  type Resolution,
+} from '../decoder/index.js';
 import type { DecodedFrame, DecoderStats, FormatInfo } from '../decoder/index.js';
 
 export interface DecodeCaptureOptions extends DecoderOptions {
@@ -55,7 +64,8 @@ export function captureSpan(capture: Capture): { startUs: number; endUs: number 
 export function resolutionKey(formats: Iterable<FormatInfo>): Resolution | undefined {
   let key: Resolution | undefined;
   for (const f of formats) {
-    if (f.remote === 'internal' && f.system !== null && f.systemValid && systemInfo(f.system) !== undefined && f.resolution !== null) key = f.resolution;
+    if (f.remote === 'internal' && f.system !== null && f.systemValid && systemInfo(f.system) !== undefined && f.resolution !== null)
+      key = f.resolution;
   }
   return key;
 }
@@ -130,36 +140,56 @@ export function summarizeCapture(capture: Capture, options: DecodeCaptureOptions
   let lastUs = NaN;
   let formatChanges = 0;
   const userEvent = options.onEvent;
-  const { decoder, link } = decodeCapture(capture, {
-    ...options,
-    onEvent: (e) => {
-      if (e.type === 'format-changed') formatChanges++;
-      userEvent?.(e);
+  const { decoder, link } = decodeCapture(
+    capture,
+    {
+      ...options,
+      onEvent: (e) => {
+        if (e.type === 'format-changed') formatChanges++;
+        userEvent?.(e);
+      },
     },
-  }, (f) => {
-    if (Number.isNaN(firstUs)) firstUs = f.timeUs;
-    lastUs = f.timeUs;
-    for (let i = 0; i < f.count; i++) {
-      const id = f.ids[i] as number;
-      const us = servoToMicros(f.positions[i] as number, channelResolution(id, f.resolution));
-      frames[id] = (frames[id] as number) + 1;
-      if (us < (min[id] as number)) min[id] = us;
-      if (us > (max[id] as number)) max[id] = us;
-      last[id] = us;
-    }
-  });
+    (f) => {
+      if (Number.isNaN(firstUs)) firstUs = f.timeUs;
+      lastUs = f.timeUs;
+      for (let i = 0; i < f.count; i++) {
+        const id = f.ids[i] as number;
+        const us = servoToMicros(f.positions[i] as number, channelResolution(id, f.resolution));
+        frames[id] = (frames[id] as number) + 1;
+        if (us < (min[id] as number)) min[id] = us;
+        if (us > (max[id] as number)) max[id] = us;
+        last[id] = us;
+      }
+    },
+  );
   const channels: ChannelSummary[] = [];
   for (let id = 0; id < CHANNEL_COUNT; id++) {
     const n = frames[id] as number;
-    if (n > 0) channels.push({ id, name: channelName(id), frames: n, minUs: min[id] as number, maxUs: max[id] as number, lastUs: last[id] as number });
+    if (n > 0)
+      channels.push({
+        id,
+        name: channelName(id),
+        frames: n,
+        minUs: min[id] as number,
+        maxUs: max[id] as number,
+        lastUs: last[id] as number,
+      });
   }
   const port = options.port ?? 0;
   let bytes = 0;
   for (const chunk of captureChunks(capture, port)) bytes += chunk.bytes.length;
   return {
-    kind: capture.kind, timing: capture.timing, port, bytes,
+    kind: capture.kind,
+    timing: capture.timing,
+    port,
+    bytes,
     durationUs: lastUs - firstUs,
-    format: decoder.format, decoder: { ...decoder.stats }, link: { ...link.stats },
-    episodes: link.episodes.map((e) => ({ ...e })), channels, formatChanges, issues: capture.issues,
+    format: decoder.format,
+    decoder: { ...decoder.stats },
+    link: { ...link.stats },
+    episodes: link.episodes.map((e) => ({ ...e })),
+    channels,
+    formatChanges,
+    issues: capture.issues,
   };
 }

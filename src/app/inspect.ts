@@ -5,7 +5,18 @@
  * of the bytes and the format the decoder settled on, so it shows the frame the way a firmware
  * decoder should read it, slot by slot, including what is wrong with a slot.
  */
-import { EMPTY_SLOT, FRAME_SIZE, XPLUS_FIRST, channelName, servoToMicros, systemInfo, type HeaderMode, type RemoteKind, type Resolution, type VtxControl } from '../decoder/index.js';
+import {
+  EMPTY_SLOT,
+  FRAME_SIZE,
+  XPLUS_FIRST,
+  channelName,
+  servoToMicros,
+  systemInfo,
+  type HeaderMode,
+  type RemoteKind,
+  type Resolution,
+  type VtxControl,
+} from '../decoder/index.js';
 
 // §8.1 and §8.2's masks. The library keeps them internal, so they are restated here.
 /** §8.1: 1024 mode, bits 15–10 channel ID, bits 9–0 position. */
@@ -133,25 +144,48 @@ function describeHeader(b: Uint8Array, resolution: Resolution, remote: RemoteKin
   const b1 = b[1] as number;
   if (remote === 'external') {
     const fades = (b0 << 8) | b1;
-    return [{
-      field: 'fades', first: 0, last: 1, raw: fades, value: fades, valid: true, label: 'fades', text: `fades ${fades}`,
-      title: `bytes 0–1: fade count, UINT16 big-endian (external remote, §8.4) = ${fades}`,
-    }];
+    return [
+      {
+        field: 'fades',
+        first: 0,
+        last: 1,
+        raw: fades,
+        value: fades,
+        valid: true,
+        label: 'fades',
+        text: `fades ${fades}`,
+        title: `bytes 0–1: fade count, UINT16 big-endian (external remote, §8.4) = ${fades}`,
+      },
+    ];
   }
-  const first: HeaderField = headerMode === 'rssi'
-    ? (() => {
-      const dBm = b0 >= 0x80 ? b0 - 0x100 : b0;
-      const loss = dBm === -128;
-      return {
-        field: 'rssi' as const, first: 0, last: 0, raw: b0, value: dBm, valid: true, label: 'RSSI',
-        text: `RSSI ${dBm}\u00a0dBm${loss ? ' (loss)' : ''}`,
-        title: `byte 0: RSSI, INT8 dBm (SPM4649T, §8.3.1) = ${dBm}\u00a0dBm${loss ? ': connection or packet loss' : dBm >= 0 ? ': not negative, so not RSSI?' : ''}`,
-      };
-    })()
-    : {
-      field: 'fades', first: 0, last: 0, raw: b0, value: b0, valid: true, label: 'fades', text: `fades ${b0}`,
-      title: `byte 0: fade count, UINT8 (internal remote, §8.3) = ${b0}`,
-    };
+  const first: HeaderField =
+    headerMode === 'rssi'
+      ? (() => {
+          const dBm = b0 >= 0x80 ? b0 - 0x100 : b0;
+          const loss = dBm === -128;
+          return {
+            field: 'rssi' as const,
+            first: 0,
+            last: 0,
+            raw: b0,
+            value: dBm,
+            valid: true,
+            label: 'RSSI',
+            text: `RSSI ${dBm}\u00a0dBm${loss ? ' (loss)' : ''}`,
+            title: `byte 0: RSSI, INT8 dBm (SPM4649T, §8.3.1) = ${dBm}\u00a0dBm${loss ? ': connection or packet loss' : dBm >= 0 ? ': not negative, so not RSSI?' : ''}`,
+          };
+        })()
+      : {
+          field: 'fades',
+          first: 0,
+          last: 0,
+          raw: b0,
+          value: b0,
+          valid: true,
+          label: 'fades',
+          text: `fades ${b0}`,
+          title: `byte 0: fade count, UINT8 (internal remote, §8.3) = ${b0}`,
+        };
   const info = systemInfo(b1);
   let title = `byte 1: system ${hex2(b1)}`;
   if (info === undefined) {
@@ -161,7 +195,13 @@ function describeHeader(b: Uint8Array, resolution: Resolution, remote: RemoteKin
     if (info.resolution !== resolution) title += `; but the channel IDs read at ${resolution}, not ${info.resolution}`;
   }
   const system: HeaderField = {
-    field: 'system', first: 1, last: 1, raw: b1, value: b1, valid: info !== undefined, label: 'sys',
+    field: 'system',
+    first: 1,
+    last: 1,
+    raw: b1,
+    value: b1,
+    valid: info !== undefined,
+    label: 'sys',
     text: info === undefined ? `${hex2(b1)} not a valid system byte` : `${hex2(b1)} ${info.protocol} ${info.periodMs} ms`,
     title,
   };
@@ -185,10 +225,24 @@ export function describeFrame(bytes: Uint8Array, resolution: Resolution, remote:
     const first = 2 + 2 * i;
     const word = ((bytes[first] as number) << 8) | (bytes[first + 1] as number);
     const s: SlotField = {
-      index: i, first, last: first + 1, word, hex: hex4(word), kind: 'invalid',
+      index: i,
+      first,
+      last: first + 1,
+      word,
+      hex: hex4(word),
+      kind: 'invalid',
       phase: resolution === 2048 ? ((word & MASK_2048_PHASE) !== 0 ? 1 : 0) : null,
-      id: null, subId: null, value9: null, channel: null, position: null, us: null, name: null, problem: null,
-      label: '', text: '', title: '',
+      id: null,
+      subId: null,
+      value9: null,
+      channel: null,
+      position: null,
+      us: null,
+      name: null,
+      problem: null,
+      label: '',
+      text: '',
+      title: '',
     };
     const where = `bytes ${first}–${first + 1}, slot ${i + 1}, word 0x${s.hex}`;
     const phaseNote = s.phase === null ? '' : `, phase ${s.phase}`;
@@ -197,7 +251,8 @@ export function describeFrame(bytes: Uint8Array, resolution: Resolution, remote:
       s.kind = 'vtx';
       s.label = 'VTX';
       s.text = i === 5 ? vtxText(vtx) : '';
-      s.title = `${where}: Spektrum VTX control (bytes 12–15 = 0x${hex4(vtx.raw >>> 16)}${hex4(vtx.raw & 0xffff)}, both words' top nibble 0xE in a phase-0 frame): ` +
+      s.title =
+        `${where}: Spektrum VTX control (bytes 12–15 = 0x${hex4(vtx.raw >>> 16)}${hex4(vtx.raw & 0xffff)}, both words' top nibble 0xE in a phase-0 frame): ` +
         `band ${vtx.band}, channel ${vtx.channel}, power ${vtx.power}, region ${vtx.region === 1 ? 'EU' : 'US'}, pit mode ${vtx.pit ? 'on' : 'off'}`;
       slots.push(s);
       continue;
@@ -255,7 +310,8 @@ export function describeFrame(bytes: Uint8Array, resolution: Resolution, remote:
     } else if (s.kind === 'xplus') {
       s.label = s.name as string;
       s.text = `${s.name} ${s.position} ${s.us}\u00a0µs`;
-      s.title = `${where}${phaseNote}, channel ID 12 = X-Plus (§8.6): sub-ID ${s.subId}${s.phase === 1 ? ' + 4 for phase 1' : ''} → channel ${s.channel} (${s.name}), ` +
+      s.title =
+        `${where}${phaseNote}, channel ID 12 = X-Plus (§8.6): sub-ID ${s.subId}${s.phase === 1 ? ' + 4 for phase 1' : ''} → channel ${s.channel} (${s.name}), ` +
         `9-bit value ${s.value9} × 4 = ${s.position} = ${s.us}\u00a0µs`;
     } else {
       const p = s.phase === 1 ? 'p' : '';
@@ -269,7 +325,12 @@ export function describeFrame(bytes: Uint8Array, resolution: Resolution, remote:
   const parts = [...header.map((h) => h.text), ...slots.filter((s) => s.kind !== 'empty' && s.text !== '').map((s) => s.text)];
   if (empty > 0) parts.push(`${empty} empty`);
   return {
-    resolution, remote, headerMode, header, slots, vtx,
+    resolution,
+    remote,
+    headerMode,
+    header,
+    slots,
+    vtx,
     phase: resolution === 2048 ? (((bytes[2] as number) & 0x80) !== 0 ? 1 : 0) : null,
     summary: parts.join(' · '),
     parts,

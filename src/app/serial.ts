@@ -15,10 +15,17 @@ export const USB_SERIAL_FILTERS: SerialPortFilter[] = USB_SERIAL_VENDORS.map(({ 
 /** Why WebSerial cannot be used here, with what to do, or null when it can. */
 export function serialUnavailable(): { title: string; detail: string } | null {
   if (!window.isSecureContext) {
-    return { title: 'Web Serial needs a secure page', detail: 'Open SatScope over https:// or from http://localhost; the browser hides serial ports from plain http pages.' };
+    return {
+      title: 'Web Serial needs a secure page',
+      detail: 'Open SatScope over https:// or from http://localhost; the browser hides serial ports from plain http pages.',
+    };
   }
   if (!('serial' in navigator)) {
-    return { title: 'This browser has no Web Serial', detail: 'Use Chrome, Edge or Opera on a desktop computer. Firefox and Safari do not support it. Replay of saved captures works everywhere.' };
+    return {
+      title: 'This browser has no Web Serial',
+      detail:
+        'Use Chrome, Edge or Opera on a desktop computer. Firefox and Safari do not support it. Replay of saved captures works everywhere.',
+    };
   }
   return null;
 }
@@ -42,13 +49,20 @@ export async function pickPort(filters: SerialPortFilter[]): Promise<SerialPort 
       return {
         problem: {
           title: 'No port chosen',
-          detail: filters.length > 0
-            ? 'Pick the USB-serial adapter wired to the satellite\'s DATA line (gray wire). If it is not in the list, choose "Any serial port…" under the arrow beside Connect receiver.'
-            : 'Pick the USB-serial adapter wired to the satellite\'s DATA line (gray wire). If it is not listed, check the cable and its driver.',
+          detail:
+            filters.length > 0
+              ? 'Pick the USB-serial adapter wired to the satellite\'s DATA line (gray wire). If it is not in the list, choose "Any serial port…" under the arrow beside Connect receiver.'
+              : "Pick the USB-serial adapter wired to the satellite's DATA line (gray wire). If it is not listed, check the cable and its driver.",
         },
       };
     }
-    if (name === 'SecurityError') return { problem: { title: 'Serial access is blocked', detail: 'The browser or an administrator policy blocks serial ports for this page. Check the site\'s permissions.' } };
+    if (name === 'SecurityError')
+      return {
+        problem: {
+          title: 'Serial access is blocked',
+          detail: "The browser or an administrator policy blocks serial ports for this page. Check the site's permissions.",
+        },
+      };
     return { problem: { title: 'Could not ask for a port', detail: String(error) } };
   }
 }

@@ -33,8 +33,23 @@ export const bindLog = signal<BindProgress[]>([]);
 export const diagnosis = signal<DiagnosisStatus | null>(null);
 
 const IDLE: SourceStatus = {
-  id: -1, label: '', kind: 'serial', state: 'idle', name: 'No receiver', clockRate: 0,
-  format: { locked: false, resolution: null, resolutionReason: 'unknown', explanation: 'Not locked on to frames yet.', remote: null, system: null, systemValid: false, headerMode: 'fades', forcedMismatch: null },
+  id: -1,
+  label: '',
+  kind: 'serial',
+  state: 'idle',
+  name: 'No receiver',
+  clockRate: 0,
+  format: {
+    locked: false,
+    resolution: null,
+    resolutionReason: 'unknown',
+    explanation: 'Not locked on to frames yet.',
+    remote: null,
+    system: null,
+    systemValid: false,
+    headerMode: 'fades',
+    forcedMismatch: null,
+  },
 };
 
 /** The selected remote's status (a placeholder when there is none). */

@@ -24,7 +24,9 @@ function stored(): Theme | null {
 /** The user's pick, or null: follow the system. */
 export const themeChoice = signal<Theme | null>(stored());
 const systemDark = signal(media?.matches ?? true);
-media?.addEventListener('change', (e) => { systemDark.value = e.matches; });
+media?.addEventListener('change', (e) => {
+  systemDark.value = e.matches;
+});
 
 /** The theme on screen. */
 export const theme = computed<Theme>(() => themeChoice.value ?? (systemDark.value ? 'dark' : 'light'));
@@ -58,14 +60,26 @@ export interface ChartColors {
 }
 
 const DARK: ChartColors = {
-  axis: '#8a97a8', grid: '#1e2835', cursor: '#8a97a8',
-  fades: '#f0b429', rssi: '#7cc4ff', period: '#4fd1a5', lost: '#ff6b6b', failsafeBand: 'rgba(255,60,60,0.25)',
+  axis: '#8a97a8',
+  grid: '#1e2835',
+  cursor: '#8a97a8',
+  fades: '#f0b429',
+  rssi: '#7cc4ff',
+  period: '#4fd1a5',
+  lost: '#ff6b6b',
+  failsafeBand: 'rgba(255,60,60,0.25)',
   remotes: ['#4fd1a5', '#f0b429', '#7cc4ff', '#ff8fab', '#c3a6ff'],
 };
 
 const LIGHT: ChartColors = {
-  axis: '#4f5b6b', grid: '#e3e8ee', cursor: '#4f5b6b',
-  fades: '#b7791f', rssi: '#1f6fd1', period: '#0a7d5a', lost: '#d1343a', failsafeBand: 'rgba(209,52,58,0.16)',
+  axis: '#4f5b6b',
+  grid: '#e3e8ee',
+  cursor: '#4f5b6b',
+  fades: '#b7791f',
+  rssi: '#1f6fd1',
+  period: '#0a7d5a',
+  lost: '#d1343a',
+  failsafeBand: 'rgba(209,52,58,0.16)',
   remotes: ['#0a7d5a', '#b7791f', '#1f6fd1', '#c2185b', '#7048e8'],
 };
 

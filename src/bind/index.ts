@@ -14,24 +14,56 @@
  * Every export is named here; the few helpers the files share among themselves are not.
  */
 export {
-  BIND_MODES, BIND_PULSE_MAX_US, BIND_PULSE_MIN_US, BIND_PULSE_TARGET_US, BIND_WINDOW, MAX_BIND_PULSES, MIN_BIND_PULSES,
-  bindMode, bindPulsesFor,
+  BIND_MODES,
+  BIND_PULSE_MAX_US,
+  BIND_PULSE_MIN_US,
+  BIND_PULSE_TARGET_US,
+  BIND_WINDOW,
+  MAX_BIND_PULSES,
+  MIN_BIND_PULSES,
+  bindMode,
+  bindPulsesFor,
   type BindMode,
 } from './modes.js';
 export {
-  CHIP_NAMES, DEFAULT_CHIPS, USB_SERIAL_CHIPS, USB_SERIAL_VENDORS,
-  adapterChips, chipBaudRate, chipsForUsbId, portName,
-  type UsbIds, type UsbSerialChip, type UsbSerialVendor,
+  CHIP_NAMES,
+  DEFAULT_CHIPS,
+  USB_SERIAL_CHIPS,
+  USB_SERIAL_VENDORS,
+  adapterChips,
+  chipBaudRate,
+  chipsForUsbId,
+  portName,
+  type UsbIds,
+  type UsbSerialChip,
+  type UsbSerialVendor,
 } from './chips.js';
 export {
-  countFallingEdges, frameLevels, measurePulses, uartWaveform,
-  type LineSegment, type PulseMeasurement, type StopBits,
+  countFallingEdges,
+  frameLevels,
+  measurePulses,
+  uartWaveform,
+  type LineSegment,
+  type PulseMeasurement,
+  type StopBits,
 } from './uart.js';
 export {
-  planPulses, validatePlan,
-  type ChipRate, type PlanCheck, type PlanOptions, type PulsePlan, type ValidateOptions,
+  planPulses,
+  validatePlan,
+  type ChipRate,
+  type PlanCheck,
+  type PlanOptions,
+  type PulsePlan,
+  type ValidateOptions,
 } from './plan.js';
 export {
-  bindForAdapter, bindTimeline, powerSignals,
-  type AdapterBind, type BindStep, type OutputSignals, type PowerLine, type PowerPolarity, type TimelineOptions,
+  bindForAdapter,
+  bindTimeline,
+  powerSignals,
+  type AdapterBind,
+  type BindStep,
+  type OutputSignals,
+  type PowerLine,
+  type PowerPolarity,
+  type TimelineOptions,
 } from './timeline.js';

@@ -3,9 +3,7 @@
  * power-up, N falling pulses (3–10) on its DATA line; N picks the mode. The pulse widths and the
  * window are what firmware that binds uses, since the spec gives only the count.
  */
-import {
-  SYSTEM_DSM2_11MS_2048, SYSTEM_DSM2_22MS_1024, SYSTEM_DSMX_11MS_2048, SYSTEM_DSMX_22MS_2048,
-} from '../decoder/spec.js';
+import { SYSTEM_DSM2_11MS_2048, SYSTEM_DSM2_22MS_1024, SYSTEM_DSMX_11MS_2048, SYSTEM_DSMX_22MS_2048 } from '../decoder/spec.js';
 
 export interface BindMode {
   /** Falling pulses the host sends (3–10). */
@@ -30,11 +28,19 @@ function mode(pulses: number, remote: BindMode['remote'], protocol: BindMode['pr
   const also = [
     periodMs === 11 ? 'also accepts 22 ms' : '',
     protocol === 'DSMX' ? 'falls back to DSM2' : 'not recommended; DSM2 transmitters are not sold in Europe',
-  ].filter(Boolean).join('; ');
+  ]
+    .filter(Boolean)
+    .join('; ');
   return {
-    pulses, remote, protocol, periodMs, recommended, systemByte,
-    description: `${pulses} pulses: ${remote} remote, ${protocol} ${periodMs} ms (${also})`
-      + (remote === 'internal' ? '. Only one remote in a system may be internal.' : '.'),
+    pulses,
+    remote,
+    protocol,
+    periodMs,
+    recommended,
+    systemByte,
+    description:
+      `${pulses} pulses: ${remote} remote, ${protocol} ${periodMs} ms (${also})` +
+      (remote === 'internal' ? '. Only one remote in a system may be internal.' : '.'),
   };
 }
 

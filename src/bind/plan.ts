@@ -6,7 +6,15 @@
  * rate (chips.ts), on the line model of uart.ts.
  */
 import type { BindStep } from './timeline.js';
-import { BIND_PULSE_MAX_US, BIND_PULSE_MIN_US, BIND_PULSE_TARGET_US, BIND_WINDOW, MAX_BIND_PULSES, MIN_BIND_PULSES, checkPulses } from './modes.js';
+import {
+  BIND_PULSE_MAX_US,
+  BIND_PULSE_MIN_US,
+  BIND_PULSE_TARGET_US,
+  BIND_WINDOW,
+  MAX_BIND_PULSES,
+  MIN_BIND_PULSES,
+  checkPulses,
+} from './modes.js';
 import { DEFAULT_CHIPS, tableRates, chipBaudRate, type UsbSerialChip } from './chips.js';
 import { frameRuns, measurePulses, uartWaveform, type PulseMeasurement, type StopBits } from './uart.js';
 
@@ -68,7 +76,6 @@ export interface PulsePlan {
   readonly worstDeviation: number;
 }
 
-
 /** Rates worth trying: whole-bit multiples of the target, and every rate a fixed-table chip has. */
 function candidateRates(targetUs: number): number[] {
   const set = new Set<number>();
@@ -114,7 +121,8 @@ export function planPulses(n: number, options: PlanOptions = {}): PulsePlan {
   const target = options.targetUs ?? BIND_PULSE_TARGET_US;
   const stopChoices = options.stopBits ?? [1, 2];
   const maxPerByte = Math.min(5, Math.max(1, Math.floor(options.maxPulsesPerByte ?? 5)));
-  const maxDeviation = options.maxDeviation ?? Math.min(BIND_PULSE_MAX_US / BIND_PULSE_TARGET_US - 1, 1 - BIND_PULSE_MIN_US / BIND_PULSE_TARGET_US);
+  const maxDeviation =
+    options.maxDeviation ?? Math.min(BIND_PULSE_MAX_US / BIND_PULSE_TARGET_US - 1, 1 - BIND_PULSE_MIN_US / BIND_PULSE_TARGET_US);
   if (!(target > 0)) throw new RangeError(`target must be positive, not ${target}`);
   const rates = options.baudRates ?? candidateRates(target);
 
@@ -181,8 +189,13 @@ export function planPulses(n: number, options: PlanOptions = {}): PulsePlan {
           best = {
             key,
             plan: {
-              pulses: n, baudRate, stopBits, bytes: Uint8Array.from(seq.bytes), pulsesPerByte: perByte,
-              chipRates, worstDeviation: seq.cost,
+              pulses: n,
+              baudRate,
+              stopBits,
+              bytes: Uint8Array.from(seq.bytes),
+              pulsesPerByte: perByte,
+              chipRates,
+              worstDeviation: seq.cost,
             },
           };
         }
@@ -190,8 +203,10 @@ export function planPulses(n: number, options: PlanOptions = {}): PulsePlan {
     }
   }
   if (!best) {
-    throw new RangeError(`no baud rate within ${(tolerance * 100).toFixed(1)} % on ${chips.join(', ')} draws ${n} pulses `
-      + `with every phase within ${(maxDeviation * 100).toFixed(0)} % of ${target} µs`);
+    throw new RangeError(
+      `no baud rate within ${(tolerance * 100).toFixed(1)} % on ${chips.join(', ')} draws ${n} pulses ` +
+        `with every phase within ${(maxDeviation * 100).toFixed(0)} % of ${target} µs`,
+    );
   }
   const p = best.plan;
   const m = measurePulses(uartWaveform(p.bytes, p.baudRate, p.stopBits));
@@ -256,7 +271,8 @@ export function validatePlan(plan: PulsePlan, n: number, options: ValidateOption
   if (!Number.isInteger(n) || n < MIN_BIND_PULSES || n > MAX_BIND_PULSES) problems.push(`${String(n)} is not a bind pulse count (3–10)`);
 
   const rates: { label: string; baud: number }[] = [{ label: `${plan.baudRate} baud`, baud: plan.baudRate }];
-  for (const chip of chips) rates.push({ label: `${chip} (${fmtUs(chipBaudRate(chip, plan.baudRate))} baud)`, baud: chipBaudRate(chip, plan.baudRate) });
+  for (const chip of chips)
+    rates.push({ label: `${chip} (${fmtUs(chipBaudRate(chip, plan.baudRate))} baud)`, baud: chipBaudRate(chip, plan.baudRate) });
 
   let nominal: PulseMeasurement | undefined;
   for (const { label, baud } of rates) {
@@ -285,16 +301,23 @@ export function validatePlan(plan: PulsePlan, n: number, options: ValidateOption
       const writeStep = steps[write]!;
       if (write < on) problems.push('timeline: the write comes before power-on');
       if (off < 0 || off > on) problems.push('timeline: no power-off before power-on');
-      if (off >= 0 && off < on && onStep.atMs - steps[off]!.atMs < 200) problems.push(`timeline: power off only ${onStep.atMs - steps[off]!.atMs} ms`);
+      if (off >= 0 && off < on && onStep.atMs - steps[off]!.atMs < 200)
+        problems.push(`timeline: power off only ${onStep.atMs - steps[off]!.atMs} ms`);
       const startMs = writeStep.atMs - onStep.atMs;
       const endMs = startMs + plan.totalUs / 1000;
       if (startMs < earliest) problems.push(`timeline: pulses start ${startMs} ms after power-on, before ${earliest} ms`);
       if (endMs > latest) problems.push(`timeline: pulses end ${endMs.toFixed(2)} ms after power-on, after ${latest} ms`);
-      if (writeStep.action === 'write' && !sameBytes(writeStep.bytes, plan.bytes)) problems.push('timeline: the write is not the plan\'s bytes');
-      if (reopen >= 0 && steps[reopen]!.atMs < writeStep.atMs + plan.totalUs / 1000) problems.push('timeline: reopen before the pulses are out');
+      if (writeStep.action === 'write' && !sameBytes(writeStep.bytes, plan.bytes))
+        problems.push("timeline: the write is not the plan's bytes");
+      if (reopen >= 0 && steps[reopen]!.atMs < writeStep.atMs + plan.totalUs / 1000)
+        problems.push('timeline: reopen before the pulses are out');
       const open = steps.findIndex((s) => s.action === 'open');
       const openStep = steps[open];
-      if (!openStep || open > off || (openStep.action === 'open' && (openStep.baudRate !== plan.baudRate || openStep.stopBits !== plan.stopBits))) {
+      if (
+        !openStep ||
+        open > off ||
+        (openStep.action === 'open' && (openStep.baudRate !== plan.baudRate || openStep.stopBits !== plan.stopBits))
+      ) {
         problems.push(`timeline: the port is not opened at ${plan.baudRate} 8N${plan.stopBits} before power-off`);
       }
     }

@@ -41,7 +41,14 @@ interface StepBase {
   readonly note: string;
 }
 export type BindStep =
-  | (StepBase & { readonly action: 'open'; readonly baudRate: number; readonly stopBits: StopBits; readonly dataBits: 8; readonly parity: 'none'; readonly flowControl: 'none' })
+  | (StepBase & {
+      readonly action: 'open';
+      readonly baudRate: number;
+      readonly stopBits: StopBits;
+      readonly dataBits: 8;
+      readonly parity: 'none';
+      readonly flowControl: 'none';
+    })
   | (StepBase & { readonly action: 'power-off'; readonly signals: OutputSignals })
   | (StepBase & { readonly action: 'power-on'; readonly signals: OutputSignals })
   | (StepBase & { readonly action: 'write'; readonly bytes: Uint8Array; readonly durationUs: number })
@@ -87,12 +94,15 @@ export function bindTimeline(n: number, options: TimelineOptions): BindStep[] {
   const reopenAfterMs = options.reopenAfterMs ?? 20;
   const liveBaudRate = options.liveBaudRate ?? 115_200;
   const plan = options.plan ?? planPulses(n);
-  if (options.powerLine !== 'rts' && options.powerLine !== 'dtr') throw new RangeError(`power line must be 'rts' or 'dtr', not ${String(options.powerLine)}`);
+  if (options.powerLine !== 'rts' && options.powerLine !== 'dtr')
+    throw new RangeError(`power line must be 'rts' or 'dtr', not ${String(options.powerLine)}`);
   if (plan.pulses !== n) throw new RangeError(`the plan is for ${plan.pulses} pulses, not ${n}`);
   if (!(offMs >= 200)) throw new RangeError(`power must stay off ≥ 200 ms, not ${offMs}`);
   const pulsesMs = plan.totalUs / 1000;
   if (!(settleMs >= 0) || settleMs + pulsesMs > BIND_WINDOW.latestMs) {
-    throw new RangeError(`pulses must start after power-on and end within ${BIND_WINDOW.latestMs} ms; settle ${settleMs} ms + ${pulsesMs.toFixed(2)} ms does not`);
+    throw new RangeError(
+      `pulses must start after power-on and end within ${BIND_WINDOW.latestMs} ms; settle ${settleMs} ms + ${pulsesMs.toFixed(2)} ms does not`,
+    );
   }
   if (!(reopenAfterMs >= 0)) throw new RangeError(`reopenAfterMs must be ≥ 0, not ${reopenAfterMs}`);
 
@@ -107,30 +117,54 @@ export function bindTimeline(n: number, options: TimelineOptions): BindStep[] {
   const pinLevel = (powered: boolean) => ((polarity === 'asserted') === powered ? 'low (asserted)' : 'high (deasserted)');
   return [
     {
-      atMs: 0, sincePowerOnMs: -t0, action: 'open', baudRate: plan.baudRate, stopBits: plan.stopBits,
-      dataBits: 8, parity: 'none', flowControl: 'none',
-      note: `Close the port if it is open, then open it at ${plan.baudRate} baud 8${plan.stopBits === 1 ? 'N1' : 'N2'}. `
-        + 'Opening asserts DTR and RTS (the OS does it on Linux and macOS, Chromium on Windows), which may switch the satellite on for a moment; the next step switches it off.',
+      atMs: 0,
+      sincePowerOnMs: -t0,
+      action: 'open',
+      baudRate: plan.baudRate,
+      stopBits: plan.stopBits,
+      dataBits: 8,
+      parity: 'none',
+      flowControl: 'none',
+      note:
+        `Close the port if it is open, then open it at ${plan.baudRate} baud 8${plan.stopBits === 1 ? 'N1' : 'N2'}. ` +
+        'Opening asserts DTR and RTS (the OS does it on Linux and macOS, Chromium on Windows), which may switch the satellite on for a moment; the next step switches it off.',
     },
     {
-      atMs: 0, sincePowerOnMs: -t0, action: 'power-off', signals: off,
-      note: `setSignals(${JSON.stringify(off)}): ${line}# pin ${pinLevel(false)}, satellite off for ${offMs} ms so it really resets`
-        + (holdBreak ? '; break holds TX low so it cannot feed the unpowered satellite.' : '.'),
+      atMs: 0,
+      sincePowerOnMs: -t0,
+      action: 'power-off',
+      signals: off,
+      note:
+        `setSignals(${JSON.stringify(off)}): ${line}# pin ${pinLevel(false)}, satellite off for ${offMs} ms so it really resets` +
+        (holdBreak ? '; break holds TX low so it cannot feed the unpowered satellite.' : '.'),
     },
     {
-      atMs: t0, sincePowerOnMs: 0, action: 'power-on', signals: on,
+      atMs: t0,
+      sincePowerOnMs: 0,
+      action: 'power-on',
+      signals: on,
       note: `t0. setSignals(${JSON.stringify(on)}): ${line}# pin ${pinLevel(true)}, satellite powered. Time the next step from when this promise resolves.`,
     },
     {
-      atMs: writeAt, sincePowerOnMs: settleMs, action: 'write', bytes: plan.bytes, durationUs: plan.totalUs,
-      note: `One write() of ${plan.bytes.length} byte${plan.bytes.length === 1 ? '' : 's'} (one USB packet): ${n} low pulses of ${fmtUs(plan.lowUs[0]!)} µs, `
-        + `${pulsesMs.toFixed(2)} ms on the wire, ending ${(settleMs + pulsesMs).toFixed(1)} ms after power-on (window ${BIND_WINDOW.earliestMs}–${BIND_WINDOW.latestMs} ms). ${selected.description}`,
+      atMs: writeAt,
+      sincePowerOnMs: settleMs,
+      action: 'write',
+      bytes: plan.bytes,
+      durationUs: plan.totalUs,
+      note:
+        `One write() of ${plan.bytes.length} byte${plan.bytes.length === 1 ? '' : 's'} (one USB packet): ${n} low pulses of ${fmtUs(plan.lowUs[0]!)} µs, ` +
+        `${pulsesMs.toFixed(2)} ms on the wire, ending ${(settleMs + pulsesMs).toFixed(1)} ms after power-on (window ${BIND_WINDOW.earliestMs}–${BIND_WINDOW.latestMs} ms). ${selected.description}`,
     },
     {
-      atMs: reopenAt, sincePowerOnMs: reopenAt - t0, action: 'reopen', baudRate: liveBaudRate, signals: on,
-      note: `await writer.close() (drains the bytes), close(), open at ${liveBaudRate} 8N1 and at once setSignals(${JSON.stringify(on)}). `
-        + `close() drops DTR and RTS (HUPCL on Linux and macOS, most Windows drivers): the switch's gate hold-up must bridge the gap, or the bind is cancelled. `
-        + 'The satellite blinks while it waits for the transmitter; frames appear once the bind takes.',
+      atMs: reopenAt,
+      sincePowerOnMs: reopenAt - t0,
+      action: 'reopen',
+      baudRate: liveBaudRate,
+      signals: on,
+      note:
+        `await writer.close() (drains the bytes), close(), open at ${liveBaudRate} 8N1 and at once setSignals(${JSON.stringify(on)}). ` +
+        `close() drops DTR and RTS (HUPCL on Linux and macOS, most Windows drivers): the switch's gate hold-up must bridge the gap, or the bind is cancelled. ` +
+        'The satellite blinks while it waits for the transmitter; frames appear once the bind takes.',
     },
   ];
 }

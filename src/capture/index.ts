@@ -4,14 +4,31 @@
  * `readCapture`, which recognises any of them. This file names every public export.
  */
 export {
-  CaptureFormatError, captureChunks, capturePorts,
-  type Capture, type CaptureChunk, type CaptureEvent, type CaptureIssue, type CaptureIssueKind, type CaptureKind,
-  type CaptureMeta, type CapturePortInfo, type CaptureTiming, type MetaScalar, type ParsedCapture,
+  CaptureFormatError,
+  captureChunks,
+  capturePorts,
+  type Capture,
+  type CaptureChunk,
+  type CaptureEvent,
+  type CaptureIssue,
+  type CaptureIssueKind,
+  type CaptureKind,
+  type CaptureMeta,
+  type CapturePortInfo,
+  type CaptureTiming,
+  type MetaScalar,
+  type ParsedCapture,
 } from './model.js';
 export { crc32 } from './crc32.js';
 export {
-  CAPTURE_FILE_EXTENSION, CAPTURE_FORMAT_VERSION, MAX_META_BYTES, MAX_RECORD_PAYLOAD, RECORD_OVERHEAD,
-  RECORD_TYPE_DATA, RECORD_TYPE_EVENT, hasCaptureMagic,
+  CAPTURE_FILE_EXTENSION,
+  CAPTURE_FORMAT_VERSION,
+  MAX_META_BYTES,
+  MAX_RECORD_PAYLOAD,
+  RECORD_OVERHEAD,
+  RECORD_TYPE_DATA,
+  RECORD_TYPE_EVENT,
+  hasCaptureMagic,
 } from './layout.js';
 export { CaptureWriter, encodeCapture, type CaptureRecordInput } from './writer.js';
 export { parseCapture } from './reader.js';

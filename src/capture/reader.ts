@@ -3,7 +3,28 @@
  */
 import { utf8Decode } from './text.js';
 import { crc32, crcRun, crcShift, mulModPoly } from './crc32.js';
-import { CAPTURE_FORMAT_VERSION, CRC_SIZE, HEADER_FIXED_SIZE, MAGIC, MAGIC_SIZE, MAX_META_BYTES, MAX_RECORD_PAYLOAD, OFF_META_LENGTH, OFF_VERSION, RECORD_HEADER_SIZE, RECORD_OVERHEAD, RECORD_TYPE_DATA, RECORD_TYPE_EVENT, REC_OFF_LENGTH, REC_OFF_PORT, REC_OFF_TIME, REC_OFF_TYPE, SYNC0, SYNC1, isCaptureMagicPrefix } from './layout.js';
+import {
+  CAPTURE_FORMAT_VERSION,
+  CRC_SIZE,
+  HEADER_FIXED_SIZE,
+  MAGIC,
+  MAGIC_SIZE,
+  MAX_META_BYTES,
+  MAX_RECORD_PAYLOAD,
+  OFF_META_LENGTH,
+  OFF_VERSION,
+  RECORD_HEADER_SIZE,
+  RECORD_OVERHEAD,
+  RECORD_TYPE_DATA,
+  RECORD_TYPE_EVENT,
+  REC_OFF_LENGTH,
+  REC_OFF_PORT,
+  REC_OFF_TIME,
+  REC_OFF_TYPE,
+  SYNC0,
+  SYNC1,
+  isCaptureMagicPrefix,
+} from './layout.js';
 import { cleanMeta, isPlainObject } from './meta.js';
 import { CaptureFormatError } from './model.js';
 import type { CaptureEvent, CaptureIssue, CaptureMeta, ParsedCapture } from './model.js';
@@ -234,7 +255,9 @@ function readHeader(bytes: Uint8Array, view: DataView, probe: RecordProbe, issue
   } else if (first >= 0) {
     headerLength = first;
   } else if (stated < 0) {
-    throw new CaptureFormatError(`damaged SatScope capture header: it announces ${metaLength} bytes of metadata (the limit is ${MAX_META_BYTES}) and no intact record follows`);
+    throw new CaptureFormatError(
+      `damaged SatScope capture header: it announces ${metaLength} bytes of metadata (the limit is ${MAX_META_BYTES}) and no intact record follows`,
+    );
   } else {
     throw new CaptureFormatError(`truncated SatScope capture: the file ends inside its header (${n} of ${stated} bytes)`);
   }
@@ -242,7 +265,10 @@ function readHeader(bytes: Uint8Array, view: DataView, probe: RecordProbe, issue
   issues.push(header);
   const problems: string[] = [];
   const parsed = parseMetaJson(bytes, HEADER_FIXED_SIZE, Math.max(HEADER_FIXED_SIZE, headerLength - CRC_SIZE));
-  const where = headerLength === stated ? '' : ` (records start at offset ${headerLength}, not ${stated < 0 ? 'where its metadata length says' : stated})`;
+  const where =
+    headerLength === stated
+      ? ''
+      : ` (records start at offset ${headerLength}, not ${stated < 0 ? 'where its metadata length says' : stated})`;
   if (parsed === undefined) {
     header.message = `damaged header${where}: it fails its CRC-32 check and its metadata cannot be read, so the metadata is lost; the records are checked separately`;
     return { meta: {}, version: CAPTURE_FORMAT_VERSION, headerLength };
@@ -295,7 +321,7 @@ function repairedHeaderMatches(bytes: Uint8Array, view: DataView, end: number): 
   const crcAt = end - CRC_SIZE;
   const fixed = expectedFixedHeader(end);
   const c = crcRun(crcRun(0xffffffff, fixed, 0, HEADER_FIXED_SIZE), bytes, HEADER_FIXED_SIZE, crcAt);
-  return ((c ^ 0xffffffff) >>> 0) === view.getUint32(crcAt, true);
+  return (c ^ 0xffffffff) >>> 0 === view.getUint32(crcAt, true);
 }
 
 /** Names of the fixed header fields that differ from what a version-1 writer writes. */
@@ -309,7 +335,8 @@ function damagedFixedFields(bytes: Uint8Array, view: DataView, end: number): str
   if (differs(0, OFF_VERSION)) names.push('signature');
   if (differs(OFF_VERSION, OFF_VERSION + 2)) names.push(`version (${view.getUint16(OFF_VERSION, true)})`);
   if (differs(OFF_VERSION + 2, OFF_META_LENGTH)) names.push('reserved flags');
-  if (differs(OFF_META_LENGTH, HEADER_FIXED_SIZE)) names.push(`metadata length (${view.getUint32(OFF_META_LENGTH, true)}, not ${end - MIN_HEADER_SIZE})`);
+  if (differs(OFF_META_LENGTH, HEADER_FIXED_SIZE))
+    names.push(`metadata length (${view.getUint32(OFF_META_LENGTH, true)}, not ${end - MIN_HEADER_SIZE})`);
   return names;
 }
 

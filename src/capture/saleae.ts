@@ -214,7 +214,8 @@ function byteValue(bytes: Uint8Array, s: number, e: number): number {
   let radix = 10;
   if (e - s > 2 && bytes[s] === ZERO) {
     const p = (bytes[s + 1] as number) | 0x20;
-    if (p === 0x78) radix = 16; // x
+    if (p === 0x78)
+      radix = 16; // x
     else if (p === 0x62) radix = 2; // b
     if (radix !== 10) s += 2;
   }
@@ -371,7 +372,13 @@ export function importSaleaeCsv(input: string | Uint8Array): Capture {
       }
     }
     if (flagged !== undefined) {
-      issue('flagged-byte', lineNo, ls, le, `byte ${fields.text(cols.value)} flagged by the analyser (${flagged}); left out because its bits are unreliable`);
+      issue(
+        'flagged-byte',
+        lineNo,
+        ls,
+        le,
+        `byte ${fields.text(cols.value)} flagged by the analyser (${flagged}); left out because its bits are unreliable`,
+      );
       continue;
     }
     let port = 0;

@@ -61,7 +61,13 @@ const isOption = (name: string): name is OptionName => Object.hasOwn(OPTIONS, na
 export function parseCommandLine(argv: readonly string[]): Args | 'help' | 'version' {
   // A lenient pass first, for messages that name the command and what it takes; the strict
   // pass after it is the authority on anything this one lets through.
-  const { values, positionals, tokens } = parseArgs({ args: [...argv], options: OPTIONS, strict: false, allowPositionals: true, tokens: true });
+  const { values, positionals, tokens } = parseArgs({
+    args: [...argv],
+    options: OPTIONS,
+    strict: false,
+    allowPositionals: true,
+    tokens: true,
+  });
   if (values.help === true) return 'help';
   if (values.version === true) return 'version';
   const [command, file, ...extra] = positionals;
@@ -86,7 +92,9 @@ export function parseCommandLine(argv: readonly string[]): Args | 'help' | 'vers
     if (OPTIONS[t.name].type === 'string') {
       if (t.value === undefined) throw new UsageError(`${t.rawName} needs a value`);
       if (!t.inlineValue && t.value.startsWith('-') && t.value !== '-') {
-        throw new UsageError(`${t.rawName} needs a value, not the option '${t.value}' (for a value that starts with '-', write ${t.rawName}=${t.value})`);
+        throw new UsageError(
+          `${t.rawName} needs a value, not the option '${t.value}' (for a value that starts with '-', write ${t.rawName}=${t.value})`,
+        );
       }
     } else if (t.inlineValue) {
       throw new UsageError(`${t.rawName} takes no value`);

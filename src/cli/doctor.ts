@@ -57,7 +57,8 @@ export function doctorCommand(argv: string[], io: DoctorIo = defaultIo): number 
   if (positionals.length === 0) return usage('no FILE given');
   if (positionals.length > 1) return usage(`unexpected argument '${positionals[1] as string}'`);
   const resolution = values.resolution ?? 'auto';
-  if (resolution !== 'auto' && resolution !== '1024' && resolution !== '2048') return usage(`--resolution must be auto, 1024 or 2048, not '${resolution}'`);
+  if (resolution !== 'auto' && resolution !== '1024' && resolution !== '2048')
+    return usage(`--resolution must be auto, 1024 or 2048, not '${resolution}'`);
   const file = positionals[0] as string;
 
   let bytes: Uint8Array;
@@ -65,7 +66,14 @@ export function doctorCommand(argv: string[], io: DoctorIo = defaultIo): number 
     bytes = readFileSync(file);
   } catch (error) {
     const code = (error as NodeJS.ErrnoException).code;
-    const why = code === 'ENOENT' ? 'no such file' : code === 'EISDIR' ? 'it is a directory' : code === 'EACCES' ? 'permission denied' : String(error);
+    const why =
+      code === 'ENOENT'
+        ? 'no such file'
+        : code === 'EISDIR'
+          ? 'it is a directory'
+          : code === 'EACCES'
+            ? 'permission denied'
+            : String(error);
     io.err(`satscope doctor: cannot read ${file}: ${why}\n`);
     return 2;
   }
@@ -101,7 +109,9 @@ export function formatDoctorReport(r: DoctorReport, name: string): string {
   const lines: string[] = [];
   const origin = r.source.startUs;
   const span = r.source.startUs !== null && r.source.endUs !== null ? `, ${((r.source.endUs - r.source.startUs) / 1e6).toFixed(1)} s` : '';
-  lines.push(`satscope doctor: ${name} (${r.source.kind}, ${r.source.timing} timing, ${r.source.ports.length === 1 ? '1 port' : `${r.source.ports.length} ports`}, ${r.source.bytes} bytes${span})`);
+  lines.push(
+    `satscope doctor: ${name} (${r.source.kind}, ${r.source.timing} timing, ${r.source.ports.length === 1 ? '1 port' : `${r.source.ports.length} ports`}, ${r.source.bytes} bytes${span})`,
+  );
   lines.push('');
   if (r.findings.length === 0) lines.push('No findings: nothing wrong was seen at the end of the capture.');
   for (const f of r.findings) {
@@ -122,13 +132,17 @@ export function formatDoctorReport(r: DoctorReport, name: string): string {
         for (const l of s.lines) lines.push(`      ${l}`);
       }
     }
-    if (f.confirm !== null) lines.push(`  To confirm: listen at ${f.confirm.baudRate} baud, ${f.confirm.parity} parity, ${f.confirm.stopBits} stop bit${f.confirm.stopBits === 1 ? '' : 's'}. ${f.confirm.note}`);
+    if (f.confirm !== null)
+      lines.push(
+        `  To confirm: listen at ${f.confirm.baudRate} baud, ${f.confirm.parity} parity, ${f.confirm.stopBits} stop bit${f.confirm.stopBits === 1 ? '' : 's'}. ${f.confirm.note}`,
+      );
     lines.push('');
   }
   const earlier = r.timeline.filter((e) => e.toUs !== null);
   if (earlier.length > 0) {
     lines.push('Seen earlier in the capture, cleared by its end:');
-    for (const e of earlier) lines.push(`  ${LABEL[e.severity].toLowerCase()}: ${e.title} (${clock(e.fromUs, origin)}–${clock(e.toUs, origin)})`);
+    for (const e of earlier)
+      lines.push(`  ${LABEL[e.severity].toLowerCase()}: ${e.title} (${clock(e.fromUs, origin)}–${clock(e.toUs, origin)})`);
     lines.push('');
   }
   return `${lines.join('\n')}\n`;

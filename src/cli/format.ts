@@ -53,21 +53,36 @@ export function formatSummary(s: CaptureSummary, name: string): string {
     return lines.join('\n');
   }
   const sys = f.system === null ? undefined : systemInfo(f.system);
-  add('System', f.system === null ? 'no system byte (external remote or a receiver that sends none)' : `${hex(f.system)}${sys ? ` ${sys.name}` : ' (not a valid system byte)'}`);
-  const byte0 = f.headerMode === 'rssi' ? 'RSSI in dBm, SPM4649T' : f.headerMode === 'unknown' ? 'fades or RSSI, not yet known' : 'UINT8 fades';
+  add(
+    'System',
+    f.system === null
+      ? 'no system byte (external remote or a receiver that sends none)'
+      : `${hex(f.system)}${sys ? ` ${sys.name}` : ' (not a valid system byte)'}`,
+  );
+  const byte0 =
+    f.headerMode === 'rssi' ? 'RSSI in dBm, SPM4649T' : f.headerMode === 'unknown' ? 'fades or RSSI, not yet known' : 'UINT8 fades';
   add('Remote', f.remote === 'internal' ? `internal (byte 0 = ${byte0})` : 'external (bytes 0–1 = UINT16 fades)');
   add('Resolution', `${f.resolution ?? '?'} — ${f.explanation}`);
   const d = s.decoder;
-  add('Frames', `${d.frames} (${d.discardedBytes} bytes discarded, ${d.resyncs} resyncs, ${d.badFrames} bad frames, ${d.emptySlots} empty slots${d.vtxFrames ? `, ${d.vtxFrames} VTX frames` : ''})`);
+  add(
+    'Frames',
+    `${d.frames} (${d.discardedBytes} bytes discarded, ${d.resyncs} resyncs, ${d.badFrames} bad frames, ${d.emptySlots} empty slots${d.vtxFrames ? `, ${d.vtxFrames} VTX frames` : ''})`,
+  );
   if (s.formatChanges > 0) add('', `the format changed ${s.formatChanges} time(s) during the capture`);
   add('Channels', s.channels.length === 0 ? 'none' : '');
-  for (const c of s.channels) lines.push(`  ${String(c.id).padStart(2)} ${c.name.padEnd(9)} ${String(c.frames).padStart(7)} frames  ${c.minUs}–${c.maxUs} µs  last ${c.lastUs} µs`);
+  for (const c of s.channels)
+    lines.push(
+      `  ${String(c.id).padStart(2)} ${c.name.padEnd(9)} ${String(c.frames).padStart(7)} frames  ${c.minUs}–${c.maxUs} µs  last ${c.lastUs} µs`,
+    );
   const l = s.link;
   const jumps = d.fadeJumps > 0 ? `; ${d.fadeJumps} implausible jump${d.fadeJumps === 1 ? '' : 's'} of the fade count not counted` : '';
   if (f.headerMode === 'rssi') add('RSSI', `last ${l.rssi} dBm, lowest ${l.minRssi} dBm`);
   else add('Fades', `${l.fades}${timed ? ` (${(l.fades / Math.max(s.durationUs / 60e6, 1e-9)).toFixed(1)} per minute)` : ''}${jumps}`);
   if (timed) {
-    add('Frame period', Number.isFinite(l.periodUs) ? `${ms(l.periodUs)} measured (${ms(l.nominalPeriodUs)} nominal)` : 'too few frames to measure');
+    add(
+      'Frame period',
+      Number.isFinite(l.periodUs) ? `${ms(l.periodUs)} measured (${ms(l.nominalPeriodUs)} nominal)` : 'too few frames to measure',
+    );
     add('Gaps', `${l.missedFrames} missed frames, longest gap ${ms(l.longestGapUs)}`);
     add('Failsafe', `${l.holds} holds, ${l.failsafes} failsafes`);
     for (const e of s.episodes) {

@@ -40,7 +40,14 @@ function load(file: string): Capture {
     bytes = readFileSync(file);
   } catch (error) {
     const code = (error as NodeJS.ErrnoException).code;
-    const why = code === 'ENOENT' ? 'no such file' : code === 'EISDIR' ? 'it is a directory' : code === 'EACCES' ? 'permission denied' : String(error);
+    const why =
+      code === 'ENOENT'
+        ? 'no such file'
+        : code === 'EISDIR'
+          ? 'it is a directory'
+          : code === 'EACCES'
+            ? 'permission denied'
+            : String(error);
     throw new UsageError(`cannot read ${file}: ${why}`);
   }
   const capture = readCapture(new Uint8Array(bytes.buffer, bytes.byteOffset, bytes.byteLength), basename(file));
@@ -156,11 +163,15 @@ async function decode(capture: Capture, args: Args, port: number, out: TextOutpu
   if (out.stopped) return finish(out, 0);
   const s = decoder.stats;
   if (s.frames === 0) {
-    process.stderr.write(`satscope: ${args.file}: no Spektrum frames found in ${s.bytes} bytes on port ${port} (is this the satellite's DATA line at 115200 baud?)\n`);
+    process.stderr.write(
+      `satscope: ${args.file}: no Spektrum frames found in ${s.bytes} bytes on port ${port} (is this the satellite's DATA line at 115200 baud?)\n`,
+    );
     return 1;
   }
   if (s.discardedBytes > 0) {
-    process.stderr.write(`satscope: ${args.file}: ${s.frames} frames; ${s.discardedBytes} bytes discarded (partial, truncated or corrupted frames), ${s.resyncs} resyncs\n`);
+    process.stderr.write(
+      `satscope: ${args.file}: ${s.frames} frames; ${s.discardedBytes} bytes discarded (partial, truncated or corrupted frames), ${s.resyncs} resyncs\n`,
+    );
   }
   return 0;
 }
@@ -188,7 +199,14 @@ async function report(capture: Capture, args: Args, out: TextOutput): Promise<nu
       writeFileSync(args.out, text);
     } catch (error) {
       const code = (error as NodeJS.ErrnoException).code;
-      const why = code === 'ENOENT' ? 'no such directory' : code === 'EISDIR' ? 'it is a directory' : code === 'EACCES' ? 'permission denied' : String(error);
+      const why =
+        code === 'ENOENT'
+          ? 'no such directory'
+          : code === 'EISDIR'
+            ? 'it is a directory'
+            : code === 'EACCES'
+              ? 'permission denied'
+              : String(error);
       process.stderr.write(`satscope: cannot write ${args.out}: ${why}\n`);
       return Promise.resolve(2);
     }
@@ -198,7 +216,9 @@ async function report(capture: Capture, args: Args, out: TextOutput): Promise<nu
   }
   const frames = r.remotes.reduce((n, x) => n + x.frames, 0);
   if (frames === 0) {
-    process.stderr.write(`satscope: ${args.file}: no Spektrum frames found in ${r.source.bytes} bytes (is this the satellite's DATA line at 115200 baud?)\n`);
+    process.stderr.write(
+      `satscope: ${args.file}: no Spektrum frames found in ${r.source.bytes} bytes (is this the satellite's DATA line at 115200 baud?)\n`,
+    );
     return finish(out, 1);
   }
   return finish(out, 0);

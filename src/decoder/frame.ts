@@ -3,8 +3,15 @@
  * filling the reusable `DecodedFrame`. Pure functions over a byte array and an offset.
  */
 import {
-  EMPTY_SLOT, MASK_1024_SXPOS, MASK_2048_PHASE, MASK_2048_SXPOS, MAX_NORMAL_CHANNEL,
-  SLOTS_PER_FRAME, XPLUS_CHANNEL_ID, XPLUS_FIRST, type Resolution,
+  EMPTY_SLOT,
+  MASK_1024_SXPOS,
+  MASK_2048_PHASE,
+  MASK_2048_SXPOS,
+  MAX_NORMAL_CHANNEL,
+  SLOTS_PER_FRAME,
+  XPLUS_CHANNEL_ID,
+  XPLUS_FIRST,
+  type Resolution,
 } from './spec.js';
 import type { DecodedFrame, VtxControl } from './types.js';
 
@@ -53,9 +60,7 @@ export const INVALID = -1;
  * test keeps apart two X-Plus words X+5…X+8 (also 0xE…, but only sent in phase-1 frames).
  */
 export function isVtxFrame(b: Uint8Array, o: number): boolean {
-  return ((b[o + 12] as number) & 0xf0) === 0xe0 &&
-    ((b[o + 14] as number) & 0xf0) === 0xe0 &&
-    ((b[o + 2] as number) & 0x80) === 0;
+  return ((b[o + 12] as number) & 0xf0) === 0xe0 && ((b[o + 14] as number) & 0xf0) === 0xe0 && ((b[o + 2] as number) & 0x80) === 0;
 }
 
 /**
@@ -111,10 +116,21 @@ export function countZeroWords(b: Uint8Array, o: number): number {
 /** A fresh, empty `DecodedFrame` whose arrays the decoder reuses. */
 export function createFrame(): DecodedFrame {
   return {
-    index: -1, offset: 0, timeUs: NaN, remote: 'external', system: null, resolution: 2048,
-    fades: null, fadesDelta: 0, rssi: null, count: 0,
-    ids: new Uint8Array(SLOTS_PER_FRAME), positions: new Uint16Array(SLOTS_PER_FRAME),
-    words: new Uint16Array(SLOTS_PER_FRAME), vtx: null, bytes: new Uint8Array(16),
+    index: -1,
+    offset: 0,
+    timeUs: NaN,
+    remote: 'external',
+    system: null,
+    resolution: 2048,
+    fades: null,
+    fadesDelta: 0,
+    rssi: null,
+    count: 0,
+    ids: new Uint8Array(SLOTS_PER_FRAME),
+    positions: new Uint16Array(SLOTS_PER_FRAME),
+    words: new Uint16Array(SLOTS_PER_FRAME),
+    vtx: null,
+    bytes: new Uint8Array(16),
   };
 }
 
@@ -128,7 +144,14 @@ export function createVtx(): VtxControl {
  * The slots must have passed `slotLayout` under the same resolution; `vtx` is what
  * `isVtxFrame` said. Returns the number of empty slots.
  */
-export function readSlots(frame: DecodedFrame, b: Uint8Array, o: number, resolution: Resolution, vtx: boolean, vtxStore: VtxControl): number {
+export function readSlots(
+  frame: DecodedFrame,
+  b: Uint8Array,
+  o: number,
+  resolution: Resolution,
+  vtx: boolean,
+  vtxStore: VtxControl,
+): number {
   const bytes = frame.bytes;
   for (let i = 0; i < 16; i++) bytes[i] = b[o + i] as number;
   return decodeSlots(frame, b, o, resolution, vtx, vtxStore);
@@ -139,7 +162,14 @@ export function readSlots(frame: DecodedFrame, b: Uint8Array, o: number, resolut
  * decoder's hottest function: plain byte arithmetic on the Uint8Array and table lookups, no
  * DataView calls.
  */
-export function decodeSlots(frame: DecodedFrame, b: Uint8Array, o: number, resolution: Resolution, vtx: boolean, vtxStore: VtxControl): number {
+export function decodeSlots(
+  frame: DecodedFrame,
+  b: Uint8Array,
+  o: number,
+  resolution: Resolution,
+  vtx: boolean,
+  vtxStore: VtxControl,
+): number {
   const { ids, positions, words } = frame;
   const channels = resolution === 2048 ? CHANNEL_2048 : CHANNEL_1024;
   const slots = vtx ? SLOTS_PER_FRAME - 2 : SLOTS_PER_FRAME;
@@ -157,12 +187,14 @@ export function decodeSlots(frame: DecodedFrame, b: Uint8Array, o: number, resol
     const channel = channels[hi] as number;
     ids[count] = channel;
     // §8.6: an X-Plus slot's 9 bits scale to 11; otherwise the position is the low 10 or 11 bits.
-    positions[count] = resolution === 1024 ? word & MASK_1024_SXPOS : channel >= XPLUS_FIRST ? (word & 0x01ff) << 2 : word & MASK_2048_SXPOS;
+    positions[count] =
+      resolution === 1024 ? word & MASK_1024_SXPOS : channel >= XPLUS_FIRST ? (word & 0x01ff) << 2 : word & MASK_2048_SXPOS;
     count++;
   }
   frame.count = count;
   if (vtx) {
-    const raw = (((b[o + 12] as number) << 24) | ((b[o + 13] as number) << 16) | ((b[o + 14] as number) << 8) | (b[o + 15] as number)) >>> 0;
+    const raw =
+      (((b[o + 12] as number) << 24) | ((b[o + 13] as number) << 16) | ((b[o + 14] as number) << 8) | (b[o + 15] as number)) >>> 0;
     vtxStore.raw = raw;
     vtxStore.band = (raw >>> 21) & 0x07;
     vtxStore.channel = (raw >>> 16) & 0x0f;
@@ -175,4 +207,3 @@ export function decodeSlots(frame: DecodedFrame, b: Uint8Array, o: number, resol
   }
   return empty;
 }
-

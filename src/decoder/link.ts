@@ -342,8 +342,21 @@ export class LinkMonitor {
   #lastInterval = NaN;
   #finished = false;
   readonly #stats: LinkStats = {
-    frames: 0, fades: 0, missedFrames: 0, missedBasis: 'none', lostFrames: 0, holds: 0, failsafes: 0, periodUs: NaN,
-    nominalPeriodUs: NaN, fadeRate: 0, longestGapUs: 0, rssi: NaN, minRssi: NaN, deliveryDelayUs: NaN, deliveryJitterUs: NaN,
+    frames: 0,
+    fades: 0,
+    missedFrames: 0,
+    missedBasis: 'none',
+    lostFrames: 0,
+    holds: 0,
+    failsafes: 0,
+    periodUs: NaN,
+    nominalPeriodUs: NaN,
+    fadeRate: 0,
+    longestGapUs: 0,
+    rssi: NaN,
+    minRssi: NaN,
+    deliveryDelayUs: NaN,
+    deliveryJitterUs: NaN,
   };
 
   /** @throws {TypeError} when a duration is not a positive finite number. */
@@ -488,7 +501,7 @@ export class LinkMonitor {
     if (l.closes === this.#closesSeen) return;
     this.#closesSeen = l.closes;
     const p = this.#stats.nominalPeriodUs;
-    for (let i = 0; i < this.#unconfirmed.length;) {
+    for (let i = 0; i < this.#unconfirmed.length; ) {
       const { episode: e, endFades } = this.#unconfirmed[i] as { episode: LinkEpisode; endFades: number };
       if (!(e.lastFrameUs < l.closedPunctualUs) || e.endUs === null) {
         i++;

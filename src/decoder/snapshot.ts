@@ -40,8 +40,17 @@ export function copyFrame(frame: DecodedFrame): FrameSnapshot {
     channels.push({ id, pos, us: servoToMicros(pos, channelResolution(id, frame.resolution)) });
   }
   return {
-    index: frame.index, offset: frame.offset, timeUs: frame.timeUs, remote: frame.remote,
-    system: frame.system, resolution: frame.resolution, fades: frame.fades, fadesDelta: frame.fadesDelta,
-    rssi: frame.rssi, channels, vtx: frame.vtx === null ? null : { ...frame.vtx }, bytes: frame.bytes.slice(),
+    index: frame.index,
+    offset: frame.offset,
+    timeUs: frame.timeUs,
+    remote: frame.remote,
+    system: frame.system,
+    resolution: frame.resolution,
+    fades: frame.fades,
+    fadesDelta: frame.fadesDelta,
+    rssi: frame.rssi,
+    channels,
+    vtx: frame.vtx === null ? null : { ...frame.vtx },
+    bytes: frame.bytes.slice(),
   };
 }

@@ -86,9 +86,26 @@ export const SYSTEM_TYPES: readonly SystemInfo[] = SYSTEMS;
 
 /** §8.5 and §8.6: channel names, 0–11 then X+1 … X+8. */
 export const CHANNEL_NAMES: readonly string[] = [
-  'Throttle', 'Aileron', 'Elevator', 'Rudder', 'Gear',
-  'Aux 1', 'Aux 2', 'Aux 3', 'Aux 4', 'Aux 5', 'Aux 6', 'Aux 7',
-  'X+1', 'X+2', 'X+3', 'X+4', 'X+5', 'X+6', 'X+7', 'X+8',
+  'Throttle',
+  'Aileron',
+  'Elevator',
+  'Rudder',
+  'Gear',
+  'Aux 1',
+  'Aux 2',
+  'Aux 3',
+  'Aux 4',
+  'Aux 5',
+  'Aux 6',
+  'Aux 7',
+  'X+1',
+  'X+2',
+  'X+3',
+  'X+4',
+  'X+5',
+  'X+6',
+  'X+7',
+  'X+8',
 ];
 
 /** The name of channel `id` (0–19), or `Ch N` outside that range. */

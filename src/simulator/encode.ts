@@ -116,7 +116,7 @@ export function vtxControl(v: VtxSettings): VtxControl {
  * (stricter than the spec module's `VTX_MASK` 0xE000E000 test, which looks at three bits).
  */
 export function isVtxRaw(raw: number): boolean {
-  return ((raw & VTX_MARKER_MASK) >>> 0) === VTX_MARKER;
+  return (raw & VTX_MARKER_MASK) >>> 0 === VTX_MARKER;
 }
 
 function writeSlots(words: ArrayLike<number>, out: Uint8Array, offset: number): void {
@@ -140,9 +140,7 @@ function target(out: Uint8Array | undefined, offset: number): Uint8Array {
 }
 
 /** Byte 0 of an internal remote: the fade counter (UINT8) or, on an SPM4649T, RSSI (INT8 dBm). */
-export type InternalHeader =
-  | { fades: number; rssi?: undefined; system: number }
-  | { rssi: number; fades?: undefined; system: number };
+export type InternalHeader = { fades: number; rssi?: undefined; system: number } | { rssi: number; fades?: undefined; system: number };
 
 /**
  * §8.3: an internal remote's frame: byte 0 = fades (UINT8) or RSSI (INT8, §8.3.1), byte 1 =
@@ -150,12 +148,7 @@ export type InternalHeader =
  * `offset` (a new 16-byte array by default) and returns it. `system` may be any byte, so that
  * receivers that send a wrong one can be simulated.
  */
-export function encodeInternalFrame(
-  header: InternalHeader,
-  words: ArrayLike<number>,
-  out?: Uint8Array,
-  offset = 0,
-): Uint8Array {
+export function encodeInternalFrame(header: InternalHeader, words: ArrayLike<number>, out?: Uint8Array, offset = 0): Uint8Array {
   const buf = target(out, offset);
   if (header.rssi !== undefined) checkInt('RSSI', header.rssi, -128, 127);
   else checkInt('fades', header.fades, 0, 0xff);

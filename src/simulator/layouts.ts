@@ -67,12 +67,7 @@ function withXPlus(slots: readonly LayoutSlot[], xplus: boolean): LayoutSlot[] {
  *
  * @throws RangeError when the combination does not exist.
  */
-export function channelLayout(
-  resolution: Resolution,
-  periodMs: 11 | 22,
-  channels: number,
-  xplus = false,
-): FrameLayout[] {
+export function channelLayout(resolution: Resolution, periodMs: 11 | 22, channels: number, xplus = false): FrameLayout[] {
   if (!Number.isInteger(channels) || channels < 1 || channels > 12) {
     throw new RangeError(`channels must be 1–12, got ${channels}`);
   }
@@ -107,10 +102,6 @@ export function channelLayout(
 /** A layout in the captures README's notation, e.g. `1p 5 2 3 0 7 6 / 1 5 2 3 4 8 9`. */
 export function describeLayout(layout: readonly FrameLayout[]): string {
   return layout
-    .map((f) =>
-      f.slots
-        .map((s, i) => (s === X ? 'X' : s === E ? '--' : String(s)) + (i === 0 && f.phase ? 'p' : ''))
-        .join(' '),
-    )
+    .map((f) => f.slots.map((s, i) => (s === X ? 'X' : s === E ? '--' : String(s)) + (i === 0 && f.phase ? 'p' : '')).join(' '))
     .join(' / ');
 }

@@ -33,7 +33,13 @@ export interface SerialFormat {
 }
 
 /** §7.1: what a satellite sends and what SatScope opens the port with. */
-export const UART_115200_8N1: Readonly<SerialFormat> = Object.freeze({ baudRate: BAUD_RATE, dataBits: 8, parity: 'none', stopBits: 1, inverted: false });
+export const UART_115200_8N1: Readonly<SerialFormat> = Object.freeze({
+  baudRate: BAUD_RATE,
+  dataBits: 8,
+  parity: 'none',
+  stopBits: 1,
+  inverted: false,
+});
 
 /** Bytes as a transmitter sends them: each byte's start-bit edge time, µs. */
 export interface Transmission {
@@ -91,11 +97,16 @@ function resolve(format: SerialFormat): Resolved {
   const dataBits = format.dataBits ?? 8;
   if (dataBits !== 7 && dataBits !== 8) throw new RangeError(`dataBits must be 7 or 8, not ${String(dataBits)}`);
   const parity = format.parity ?? 'none';
-  if (parity !== 'none' && parity !== 'even' && parity !== 'odd') throw new RangeError(`parity must be none, even or odd, not ${String(parity)}`);
+  if (parity !== 'none' && parity !== 'even' && parity !== 'odd')
+    throw new RangeError(`parity must be none, even or odd, not ${String(parity)}`);
   const stopBits = format.stopBits ?? 1;
   if (stopBits !== 1 && stopBits !== 2) throw new RangeError(`stopBits must be 1 or 2, not ${String(stopBits)}`);
   return {
-    bitUs: 1e6 / baudRate, dataBits, parity, stopBits, inverted: format.inverted ?? false,
+    bitUs: 1e6 / baudRate,
+    dataBits,
+    parity,
+    stopBits,
+    inverted: format.inverted ?? false,
     frameBits: 1 + dataBits + (parity === 'none' ? 0 : 1) + stopBits,
   };
 }
@@ -162,7 +173,7 @@ class Sampler {
   level(t: number): 0 | 1 {
     const e = this.signal.edgesUs;
     while (this.#k < e.length && (e[this.#k] as number) <= t) this.#k++;
-    return ((this.signal.initial ^ (this.#k & 1)) as 0 | 1);
+    return (this.signal.initial ^ (this.#k & 1)) as 0 | 1;
   }
   /** First time ≥ t where the line falls (a high-to-low edge), or Infinity. */
   nextFall(t: number): number {
@@ -291,7 +302,12 @@ export interface StreamOptions {
  * Packets sent every `periodUs`, bytes back to back within a packet. `make(i, rng)` builds
  * packet i.
  */
-function packetStream(format: SerialFormat, options: StreamOptions, defaultPeriodUs: number, make: (index: number, rng: Prng) => Uint8Array): Transmission {
+function packetStream(
+  format: SerialFormat,
+  options: StreamOptions,
+  defaultPeriodUs: number,
+  make: (index: number, rng: Prng) => Uint8Array,
+): Transmission {
   const f = resolve(format);
   const period = options.periodUs ?? defaultPeriodUs;
   if (!(period > 0)) throw new RangeError(`periodUs must be positive, not ${period}`);
@@ -439,7 +455,13 @@ export function ibusStream(options: StreamOptions): Transmission {
 }
 
 /** SBUS's line setting: 100000 baud, 8 data bits, even parity, 2 stop bits, inverted. */
-export const SBUS_FORMAT: Readonly<SerialFormat> = Object.freeze({ baudRate: 100_000, dataBits: 8, parity: 'even', stopBits: 2, inverted: true });
+export const SBUS_FORMAT: Readonly<SerialFormat> = Object.freeze({
+  baudRate: 100_000,
+  dataBits: 8,
+  parity: 'even',
+  stopBits: 2,
+  inverted: true,
+});
 
 /**
  * SBUS: 0x0F, 16 channels of 11 bits packed LSB first in 22 bytes, a flags byte and 0x00;
@@ -461,7 +483,13 @@ export function sbusStream(options: StreamOptions): Transmission {
 }
 
 /** CRSF's line setting: 420000 baud 8N1, not inverted. */
-export const CRSF_FORMAT: Readonly<SerialFormat> = Object.freeze({ baudRate: 420_000, dataBits: 8, parity: 'none', stopBits: 1, inverted: false });
+export const CRSF_FORMAT: Readonly<SerialFormat> = Object.freeze({
+  baudRate: 420_000,
+  dataBits: 8,
+  parity: 'none',
+  stopBits: 1,
+  inverted: false,
+});
 
 /**
  * CRSF RC channels: 0xC8 (flight controller address), length 24, type 0x16, 16 channels of

@@ -1,12 +1,7 @@
 /**
  * Named scenarios for tests, fixtures and benchmarks, and the web app's demo.
  */
-import {
-  SYSTEM_DSM2_11MS_2048,
-  SYSTEM_DSM2_22MS_1024,
-  SYSTEM_DSMX_11MS_2048,
-  SYSTEM_DSMX_22MS_2048,
-} from '../decoder/spec.js';
+import { SYSTEM_DSM2_11MS_2048, SYSTEM_DSM2_22MS_1024, SYSTEM_DSMX_11MS_2048, SYSTEM_DSMX_22MS_2048 } from '../decoder/spec.js';
 import type { Scenario } from './scenario.js';
 
 /** A clone's byte time (88.6 µs instead of 86.8 µs; see the captures README). */
@@ -69,8 +64,21 @@ const PRESET_LIST: readonly Scenario[] = [
   { name: 'empty-slots-12ch', system: SYSTEM_DSMX_11MS_2048, channels: 12, seed: 116 },
   { name: 'empty-slots-22ms-5ch', system: SYSTEM_DSMX_22MS_2048, channels: 5, seed: 117 },
   // Fade counters starting just below their wrap.
-  { name: 'fade-wrap-internal', system: SYSTEM_DSMX_11MS_2048, channels: 7, fades: { start: 250, lossRate: 0.02, randomRate: 0.02 }, seed: 118 },
-  { name: 'fade-wrap-external', system: SYSTEM_DSMX_11MS_2048, remote: 'external', channels: 7, fades: { start: 65530, lossRate: 0.02, randomRate: 0.02 }, seed: 119 },
+  {
+    name: 'fade-wrap-internal',
+    system: SYSTEM_DSMX_11MS_2048,
+    channels: 7,
+    fades: { start: 250, lossRate: 0.02, randomRate: 0.02 },
+    seed: 118,
+  },
+  {
+    name: 'fade-wrap-external',
+    system: SYSTEM_DSMX_11MS_2048,
+    remote: 'external',
+    channels: 7,
+    fades: { start: 65530, lossRate: 0.02, randomRate: 0.02 },
+    seed: 119,
+  },
   // A short dropout (hold last) and one over a second (failsafe), then recovery.
   {
     name: 'dropouts-failsafe',

@@ -3,12 +3,7 @@
  * All times are µs; scenario event times (dropouts, X-Plus windows, VTX bursts) count from the
  * first frame slot, and repeat every `cycleUs` when that is set.
  */
-import {
-  BYTE_TIME_US,
-  CHANNEL_COUNT,
-  FRAME_SIZE,
-  systemInfo,
-} from '../decoder/spec.js';
+import { BYTE_TIME_US, CHANNEL_COUNT, FRAME_SIZE, systemInfo } from '../decoder/spec.js';
 import type { Resolution } from '../decoder/spec.js';
 import type { HeaderMode, RemoteKind } from '../decoder/types.js';
 import type { VtxSettings } from './encode.js';

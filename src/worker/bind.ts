@@ -27,7 +27,12 @@ export async function runBind(
   let keepOn: SerialOutputSignals = {};
   const done = (step: BindStep, text: string) => {
     const now = performance.now();
-    report({ step: step.action, text, atMs: Math.round(now - start), sincePowerOnMs: Number.isNaN(powerOnAt) ? null : Math.round((now - powerOnAt) * 10) / 10 });
+    report({
+      step: step.action,
+      text,
+      atMs: Math.round(now - start),
+      sincePowerOnMs: Number.isNaN(powerOnAt) ? null : Math.round((now - powerOnAt) * 10) / 10,
+    });
   };
   try {
     for (const step of steps) {
@@ -35,9 +40,12 @@ export async function runBind(
       // start: power-on from power-off (the satellite must be off long enough to reset), the
       // pulses and the reopen from power-on (they must land in the bind window).
       const offMs = -(steps.find((s) => s.action === 'power-off')?.sincePowerOnMs ?? 0);
-      const due = step.action === 'power-on' ? powerOffAt + offMs
-        : step.action === 'write' || step.action === 'reopen' ? powerOnAt + step.sincePowerOnMs
-          : start + step.atMs;
+      const due =
+        step.action === 'power-on'
+          ? powerOffAt + offMs
+          : step.action === 'write' || step.action === 'reopen'
+            ? powerOnAt + step.sincePowerOnMs
+            : start + step.atMs;
       await sleepUntil(due);
       switch (step.action) {
         case 'open':

@@ -178,7 +178,11 @@ export class Engine {
     const from = this.#nextBin;
     const n = Math.max(0, last - from);
     const out = {
-      t: new Float64Array(n), fadeRate: new Float32Array(n), rssi: new Float32Array(n), periodMs: new Float32Array(n), lost: new Float32Array(n),
+      t: new Float64Array(n),
+      fadeRate: new Float32Array(n),
+      rssi: new Float32Array(n),
+      periodMs: new Float32Array(n),
+      lost: new Float32Array(n),
     };
     for (let k = 0; k < n; k++) {
       const b = from + k;
@@ -208,7 +212,8 @@ export class Engine {
     const retracted = this.link.takeRetracted();
     for (const id of retracted) this.#sent.delete(id);
     const series = this.#takeSeries(now);
-    if (!this.#changed && before === this.link.state && episodes.length === 0 && retracted.length === 0 && series.t.length === 0) return null;
+    if (!this.#changed && before === this.link.state && episodes.length === 0 && retracted.length === 0 && series.t.length === 0)
+      return null;
     this.#changed = false;
     const l = this.link.stats;
     const s = this.decoder.stats;
@@ -220,10 +225,19 @@ export class Engine {
       seenUs: this.#seenUs.slice(),
       resolution: this.decoder.format.resolution,
       link: {
-        state: this.link.state, lastFrameUs: this.link.lastFrameUs, holds: l.holds, failsafes: l.failsafes,
-        periodUs: l.periodUs, nominalPeriodUs: l.nominalPeriodUs, fades: l.fades, fadeRate: l.fadeRate,
-        missedFrames: l.missedFrames, missedBasis: l.missedBasis, rssi: l.rssi,
-        deliveryDelayUs: l.deliveryDelayUs, deliveryJitterUs: l.deliveryJitterUs,
+        state: this.link.state,
+        lastFrameUs: this.link.lastFrameUs,
+        holds: l.holds,
+        failsafes: l.failsafes,
+        periodUs: l.periodUs,
+        nominalPeriodUs: l.nominalPeriodUs,
+        fades: l.fades,
+        fadeRate: l.fadeRate,
+        missedFrames: l.missedFrames,
+        missedBasis: l.missedBasis,
+        rssi: l.rssi,
+        deliveryDelayUs: l.deliveryDelayUs,
+        deliveryJitterUs: l.deliveryJitterUs,
       },
       mismatch: this.#mismatch,
       ended,
@@ -235,7 +249,15 @@ export class Engine {
     this.#frames = 0;
     return {
       batch,
-      transfer: [batch.positions.buffer, batch.seenUs.buffer, series.t.buffer, series.fadeRate.buffer, series.rssi.buffer, series.periodMs.buffer, series.lost.buffer] as ArrayBuffer[],
+      transfer: [
+        batch.positions.buffer,
+        batch.seenUs.buffer,
+        series.t.buffer,
+        series.fadeRate.buffer,
+        series.rssi.buffer,
+        series.periodMs.buffer,
+        series.lost.buffer,
+      ] as ArrayBuffer[],
     };
   }
 
@@ -261,5 +283,4 @@ export class Engine {
     if (this.#sent.size > 2 * all.length + 16) for (const id of this.#sent.keys()) if (id < oldest) this.#sent.delete(id);
     return out.reverse();
   }
-
 }

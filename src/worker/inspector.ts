@@ -108,7 +108,8 @@ export class InspectorLog {
    */
   constructor(capacity = 4096, rawBytes = 1 << 16) {
     if (!Number.isInteger(capacity) || capacity < 1) throw new RangeError(`capacity must be a positive integer, got ${capacity}`);
-    if (!Number.isInteger(rawBytes) || rawBytes < FRAME_SIZE) throw new RangeError(`rawBytes must be an integer ≥ ${FRAME_SIZE}, got ${rawBytes}`);
+    if (!Number.isInteger(rawBytes) || rawBytes < FRAME_SIZE)
+      throw new RangeError(`rawBytes must be an integer ≥ ${FRAME_SIZE}, got ${rawBytes}`);
     this.capacity = capacity;
     this.rawBytes = rawBytes;
     this.#kind = new Uint8Array(capacity);
@@ -186,8 +187,12 @@ export class InspectorLog {
         const reason = REASONS.indexOf(event.reason);
         // A run of discards (16 bytes at a time before a lock) reads better as one row.
         const last = this.#count > 0 ? (this.#first + this.#count - 1) % this.capacity : -1;
-        if (last >= 0 && this.#kind[last] === K_DISCARDED && this.#flags[last] === reason &&
-          (this.#offset[last] as number) + (this.#length[last] as number) === event.offset) {
+        if (
+          last >= 0 &&
+          this.#kind[last] === K_DISCARDED &&
+          this.#flags[last] === reason &&
+          (this.#offset[last] as number) + (this.#length[last] as number) === event.offset
+        ) {
           this.#length[last] = (this.#length[last] as number) + event.length;
           return;
         }
@@ -331,7 +336,8 @@ export class InspectorLog {
       const end = this.#chunkEnd[i] as number;
       const prevEnd = c > 0 ? (this.#chunkEnd[(c - 1) % CHUNKS] as number) : 0;
       if (x >= prevEnd && x < end) {
-        if (this.#chunkPerByte[i] === 1 && this.#rawTime !== null && x >= this.#end - this.rawBytes) return this.#rawTime[x % this.rawBytes] as number;
+        if (this.#chunkPerByte[i] === 1 && this.#rawTime !== null && x >= this.#end - this.rawBytes)
+          return this.#rawTime[x % this.rawBytes] as number;
         return (this.#chunkTime[i] as number) - (end - 1 - x) * BYTE_TIME_US;
       }
       if (x >= end) return NaN;

@@ -126,7 +126,10 @@ export class Recorder {
       bytes: this.#at,
       records: this.#records,
       durationUs: Number.isFinite(this.#firstUs) ? this.#lastUs - this.#firstUs : 0,
-      recovered: this.#recovered === null ? null : { name: this.#recovered.name, bytes: this.#recovered.bytes, createdAt: this.#recovered.createdAt },
+      recovered:
+        this.#recovered === null
+          ? null
+          : { name: this.#recovered.name, bytes: this.#recovered.bytes, createdAt: this.#recovered.createdAt },
       error: this.#error,
     };
   }
@@ -223,7 +226,7 @@ export class Recorder {
    * bytes alone (every intact record's data, in order).
    */
   async export(which: 'last' | 'recovered', what: 'sscap' | 'raw'): Promise<{ name: string; data: ArrayBuffer } | string> {
-    const name = which === 'last' ? this.#last : this.#recovered?.name ?? null;
+    const name = which === 'last' ? this.#last : (this.#recovered?.name ?? null);
     if (name === null || this.#dir === undefined) return which === 'last' ? 'Nothing recorded yet.' : 'No unfinished recording.';
     const file = await (await this.#dir.getFileHandle(name)).getFile();
     const data = await file.arrayBuffer();

@@ -11,7 +11,16 @@ import { type LinkSeries, decodeCapture, resolutionKey, timingJitterUs } from '.
 import { Engine } from './engine.js';
 import { Diagnosis } from './diagnosis.js';
 import { runBind } from './bind.js';
-import { REMOTE_LABELS, type BindProgress, type FromWorker, type Overview, type PortIdentity, type SourceKind, type SourceStatus, type ToWorker } from './protocol.js';
+import {
+  REMOTE_LABELS,
+  type BindProgress,
+  type FromWorker,
+  type Overview,
+  type PortIdentity,
+  type SourceKind,
+  type SourceStatus,
+  type ToWorker,
+} from './protocol.js';
 import { Recorder } from './recorder.js';
 import type { ReportReply, ReportRequest } from './report-worker.js';
 import { DemoSource } from './sources/demo.js';
@@ -71,7 +80,11 @@ let replayName = '';
 let replayBytes: Uint8Array | null = null;
 const recorder = new Recorder((recording) => post({ type: 'recording', recording }));
 /** The doctor for the session: findings to the page (diagnosis.ts). */
-const diagnosis = new Diagnosis(post, () => clockUs(), () => [...sources.values()].filter((s) => s.kind === 'serial' && s.state === 'reading').map((s) => s.id));
+const diagnosis = new Diagnosis(
+  post,
+  () => clockUs(),
+  () => [...sources.values()].filter((s) => s.kind === 'serial' && s.state === 'reading').map((s) => s.id),
+);
 
 function freeId(): number {
   let id = 0;
@@ -103,7 +116,13 @@ function clockRate(): number {
 /** Sends the list of sources when anything in it changed. */
 function sendSources(): void {
   const list: SourceStatus[] = [...sources.values()].map((s) => ({
-    id: s.id, label: s.label, kind: s.kind, state: s.state, name: s.name, clockRate: clockRate(), format: s.engine.decoder.format,
+    id: s.id,
+    label: s.label,
+    kind: s.kind,
+    state: s.state,
+    name: s.name,
+    clockRate: clockRate(),
+    format: s.engine.decoder.format,
   }));
   const key = JSON.stringify(list);
   if (key === lastSent) return;
@@ -130,12 +149,20 @@ function shareResolution(): void {
       s.engine.setResolution(key ?? 'auto', clockUs(), 'internal-remote');
       s.sharedKey = key;
       s.sharedAt = { frames: d.stats.frames, discarded: d.stats.discardedBytes };
-    } else if (s.sharedAt !== undefined && d.stats.frames === s.sharedAt.frames && d.stats.discardedBytes - s.sharedAt.discarded > REFUSE_AFTER_BYTES) {
+    } else if (
+      s.sharedAt !== undefined &&
+      d.stats.frames === s.sharedAt.frames &&
+      d.stats.discardedBytes - s.sharedAt.discarded > REFUSE_AFTER_BYTES
+    ) {
       // Its bytes do not read at that resolution (a remote of another system?): its own reading wins.
       s.engine.setResolution('auto', clockUs());
       s.refusedKey = key;
       s.sharedKey = undefined;
-      notice('warning', `Remote ${s.label} does not read at the internal remote's resolution`, `Its frames only make sense at the other resolution; it is decoded on its own (${key ?? ''} did not fit). Are both remotes bound to the same transmitter?`);
+      notice(
+        'warning',
+        `Remote ${s.label} does not read at the internal remote's resolution`,
+        `Its frames only make sense at the other resolution; it is decoded on its own (${key ?? ''} did not fit). Are both remotes bound to the same transmitter?`,
+      );
     }
   }
 }
@@ -149,8 +176,11 @@ function tellMismatch(s: Source): void {
   if (m === (s.toldMismatch ?? null)) return;
   s.toldMismatch = m;
   if (m === null || resolution === 'auto') return;
-  notice('warning', `Remote ${s.label}: forced ${resolution}: no frame matches; the stream looks like ${m}`,
-    `Nothing is counted as missed while no frame decodes. Choose Auto or ${m} to decode it again.`);
+  notice(
+    'warning',
+    `Remote ${s.label}: forced ${resolution}: no frame matches; the stream looks like ${m}`,
+    `Nothing is counted as missed while no frame decodes. Choose Auto or ${m} to decode it again.`,
+  );
 }
 
 /** Bytes an external remote may discard at the internal remote's resolution before it is given up. */
@@ -231,7 +261,8 @@ async function closeAll(): Promise<void> {
 function sameAdapter(a: PortIdentity | undefined, b: PortIdentity): boolean {
   if (a === undefined) return false;
   // USB IDs survive a replug (the place in getPorts() may not); without them, the place it is.
-  if (a.usbVendorId !== undefined || b.usbVendorId !== undefined) return a.usbVendorId === b.usbVendorId && a.usbProductId === b.usbProductId;
+  if (a.usbVendorId !== undefined || b.usbVendorId !== undefined)
+    return a.usbVendorId === b.usbVendorId && a.usbProductId === b.usbProductId;
   return a.index === b.index;
 }
 
@@ -277,7 +308,11 @@ async function openSerial(identity: PortIdentity, signals?: SerialOutputSignals)
       recorder.event('device lost', nowUs(), id);
       diagnosis.close(id);
       setState(source, 'lost');
-      notice('error', `Remote ${source.label}: the adapter was unplugged`, 'Reading stopped; everything recorded so far is kept. Plug it back in and it reconnects by itself.');
+      notice(
+        'error',
+        `Remote ${source.label}: the adapter was unplugged`,
+        'Reading stopped; everything recorded so far is kept. Plug it back in and it reconnects by itself.',
+      );
       if (reconnectTimer === undefined) reconnectTimer = setInterval(() => enqueue(reconnectLost), RECONNECT_MS);
     },
   });
@@ -355,9 +390,19 @@ async function bind(message: Extract<ToWorker, { type: 'bind' }>): Promise<void>
     return;
   }
   if (await openSerial(message.port, keepOn)) {
-    report({ step: 'live', text: 'reading at 115200: the satellite blinks until the transmitter binds, then frames appear', atMs: 0, sincePowerOnMs: null });
+    report({
+      step: 'live',
+      text: 'reading at 115200: the satellite blinks until the transmitter binds, then frames appear',
+      atMs: 0,
+      sincePowerOnMs: null,
+    });
   } else {
-    report({ step: 'failed', text: 'the pulses were sent, but the port could not be opened again at 115200', atMs: 0, sincePowerOnMs: null });
+    report({
+      step: 'failed',
+      text: 'the pulses were sent, but the port could not be opened again at 115200',
+      atMs: 0,
+      sincePowerOnMs: null,
+    });
   }
 }
 
@@ -405,13 +450,21 @@ function overviewOf(capture: Capture, ports: readonly number[]): { overview: Ove
     untimed.push(marks);
     for (const e of link.episodes) if (e.kind === 'failsafe') failsafe.push({ startUs: e.startUs, endUs: e.endUs ?? e.startUs });
     const info = decoder.format.system === null ? undefined : systemInfo(decoder.format.system);
-    if (Number.isNaN(periodUs)) periodUs = info ? (info.periodMs === 11 ? FRAME_PERIOD_11MS_US : FRAME_PERIOD_22MS_US) : decoder.format.resolution === 1024 ? FRAME_PERIOD_22MS_US : NaN;
+    if (Number.isNaN(periodUs))
+      periodUs = info
+        ? info.periodMs === 11
+          ? FRAME_PERIOD_11MS_US
+          : FRAME_PERIOD_22MS_US
+        : decoder.format.resolution === 1024
+          ? FRAME_PERIOD_22MS_US
+          : NaN;
   }
   if (Number.isNaN(periodUs)) periodUs = FRAME_PERIOD_11MS_US;
   if (capture.timing === 'none') {
     const usPerByte = periodUs / FRAME_SIZE;
     let bins = 0;
-    for (const marks of untimed) for (const m of marks) bins = Math.max(bins, Math.floor(((m.offset + FRAME_SIZE) * usPerByte) / BIN_US) + 1);
+    for (const marks of untimed)
+      for (const m of marks) bins = Math.max(bins, Math.floor(((m.offset + FRAME_SIZE) * usPerByte) / BIN_US) + 1);
     const t = Float64Array.from({ length: bins }, (_, b) => b * BIN_US);
     const fades = new Float32Array(bins);
     const lost = new Float32Array(bins);
@@ -451,13 +504,21 @@ function replayStatus(): void {
   post({
     type: 'replay',
     replay: {
-      name: replayName, kind: c.kind, timing: c.timing, startUs: replay.startUs, endUs: replay.endUs,
-      positionUs: replay.positionUs, playing: replay.playing, speed: replay.speed, frames, issues: c.issues.map((i) => i.message),
-      recordedTiming: replay.recordedTiming, ended: replay.ended,
+      name: replayName,
+      kind: c.kind,
+      timing: c.timing,
+      startUs: replay.startUs,
+      endUs: replay.endUs,
+      positionUs: replay.positionUs,
+      playing: replay.playing,
+      speed: replay.speed,
+      frames,
+      issues: c.issues.map((i) => i.message),
+      recordedTiming: replay.recordedTiming,
+      ended: replay.ended,
     },
   });
 }
-
 
 /** Fresh decodes for every port of the replayed capture. */
 function resetReplaySources(capture: Capture, ports: readonly number[]): void {
@@ -486,7 +547,11 @@ async function openReplay(name: string, data: ArrayBuffer): Promise<void> {
   replayName = name;
   replayBytes = new Uint8Array(data);
   if (capture.issues.length > 0) {
-    notice('warning', `${name}: ${capture.issues.length} damaged part(s) skipped`, `${capture.issues[0]?.message ?? ''} Every intact record is kept.`);
+    notice(
+      'warning',
+      `${name}: ${capture.issues.length} damaged part(s) skipped`,
+      `${capture.issues[0]?.message ?? ''} Every intact record is kept.`,
+    );
   }
   const { overview, periodUs } = overviewOf(capture, capturePorts(capture));
   const r = new ReplaySource(
@@ -512,7 +577,11 @@ async function openReplay(name: string, data: ArrayBuffer): Promise<void> {
   diagnosis.replay(capture, r.startUs);
   post({ type: 'overview', overview }, [overview.t.buffer, overview.fadeRate.buffer, overview.lost.buffer]);
   if (!r.recordedTiming) {
-    notice('info', `${name}: no recorded timing`, `Replayed at the receiver's pace (a frame every ${periodUs / 1000} ms). Holds, failsafes, lost frames and the frame period cannot be measured without the recorded times.`);
+    notice(
+      'info',
+      `${name}: no recorded timing`,
+      `Replayed at the receiver's pace (a frame every ${periodUs / 1000} ms). Holds, failsafes, lost frames and the frame period cannot be measured without the recorded times.`,
+    );
   }
   resetReplaySources(capture, r.ports);
   r.play();
@@ -543,7 +612,15 @@ function makeReport(bytes: Uint8Array, name: string, format: 'html' | 'json'): v
       return;
     }
     const base = (name.replace(/\.[^.]+$/, '') || 'satscope').replace(/[^\w.-]+/g, '-');
-    post({ type: 'export-ready', name: `${base}.report.${format}`, mime: format === 'html' ? 'text/html' : 'application/json', data: reply.data }, [reply.data]);
+    post(
+      {
+        type: 'export-ready',
+        name: `${base}.report.${format}`,
+        mime: format === 'html' ? 'text/html' : 'application/json',
+        data: reply.data,
+      },
+      [reply.data],
+    );
   });
   const request: ReportRequest = { bytes: copy, name, format, resolution };
   helper.postMessage(request, [copy.buffer]);
@@ -590,15 +667,20 @@ async function handle(message: ToWorker): Promise<void> {
       // One entry per port number (= source id): the remote's label and its adapter.
       const ports = Array.from({ length: Math.max(...live.map((s) => s.id)) + 1 }, (_, id) => {
         const s = sources.get(id);
-        return s === undefined ? {} : { name: s.label, baudRate: 115200, usbVendorId: s.identity?.usbVendorId, usbProductId: s.identity?.usbProductId };
+        return s === undefined
+          ? {}
+          : { name: s.label, baudRate: 115200, usbVendorId: s.identity?.usbVendorId, usbProductId: s.identity?.usbProductId };
       });
-      await recorder.start({
-        baudRate: 115200,
-        source: live[0]?.kind === 'demo' ? 'demo' : 'webserial',
-        usbVendorId: first?.usbVendorId,
-        usbProductId: first?.usbProductId,
-        ports,
-      }, new Date().toISOString());
+      await recorder.start(
+        {
+          baudRate: 115200,
+          source: live[0]?.kind === 'demo' ? 'demo' : 'webserial',
+          usbVendorId: first?.usbVendorId,
+          usbProductId: first?.usbProductId,
+          ports,
+        },
+        new Date().toISOString(),
+      );
       break;
     }
     case 'record-stop':
@@ -627,7 +709,11 @@ async function handle(message: ToWorker): Promise<void> {
         name = 'live session';
       }
       if (bytes === null) {
-        notice('warning', 'Nothing to report on yet', 'Record the live session (● Record) or open a capture; the report covers what was recorded.');
+        notice(
+          'warning',
+          'Nothing to report on yet',
+          'Record the live session (● Record) or open a capture; the report covers what was recorded.',
+        );
         break;
       }
       makeReport(bytes, name, message.format);
@@ -643,7 +729,8 @@ async function handle(message: ToWorker): Promise<void> {
         nowUs,
         event: (text, t) => recorder.event(text, t, s.id),
         data: (bytes, t) => recorder.data(bytes, t, s.id),
-        state: (state, name) => setState(s, state, name === undefined ? s.name.replace(/ at .*$/, ' at 115200 baud') : s.name.replace(/ at .*$/, ` ${name}`)),
+        state: (state, name) =>
+          setState(s, state, name === undefined ? s.name.replace(/ at .*$/, ' at 115200 baud') : s.name.replace(/ at .*$/, ` ${name}`)),
       });
       if (problem !== null) notice('warning', `Remote ${s.label}: could not listen at ${message.probe.baudRate} baud`, problem);
       break;

@@ -49,7 +49,9 @@ export async function shot(page: Page, name: string): Promise<string> {
 
 /** The µs value each channel bar on the page shows (0–11 and X-Plus), by channel name (NaN: no data). */
 export async function barValues(page: Page): Promise<Record<string, number>> {
-  return page.$$eval('.channels [role="meter"]', (bars) => Object.fromEntries(bars.map((b) => [b.getAttribute('aria-label'), Number(b.getAttribute('aria-valuenow') ?? NaN)])));
+  return page.$$eval('.channels [role="meter"]', (bars) =>
+    Object.fromEntries(bars.map((b) => [b.getAttribute('aria-label'), Number(b.getAttribute('aria-valuenow') ?? NaN)])),
+  );
 }
 
 /** Writes chunks as a .sscap file (as the recorder would), for replay tests. */

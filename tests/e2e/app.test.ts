@@ -13,7 +13,17 @@ import { channelName } from '../../src/decoder/index.js';
 import { CaptureWriter, capturePorts, parseCapture, readCapture } from '../../src/capture/index.js';
 import { decodeCapture, summarizeCapture } from '../../src/analysis/index.js';
 import { preset, simulate } from '../../src/simulator/index.js';
-import { SHARED_CAPTURES, SHOTS as SHOTS_DIR, barValues, browserUnavailable, shot, startApp, usbChunks, writeCapture, type AppSession } from './app-fixture.js';
+import {
+  SHARED_CAPTURES,
+  SHOTS as SHOTS_DIR,
+  barValues,
+  browserUnavailable,
+  shot,
+  startApp,
+  usbChunks,
+  writeCapture,
+  type AppSession,
+} from './app-fixture.js';
 
 const skip = browserUnavailable();
 if (skip !== null) console.warn(`skipping the page tests: ${skip}`);
@@ -39,7 +49,9 @@ async function open(query = ''): Promise<{ page: Page; errors: string[]; request
   const errors: string[] = [];
   const requests: string[] = [];
   page.on('pageerror', (e) => errors.push(e.message));
-  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
+  page.on('console', (m) => {
+    if (m.type() === 'error') errors.push(m.text());
+  });
   page.on('request', (r) => requests.push(r.url()));
   await page.goto(app.server.url(`/${query}`));
   return { page, errors, requests };
@@ -71,7 +83,9 @@ describe.skipIf(skip !== null)('the page', () => {
     await page.waitForTimeout(1500);
     await shot(page, 'live-demo');
     // Strict CSP, everything from this origin, no violation.
-    await expect(page.locator('meta[http-equiv="Content-Security-Policy"]').getAttribute('content')).resolves.toMatch(/default-src 'self'; script-src 'self'/);
+    await expect(page.locator('meta[http-equiv="Content-Security-Policy"]').getAttribute('content')).resolves.toMatch(
+      /default-src 'self'; script-src 'self'/,
+    );
     const origin = app.server.origin;
     expect(requests.filter((u) => !u.startsWith(origin) && !u.startsWith('blob:') && !u.startsWith('data:'))).toEqual([]);
     expect(errors).toEqual([]);
@@ -248,9 +262,15 @@ describe.skipIf(skip !== null)('the page', () => {
     const path = join(dir, 'damaged.sscap');
     writeCapture(path, usbChunks(sim.bytes, sim.timesUs));
     const expected = { discarded: [] as { offset: number; length: number }[], frames: [] as number[] };
-    const { decoder } = decodeCapture(readCapture(new Uint8Array(readFileSync(path)), 'd.sscap'), {
-      onEvent: (e) => { if (e.type === 'discarded') expected.discarded.push({ offset: e.offset, length: e.length }); },
-    }, (f) => expected.frames.push(f.offset));
+    const { decoder } = decodeCapture(
+      readCapture(new Uint8Array(readFileSync(path)), 'd.sscap'),
+      {
+        onEvent: (e) => {
+          if (e.type === 'discarded') expected.discarded.push({ offset: e.offset, length: e.length });
+        },
+      },
+      (f) => expected.frames.push(f.offset),
+    );
     expect(expected.discarded.length).toBeGreaterThan(2);
     const { page, errors } = await open('?demo=0');
     await replayFile(page, path);
@@ -259,11 +279,17 @@ describe.skipIf(skip !== null)('the page', () => {
     const rows = page.locator('.insp-body [role="row"]');
     await rows.first().waitFor();
     await page.waitForTimeout(600);
-    const shown = await rows.evaluateAll((els) => els.map((el) => ({ cls: el.className, offset: Number(el.children[1]?.textContent), text: el.textContent ?? '' })));
+    const shown = await rows.evaluateAll((els) =>
+      els.map((el) => ({ cls: el.className, offset: Number(el.children[1]?.textContent), text: el.textContent ?? '' })),
+    );
     const frames = shown.filter((r) => r.cls.includes('frame')).map((r) => r.offset);
     expect(frames).toEqual(expected.frames);
     // Every discard the library reports is shown at its offset (runs of one reason merged).
-    for (const d of expected.discarded) expect(shown.some((r) => r.cls.includes('discard') && r.offset <= d.offset && r.text.includes('discarded')), `discard at ${d.offset}`).toBe(true);
+    for (const d of expected.discarded)
+      expect(
+        shown.some((r) => r.cls.includes('discard') && r.offset <= d.offset && r.text.includes('discarded')),
+        `discard at ${d.offset}`,
+      ).toBe(true);
     expect(shown.some((r) => r.text.includes('resync'))).toBe(true);
     expect(decoder.stats.frames).toBe(frames.length);
     const panel = page.locator('.panel', { has: page.getByText('Frame inspector') }).last();
@@ -273,18 +299,29 @@ describe.skipIf(skip !== null)('the page', () => {
     await page.context().close();
   });
 
-  it('gives up the internal remote\'s resolution for a remote whose bytes do not read at it', async () => {
+  it("gives up the internal remote's resolution for a remote whose bytes do not read at it", async () => {
     const a = simulate({ ...preset('dsmx-11ms-2048-internal'), seed: 31 }, 2_000_000);
     const b = simulate({ ...preset('dsm2-22ms-1024-external'), seed: 32 }, 2_000_000);
     const writer = new CaptureWriter({ source: 'test', ports: [{ name: 'A' }, { name: 'B' }] });
-    const chunks = [...usbChunks(a.bytes, a.timesUs).map((c) => ({ ...c, port: 0 })), ...usbChunks(b.bytes, b.timesUs).map((c) => ({ ...c, port: 1 }))];
+    const chunks = [
+      ...usbChunks(a.bytes, a.timesUs).map((c) => ({ ...c, port: 0 })),
+      ...usbChunks(b.bytes, b.timesUs).map((c) => ({ ...c, port: 1 })),
+    ];
     const path = join(dir, 'mixed.sscap');
-    writeFileSync(path, Buffer.concat([writer.header(), ...chunks.sort((x, y) => x.timeUs - y.timeUs).map((c) => writer.data(c.bytes, c.timeUs, c.port))]));
+    writeFileSync(
+      path,
+      Buffer.concat([writer.header(), ...chunks.sort((x, y) => x.timeUs - y.timeUs).map((c) => writer.data(c.bytes, c.timeUs, c.port))]),
+    );
     const expectB = summarizeCapture(parseCapture(new Uint8Array(readFileSync(path))), { port: 1 });
     const { page } = await open('?demo=0');
     await replayFile(page, path);
     await page.getByRole('radio', { name: '4×' }).click();
-    await page.getByRole('alert').or(page.getByRole('status')).filter({ hasText: 'does not read at the internal remote' }).first().waitFor({ timeout: 10_000 });
+    await page
+      .getByRole('alert')
+      .or(page.getByRole('status'))
+      .filter({ hasText: 'does not read at the internal remote' })
+      .first()
+      .waitFor({ timeout: 10_000 });
     await page.getByRole('radio', { name: 'max' }).click();
     await page.locator('[data-testid="source-status"]', { hasText: '(end)' }).waitFor({ timeout: 20_000 });
     await page.getByTestId('remote-B').click();
@@ -313,7 +350,9 @@ describe.skipIf(skip !== null)('the page', () => {
   it('tells a browser without Web Serial what to do, and still runs the demo', async () => {
     const context = await app.browser.newContext({ viewport: { width: 1400, height: 1000 } });
     // What Firefox and Safari look like to the page.
-    await context.addInitScript(() => { delete (Navigator.prototype as unknown as { serial?: unknown }).serial; });
+    await context.addInitScript(() => {
+      delete (Navigator.prototype as unknown as { serial?: unknown }).serial;
+    });
     const page = await context.newPage();
     await page.goto(app.server.url('/?demo=0'));
     // The empty state says so before anything is pressed, and the button says it again.
@@ -341,7 +380,11 @@ describe.skipIf(skip !== null)('the page', () => {
 
   it('works offline once loaded: the service worker serves the page', async () => {
     const { page } = await open();
-    await page.waitForFunction(() => navigator.serviceWorker.controller !== null || navigator.serviceWorker.ready.then(() => true), undefined, { timeout: 10_000 });
+    await page.waitForFunction(
+      () => navigator.serviceWorker.controller !== null || navigator.serviceWorker.ready.then(() => true),
+      undefined,
+      { timeout: 10_000 },
+    );
     await page.evaluate(() => navigator.serviceWorker.ready);
     await page.reload();
     await page.context().setOffline(true);
@@ -349,5 +392,4 @@ describe.skipIf(skip !== null)('the page', () => {
     await page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor({ timeout: 10_000 });
     await page.context().close();
   });
-
 });

@@ -59,7 +59,10 @@ describe.skipIf(skip !== null)('binding a satellite', () => {
     await page.getByRole('button', { name: 'Bind on Serial port' }).click();
     const result = page.locator('.bind .progress li.live, .bind .progress li.failed');
     await result.first().waitFor({ timeout: 5000 });
-    await expect(page.locator('.bind .progress li.failed').count(), await page.locator('.bind .progress').textContent() ?? '').resolves.toBe(0);
+    await expect(
+      page.locator('.bind .progress li.failed').count(),
+      (await page.locator('.bind .progress').textContent()) ?? '',
+    ).resolves.toBe(0);
 
     // What reached the wire, in order, with the shim's and the pty's monotonic times.
     const changes = fake.signalChanges.slice(since).filter((c) => c.op === 'set');
@@ -83,7 +86,9 @@ describe.skipIf(skip !== null)('binding a satellite', () => {
     // After the reopen at 115200 the power line is asserted again, after the pulses.
     const again = changes.slice(onAt + 1).find((c) => c.requestToSend && c.tUs > pulses[0]!.tUs);
     expect(again).toBeDefined();
-    console.log(`[bind] off ${((on.tUs - off.tUs) / 1000).toFixed(1)} ms, pulses at t0 + ${writeMs.toFixed(1)} ms, power re-asserted at t0 + ${((again!.tUs - on.tUs) / 1000).toFixed(1)} ms`);
+    console.log(
+      `[bind] off ${((on.tUs - off.tUs) / 1000).toFixed(1)} ms, pulses at t0 + ${writeMs.toFixed(1)} ms, power re-asserted at t0 + ${((again!.tUs - on.tUs) / 1000).toFixed(1)} ms`,
+    );
 
     // The satellite, now bound as internal DSMX 11 ms, starts sending frames.
     const sim = simulate(preset('dsmx-11ms-2048-internal'), 1_500_000);

@@ -99,7 +99,9 @@ describe.skipIf(skip !== null)('honest states', () => {
     expect(end).toBe(span2);
     const state = await page.getByTestId('link-state').textContent();
     expect(state).toBe('Live');
-    await expect(page.locator('.link dd').nth(1).textContent()).resolves.toBe(`${summary.link.holds} holds · ${summary.link.failsafes} failsafes`);
+    await expect(page.locator('.link dd').nth(1).textContent()).resolves.toBe(
+      `${summary.link.holds} holds · ${summary.link.failsafes} failsafes`,
+    );
     await expect(page.getByTestId('count-missed').textContent()).resolves.toBe(String(summary.link.missedFrames));
     await shot(page, 'replay-ended');
     // The wall clock moving on changes nothing.
@@ -120,7 +122,10 @@ describe.skipIf(skip !== null)('honest states', () => {
     await page.getByRole('button', { name: 'Settings', exact: true }).click();
     await page.getByRole('combobox', { name: 'Resolution' }).selectOption('1024');
     await page.keyboard.press('Escape');
-    await page.getByTestId('link-hint').filter({ hasText: 'Forced 1024: no frame matches; the stream looks like 2048' }).waitFor({ timeout: 5000 });
+    await page
+      .getByTestId('link-hint')
+      .filter({ hasText: 'Forced 1024: no frame matches; the stream looks like 2048' })
+      .waitFor({ timeout: 5000 });
     await shot(page, 'forced-1024');
     await page.waitForTimeout(2500);
     await expect(page.getByTestId('link-state').textContent()).resolves.toBe('Waiting');

@@ -52,7 +52,9 @@ afterAll(async () => {
   rmSync(dir, { recursive: true, force: true });
 });
 
-async function open(options: { width?: number; height?: number; scheme?: 'light' | 'dark'; query?: string } = {}): Promise<{ page: Page; errors: string[] }> {
+async function open(
+  options: { width?: number; height?: number; scheme?: 'light' | 'dark'; query?: string } = {},
+): Promise<{ page: Page; errors: string[] }> {
   const context = await app.browser.newContext({
     viewport: { width: options.width ?? 1280, height: options.height ?? 800 },
     colorScheme: options.scheme ?? 'dark',
@@ -61,7 +63,9 @@ async function open(options: { width?: number; height?: number; scheme?: 'light'
   const page = await context.newPage();
   const errors: string[] = [];
   page.on('pageerror', (e) => errors.push(e.message));
-  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
+  page.on('console', (m) => {
+    if (m.type() === 'error') errors.push(m.text());
+  });
   await page.goto(app.server.url(`/${options.query ?? ''}`));
   return { page, errors };
 }
@@ -88,7 +92,10 @@ async function overflowing(page: Page): Promise<string[]> {
       let clipped = false;
       while (p !== null && p !== document.body) {
         const o = getComputedStyle(p).overflowX;
-        if (o === 'auto' || o === 'scroll' || o === 'hidden' || o === 'clip') { clipped = true; break; }
+        if (o === 'auto' || o === 'scroll' || o === 'hidden' || o === 'clip') {
+          clipped = true;
+          break;
+        }
         p = p.parentElement;
       }
       if (!clipped) out.push(`${el.tagName.toLowerCase()}.${el.className} right=${Math.round(r.right)}`);
@@ -102,14 +109,28 @@ async function axe(page: Page, label: string): Promise<string[]> {
   const t0 = Date.now();
   await page.evaluate(AXE_SOURCE);
   const result = await page.evaluate(async () => {
-    const w = window as unknown as { axe: { run(ctx: Document, opts: object): Promise<{ violations: { id: string; impact: string; nodes: { target: string[] }[] }[]; passes: unknown[] }> } };
+    const w = window as unknown as {
+      axe: {
+        run(
+          ctx: Document,
+          opts: object,
+        ): Promise<{ violations: { id: string; impact: string; nodes: { target: string[] }[] }[]; passes: unknown[] }>;
+      };
+    };
     const r = await w.axe.run(document, { resultTypes: ['violations'] });
-    return { violations: r.violations.map((v) => ({ id: v.id, impact: v.impact, targets: v.nodes.map((n) => n.target.join(' ')) })), passes: r.passes.length };
+    return {
+      violations: r.violations.map((v) => ({ id: v.id, impact: v.impact, targets: v.nodes.map((n) => n.target.join(' ')) })),
+      passes: r.passes.length,
+    };
   });
   const byImpact: Record<string, number> = {};
   for (const v of result.violations) byImpact[v.impact] = (byImpact[v.impact] ?? 0) + v.targets.length;
-  console.log(`axe ${label} (${Date.now() - t0} ms): ${JSON.stringify(byImpact)} ${result.violations.map((v) => `${v.id}(${v.impact})`).join(' ')}`);
-  return result.violations.filter((v) => v.impact === 'serious' || v.impact === 'critical').map((v) => `${v.id}: ${v.targets.slice(0, 3).join(', ')}`);
+  console.log(
+    `axe ${label} (${Date.now() - t0} ms): ${JSON.stringify(byImpact)} ${result.violations.map((v) => `${v.id}(${v.impact})`).join(' ')}`,
+  );
+  return result.violations
+    .filter((v) => v.impact === 'serious' || v.impact === 'critical')
+    .map((v) => `${v.id}: ${v.targets.slice(0, 3).join(', ')}`);
 }
 
 async function demoRunning(page: Page): Promise<void> {
@@ -124,7 +145,7 @@ async function replayed(page: Page, path: string): Promise<void> {
   await page.locator('[data-testid="source-status"]', { hasText: '(end)' }).waitFor({ timeout: 20_000 });
 }
 
-describe('the graphs\' axes', () => {
+describe("the graphs' axes", () => {
   it('count time back from now in round steps, so the labels stay put as the window slides', () => {
     expect(timeStep(60, 600)).toBe(10);
     expect(timeStep(10, 600)).toBe(2);
@@ -174,7 +195,8 @@ describe.skipIf(skip !== null)('the page on any screen', () => {
     expect(text).toMatch(/black.*ground/s);
     expect(text).toMatch(/orange.*3\.3 V/s);
     expect(text).toMatch(/Never 5 V/);
-    for (const name of ['Connect receiver', 'Open capture…', 'Start demo']) await empty.getByRole('button', { name, exact: true }).waitFor();
+    for (const name of ['Connect receiver', 'Open capture…', 'Start demo'])
+      await empty.getByRole('button', { name, exact: true }).waitFor();
     // None of the views that have nothing to say.
     await expect(page.locator('.bar:not(.scale)').count()).resolves.toBe(0);
     await expect(page.getByText('no data').count()).resolves.toBe(0);
@@ -242,7 +264,10 @@ describe.skipIf(skip !== null)('the page on any screen', () => {
   it('keeps the toolbar on one row at 1280 px, with the rarer actions behind menus', async () => {
     const { page } = await open({ width: 1280, height: 800 });
     await demoRunning(page);
-    const rows = await page.$$eval('.toolbar > :not(.recovered)', (els) => new Set(els.map((e) => Math.round(e.getBoundingClientRect().top + e.getBoundingClientRect().height / 2))).size);
+    const rows = await page.$$eval(
+      '.toolbar > :not(.recovered)',
+      (els) => new Set(els.map((e) => Math.round(e.getBoundingClientRect().top + e.getBoundingClientRect().height / 2))).size,
+    );
     const height = await page.locator('.toolbar').evaluate((e) => e.getBoundingClientRect().height);
     console.log(`1280 toolbar: ${rows} distinct row centres, ${Math.round(height)} px high`);
     expect(height).toBeLessThan(56);
@@ -260,7 +285,9 @@ describe.skipIf(skip !== null)('the page on any screen', () => {
     await page.getByRole('combobox', { name: 'Resolution' }).waitFor();
     await page.keyboard.press('Escape');
     await expect(page.getByRole('combobox', { name: 'Resolution' }).count()).resolves.toBe(0);
-    await expect(page.getByRole('button', { name: 'Settings', exact: true }).evaluate((e) => e === document.activeElement)).resolves.toBe(true);
+    await expect(page.getByRole('button', { name: 'Settings', exact: true }).evaluate((e) => e === document.activeElement)).resolves.toBe(
+      true,
+    );
     await page.context().close();
   });
 
@@ -276,7 +303,11 @@ describe.skipIf(skip !== null)('the page on any screen', () => {
         const el = document.activeElement as HTMLElement | null;
         if (el === null || el === document.body) return null;
         const s = getComputedStyle(el);
-        return { inB: el.closest('[data-testid="remote-B"]') !== null && el.tagName === 'BUTTON', outline: `${s.outlineStyle} ${s.outlineWidth}`, text: el.textContent ?? '' };
+        return {
+          inB: el.closest('[data-testid="remote-B"]') !== null && el.tagName === 'BUTTON',
+          outline: `${s.outlineStyle} ${s.outlineWidth}`,
+          text: el.textContent ?? '',
+        };
       });
       if (focus === null) continue;
       outlines.push(focus.outline);
@@ -343,10 +374,13 @@ describe.skipIf(skip !== null)('the page on any screen', () => {
     await lost.focus();
     await page.keyboard.press('End');
     for (let i = 0; i < 10; i++) await page.keyboard.press('ArrowLeft');
-    const time = async () => Number(((await lost.locator('.u-legend .u-value').nth(0).textContent()) ?? '').replace('−', '-').replace(' s', ''));
+    const time = async () =>
+      Number(((await lost.locator('.u-legend .u-value').nth(0).textContent()) ?? '').replace('−', '-').replace(' s', ''));
     await expect.poll(time).toBeLessThan(-0.8);
     // The other graphs show the same time.
-    await expect.poll(async () => page.locator('.chart[data-chart="periodMs"] .u-legend .u-value').nth(0).textContent()).toBe(await lost.locator('.u-legend .u-value').nth(0).textContent());
+    await expect
+      .poll(async () => page.locator('.chart[data-chart="periodMs"] .u-legend .u-value').nth(0).textContent())
+      .toBe(await lost.locator('.u-legend .u-value').nth(0).textContent());
     await page.context().close();
   });
 
@@ -364,7 +398,10 @@ describe.skipIf(skip !== null)('the page on any screen', () => {
     expect(text).toContain(`${expected.vtxFrames} VTX frame`);
     if (expected.emptySlots > 0) expect(text).toContain(`${expected.emptySlots} empty slot`);
     // A decoded value never breaks across lines.
-    const broken = await page.$$eval('.inspector .summary .v', (els) => els.filter((e) => e.getClientRects().length > 1 || e.getBoundingClientRect().height > 24).length);
+    const broken = await page.$$eval(
+      '.inspector .summary .v',
+      (els) => els.filter((e) => e.getClientRects().length > 1 || e.getBoundingClientRect().height > 24).length,
+    );
     expect(broken).toBe(0);
     await page.locator('.inspector').screenshot({ path: join(SHOTS, 'ui-inspector-vtx-1280-dark.png') });
     expect(errors).toEqual([]);

@@ -56,7 +56,11 @@ class PortChunks {
   readonly #bytesBefore: Float64Array | undefined;
 
   /** @param usPerByte without timing, the pace bytes are played at (µs a byte); NaN with timing */
-  constructor(readonly capture: Capture, readonly port: number, readonly usPerByte: number) {
+  constructor(
+    readonly capture: Capture,
+    readonly port: number,
+    readonly usPerByte: number,
+  ) {
     const ports = capture.chunkPorts;
     let n = 0;
     const index = new Uint32Array(ports.length);
@@ -300,7 +304,8 @@ export class ReplaySource {
         const limit = Math.min(times.length, c.nextByte + 4096);
         let end = c.nextByte;
         while (end < limit && !((times[end] as number) > clockUs)) end++;
-        if (end > c.nextByte) this.#feed(c.port, chunk.bytes.subarray(c.nextByte, end), times.subarray(c.nextByte, end), times[end - 1] as number);
+        if (end > c.nextByte)
+          this.#feed(c.port, chunk.bytes.subarray(c.nextByte, end), times.subarray(c.nextByte, end), times[end - 1] as number);
         c.nextByte = end;
         if (end === times.length) {
           c.next++;

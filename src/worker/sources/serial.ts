@@ -48,11 +48,15 @@ export function openProblem(error: unknown): SerialProblem {
   if (name === 'NetworkError' || /failed to open/i.test(message)) {
     return {
       title: 'The port is busy',
-      detail: 'Another program or browser tab has it open (a serial monitor, a flight-controller configurator, another SatScope tab). Close it, then connect again.',
+      detail:
+        'Another program or browser tab has it open (a serial monitor, a flight-controller configurator, another SatScope tab). Close it, then connect again.',
     };
   }
   if (name === 'SecurityError' || name === 'NotAllowedError') {
-    return { title: 'Permission refused', detail: 'The browser did not allow this page to use the port. Connect again and allow it, or check the site settings.' };
+    return {
+      title: 'Permission refused',
+      detail: 'The browser did not allow this page to use the port. Connect again and allow it, or check the site settings.',
+    };
   }
   if (name === 'InvalidStateError') {
     return { title: 'The port is already open', detail: 'Disconnect first, then connect again.' };
@@ -66,7 +70,10 @@ export class SerialSource {
   #closing = false;
   #done: Promise<void> = Promise.resolve();
 
-  constructor(readonly nowUs: () => number, readonly events: SerialEvents) {}
+  constructor(
+    readonly nowUs: () => number,
+    readonly events: SerialEvents,
+  ) {}
 
   get port(): SerialPort | undefined {
     return this.#port;
@@ -77,8 +84,19 @@ export class SerialSource {
    * the line that powers the satellite). `line` is for the doctor's short listen at another
    * setting (default 115200 8N1). @throws the port's own error when it cannot be opened.
    */
-  async open(port: SerialPort, signals?: SerialOutputSignals, line: { baudRate?: number; parity?: ParityType; stopBits?: 1 | 2 } = {}): Promise<void> {
-    await port.open({ baudRate: line.baudRate ?? BAUD_RATE, dataBits: 8, stopBits: line.stopBits ?? 1, parity: line.parity ?? 'none', flowControl: 'none', bufferSize: 1 << 20 });
+  async open(
+    port: SerialPort,
+    signals?: SerialOutputSignals,
+    line: { baudRate?: number; parity?: ParityType; stopBits?: 1 | 2 } = {},
+  ): Promise<void> {
+    await port.open({
+      baudRate: line.baudRate ?? BAUD_RATE,
+      dataBits: 8,
+      stopBits: line.stopBits ?? 1,
+      parity: line.parity ?? 'none',
+      flowControl: 'none',
+      bufferSize: 1 << 20,
+    });
     if (signals !== undefined) {
       try {
         await port.setSignals(signals);

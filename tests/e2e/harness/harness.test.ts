@@ -161,7 +161,10 @@ describe.skipIf(!!skipReason)('e2e harness: real WebSerial on a pty in place of 
     await policy?.remove();
     await server?.close();
     if (dir) rmSync(dir, { recursive: true, force: true });
-    console.log('[e2e harness] timings (ms):', JSON.stringify(Object.fromEntries(Object.entries(timings).map(([k, v]) => [k, Math.round(v)]))));
+    console.log(
+      '[e2e harness] timings (ms):',
+      JSON.stringify(Object.fromEntries(Object.entries(timings).map(([k, v]) => [k, Math.round(v)]))),
+    );
   });
 
   it('lists exactly one port and delivers the bytes written into the pty, unchanged', async () => {

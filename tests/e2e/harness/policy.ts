@@ -21,7 +21,6 @@ export interface SerialPolicy {
   remove(): Promise<void>;
 }
 
-
 /** Rewrite the policy file from the live owners; delete it when there are none. Sync, no lock. */
 function rewrite(): string[] {
   mkdirSync(REGISTRY, { recursive: true });

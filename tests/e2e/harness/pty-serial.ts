@@ -434,10 +434,10 @@ export async function openFakeSerialPort(options: FakeSerialPortOptions = {}): P
     },
     async setInputSignals(s) {
       const bits =
-        (s.clearToSend ?? true ? 0x020 : 0) | // TIOCM_CTS
-        (s.dataSetReady ?? true ? 0x100 : 0) | // TIOCM_DSR
-        (s.dataCarrierDetect ?? true ? 0x040 : 0) | // TIOCM_CD
-        (s.ringIndicator ?? false ? 0x080 : 0); // TIOCM_RI
+        ((s.clearToSend ?? true) ? 0x020 : 0) | // TIOCM_CTS
+        ((s.dataSetReady ?? true) ? 0x100 : 0) | // TIOCM_DSR
+        ((s.dataCarrierDetect ?? true) ? 0x040 : 0) | // TIOCM_CD
+        ((s.ringIndicator ?? false) ? 0x080 : 0); // TIOCM_RI
       const p = Buffer.alloc(4);
       p.writeUInt32LE(bits);
       const ack = waitEvent((e) => e.type === 'signals-in', 'input signals');

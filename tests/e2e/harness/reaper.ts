@@ -66,11 +66,10 @@ let started = false;
 export function ensureReaper(paths: { lockDir: string; registry: string; policyFile: string; policyDir: string }): void {
   if (started) return;
   started = true;
-  const child = spawn(
-    'python3',
-    ['-c', REAPER, String(process.pid), paths.lockDir, paths.registry, paths.policyFile, paths.policyDir],
-    { stdio: ['pipe', 'ignore', 'ignore'], detached: true },
-  );
+  const child = spawn('python3', ['-c', REAPER, String(process.pid), paths.lockDir, paths.registry, paths.policyFile, paths.policyDir], {
+    stdio: ['pipe', 'ignore', 'ignore'],
+    detached: true,
+  });
   child.on('error', () => {
     /* no python3: in-process cleanup only */
   });

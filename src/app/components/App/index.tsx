@@ -67,29 +67,79 @@ export function App({ granted }: { granted: SerialPort[] }) {
   }, [replayName, replaySpan > 0]);
   return (
     <>
-      <Toolbar granted={granted} onBind={() => { binding.value = !binding.value; }} />
-      {binding.value ? <BindPanel granted={granted} onClose={() => { binding.value = false; }} /> : null}
+      <Toolbar
+        granted={granted}
+        onBind={() => {
+          binding.value = !binding.value;
+        }}
+      />
+      {binding.value ? (
+        <BindPanel
+          granted={granted}
+          onClose={() => {
+            binding.value = false;
+          }}
+        />
+      ) : null}
       <ReplayBar />
       <Notices />
-      {empty ? <main class="start"><EmptyState onBind={() => { binding.value = true; }} /></main> : (
-      <main class="grid">
-        {/* On a phone both columns dissolve into one, ordered by what matters first (style.css). */}
-        <aside class="side">
-          <div class="panel p-link"><LinkPanel windowUs={windowUs} /></div>
-          <div class="panel p-system"><h2>System</h2><SystemBadge /></div>
-          <div class="panel p-counters"><h2>Counters</h2><Counters /></div>
-        </aside>
-        <div class="main">
-          <div class="panel p-diagnosis" id="diagnosis"><DiagnosisPanel /></div>
-          {sources.value.length > 1 ? <div class="panel p-remotes"><Remotes windowUs={windowUs} /></div> : null}
-          <div class="panel p-channels"><h2>Channels{sources.value.length > 1 ? ` — remote ${status.value.label}` : ''}</h2><ChannelBars ids={NORMAL} label="Channels 0–11" /></div>
-          {xplusSeen.value ? <div class="panel p-xplus"><h2>X-Plus</h2><ChannelBars ids={XPLUS} label="X-Plus channels" /></div> : null}
-          <div class="panel p-graphs"><Graphs windowUs={windowUs} /></div>
-          <div class="panel p-inspector"><InspectorPanel /></div>
-        </div>
-      </main>
+      {empty ? (
+        <main class="start">
+          <EmptyState
+            onBind={() => {
+              binding.value = true;
+            }}
+          />
+        </main>
+      ) : (
+        <main class="grid">
+          {/* On a phone both columns dissolve into one, ordered by what matters first (style.css). */}
+          <aside class="side">
+            <div class="panel p-link">
+              <LinkPanel windowUs={windowUs} />
+            </div>
+            <div class="panel p-system">
+              <h2>System</h2>
+              <SystemBadge />
+            </div>
+            <div class="panel p-counters">
+              <h2>Counters</h2>
+              <Counters />
+            </div>
+          </aside>
+          <div class="main">
+            <div class="panel p-diagnosis" id="diagnosis">
+              <DiagnosisPanel />
+            </div>
+            {sources.value.length > 1 ? (
+              <div class="panel p-remotes">
+                <Remotes windowUs={windowUs} />
+              </div>
+            ) : null}
+            <div class="panel p-channels">
+              <h2>Channels{sources.value.length > 1 ? ` — remote ${status.value.label}` : ''}</h2>
+              <ChannelBars ids={NORMAL} label="Channels 0–11" />
+            </div>
+            {xplusSeen.value ? (
+              <div class="panel p-xplus">
+                <h2>X-Plus</h2>
+                <ChannelBars ids={XPLUS} label="X-Plus channels" />
+              </div>
+            ) : null}
+            <div class="panel p-graphs">
+              <Graphs windowUs={windowUs} />
+            </div>
+            <div class="panel p-inspector">
+              <InspectorPanel />
+            </div>
+          </div>
+        </main>
       )}
-      {dragging ? <div class="drop" aria-hidden="true">Drop a capture (.sscap, raw .bin, Saleae CSV) to replay it</div> : null}
+      {dragging ? (
+        <div class="drop" aria-hidden="true">
+          Drop a capture (.sscap, raw .bin, Saleae CSV) to replay it
+        </div>
+      ) : null}
     </>
   );
 }

@@ -71,79 +71,123 @@ export function BindPanel({ granted, onClose }: { granted: SerialPort[]; onClose
     <section class="bind panel" aria-label="Bind a satellite">
       <div class="bind-head">
         <h2>Bind a satellite</h2>
-        <button type="button" class="link" onClick={onClose}>Close</button>
+        <button type="button" class="link" onClick={onClose}>
+          Close
+        </button>
       </div>
       <div class="bind-grid">
         <div>
           <div class="table-scroll" tabIndex={0} role="region" aria-label="Bind modes">
-          <table class="modes">
-            <thead><tr><th><span class="sr-only">Choose</span></th><th>Pulses</th><th>Remote</th><th>Protocol</th><th>Reports</th></tr></thead>
-            <tbody>
-              {BIND_MODES.map((m) => (
-                <tr key={m.pulses} class={m.pulses === pulses ? 'on' : ''} onClick={() => setPulses(m.pulses)}>
-                  <td><input type="radio" name="bind-mode" aria-label={`${m.pulses} pulses`} checked={m.pulses === pulses} onChange={() => setPulses(m.pulses)} /></td>
-                  <td class="num">{m.pulses}</td>
-                  <td>{m.remote}</td>
-                  <td>{m.protocol} {m.periodMs} ms{m.recommended ? <em> recommended</em> : null}</td>
-                  <td>{m.remote === 'internal' ? `system ${hex(m.systemByte)}` : 'UINT16 fades'}</td>
+            <table class="modes">
+              <thead>
+                <tr>
+                  <th>
+                    <span class="sr-only">Choose</span>
+                  </th>
+                  <th>Pulses</th>
+                  <th>Remote</th>
+                  <th>Protocol</th>
+                  <th>Reports</th>
                 </tr>
-              ))}
-            </tbody>
-          </table>
+              </thead>
+              <tbody>
+                {BIND_MODES.map((m) => (
+                  <tr key={m.pulses} class={m.pulses === pulses ? 'on' : ''} onClick={() => setPulses(m.pulses)}>
+                    <td>
+                      <input
+                        type="radio"
+                        name="bind-mode"
+                        aria-label={`${m.pulses} pulses`}
+                        checked={m.pulses === pulses}
+                        onChange={() => setPulses(m.pulses)}
+                      />
+                    </td>
+                    <td class="num">{m.pulses}</td>
+                    <td>{m.remote}</td>
+                    <td>
+                      {m.protocol} {m.periodMs} ms{m.recommended ? <em> recommended</em> : null}
+                    </td>
+                    <td>{m.remote === 'internal' ? `system ${hex(m.systemByte)}` : 'UINT16 fades'}</td>
+                  </tr>
+                ))}
+              </tbody>
+            </table>
           </div>
           <p class="explain">
-            {mode?.description} Bind exactly one remote as <strong>internal</strong> (the A receiver: it negotiates
-            with the transmitter and its system byte tells every remote's format); bind all the others
-            as <strong>external</strong>, at the same time.
+            {mode?.description} Bind exactly one remote as <strong>internal</strong> (the A receiver: it negotiates with the transmitter and
+            its system byte tells every remote's format); bind all the others as <strong>external</strong>, at the same time.
           </p>
           <div class="controls">
-            <label>Power switched by
+            <label>
+              Power switched by
               <select value={powerLine} onChange={(e) => setPowerLine((e.currentTarget as HTMLSelectElement).value as PowerLine)}>
                 <option value="rts">RTS</option>
                 <option value="dtr">DTR</option>
               </select>
             </label>
-            <label>Satellite on when the line is
+            <label>
+              Satellite on when the line is
               <select value={polarity} onChange={(e) => setPolarity((e.currentTarget as HTMLSelectElement).value as PowerPolarity)}>
                 <option value="asserted">asserted (pin low, P-MOSFET)</option>
                 <option value="deasserted">deasserted (pin high)</option>
               </select>
             </label>
-            <label>Adapter
+            <label>
+              Adapter
               <select value={String(choice)} onChange={(e) => setChoice(Number((e.currentTarget as HTMLSelectElement).value))}>
-                {ports.map((_, i) => <option key={i} value={String(i)}>{optionLabel(i)}</option>)}
+                {ports.map((_, i) => (
+                  <option key={i} value={String(i)}>
+                    {optionLabel(i)}
+                  </option>
+                ))}
                 <option value={String(ANOTHER)}>{ports.length > 0 ? 'Another port…' : 'Choose when binding…'}</option>
               </select>
             </label>
           </div>
-          <p class="adapter" data-testid="bind-adapter">{preview.adapter}</p>
+          <p class="adapter" data-testid="bind-adapter">
+            {preview.adapter}
+          </p>
           <div class="table-scroll" tabIndex={0} role="region" aria-label="What the bind does">
-          <table class="timeline" aria-label="Bind timeline">
-            <thead><tr><th>When</th><th>Step</th><th>What happens</th></tr></thead>
-            <tbody>
-              {steps.map((s) => {
-                const p = plainStep(s, steps, pulses);
-                return (
-                  <tr key={s.action}>
-                    <td class="num">{sincePowerOn(s.sincePowerOnMs)}</td>
-                    <td class="step">{p.name}</td>
-                    <td class="note">{p.what}</td>
-                  </tr>
-                );
-              })}
-            </tbody>
-          </table>
+            <table class="timeline" aria-label="Bind timeline">
+              <thead>
+                <tr>
+                  <th>When</th>
+                  <th>Step</th>
+                  <th>What happens</th>
+                </tr>
+              </thead>
+              <tbody>
+                {steps.map((s) => {
+                  const p = plainStep(s, steps, pulses);
+                  return (
+                    <tr key={s.action}>
+                      <td class="num">{sincePowerOn(s.sincePowerOnMs)}</td>
+                      <td class="step">{p.name}</td>
+                      <td class="note">{p.what}</td>
+                    </tr>
+                  );
+                })}
+              </tbody>
+            </table>
           </div>
           <details class="technical">
             <summary>Technical details: the serial-port calls</summary>
             <p class="plan" data-testid="bind-plan">
-              Pulses: <code>{Array.from(plan.bytes, hex).join(' ')}</code> at {plan.baudRate} baud 8N{plan.stopBits}: each {Math.round(plan.lowUs[0] ?? 0)} µs low,
-              {' '}{Math.round(plan.highUs[0] ?? 0)} µs high, {(plan.totalUs / 1000).toFixed(2)} ms in all. Planned for
-              {' '}{plan.chipRates.map((c) => `${c.chip} (${Math.round(c.baudRate)} baud)`).join(', ')}{preview.chipsKnown ? '' : port === undefined ? ': the default chips, as no port is chosen yet' : ': the default chips, as the port\'s USB IDs name none'}.
+              Pulses: <code>{Array.from(plan.bytes, hex).join(' ')}</code> at {plan.baudRate} baud 8N{plan.stopBits}: each{' '}
+              {Math.round(plan.lowUs[0] ?? 0)} µs low, {Math.round(plan.highUs[0] ?? 0)} µs high, {(plan.totalUs / 1000).toFixed(2)} ms in
+              all. Planned for {plan.chipRates.map((c) => `${c.chip} (${Math.round(c.baudRate)} baud)`).join(', ')}
+              {preview.chipsKnown
+                ? ''
+                : port === undefined
+                  ? ': the default chips, as no port is chosen yet'
+                  : ": the default chips, as the port's USB IDs name none"}
+              .
             </p>
             <ol class="calls">
               {steps.map((s) => (
-                <li key={s.action}><span class="num">{sincePowerOn(s.sincePowerOnMs)}</span> <code>{s.action}</code>: {s.note}</li>
+                <li key={s.action}>
+                  <span class="num">{sincePowerOn(s.sincePowerOnMs)}</span> <code>{s.action}</code>: {s.note}
+                </li>
               ))}
             </ol>
           </details>
@@ -156,14 +200,20 @@ export function BindPanel({ granted, onClose }: { granted: SerialPort[]; onClose
             <ol class="progress" aria-label="Bind progress" aria-live="polite">
               {bindLog.value.map((p, i) => (
                 <li key={i} class={p.step}>
-                  <span class="num">{p.sincePowerOnMs === null ? '' : `t0 ${p.sincePowerOnMs >= 0 ? '+' : '−'} ${Math.abs(p.sincePowerOnMs)} ms`}</span> {p.text}
+                  <span class="num">
+                    {p.sincePowerOnMs === null ? '' : `t0 ${p.sincePowerOnMs >= 0 ? '+' : '−'} ${Math.abs(p.sincePowerOnMs)} ms`}
+                  </span>{' '}
+                  {p.text}
                 </li>
               ))}
             </ol>
           ) : null}
         </div>
         <figure class="wiring">
-          <img src={wiring} alt="Wiring: adapter TX through a diode and 470 Ω to the satellite's DATA, RX straight to DATA, RTS or DTR switching the satellite's 3.3 V through a P-MOSFET, grounds joined." />
+          <img
+            src={wiring}
+            alt="Wiring: adapter TX through a diode and 470 Ω to the satellite's DATA, RX straight to DATA, RTS or DTR switching the satellite's 3.3 V through a P-MOSFET, grounds joined."
+          />
           <figcaption>Wiring for binding (details in docs/bind-wiring.md). Use a 3.3 V adapter.</figcaption>
         </figure>
       </div>

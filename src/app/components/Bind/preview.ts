@@ -3,7 +3,16 @@
  * on the chosen port (the same `bindForAdapter` call, with the port's USB IDs), the adapter it
  * was made for, and each step as "Power off", "Power on", "9 pulses".
  */
-import { CHIP_NAMES, DEFAULT_CHIPS, bindForAdapter, type AdapterBind, type BindStep, type PowerLine, type PowerPolarity, type UsbIds } from '../../../bind/index.js';
+import {
+  CHIP_NAMES,
+  DEFAULT_CHIPS,
+  bindForAdapter,
+  type AdapterBind,
+  type BindStep,
+  type PowerLine,
+  type PowerPolarity,
+  type UsbIds,
+} from '../../../bind/index.js';
 
 export interface BindPreview extends AdapterBind {
   /** Which adapter the pulses were made for, and why, in plain words. */
@@ -23,8 +32,9 @@ export function bindPreview(pulses: number, usb: UsbIds | null, powerLine: Power
   const common = names(DEFAULT_CHIPS.map((c) => CHIP_NAMES[c]));
   let adapter: string;
   if (usb === null) {
-    adapter = `No port chosen yet, so these pulses are the ones that work on every common adapter (${common}). `
-      + 'Once you choose the port, they are made for its chip and shown here.';
+    adapter =
+      `No port chosen yet, so these pulses are the ones that work on every common adapter (${common}). ` +
+      'Once you choose the port, they are made for its chip and shown here.';
   } else if (!bind.chipsKnown) {
     adapter = `SatScope does not know this adapter's chip, so the pulses are the ones that work on every common adapter (${common}).`;
   } else if (chips.length > 1) {
@@ -56,6 +66,9 @@ export function plainStep(step: BindStep, steps: readonly BindStep[], pulses: nu
         what: `${pulses} short pulses on the DATA wire, ${(step.durationUs / 1000).toFixed(1)} ms in all: the satellite enters bind mode and its light blinks fast.`,
       };
     case 'reopen':
-      return { name: 'Back to reading', what: 'The adapter goes back to reading frames. Now put the transmitter in bind mode; frames appear once the bind takes.' };
+      return {
+        name: 'Back to reading',
+        what: 'The adapter goes back to reading frames. Now put the transmitter in bind mode; frames appear once the bind takes.',
+      };
   }
 }

@@ -91,13 +91,17 @@ export function ChannelBars({ ids, label }: { ids: number[]; label: string }) {
     <section class="channels" aria-label={label}>
       {/* The scale: the same columns as a bar, labels only over the track. */}
       <div class="bar scale" aria-hidden="true">
-        <span class="name" /><span class="id" />
+        <span class="name" />
+        <span class="id" />
         <div class="track-scale">
           <span style={{ left: left(1102) }}>−100 %</span>
           <span style={{ left: left(1500) }}>0</span>
           <span style={{ left: left(1898) }}>+100 %</span>
         </div>
-        <span class="us" /><span class="raw" /><span class="pct" /><span class="age" />
+        <span class="us" />
+        <span class="raw" />
+        <span class="pct" />
+        <span class="age" />
       </div>
       <div class="channel-list" ref={list}>
         {ids.map((id) => (

@@ -16,10 +16,20 @@ type Key = 'frames' | 'bytes' | 'resyncs' | 'discarded' | 'bad' | 'empty' | 'vtx
 const ROWS: readonly (readonly [Key, string, string, boolean])[] = [
   ['frames', 'Frames', 'Frames decoded.', false],
   ['bytes', 'Bytes', 'Bytes read from the port or the capture.', false],
-  ['resyncs', 'Resyncs', 'Times the decoder lost its place in the stream and found it again. Often: a loose DATA or ground wire, or the wrong baud rate.', true],
+  [
+    'resyncs',
+    'Resyncs',
+    'Times the decoder lost its place in the stream and found it again. Often: a loose DATA or ground wire, or the wrong baud rate.',
+    true,
+  ],
   ['discarded', 'Bytes discarded', 'Bytes that were not part of a frame: noise, or cut-off frames. Check the wiring and the ground.', true],
   ['bad', 'Bad frames', 'Frames with channel IDs that cannot be: noise on the line, or the wrong resolution forced in Settings.', true],
-  ['empty', 'Empty slots', 'Slots sent as 0xFFFF: the transmitter has fewer channels than the frame has room for. Normal with 6- or 7-channel setups.', false],
+  [
+    'empty',
+    'Empty slots',
+    'Slots sent as 0xFFFF: the transmitter has fewer channels than the frame has room for. Normal with 6- or 7-channel setups.',
+    false,
+  ],
   ['vtx', 'VTX frames', 'Frames carrying video-transmitter control instead of the last two channels (Spektrum VTX).', false],
   ['fades', 'Fades', 'Frames the receiver missed on the radio side (its own count); a rising rate means a weak or blocked antenna.', false],
   ['missed', 'Missed frames', 'Frames that should have arrived on the serial line and did not.', true],
@@ -72,15 +82,17 @@ export function Counters() {
     <section class="counters" aria-label="Counters">
       <dl ref={list}>
         {ROWS.map(([key, label, help]) => [
-          <dt key={`${key}-t`} title={help} hidden={key === 'empty' || key === 'vtx'}>{label}</dt>,
-          <dd key={key} data-key={key} data-testid={`count-${key}`} title={help} hidden={key === 'empty' || key === 'vtx'}>—</dd>,
+          <dt key={`${key}-t`} title={help} hidden={key === 'empty' || key === 'vtx'}>
+            {label}
+          </dt>,
+          <dd key={key} data-key={key} data-testid={`count-${key}`} title={help} hidden={key === 'empty' || key === 'vtx'}>
+            —
+          </dd>,
         ])}
       </dl>
       <details class="help">
         <summary>What these mean</summary>
-        <dl>
-          {ROWS.map(([key, label, help]) => [<dt key={`${key}-t`}>{label}</dt>, <dd key={key}>{help}</dd>])}
-        </dl>
+        <dl>{ROWS.map(([key, label, help]) => [<dt key={`${key}-t`}>{label}</dt>, <dd key={key}>{help}</dd>])}</dl>
       </details>
     </section>
   );

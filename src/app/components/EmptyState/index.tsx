@@ -22,17 +22,33 @@ function Wiring() {
     <svg class="wiring-svg" viewBox="0 0 340 186" role="img" aria-labelledby="wiring-title">
       <title id="wiring-title">Adapter 3.3 V to the orange wire, GND to the black wire, RX to the grey DATA wire. TX stays free.</title>
       <rect class="box" x="6" y="14" width="104" height="158" rx="8" />
-      <text class="box-title" x="58" y="32" text-anchor="middle">USB-serial</text>
-      <text class="box-sub" x="58" y="164" text-anchor="middle">set to 3.3 V</text>
+      <text class="box-title" x="58" y="32" text-anchor="middle">
+        USB-serial
+      </text>
+      <text class="box-sub" x="58" y="164" text-anchor="middle">
+        set to 3.3 V
+      </text>
       <rect class="box" x="236" y="14" width="98" height="158" rx="8" />
-      <text class="box-title" x="285" y="32" text-anchor="middle">Satellite</text>
+      <text class="box-title" x="285" y="32" text-anchor="middle">
+        Satellite
+      </text>
       {WIRES.map((w, i) => (
         <g key={w.cls}>
-          <text class="pin" x="100" y={(y[i] as number) + 18} text-anchor="end">{w.pin}</text>
+          <text class="pin" x="100" y={(y[i] as number) + 18} text-anchor="end">
+            {w.pin}
+          </text>
           <circle class="pad" cx="110" cy={(y[i] as number) + 14} r="4" />
-          <path class={`wire-edge`} d={`M110 ${(y[i] as number) + 14} C 170 ${(y[i] as number) + 14}, 180 ${(y[i] as number) + 14}, 236 ${(y[i] as number) + 14}`} />
-          <path class={`wire ${w.cls}`} d={`M110 ${(y[i] as number) + 14} C 170 ${(y[i] as number) + 14}, 180 ${(y[i] as number) + 14}, 236 ${(y[i] as number) + 14}`} />
-          <text class="pin" x="246" y={(y[i] as number) + 18}>{w.wire}</text>
+          <path
+            class={`wire-edge`}
+            d={`M110 ${(y[i] as number) + 14} C 170 ${(y[i] as number) + 14}, 180 ${(y[i] as number) + 14}, 236 ${(y[i] as number) + 14}`}
+          />
+          <path
+            class={`wire ${w.cls}`}
+            d={`M110 ${(y[i] as number) + 14} C 170 ${(y[i] as number) + 14}, 180 ${(y[i] as number) + 14}, 236 ${(y[i] as number) + 14}`}
+          />
+          <text class="pin" x="246" y={(y[i] as number) + 18}>
+            {w.wire}
+          </text>
         </g>
       ))}
     </svg>
@@ -43,7 +59,9 @@ export function EmptyState({ onBind }: { onBind(): void }) {
   const noSerial = serialUnavailable();
   return (
     <section class="empty panel" aria-labelledby="empty-title" data-testid="empty-state">
-      <h2 id="empty-title" class="empty-title">Connect a Spektrum satellite</h2>
+      <h2 id="empty-title" class="empty-title">
+        Connect a Spektrum satellite
+      </h2>
       <div class="empty-grid">
         <div class="empty-text">
           <ol class="steps">
@@ -51,35 +69,62 @@ export function EmptyState({ onBind }: { onBind(): void }) {
               <strong>Wire it</strong> to a <strong>3.3 V</strong> USB-serial adapter (FTDI, CP2102, CH340…):
               <table class="wires">
                 <caption class="sr-only">Wiring</caption>
-                <thead><tr><th scope="col">Satellite wire</th><th scope="col">Adapter pin</th></tr></thead>
+                <thead>
+                  <tr>
+                    <th scope="col">Satellite wire</th>
+                    <th scope="col">Adapter pin</th>
+                  </tr>
+                </thead>
                 <tbody>
                   {WIRES.map((w) => (
                     <tr key={w.cls}>
-                      <td><span class={`dot ${w.cls}`} aria-hidden="true" />{w.wire}: {w.what}</td>
-                      <td><strong>{w.pin}</strong></td>
+                      <td>
+                        <span class={`dot ${w.cls}`} aria-hidden="true" />
+                        {w.wire}: {w.what}
+                      </td>
+                      <td>
+                        <strong>{w.pin}</strong>
+                      </td>
                     </tr>
                   ))}
                 </tbody>
               </table>
-              <p class="warning" role="note"><strong>Never 5 V.</strong> The satellite runs on 3.3 V: 5 V on the orange wire or on DATA can destroy it. The adapter's TX stays free (it is only used to bind).</p>
+              <p class="warning" role="note">
+                <strong>Never 5 V.</strong> The satellite runs on 3.3 V: 5 V on the orange wire or on DATA can destroy it. The adapter's TX
+                stays free (it is only used to bind).
+              </p>
             </li>
             <li>
               <strong>Connect receiver</strong> and pick the adapter. Bars appear as soon as frames arrive.
-              {noSerial !== null ? <span class="note"> {noSerial.title}: {noSerial.detail}</span> : null}
+              {noSerial !== null ? (
+                <span class="note">
+                  {' '}
+                  {noSerial.title}: {noSerial.detail}
+                </span>
+              ) : null}
             </li>
             <li>
               Nothing arrives? A new satellite must be bound to the transmitter first:{' '}
-              <button type="button" class="link inline" onClick={onBind}>bind it from here</button>.
+              <button type="button" class="link inline" onClick={onBind}>
+                bind it from here
+              </button>
+              .
             </li>
           </ol>
           <div class="empty-actions">
-            <button type="button" class="primary" onClick={() => void chooseAndConnect(true)}>Connect receiver</button>
-            <button type="button" onClick={chooseCapture}>Open capture…</button>
-            <button type="button" onClick={() => send({ type: 'demo-start' })}>Start demo</button>
+            <button type="button" class="primary" onClick={() => void chooseAndConnect(true)}>
+              Connect receiver
+            </button>
+            <button type="button" onClick={chooseCapture}>
+              Open capture…
+            </button>
+            <button type="button" onClick={() => send({ type: 'demo-start' })}>
+              Start demo
+            </button>
           </div>
           <p class="muted small">
-            No receiver at hand? <strong>Start demo</strong> simulates two remotes; <strong>Open capture</strong> replays a
-            recording (.sscap, raw .bin or a Saleae CSV export), or drop the file anywhere on the page.
+            No receiver at hand? <strong>Start demo</strong> simulates two remotes; <strong>Open capture</strong> replays a recording
+            (.sscap, raw .bin or a Saleae CSV export), or drop the file anywhere on the page.
           </p>
         </div>
         <figure class="empty-figure">

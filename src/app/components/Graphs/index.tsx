@@ -12,7 +12,17 @@ import 'uplot/dist/uPlot.min.css';
 import { onFrame } from '../../frame-loop.js';
 import type { Live, SeriesBuffer } from '../../live.js';
 import { current, status } from '../../store.js';
-import { agoAxis, hoverCursor, keyboardCursor, legendTime, legendValue, showNewest, valueAxis, valueScale, type ValueScale } from '../../axes.js';
+import {
+  agoAxis,
+  hoverCursor,
+  keyboardCursor,
+  legendTime,
+  legendValue,
+  showNewest,
+  valueAxis,
+  valueScale,
+  type ValueScale,
+} from '../../axes.js';
 import { chartColors, theme } from '../../theme.js';
 import './style.css';
 
@@ -105,9 +115,11 @@ export function Graphs({ windowUs }: { windowUs: Signal<number> }) {
       return makeChart(box, spec, width(), sync);
     });
     const keys = charts.map((c) => keyboardCursor(c, c.root.parentElement as HTMLElement));
-    const resize = new ResizeObserver(() => charts.forEach((c) => {
-      c.setSize({ width: width(), height: HEIGHT });
-    }));
+    const resize = new ResizeObserver(() =>
+      charts.forEach((c) => {
+        c.setSize({ width: width(), height: HEIGHT });
+      }),
+    );
     resize.observe(el);
     let version = -1;
     let drawnAt = 0;
@@ -157,7 +169,16 @@ export function Graphs({ windowUs }: { windowUs: Signal<number> }) {
         <h2>Link over time</h2>
         <div class="window" role="radiogroup" aria-label="Window">
           {WINDOWS.map(([us, label]) => (
-            <button key={label} type="button" role="radio" aria-checked={windowUs.value === us} class={windowUs.value === us ? 'on' : ''} onClick={() => { windowUs.value = us; }}>
+            <button
+              key={label}
+              type="button"
+              role="radio"
+              aria-checked={windowUs.value === us}
+              class={windowUs.value === us ? 'on' : ''}
+              onClick={() => {
+                windowUs.value = us;
+              }}
+            >
               {label}
             </button>
           ))}

@@ -35,7 +35,11 @@ function hex(bytes: Uint8Array, from = 0, to = bytes.length): string {
 
 function FrameCells({ e }: { e: InspectEntry }) {
   if (e.bytes === null || e.bytes.length < 16) {
-    return <span role="cell" class="wide gone">bytes no longer held (older than the raw buffer)</span>;
+    return (
+      <span role="cell" class="wide gone">
+        bytes no longer held (older than the raw buffer)
+      </span>
+    );
   }
   const d = describeFrame(e.bytes, e.resolution ?? 2048, e.remote ?? 'internal', e.headerMode ?? 'fades');
   const b = e.bytes;
@@ -45,14 +49,24 @@ function FrameCells({ e }: { e: InspectEntry }) {
     <>
       <span role="cell" class="hexcell hexw">
         {d.header.map((h) => (
-          <span key={h.first} class={`g k-header${h.valid ? '' : ' k-invalid'}`} title={h.title} data-tag={h.label}>{hex(b, h.first, h.last + 1)}</span>
+          <span key={h.first} class={`g k-header${h.valid ? '' : ' k-invalid'}`} title={h.title} data-tag={h.label}>
+            {hex(b, h.first, h.last + 1)}
+          </span>
         ))}
         {d.slots.map((s) => (
-          <span key={s.first} class={`g k-${s.kind}`} title={s.title} data-tag={s.label}>{hex(b, s.first, s.last + 1)}</span>
+          <span key={s.first} class={`g k-${s.kind}`} title={s.title} data-tag={s.label}>
+            {hex(b, s.first, s.last + 1)}
+          </span>
         ))}
       </span>
       {/* One item per value, each unbreakable: a line breaks between values, never inside one. */}
-      <span role="cell" class="summary">{d.parts.map((p, i) => <span key={i} class="v">{p}</span>)}</span>
+      <span role="cell" class="summary">
+        {d.parts.map((p, i) => (
+          <span key={i} class="v">
+            {p}
+          </span>
+        ))}
+      </span>
     </>
   );
 }
@@ -62,23 +76,47 @@ function EventCells({ e }: { e: InspectEntry }) {
     case 'discarded':
       return (
         <span role="cell" class="wide">
-          <strong>discarded {e.length} byte{e.length === 1 ? '' : 's'}</strong> ({REASONS[e.reason ?? ''] ?? e.reason})
-          {e.bytes !== null
-            ? <span class="raw">{hex(e.bytes)}{e.truncated ? ` … (first ${e.bytes.length} shown)` : ''}</span>
-            : <span class="gone"> bytes no longer held</span>}
+          <strong>
+            discarded {e.length} byte{e.length === 1 ? '' : 's'}
+          </strong>{' '}
+          ({REASONS[e.reason ?? ''] ?? e.reason})
+          {e.bytes !== null ? (
+            <span class="raw">
+              {hex(e.bytes)}
+              {e.truncated ? ` … (first ${e.bytes.length} shown)` : ''}
+            </span>
+          ) : (
+            <span class="gone"> bytes no longer held</span>
+          )}
         </span>
       );
     case 'resync':
-      return <span role="cell" class="wide"><strong>resync</strong>: frames continue here (the bytes before did not fit the stream)</span>;
+      return (
+        <span role="cell" class="wide">
+          <strong>resync</strong>: frames continue here (the bytes before did not fit the stream)
+        </span>
+      );
     case 'locked':
-      return <span role="cell" class="wide"><strong>locked on</strong>: {e.text ?? ''}</span>;
+      return (
+        <span role="cell" class="wide">
+          <strong>locked on</strong>: {e.text ?? ''}
+        </span>
+      );
     default:
-      return <span role="cell" class="wide"><strong>format changed</strong>: {e.text ?? ''}</span>;
+      return (
+        <span role="cell" class="wide">
+          <strong>format changed</strong>: {e.text ?? ''}
+        </span>
+      );
   }
 }
 
 const ROW_CLASS: Record<InspectEntry['kind'], string> = {
-  frame: 'frame', discarded: 'discard', resync: 'resync', locked: 'info', 'format-changed': 'info',
+  frame: 'frame',
+  discarded: 'discard',
+  resync: 'resync',
+  locked: 'info',
+  'format-changed': 'info',
 };
 
 /** Whether two byte copies hold the same bytes (a frame's 16, a discard's first 256 at most). */
@@ -98,17 +136,29 @@ class Row extends Component<{ e: InspectEntry }> {
   override shouldComponentUpdate(next: { e: InspectEntry }): boolean {
     const a = this.props.e;
     const b = next.e;
-    return a.kind !== b.kind || a.offset !== b.offset || a.length !== b.length || !Object.is(a.timeUs, b.timeUs) ||
-      a.resolution !== b.resolution || a.remote !== b.remote || a.headerMode !== b.headerMode || a.text !== b.text ||
-      !sameBytes(a.bytes, b.bytes);
+    return (
+      a.kind !== b.kind ||
+      a.offset !== b.offset ||
+      a.length !== b.length ||
+      !Object.is(a.timeUs, b.timeUs) ||
+      a.resolution !== b.resolution ||
+      a.remote !== b.remote ||
+      a.headerMode !== b.headerMode ||
+      a.text !== b.text ||
+      !sameBytes(a.bytes, b.bytes)
+    );
   }
 
   override render() {
     const { e } = this.props;
     return (
       <div role="row" class={`row ${ROW_CLASS[e.kind]}`}>
-        <span role="cell" class="num">{time(e.timeUs)}</span>
-        <span role="cell" class="num">{e.offset}</span>
+        <span role="cell" class="num">
+          {time(e.timeUs)}
+        </span>
+        <span role="cell" class="num">
+          {e.offset}
+        </span>
         {e.kind === 'frame' ? <FrameCells e={e} /> : <EventCells e={e} />}
       </div>
     );
@@ -127,7 +177,12 @@ const LEGEND: [string, string][] = [
   ['l-info', 'lock / format'],
 ];
 
-export function Inspector({ entries, onRefresh, following, onFollow }: {
+export function Inspector({
+  entries,
+  onRefresh,
+  following,
+  onFollow,
+}: {
   entries: InspectEntry[] | null;
   onRefresh(): void;
   following: boolean;
@@ -145,7 +200,9 @@ export function Inspector({ entries, onRefresh, following, onFollow }: {
     el.scrollTop = el.scrollHeight;
     // Rows out of view are laid out at an estimated height until they come into view: once the
     // newest rows have been drawn at their real height, pin to the bottom again.
-    const id = requestAnimationFrame(() => { el.scrollTop = el.scrollHeight; });
+    const id = requestAnimationFrame(() => {
+      el.scrollTop = el.scrollHeight;
+    });
     return () => cancelAnimationFrame(id);
   }, [entries, following]);
 
@@ -154,7 +211,9 @@ export function Inspector({ entries, onRefresh, following, onFollow }: {
     if (el === null) return undefined;
     // Scrolling away from the bottom pauses following, so rows stop moving under the reader;
     // only a scroll the user made, not one from rows coming, going or resizing.
-    const mark = () => { intent.current = performance.now(); };
+    const mark = () => {
+      intent.current = performance.now();
+    };
     const scroll = () => {
       const { following: on, onFollow: set } = follow.current;
       if (on && performance.now() - intent.current < 1000 && el.scrollHeight - el.scrollTop - el.clientHeight > AWAY_PX) set(false);
@@ -206,19 +265,42 @@ export function Inspector({ entries, onRefresh, following, onFollow }: {
           <button type="button" class={following ? 'on' : ''} aria-pressed={following} onClick={() => onFollow(!following)}>
             Follow
           </button>
-          <button type="button" onClick={onRefresh}>Refresh</button>
+          <button type="button" onClick={onRefresh}>
+            Refresh
+          </button>
         </div>
       </div>
       {frames > 0 ? (
         <p class="insp-counts" data-testid="inspector-counts">
           {frames} frame{frames === 1 ? '' : 's'} shown
-          {emptySlots > 0 ? <> · <span class="k-empty-text">{emptySlots} empty slot{emptySlots === 1 ? '' : 's'} (0xFFFF) in {emptyFrames} frame{emptyFrames === 1 ? '' : 's'}</span></> : ' · no empty slots'}
-          {vtxFrames > 0 ? <> · <span class="k-vtx-text">{vtxFrames} VTX frame{vtxFrames === 1 ? '' : 's'}</span></> : null}
+          {emptySlots > 0 ? (
+            <>
+              {' '}
+              ·{' '}
+              <span class="k-empty-text">
+                {emptySlots} empty slot{emptySlots === 1 ? '' : 's'} (0xFFFF) in {emptyFrames} frame{emptyFrames === 1 ? '' : 's'}
+              </span>
+            </>
+          ) : (
+            ' · no empty slots'
+          )}
+          {vtxFrames > 0 ? (
+            <>
+              {' '}
+              ·{' '}
+              <span class="k-vtx-text">
+                {vtxFrames} VTX frame{vtxFrames === 1 ? '' : 's'}
+              </span>
+            </>
+          ) : null}
         </p>
       ) : null}
       <ul class="insp-legend" aria-label="Colour key">
         {LEGEND.map(([cls, label]) => (
-          <li key={cls}><span class={`swatch ${cls}`} aria-hidden="true" />{label}</li>
+          <li key={cls}>
+            <span class={`swatch ${cls}`} aria-hidden="true" />
+            {label}
+          </li>
         ))}
         <li class="muted">tag “p”: phase bit set · hover a byte group for its decode</li>
       </ul>
@@ -231,13 +313,21 @@ export function Inspector({ entries, onRefresh, following, onFollow }: {
           <div role="table" class="insp-table" aria-label="Frames and decoder events, oldest first">
             <div role="rowgroup" class="insp-thead">
               <div role="row" class="row">
-                <span role="columnheader" class="num">Time (s)</span>
-                <span role="columnheader" class="num">Offset</span>
-                <span role="columnheader" class="hexw"><span class="label">Bytes</span></span>
+                <span role="columnheader" class="num">
+                  Time (s)
+                </span>
+                <span role="columnheader" class="num">
+                  Offset
+                </span>
+                <span role="columnheader" class="hexw">
+                  <span class="label">Bytes</span>
+                </span>
                 <span role="columnheader">Decoded</span>
               </div>
             </div>
-            <div role="rowgroup" class="insp-body">{rows}</div>
+            <div role="rowgroup" class="insp-body">
+              {rows}
+            </div>
           </div>
         )}
       </div>

@@ -32,7 +32,15 @@ export function InspectorPanel() {
     return (
       <div class="inspector-closed">
         <h2>Frame inspector</h2>
-        <button type="button" onClick={() => { inspection.value = null; open.value = true; }}>Inspect frames…</button>
+        <button
+          type="button"
+          onClick={() => {
+            inspection.value = null;
+            open.value = true;
+          }}
+        >
+          Inspect frames…
+        </button>
         <span class="muted">each frame in hex with its fields, discarded bytes and resyncs where they happened</span>
       </div>
     );
@@ -43,10 +51,20 @@ export function InspectorPanel() {
         key={id}
         entries={inspection.value}
         following={following.value}
-        onFollow={(on) => { following.value = on; }}
+        onFollow={(on) => {
+          following.value = on;
+        }}
         onRefresh={refresh}
       />
-      <button type="button" class="link" onClick={() => { open.value = false; }}>Close the inspector</button>
+      <button
+        type="button"
+        class="link"
+        onClick={() => {
+          open.value = false;
+        }}
+      >
+        Close the inspector
+      </button>
     </div>
   );
 }

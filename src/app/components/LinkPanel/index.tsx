@@ -52,7 +52,12 @@ export function LinkPanel({ windowUs }: { windowUs: Signal<number> }) {
       if (counts.current !== null) counts.current.textContent = l === null ? 'none' : `${l.holds} holds · ${l.failsafes} failsafes`;
       const parts = drawEpisodes(strip.current, live.episodes.values(), now, windowUs.value);
       const el = strip.current;
-      el.setAttribute('aria-label', parts.length === 0 ? 'No hold or failsafe in this window' : `${parts.filter((p) => p === 'failsafe').length} failsafe and ${parts.filter((p) => p === 'hold').length} hold episodes in this window`);
+      el.setAttribute(
+        'aria-label',
+        parts.length === 0
+          ? 'No hold or failsafe in this window'
+          : `${parts.filter((p) => p === 'failsafe').length} failsafe and ${parts.filter((p) => p === 'hold').length} hold episodes in this window`,
+      );
     });
   }, [windowUs]);
 
@@ -61,15 +66,28 @@ export function LinkPanel({ windowUs }: { windowUs: Signal<number> }) {
   // A replay at its end keeps its last state, frozen, and says it ended; a forced resolution
   // that matches no frame is not link loss.
   const label = LABEL[state];
-  const hint = linkEnded.value ? `Replay ended: the state at the end of the capture` : mismatch !== null
-    ? `Forced ${resolutionOverride.value}: no frame matches; the stream looks like ${mismatch}` : HINT[state];
+  const hint = linkEnded.value
+    ? `Replay ended: the state at the end of the capture`
+    : mismatch !== null
+      ? `Forced ${resolutionOverride.value}: no frame matches; the stream looks like ${mismatch}`
+      : HINT[state];
   return (
     <section class={`link ${state}`} aria-label="Link state">
-      <div class="state" role="status" aria-live="polite" data-testid="link-state">{label}</div>
-      <div class="hint" data-testid="link-hint">{hint}</div>
+      <div class="state" role="status" aria-live="polite" data-testid="link-state">
+        {label}
+      </div>
+      <div class="hint" data-testid="link-hint">
+        {hint}
+      </div>
       <dl>
-        <dt>Last frame</dt><dd><span ref={since}>none yet</span></dd>
-        <dt>Episodes</dt><dd><span ref={counts}>none</span></dd>
+        <dt>Last frame</dt>
+        <dd>
+          <span ref={since}>none yet</span>
+        </dd>
+        <dt>Episodes</dt>
+        <dd>
+          <span ref={counts}>none</span>
+        </dd>
       </dl>
       <TopFinding />
       <div class="timeline" ref={strip} role="img" aria-label="No hold or failsafe in this window" />

@@ -7,7 +7,14 @@ import type { ComponentChildren } from 'preact';
 import { useEffect, useId, useRef, useState } from 'preact/hooks';
 import './style.css';
 
-export function Menu({ label, title, align = 'start', disabled = false, className = '', children }: {
+export function Menu({
+  label,
+  title,
+  align = 'start',
+  disabled = false,
+  className = '',
+  children,
+}: {
   /** The button's text (and accessible name). */
   label: ComponentChildren;
   title?: string;
@@ -50,9 +57,18 @@ export function Menu({ label, title, align = 'start', disabled = false, classNam
   };
   return (
     <div class={`menu ${className}`} ref={root}>
-      <button ref={button} type="button" class="menu-button" aria-expanded={open} aria-controls={id} disabled={disabled} title={title}
-        onClick={() => setOpen(!open)}>
-        {label}<span class="caret" aria-hidden="true" />
+      <button
+        ref={button}
+        type="button"
+        class="menu-button"
+        aria-expanded={open}
+        aria-controls={id}
+        disabled={disabled}
+        title={title}
+        onClick={() => setOpen(!open)}
+      >
+        {label}
+        <span class="caret" aria-hidden="true" />
       </button>
       <div id={id} class={`menu-pop ${align}`} hidden={!open}>
         {open ? children(close) : null}

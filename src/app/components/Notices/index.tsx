@@ -11,7 +11,9 @@ export function Notices() {
         <div key={n.id} class={`notice ${n.level}`} role={n.level === 'error' ? 'alert' : 'status'}>
           <strong>{n.title}</strong>
           <span>{n.detail}</span>
-          <button type="button" class="link" aria-label="Dismiss" onClick={() => dismiss(n.id)}>✕</button>
+          <button type="button" class="link" aria-label="Dismiss" onClick={() => dismiss(n.id)}>
+            ✕
+          </button>
         </div>
       ))}
     </section>

@@ -39,20 +39,28 @@ export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
     const box = chart.current;
     if (box === null || list.length < 2) return undefined;
     const order = list.map((s) => s.id);
-    const plot = new uPlot({
-      width: Math.max(200, box.clientWidth),
-      height: 120,
-      legend: { show: true, live: true },
-      cursor: hoverCursor(),
-      scales: { x: { time: false }, y: valueScale(FADE_SCALE) },
-      axes: [agoAxis(), valueAxis('Fades /s', FADE_SCALE)],
-      series: [
-        { label: 'Time', value: legendTime },
-        ...order.map((id, i) => ({
-          label: list[i]?.label ?? String(id), stroke: colors[i % colors.length], width: 1.5, points: { show: false }, value: legendValue('/s', 1),
-        })),
-      ],
-    }, [[], ...order.map(() => [])], box);
+    const plot = new uPlot(
+      {
+        width: Math.max(200, box.clientWidth),
+        height: 120,
+        legend: { show: true, live: true },
+        cursor: hoverCursor(),
+        scales: { x: { time: false }, y: valueScale(FADE_SCALE) },
+        axes: [agoAxis(), valueAxis('Fades /s', FADE_SCALE)],
+        series: [
+          { label: 'Time', value: legendTime },
+          ...order.map((id, i) => ({
+            label: list[i]?.label ?? String(id),
+            stroke: colors[i % colors.length],
+            width: 1.5,
+            points: { show: false },
+            value: legendValue('/s', 1),
+          })),
+        ],
+      },
+      [[], ...order.map(() => [])],
+      box,
+    );
     const keys = keyboardCursor(plot, box);
     const resize = new ResizeObserver(() => plot.setSize({ width: Math.max(200, box.clientWidth), height: 120 }));
     resize.observe(box);
@@ -115,11 +123,20 @@ export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
       const body = table.current;
       if (body === null) return;
       const lives = allLives();
-      const text = list.map((s) => {
-        const live = lives.get(s.id);
-        const l = live?.link;
-        return [stateOf(live), live?.counters.frames ?? 0, l?.fades ?? 0, l === null || l === undefined ? '—' : (l.fadeRate * 60).toFixed(0), l?.holds ?? 0, l?.failsafes ?? 0].join('|');
-      }).join(';');
+      const text = list
+        .map((s) => {
+          const live = lives.get(s.id);
+          const l = live?.link;
+          return [
+            stateOf(live),
+            live?.counters.frames ?? 0,
+            l?.fades ?? 0,
+            l === null || l === undefined ? '—' : (l.fadeRate * 60).toFixed(0),
+            l?.holds ?? 0,
+            l?.failsafes ?? 0,
+          ].join('|');
+        })
+        .join(';');
       if (text === shown) return;
       shown = text;
       list.forEach((s, i) => {
@@ -129,8 +146,11 @@ export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
         const cells = row.querySelectorAll<HTMLElement>('[data-cell]');
         const l = live?.link;
         const values: Record<string, string> = {
-          state: stateOf(live), frames: String(live?.counters.frames ?? 0), fades: String(l?.fades ?? 0),
-          rate: l === null || l === undefined ? '—' : `${(l.fadeRate * 60).toFixed(0)}/min`, episodes: `${l?.holds ?? 0} / ${l?.failsafes ?? 0}`,
+          state: stateOf(live),
+          frames: String(live?.counters.frames ?? 0),
+          fades: String(l?.fades ?? 0),
+          rate: l === null || l === undefined ? '—' : `${(l.fadeRate * 60).toFixed(0)}/min`,
+          episodes: `${l?.holds ?? 0} / ${l?.failsafes ?? 0}`,
         };
         for (const c of cells) {
           const v = values[c.dataset.cell as string] ?? '';
@@ -146,43 +166,103 @@ export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
     <section class="remotes" aria-label="Remotes">
       <h2>Remotes side by side</h2>
       <div class="table-scroll" tabIndex={0} role="region" aria-label="Remotes table">
-      <table class="remote-table">
-        <thead>
-          <tr><th>Remote</th><th>State</th><th>Fades</th><th>Fade rate</th><th>Holds / failsafes</th><th>Frames</th><th>Source</th><th><span class="sr-only">Actions</span></th></tr>
-        </thead>
-        <tbody ref={table}>
-          {list.map((s, i) => (
-            <tr key={s.id} class={selected.value === s.id ? 'on' : ''} onClick={() => select(s.id)} data-testid={`remote-${s.label}`}>
-              <td class="remote-cell">
-                <span class="swatch" aria-hidden="true" style={{ background: colors[i % colors.length] }} />
-                <select aria-label={`Label of ${s.name}`} value={s.label} onClick={(e) => e.stopPropagation()} onChange={(e) => send({ type: 'set-label', source: s.id, label: (e.currentTarget as HTMLSelectElement).value })}>
-                  {[...new Set([...REMOTE_LABELS, s.label])].map((l) => <option key={l} value={l}>{l}</option>)}
-                </select>
-                <span class="kind">{s.format.remote === 'internal' ? 'internal' : s.format.remote === 'external' ? 'external' : ''}</span>
-              </td>
-              <td><span data-cell="state" class="state-chip waiting">waiting</span></td>
-              <td data-cell="fades" class="num">0</td>
-              <td data-cell="rate" class="num">—</td>
-              <td data-cell="episodes" class="num">0 / 0</td>
-              <td data-cell="frames" class="num">0</td>
-              <td class="name">
-                {/* The row's keyboard way in: a real button, so Tab reaches it and Enter or Space shows the remote. */}
-                <button type="button" class="show" aria-pressed={selected.value === s.id} title={`Show remote ${s.label} in the views below`}
-                  onClick={(e) => { e.stopPropagation(); select(s.id); }}>
-                  {s.name}
-                </button>
-              </td>
-              <td>{s.kind === 'serial' ? <button type="button" class="link" onClick={(e) => { e.stopPropagation(); send({ type: 'serial-close', source: s.id }); }}>Disconnect</button> : null}</td>
+        <table class="remote-table">
+          <thead>
+            <tr>
+              <th>Remote</th>
+              <th>State</th>
+              <th>Fades</th>
+              <th>Fade rate</th>
+              <th>Holds / failsafes</th>
+              <th>Frames</th>
+              <th>Source</th>
+              <th>
+                <span class="sr-only">Actions</span>
+              </th>
             </tr>
-          ))}
-        </tbody>
-      </table>
+          </thead>
+          <tbody ref={table}>
+            {list.map((s, i) => (
+              <tr key={s.id} class={selected.value === s.id ? 'on' : ''} onClick={() => select(s.id)} data-testid={`remote-${s.label}`}>
+                <td class="remote-cell">
+                  <span class="swatch" aria-hidden="true" style={{ background: colors[i % colors.length] }} />
+                  <select
+                    aria-label={`Label of ${s.name}`}
+                    value={s.label}
+                    onClick={(e) => e.stopPropagation()}
+                    onChange={(e) => send({ type: 'set-label', source: s.id, label: (e.currentTarget as HTMLSelectElement).value })}
+                  >
+                    {[...new Set([...REMOTE_LABELS, s.label])].map((l) => (
+                      <option key={l} value={l}>
+                        {l}
+                      </option>
+                    ))}
+                  </select>
+                  <span class="kind">{s.format.remote === 'internal' ? 'internal' : s.format.remote === 'external' ? 'external' : ''}</span>
+                </td>
+                <td>
+                  <span data-cell="state" class="state-chip waiting">
+                    waiting
+                  </span>
+                </td>
+                <td data-cell="fades" class="num">
+                  0
+                </td>
+                <td data-cell="rate" class="num">
+                  —
+                </td>
+                <td data-cell="episodes" class="num">
+                  0 / 0
+                </td>
+                <td data-cell="frames" class="num">
+                  0
+                </td>
+                <td class="name">
+                  {/* The row's keyboard way in: a real button, so Tab reaches it and Enter or Space shows the remote. */}
+                  <button
+                    type="button"
+                    class="show"
+                    aria-pressed={selected.value === s.id}
+                    title={`Show remote ${s.label} in the views below`}
+                    onClick={(e) => {
+                      e.stopPropagation();
+                      select(s.id);
+                    }}
+                  >
+                    {s.name}
+                  </button>
+                </td>
+                <td>
+                  {s.kind === 'serial' ? (
+                    <button
+                      type="button"
+                      class="link"
+                      onClick={(e) => {
+                        e.stopPropagation();
+                        send({ type: 'serial-close', source: s.id });
+                      }}
+                    >
+                      Disconnect
+                    </button>
+                  ) : null}
+                </td>
+              </tr>
+            ))}
+          </tbody>
+        </table>
       </div>
-      <div class="remote-chart" ref={chart} role="figure" aria-label="Fade rate of every remote over time: hover, or the arrow keys, for the values" />
+      <div
+        class="remote-chart"
+        ref={chart}
+        role="figure"
+        aria-label="Fade rate of every remote over time: hover, or the arrow keys, for the values"
+      />
       <div class="lanes" ref={lanes} role="group" aria-label="Hold and failsafe episodes per remote">
         {list.map((s, i) => (
           <div key={s.id} class="lane">
-            <span class="lane-label" style={{ color: colors[i % colors.length] }}>{s.label}</span>
+            <span class="lane-label" style={{ color: colors[i % colors.length] }}>
+              {s.label}
+            </span>
             <div class="lane-strip" />
           </div>
         ))}

@@ -31,33 +31,39 @@ export function ReplayBar() {
     const x = Array.from(o.t, (t) => t / 1e6);
     const bands = o.failsafe;
     const c = chartColors(palette);
-    const plot = new uPlot({
-      width: Math.max(300, el.clientWidth),
-      height: 56,
-      legend: { show: false },
-      cursor: { show: false },
-      axes: [{ show: false }, { show: false }],
-      scales: { x: { time: false } },
-      series: [
-        {},
-        { stroke: c.lost, fill: `${c.lost}66`, paths: uPlot.paths.bars?.({ size: [1, Infinity] }), points: { show: false } },
-        { stroke: c.fades, width: 1, points: { show: false } },
-      ],
-      hooks: {
-        drawClear: [(u) => {
-          // Failsafe episodes as red bands behind the series.
-          const ctx = u.ctx;
-          ctx.save();
-          ctx.fillStyle = c.failsafeBand;
-          for (const b of bands) {
-            const a = u.valToPos(b.startUs / 1e6, 'x', true);
-            const z = u.valToPos(b.endUs / 1e6, 'x', true);
-            ctx.fillRect(a, u.bbox.top, Math.max(2, z - a), u.bbox.height);
-          }
-          ctx.restore();
-        }],
+    const plot = new uPlot(
+      {
+        width: Math.max(300, el.clientWidth),
+        height: 56,
+        legend: { show: false },
+        cursor: { show: false },
+        axes: [{ show: false }, { show: false }],
+        scales: { x: { time: false } },
+        series: [
+          {},
+          { stroke: c.lost, fill: `${c.lost}66`, paths: uPlot.paths.bars?.({ size: [1, Infinity] }), points: { show: false } },
+          { stroke: c.fades, width: 1, points: { show: false } },
+        ],
+        hooks: {
+          drawClear: [
+            (u) => {
+              // Failsafe episodes as red bands behind the series.
+              const ctx = u.ctx;
+              ctx.save();
+              ctx.fillStyle = c.failsafeBand;
+              for (const b of bands) {
+                const a = u.valToPos(b.startUs / 1e6, 'x', true);
+                const z = u.valToPos(b.endUs / 1e6, 'x', true);
+                ctx.fillRect(a, u.bbox.top, Math.max(2, z - a), u.bbox.height);
+              }
+              ctx.restore();
+            },
+          ],
+        },
       },
-    }, [x, Array.from(o.lost), Array.from(o.fadeRate)], el);
+      [x, Array.from(o.lost), Array.from(o.fadeRate)],
+      el,
+    );
     return () => plot.destroy();
     // The overview can arrive before the replay status that makes this bar (and its box) appear.
   }, [o, r !== null, palette]);
@@ -66,23 +72,46 @@ export function ReplayBar() {
   return (
     <section class="replay" aria-label="Replay">
       <div class="replay-row">
-        <strong class="name" title={r.name}>{r.name}</strong>
-        <span class="muted">{r.kind}, timing {r.timing}</span>
+        <strong class="name" title={r.name}>
+          {r.name}
+        </strong>
+        <span class="muted">
+          {r.kind}, timing {r.timing}
+        </span>
         {r.playing ? (
-          <button type="button" class="primary" onClick={() => send({ type: 'replay-pause' })}>Pause</button>
+          <button type="button" class="primary" onClick={() => send({ type: 'replay-pause' })}>
+            Pause
+          </button>
         ) : (
-          <button type="button" class="primary" onClick={() => {
-            // At the end, play starts over.
-            if (r.positionUs >= r.endUs) send({ type: 'replay-seek', timeUs: r.startUs });
-            send({ type: 'replay-play' });
-          }}>Play</button>
+          <button
+            type="button"
+            class="primary"
+            onClick={() => {
+              // At the end, play starts over.
+              if (r.positionUs >= r.endUs) send({ type: 'replay-seek', timeUs: r.startUs });
+              send({ type: 'replay-play' });
+            }}
+          >
+            Play
+          </button>
         )}
         <div class="window" role="radiogroup" aria-label="Speed">
           {SPEEDS.map(([v, label]) => (
-            <button key={label} type="button" role="radio" aria-checked={r.speed === v} class={r.speed === v ? 'on' : ''} onClick={() => send({ type: 'replay-speed', speed: v })}>{label}</button>
+            <button
+              key={label}
+              type="button"
+              role="radio"
+              aria-checked={r.speed === v}
+              class={r.speed === v ? 'on' : ''}
+              onClick={() => send({ type: 'replay-speed', speed: v })}
+            >
+              {label}
+            </button>
           ))}
         </div>
-        <span class="time" data-testid="replay-time">{clock(r.positionUs - r.startUs)} / {clock(span)}</span>
+        <span class="time" data-testid="replay-time">
+          {clock(r.positionUs - r.startUs)} / {clock(span)}
+        </span>
       </div>
       <div class="overview" ref={chart} />
       <input

@@ -28,14 +28,18 @@ export function SystemBadge() {
   const hex = format.system === null ? null : `0x${format.system.toString(16).toUpperCase().padStart(2, '0')}`;
   return (
     <section class="badge" aria-label="System" title={format.explanation}>
-      <span class="chip strong" data-testid="protocol">{protocol(format.system, format.resolution, nominalPeriodUs.value)}</span>
+      <span class="chip strong" data-testid="protocol">
+        {protocol(format.system, format.resolution, nominalPeriodUs.value)}
+      </span>
       <span class="chip" data-testid="resolution">
         {format.resolution ?? '?'}
         {inferred ? <em> inferred</em> : null}
         {format.resolutionReason === 'override' ? <em> set by you</em> : null}
         {format.resolutionReason === 'internal-remote' ? <em> from the internal remote</em> : null}
       </span>
-      <span class="chip" data-testid="remote">{format.remote === 'internal' ? 'Internal remote' : 'External remote'}</span>
+      <span class="chip" data-testid="remote">
+        {format.remote === 'internal' ? 'Internal remote' : 'External remote'}
+      </span>
       {hex !== null ? <span class="chip">system {hex}</span> : null}
       {format.headerMode === 'rssi' ? <span class="chip accent">RSSI (SPM4649T)</span> : null}
       <p class="why">{format.explanation}</p>

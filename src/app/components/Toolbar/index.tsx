@@ -33,13 +33,24 @@ function summary(list: SourceStatus[]): { text: string; tone: string } {
   }
   const lost = list.some((s) => s.state === 'lost');
   const opening = list.some((s) => s.state === 'opening');
-  const text = list.map((s) => `${s.label}: ${s.name}${s.state === 'lost' ? ': device lost' : s.state === 'opening' ? ': opening…' : ''}`).join(' · ');
+  const text = list
+    .map((s) => `${s.label}: ${s.name}${s.state === 'lost' ? ': device lost' : s.state === 'opening' ? ': opening…' : ''}`)
+    .join(' · ');
   return { text, tone: lost ? 'serial lost' : opening ? 'serial opening' : 'serial reading' };
 }
 
 function Sun() {
   return (
-    <svg viewBox="0 0 24 24" width="18" height="18" aria-hidden="true" fill="none" stroke="currentColor" stroke-width="2" stroke-linecap="round">
+    <svg
+      viewBox="0 0 24 24"
+      width="18"
+      height="18"
+      aria-hidden="true"
+      fill="none"
+      stroke="currentColor"
+      stroke-width="2"
+      stroke-linecap="round"
+    >
       <circle cx="12" cy="12" r="4.5" />
       <path d="M12 2v2.5M12 19.5V22M2 12h2.5M19.5 12H22M4.9 4.9l1.8 1.8M17.3 17.3l1.8 1.8M4.9 19.1l1.8-1.8M17.3 6.7l1.8-1.8" />
     </svg>
@@ -48,7 +59,16 @@ function Sun() {
 
 function Moon() {
   return (
-    <svg viewBox="0 0 24 24" width="18" height="18" aria-hidden="true" fill="none" stroke="currentColor" stroke-width="2" stroke-linejoin="round">
+    <svg
+      viewBox="0 0 24 24"
+      width="18"
+      height="18"
+      aria-hidden="true"
+      fill="none"
+      stroke="currentColor"
+      stroke-width="2"
+      stroke-linejoin="round"
+    >
       <path d="M20 14.5A8 8 0 0 1 9.5 4a8 8 0 1 0 10.5 10.5z" />
     </svg>
   );
@@ -70,7 +90,16 @@ export function Toolbar({ granted, onBind }: { granted: SerialPort[]; onBind(): 
   return (
     <header class="toolbar">
       <h1 class="brand">
-        <svg viewBox="0 0 64 64" width="26" height="26" aria-hidden="true"><path d="M10 44h8l5-22 7 30 6-38 6 30h12" fill="none" stroke="currentColor" stroke-width="5" stroke-linejoin="round" stroke-linecap="round" /></svg>
+        <svg viewBox="0 0 64 64" width="26" height="26" aria-hidden="true">
+          <path
+            d="M10 44h8l5-22 7 30 6-38 6 30h12"
+            fill="none"
+            stroke="currentColor"
+            stroke-width="5"
+            stroke-linejoin="round"
+            stroke-linecap="round"
+          />
+        </svg>
         <span>SatScope</span>
       </h1>
       <div class={`pill ${pill.tone}`} role="status" data-testid="source-status" title={pill.text}>
@@ -78,53 +107,119 @@ export function Toolbar({ granted, onBind }: { granted: SerialPort[]; onBind(): 
       </div>
       <div class="tb-group source" role="group" aria-label="Source">
         <div class="split">
-          <button type="button" class="primary" onClick={() => void chooseAndConnect(true)}>{kind === 'serial' ? 'Add receiver' : 'Connect receiver'}</button>
+          <button type="button" class="primary" onClick={() => void chooseAndConnect(true)}>
+            {kind === 'serial' ? 'Add receiver' : 'Connect receiver'}
+          </button>
           <Menu label={<span class="sr-only">More ways to connect</span>} className="split-more" title="More ways to connect">
             {(close) => (
               <>
-                <button type="button" onClick={() => { close(); void chooseAndConnect(false); }}>Any serial port…</button>
+                <button
+                  type="button"
+                  onClick={() => {
+                    close();
+                    void chooseAndConnect(false);
+                  }}
+                >
+                  Any serial port…
+                </button>
                 <p class="hint">Connect receiver lists USB-serial adapters (FTDI, CP210x, CH340, PL2303…). This lists every serial port.</p>
-                {kind === 'serial' ? <button type="button" onClick={() => { close(); send({ type: 'close-all' }); }}>Disconnect all</button> : null}
+                {kind === 'serial' ? (
+                  <button
+                    type="button"
+                    onClick={() => {
+                      close();
+                      send({ type: 'close-all' });
+                    }}
+                  >
+                    Disconnect all
+                  </button>
+                ) : null}
               </>
             )}
           </Menu>
         </div>
         {granted.map((port, i) => (
-          <button key={i} type="button" onClick={() => void connect(port)} title="A port this page was allowed before: connect it (several can run side by side)">
+          <button
+            key={i}
+            type="button"
+            onClick={() => void connect(port)}
+            title="A port this page was allowed before: connect it (several can run side by side)"
+          >
             {portLabel(port)}
           </button>
         ))}
         {kind === 'demo' ? (
-          <button type="button" onClick={() => send({ type: 'demo-stop' })}>Stop demo</button>
+          <button type="button" onClick={() => send({ type: 'demo-stop' })}>
+            Stop demo
+          </button>
         ) : (
-          <button type="button" onClick={() => send({ type: 'demo-start' })}>Demo</button>
+          <button type="button" onClick={() => send({ type: 'demo-start' })}>
+            Demo
+          </button>
         )}
-        <button type="button" onClick={chooseCapture}>Open capture…</button>
-        <button type="button" onClick={onBind} title="Put a satellite into bind mode through the adapter (spec §7.2)">Bind…</button>
-        <input ref={setCaptureInput} type="file" accept=".sscap,.bin,.csv,.txt" hidden aria-label="Capture file" onChange={(e) => {
-          const f = (e.currentTarget as HTMLInputElement).files?.[0];
-          if (f) void openCapture(f);
-          (e.currentTarget as HTMLInputElement).value = '';
-        }} />
+        <button type="button" onClick={chooseCapture}>
+          Open capture…
+        </button>
+        <button type="button" onClick={onBind} title="Put a satellite into bind mode through the adapter (spec §7.2)">
+          Bind…
+        </button>
+        <input
+          ref={setCaptureInput}
+          type="file"
+          accept=".sscap,.bin,.csv,.txt"
+          hidden
+          aria-label="Capture file"
+          onChange={(e) => {
+            const f = (e.currentTarget as HTMLInputElement).files?.[0];
+            if (f) void openCapture(f);
+            (e.currentTarget as HTMLInputElement).value = '';
+          }}
+        />
       </div>
       <div class="tb-group recorder" role="group" aria-label="Recording">
         {rec?.active ? (
           <button type="button" class="rec on" onClick={() => send({ type: 'record-stop' })} aria-label="Stop recording">
-            ■ Stop <span class="rec-info">{duration(rec.durationUs)} · {size(rec.bytes)}</span>
+            ■ Stop{' '}
+            <span class="rec-info">
+              {duration(rec.durationUs)} · {size(rec.bytes)}
+            </span>
           </button>
         ) : (
-          <button type="button" class="rec" disabled={!live} onClick={() => send({ type: 'record-start' })} title={live ? 'Record raw bytes with their arrival times' : 'Connect a receiver or start the demo to record'}>
+          <button
+            type="button"
+            class="rec"
+            disabled={!live}
+            onClick={() => send({ type: 'record-start' })}
+            title={live ? 'Record raw bytes with their arrival times' : 'Connect a receiver or start the demo to record'}
+          >
             ● Record
           </button>
         )}
         {rec !== null && !rec.active && rec.bytes > 0 ? (
           <div class="split">
-            <button type="button" onClick={() => { send({ type: 'export', what: 'sscap', recording: 'last' }); setExported(true); }}
-              title={`Save the recording (${size(rec.bytes)}) as .sscap: bytes with their arrival times`}>Export .sscap</button>
+            <button
+              type="button"
+              onClick={() => {
+                send({ type: 'export', what: 'sscap', recording: 'last' });
+                setExported(true);
+              }}
+              title={`Save the recording (${size(rec.bytes)}) as .sscap: bytes with their arrival times`}
+            >
+              Export .sscap
+            </button>
             <Menu label={<span class="sr-only">Other export formats</span>} className="split-more" align="end" title="Other export formats">
               {(close) => (
                 <>
-                  <button type="button" onClick={() => { close(); send({ type: 'export', what: 'raw', recording: 'last' }); setExported(true); }}>raw .bin</button>
+                  <button
+                    type="button"
+                    onClick={() => {
+                      close();
+                      send({ type: 'export', what: 'raw', recording: 'last' });
+                      setExported(true);
+                    }}
+                  >
+                    raw .bin
+                  </button>
                   <p class="hint">Only the bytes, without times: for other tools.</p>
                 </>
               )}
@@ -134,19 +229,49 @@ export function Toolbar({ granted, onBind }: { granted: SerialPort[]; onBind(): 
         {exported ? <span class="muted saved">saved</span> : null}
       </div>
       <div class="tb-group report" role="group" aria-label="Report">
-        <Menu label="Report" align="end" disabled={!canReport}
-          title={canReport ? 'One-page link-quality report of the capture being replayed, or of what was recorded live' : 'Open a capture or record first: a report covers one of them'}>
+        <Menu
+          label="Report"
+          align="end"
+          disabled={!canReport}
+          title={
+            canReport
+              ? 'One-page link-quality report of the capture being replayed, or of what was recorded live'
+              : 'Open a capture or record first: a report covers one of them'
+          }
+        >
           {(close) => (
             <>
-              <button type="button" onClick={() => { close(); send({ type: 'report', format: 'html' }); }}>Report as a page (HTML)</button>
-              <button type="button" onClick={() => { close(); send({ type: 'report', format: 'json' }); }}>Report as data (JSON)</button>
+              <button
+                type="button"
+                onClick={() => {
+                  close();
+                  send({ type: 'report', format: 'html' });
+                }}
+              >
+                Report as a page (HTML)
+              </button>
+              <button
+                type="button"
+                onClick={() => {
+                  close();
+                  send({ type: 'report', format: 'json' });
+                }}
+              >
+                Report as data (JSON)
+              </button>
             </>
           )}
         </Menu>
       </div>
       <div class="tb-group settings" role="group" aria-label="Settings">
-        <button type="button" class="icon" aria-label="Dark theme" aria-pressed={dark} title={dark ? 'Switch to the light theme' : 'Switch to the dark theme'}
-          onClick={() => setTheme(dark ? 'light' : 'dark')}>
+        <button
+          type="button"
+          class="icon"
+          aria-label="Dark theme"
+          aria-pressed={dark}
+          title={dark ? 'Switch to the light theme' : 'Switch to the dark theme'}
+          onClick={() => setTheme(dark ? 'light' : 'dark')}
+        >
           {dark ? <Moon /> : <Sun />}
         </button>
         <Menu label="Settings" align="end" title="Resolution and theme">
@@ -154,12 +279,15 @@ export function Toolbar({ granted, onBind }: { granted: SerialPort[]; onBind(): 
             <>
               <label>
                 Resolution
-                <select value={String(resolutionOverride.value)} onChange={(e) => {
-                  const v = (e.currentTarget as HTMLSelectElement).value;
-                  const r = v === 'auto' ? 'auto' : (Number(v) as 1024 | 2048);
-                  resolutionOverride.value = r;
-                  send({ type: 'set-resolution', resolution: r });
-                }}>
+                <select
+                  value={String(resolutionOverride.value)}
+                  onChange={(e) => {
+                    const v = (e.currentTarget as HTMLSelectElement).value;
+                    const r = v === 'auto' ? 'auto' : (Number(v) as 1024 | 2048);
+                    resolutionOverride.value = r;
+                    send({ type: 'set-resolution', resolution: r });
+                  }}
+                >
                   <option value="auto">auto</option>
                   <option value="2048">2048</option>
                   <option value="1024">1024</option>
@@ -168,10 +296,13 @@ export function Toolbar({ granted, onBind }: { granted: SerialPort[]; onBind(): 
               <p class="hint">Auto reads it from the system byte or the channel IDs. Force it only for a receiver that reports it wrong.</p>
               <label>
                 Theme
-                <select value={themeChoice.value ?? 'system'} onChange={(e) => {
-                  const v = (e.currentTarget as HTMLSelectElement).value;
-                  setTheme(v === 'light' || v === 'dark' ? v : null);
-                }}>
+                <select
+                  value={themeChoice.value ?? 'system'}
+                  onChange={(e) => {
+                    const v = (e.currentTarget as HTMLSelectElement).value;
+                    setTheme(v === 'light' || v === 'dark' ? v : null);
+                  }}
+                >
                   <option value="system">as the system</option>
                   <option value="light">light</option>
                   <option value="dark">dark</option>
@@ -184,12 +315,22 @@ export function Toolbar({ granted, onBind }: { granted: SerialPort[]; onBind(): 
       {rec?.recovered ? (
         <div class="recovered" role="alert">
           An unfinished recording from {new Date(rec.recovered.createdAt).toLocaleString()} ({size(rec.recovered.bytes)}) was kept.
-          <button type="button" onClick={() => send({ type: 'export', what: 'sscap', recording: 'recovered' })}>Export .sscap</button>
-          <button type="button" onClick={() => send({ type: 'export', what: 'raw', recording: 'recovered' })}>raw .bin</button>
-          <button type="button" class="link" onClick={() => send({ type: 'discard-recovered' })}>Discard</button>
+          <button type="button" onClick={() => send({ type: 'export', what: 'sscap', recording: 'recovered' })}>
+            Export .sscap
+          </button>
+          <button type="button" onClick={() => send({ type: 'export', what: 'raw', recording: 'recovered' })}>
+            raw .bin
+          </button>
+          <button type="button" class="link" onClick={() => send({ type: 'discard-recovered' })}>
+            Discard
+          </button>
         </div>
       ) : null}
-      {rec?.error ? <div class="recovered error" role="alert">{rec.error}</div> : null}
+      {rec?.error ? (
+        <div class="recovered error" role="alert">
+          {rec.error}
+        </div>
+      ) : null}
     </header>
   );
 }
