@@ -13,7 +13,7 @@ const script = fileURLToPath(new URL('../scripts/fuzz.mjs', import.meta.url));
 
 describe('fuzzing the built decoder', () => {
   it('survives 40,000 random and damaged inputs under every option: no throw, no hang, same frames however chunked', async () => {
-    const { stdout } = await run(process.execPath, [script, '--count', '40000', '--from', String(Date.now() % 1e9)]);
-    expect(stdout).toMatch(/^40000 inputs from \d+, every option and timing: 0 throws, 0 hangs/);
+    const { stdout } = await run(process.execPath, [script, '--count', '40000', '--from', '0']);
+    expect(stdout).toMatch(/^40000 inputs from 0, every option and timing: 0 throws, 0 hangs/);
   }, 120_000);
 });

@@ -71,7 +71,7 @@ describe('chunk-split invariance', () => {
           expect(d.stats).toEqual(whole.stats);
         },
       ),
-      { numRuns: 60 },
+      { numRuns: 60, seed: 2026_11_23 },
     );
   });
 });
@@ -91,7 +91,7 @@ describe('fuzzing', () => {
         expect(s.pendingBytes).toBe(0);
         expect(s.frameBytes + s.discardedBytes).toBe(bytes.length);
       }),
-      { numRuns: 300 },
+      { numRuns: 300, seed: 2026_11_23 },
     );
   });
 
@@ -113,7 +113,7 @@ describe('fuzzing', () => {
           expect(got.slice(-tail.length)).toEqual(tail);
         },
       ),
-      { numRuns: 150 },
+      { numRuns: 150, seed: 2026_11_23 },
     );
   });
 
@@ -156,7 +156,7 @@ describe('fuzzing', () => {
           bytes = [];
         },
       ),
-      { numRuns: 150 },
+      { numRuns: 150, seed: 2026_11_23 },
     );
   });
 });
