@@ -68,7 +68,7 @@ export class Live {
   readonly series = new SeriesBuffer();
   readonly episodes = new Map<number, Episode>();
   link: Batch['link'] | null = null;
-  counters: Batch['counters'] = { bytes: 0, frames: 0, resyncs: 0, discardedBytes: 0, badFrames: 0 };
+  counters: Batch['counters'] = { bytes: 0, frames: 0, resyncs: 0, discardedBytes: 0, badFrames: 0, emptySlots: 0, vtxFrames: 0 };
   resolution: 1024 | 2048 | null = null;
   /** The source has ended: its clock and state stand still. */
   ended = false;
@@ -108,7 +108,7 @@ export class Live {
     this.series.clear();
     this.episodes.clear();
     this.link = null;
-    this.counters = { bytes: 0, frames: 0, resyncs: 0, discardedBytes: 0, badFrames: 0 };
+    this.counters = { bytes: 0, frames: 0, resyncs: 0, discardedBytes: 0, badFrames: 0, emptySlots: 0, vtxFrames: 0 };
     this.resolution = null;
     this.ended = false;
     this.mismatch = null;

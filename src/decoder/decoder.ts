@@ -448,7 +448,10 @@ export class SpektrumDecoder {
       // happens to fit the old count further on.
       const internal = this.#remote === 'internal';
       const restartAfter = internal && q !== NOT_FOUND && q > o + FRAME_SIZE && this.#ownChainAt(o + FRAME_SIZE);
-      if (fits && (q === NOT_FOUND ? this.#lastOfItsKind(o, layout) : (restartAfter && this.#knownLayout(layout)) || this.#standsAlone(o, layout, q))) {
+      if (
+        fits &&
+        (q === NOT_FOUND ? this.#lastOfItsKind(o, layout) : (restartAfter && this.#knownLayout(layout)) || this.#standsAlone(o, layout, q))
+      ) {
         // This frame is whole: what follows it up to q is noise, or something new starts after it.
         return this.#emit(o, layout);
       }
@@ -673,8 +676,13 @@ export class SpektrumDecoder {
     const b = a + FRAME_SIZE;
     if (b + FRAME_SIZE > this.#tail) return false;
     const resolution = this.#resolution as Resolution;
-    return buf[a + 1] === this.#system && buf[b + 1] === this.#system && slotLayout(buf, a, resolution) !== INVALID &&
-      slotLayout(buf, b, resolution) !== INVALID && byte0Follows(buf[a] as number, buf[b] as number, this.#b0Mode);
+    return (
+      buf[a + 1] === this.#system &&
+      buf[b + 1] === this.#system &&
+      slotLayout(buf, a, resolution) !== INVALID &&
+      slotLayout(buf, b, resolution) !== INVALID &&
+      byte0Follows(buf[a] as number, buf[b] as number, this.#b0Mode)
+    );
   }
 
   /**

@@ -107,7 +107,15 @@ export interface Batch {
   mismatch: 1024 | 2048 | null;
   /** The source has ended (a replay at its end): the state shown is the last one, frozen. */
   ended: boolean;
-  counters: { bytes: number; frames: number; resyncs: number; discardedBytes: number; badFrames: number };
+  counters: {
+    bytes: number;
+    frames: number;
+    resyncs: number;
+    discardedBytes: number;
+    badFrames: number;
+    emptySlots: number;
+    vtxFrames: number;
+  };
   /** Completed graph buckets: start time, fades/s, mean RSSI (NaN without), mean frame interval ms (NaN if <2 frames), lost frames. */
   series: { t: Float64Array; fadeRate: Float32Array; rssi: Float32Array; periodMs: Float32Array; lost: Float32Array };
   /** Hold and failsafe episodes that started, ended or were re-dated since the last batch. */

@@ -37,8 +37,7 @@ const ROWS: readonly (readonly [Key, string, string, boolean])[] = [
   ['rssi', 'RSSI', 'Signal strength the receiver reports (SPM4649T).', false],
 ];
 
-/** Counters the worker may or may not send yet (the decoder has them). */
-type Counts = Live['counters'] & { emptySlots?: number; vtxFrames?: number };
+type Counts = Live['counters'];
 
 export function Counters() {
   const list = useRef<HTMLDListElement>(null);
