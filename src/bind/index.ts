@@ -47,15 +47,8 @@ export {
   type PulseMeasurement,
   type StopBits,
 } from './uart.js';
-export {
-  planPulses,
-  validatePlan,
-  type ChipRate,
-  type PlanCheck,
-  type PlanOptions,
-  type PulsePlan,
-  type ValidateOptions,
-} from './plan.js';
+export { planPulses, type ChipRate, type PlanOptions, type PulsePlan } from './plan.js';
+export { validatePlan, type PlanCheck, type ValidateOptions } from './check.js';
 export {
   bindForAdapter,
   bindTimeline,

@@ -11,16 +11,9 @@
  */
 import { Doctor, doctorEvent, type ConfirmProbe, type DoctorFinding } from '../analysis/index.js';
 import type { Capture } from '../capture/index.js';
-import type { DecodedFrame } from '../decoder/index.js';
 import type { Engine } from './engine.js';
 import type { DiagnosisStatus, FromWorker } from './protocol.js';
 import { SerialSource } from './sources/serial.js';
-
-/** What an engine hands the doctor: each chunk as it arrives, each frame after the link monitor counted it. */
-export interface EngineTap {
-  bytes(bytes: Uint8Array, time: number | Float64Array | undefined): void;
-  frame(f: DecodedFrame): void;
-}
 
 /** The page hears from the doctor at most this often. */
 const MIN_POST_MS = 250;

@@ -4,11 +4,10 @@
  * channel, and 100 ms graph buckets. `batch()` hands the page what changed since the last call.
  * Time is always passed in: the arrival clock live, the capture's own clock in replay.
  */
-import { BYTE_TIME_US, CHANNEL_COUNT, LinkMonitor, SpektrumDecoder, type LinkEpisode, type Resolution } from '../decoder/index.js';
+import { BYTE_TIME_US, CHANNEL_COUNT, LinkMonitor, SpektrumDecoder, type DecodedFrame, type LinkEpisode, type Resolution } from '../decoder/index.js';
 import { LinkSeries } from '../analysis/index.js';
 import { InspectorLog } from './inspector.js';
 import { BUCKET_US, type Batch } from './protocol.js';
-import type { EngineTap } from './diagnosis.js';
 
 export interface EngineOptions {
   resolution: 'auto' | 1024 | 2048;
@@ -27,6 +26,12 @@ export const SETTLE_US = 500_000;
 
 /** Pushes remembered to date the bytes the decoder still holds. */
 const PUSHES_KEPT = 32;
+
+/** What an engine hands a listener (the doctor): each chunk as it arrives, each frame after the link monitor counted it. */
+export interface EngineTap {
+  bytes(bytes: Uint8Array, time: number | Float64Array | undefined): void;
+  frame(f: DecodedFrame): void;
+}
 
 export class Engine {
   readonly decoder: SpektrumDecoder;
