@@ -394,6 +394,16 @@ describe('healthReport: glitches', () => {
     ]);
   });
 
+  it('shows empty (0xFFFF) slots and VTX frames where a stream has them, and no such row where it has none', () => {
+    const empty = healthReport(perByte(run(preset('empty-slots-12ch'), 2_000_000)));
+    const vtx = healthReport(perByte(run(preset('vtx'), 2_000_000)));
+    const plain = healthReport(perByte(run(preset('dsmx-11ms-2048-internal'), 2_000_000)));
+    expect(empty.remotes[0]!.decoder.emptySlots).toBeGreaterThan(0);
+    expect(reportHtml(empty)).toMatch(new RegExp(`${empty.remotes[0]!.decoder.emptySlots} empty \\(0xFFFF\\)`));
+    expect(reportHtml(vtx)).toMatch(new RegExp(`${vtx.remotes[0]!.decoder.vtxFrames} VTX frames`));
+    expect(reportHtml(plain)).not.toMatch(/empty \(0xFFFF\)|VTX frames/);
+  });
+
   it('finds none in clean streams of every preset without damage', () => {
     for (const name of ['dsm2-22ms-1024-internal', 'dsmx-22ms-2048-external', 'xplus-dx9', 'xplus-8', 'vtx', 'demo']) {
       const r = healthReport(perByte(run(preset(name), 12_000_000))).remotes[0]!;

@@ -321,6 +321,15 @@ function metricRows(r: RemoteReport, timed: boolean, compact: boolean): [string,
     'Decoder',
     `${d.bytes} bytes, ${d.discardedBytes} discarded, ${d.resyncs} resyncs, ${d.badFrames} bad frames${d.formatChanges ? `, ${d.formatChanges} format changes` : ''}`,
   ]);
+  // Empty (0xFFFF) slots and VTX frames, where they occur: the first says channels the receiver leaves unused.
+  if (d.emptySlots > 0 || d.vtxFrames > 0) {
+    rows.push([
+      'Slots',
+      [d.emptySlots > 0 ? `${d.emptySlots} empty (0xFFFF)` : '', d.vtxFrames > 0 ? `${d.vtxFrames} VTX frames` : '']
+        .filter(Boolean)
+        .join(', '),
+    ]);
+  }
   rows.push(['Glitches', r.glitches.count === 0 ? 'none' : `${r.glitches.count} spikes in ${r.glitches.frames} frames`]);
   if (compact) rows.push(['Channels', channelList(r)]);
   return rows;

@@ -5,7 +5,7 @@
 import { type UsbSerialChip, chipBaudRate } from './chips.js';
 import { BIND_PULSE_MAX_US, BIND_PULSE_MIN_US, BIND_WINDOW, MAX_BIND_PULSES, MIN_BIND_PULSES } from './modes.js';
 import { type PulsePlan, fmtUs } from './plan.js';
-import { type BindStep } from './timeline.js';
+import type { BindStep } from './timeline.js';
 import { type PulseMeasurement, measurePulses, uartWaveform } from './uart.js';
 
 export interface ValidateOptions {

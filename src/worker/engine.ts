@@ -4,7 +4,15 @@
  * channel, and 100 ms graph buckets. `batch()` hands the page what changed since the last call.
  * Time is always passed in: the arrival clock live, the capture's own clock in replay.
  */
-import { BYTE_TIME_US, CHANNEL_COUNT, LinkMonitor, SpektrumDecoder, type DecodedFrame, type LinkEpisode, type Resolution } from '../decoder/index.js';
+import {
+  BYTE_TIME_US,
+  CHANNEL_COUNT,
+  LinkMonitor,
+  SpektrumDecoder,
+  type DecodedFrame,
+  type LinkEpisode,
+  type Resolution,
+} from '../decoder/index.js';
 import { LinkSeries } from '../analysis/index.js';
 import { InspectorLog } from './inspector.js';
 import { BUCKET_US, type Batch } from './protocol.js';
