@@ -441,34 +441,47 @@ export class SpektrumDecoder {
         }
       }
       // The frame at o does not continue the stream (or the next one does not continue it).
-      const q = this.#search(o + 1, o + MAX_RESYNC_BYTES);
-      if (q === NEED_MORE) return undefined;
-      // This remote's own chain that starts right after this frame (or at it) is the remote going
-      // on after its count fell (a restart), not noise to skip on the way to a frame that
-      // happens to fit the old count further on.
-      const internal = this.#remote === 'internal';
-      const restartAfter = internal && q !== NOT_FOUND && q > o + FRAME_SIZE && this.#ownChainAt(o + FRAME_SIZE);
-      if (
-        fits &&
-        (q === NOT_FOUND ? this.#lastOfItsKind(o, layout) : (restartAfter && this.#knownLayout(layout)) || this.#standsAlone(o, layout, q))
-      ) {
-        // This frame is whole: what follows it up to q is noise, or something new starts after it.
-        return this.#emit(o, layout);
-      }
-      if (!fits && internal && q !== NOT_FOUND && q >= o + FRAME_SIZE && this.#ownChainAt(o)) {
-        this.#unlock();
-        continue;
-      }
-      if (q !== NOT_FOUND) {
-        this.#resync(o, q);
-        continue;
-      }
-      // Nothing continues within reach: the format may have changed. Acquire afresh from here.
-      this.#unlock();
+      const broken = this.#broken(o, layout, fits);
+      if (broken === undefined) return undefined;
+      if (broken !== null) return broken;
     }
   }
 
   // ---- locked path -------------------------------------------------------------------------
+
+  /**
+   * The frame at `o` does not continue the stream, or the frame after it does not continue it:
+   * find where frames go on. Returns the frame at `o` when it is whole after all, null when the
+   * caller should go round again (bytes were discarded, or the lock was let go), undefined when
+   * more bytes are needed. Kept out of next() so that the common path stays small.
+   */
+  #broken(o: number, layout: number, fits: boolean): DecodedFrame | null | undefined {
+    const q = this.#search(o + 1, o + MAX_RESYNC_BYTES);
+    if (q === NEED_MORE) return undefined;
+    // This remote's own chain that starts right after this frame (or at it) is the remote going
+    // on after its count fell (a restart), not noise to skip on the way to a frame that
+    // happens to fit the old count further on.
+    const internal = this.#remote === 'internal';
+    const restartAfter = internal && q !== NOT_FOUND && q > o + FRAME_SIZE && this.#ownChainAt(o + FRAME_SIZE);
+    if (
+      fits &&
+      (q === NOT_FOUND ? this.#lastOfItsKind(o, layout) : (restartAfter && this.#knownLayout(layout)) || this.#standsAlone(o, layout, q))
+    ) {
+      // This frame is whole: what follows it up to q is noise, or something new starts after it.
+      return this.#emit(o, layout);
+    }
+    if (!fits && internal && q !== NOT_FOUND && q >= o + FRAME_SIZE && this.#ownChainAt(o)) {
+      this.#unlock();
+      return null;
+    }
+    if (q !== NOT_FOUND) {
+      this.#resync(o, q);
+      return null;
+    }
+    // Nothing continues within reach: the format may have changed. Acquire afresh from here.
+    this.#unlock();
+    return null;
+  }
 
   /**
    * The common locked case in one pass: the frame at the head has the layout read while
