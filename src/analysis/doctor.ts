@@ -21,7 +21,7 @@ import {
   type Resolution,
   type SpektrumDecoder,
 } from '../decoder/index.js';
-import { REPORT_THRESHOLDS } from './report.js';
+import { plural, REPORT_THRESHOLDS } from './report.js';
 import { BurstClock, classifyLine, PACKET_KINDS, PacketScanner, type LineVerdict, type PacketKind } from './doctor-line.js';
 import {
   ArduPilotGuess,
@@ -261,7 +261,6 @@ const CONFIDENCE_ORDER: Record<Confidence, number> = { certain: 0, likely: 1, po
 
 /** "2.4 s" */
 const dur = (us: number): string => `${(us / 1e6).toFixed(1)} s`;
-const plural = (n: number, one: string, many = `${one}s`): string => `${n} ${n === 1 ? one : many}`;
 
 /** Advice from spec §5 for a weak link. */
 const LINK_ADVICE = [

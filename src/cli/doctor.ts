@@ -5,11 +5,10 @@
  * Exit codes: 0 no problem found at the end of the capture, 1 a problem found (or the file is
  * not a capture), 2 bad usage or an unreadable file.
  */
-import { readFileSync } from 'node:fs';
 import { basename } from 'node:path';
 import { parseArgs } from 'node:util';
-import { doctorCapture, type DoctorFinding, type DoctorReport } from '../analysis/index.js';
-import { CaptureFormatError, readCapture, type Capture } from '../capture/index.js';
+import { doctorCapture, formatClock, type DoctorFinding, type DoctorReport } from '../analysis/index.js';
+import { loadCapture } from './input.js';
 
 export const DOCTOR_USAGE = `Usage:
   satscope doctor FILE [--json] [--resolution auto|1024|2048]
@@ -61,32 +60,12 @@ export function doctorCommand(argv: string[], io: DoctorIo = defaultIo): number 
     return usage(`--resolution must be auto, 1024 or 2048, not '${resolution}'`);
   const file = positionals[0] as string;
 
-  let bytes: Uint8Array;
-  try {
-    bytes = readFileSync(file);
-  } catch (error) {
-    const code = (error as NodeJS.ErrnoException).code;
-    const why =
-      code === 'ENOENT'
-        ? 'no such file'
-        : code === 'EISDIR'
-          ? 'it is a directory'
-          : code === 'EACCES'
-            ? 'permission denied'
-            : String(error);
-    io.err(`satscope doctor: cannot read ${file}: ${why}\n`);
-    return 2;
+  const loaded = loadCapture(file);
+  if ('error' in loaded) {
+    io.err(`satscope doctor: ${loaded.error}\n`);
+    return loaded.exitCode;
   }
-  let capture: Capture;
-  try {
-    capture = readCapture(new Uint8Array(bytes.buffer, bytes.byteOffset, bytes.byteLength), basename(file));
-  } catch (error) {
-    if (error instanceof CaptureFormatError) {
-      io.err(`satscope doctor: ${file}: ${error.message}\n`);
-      return 1;
-    }
-    throw error;
-  }
+  const { capture } = loaded;
   for (const issue of capture.issues) io.err(`satscope doctor: ${file}: ${issue.message}\n`);
   const report = doctorCapture(capture, { resolution: resolution === 'auto' ? 'auto' : (Number(resolution) as 1024 | 2048) });
   io.out(values.json === true ? `${JSON.stringify(report, null, 2)}\n` : formatDoctorReport(report, basename(file)));
@@ -97,11 +76,7 @@ const LABEL: Record<DoctorFinding['severity'], string> = { problem: 'PROBLEM', w
 
 /** "0:02.1" from the capture's start. */
 function clock(us: number | null, origin: number | null): string {
-  if (us === null || origin === null || !Number.isFinite(us)) return '';
-  const s = Math.max(0, (us - origin) / 1e6);
-  const m = Math.floor(s / 60);
-  const rest = (s - m * 60).toFixed(1).padStart(4, '0');
-  return `${m}:${rest}`;
+  return us === null || origin === null || !Number.isFinite(us) ? '' : formatClock(us - origin);
 }
 
 /** The report as text a person reads in a terminal. */

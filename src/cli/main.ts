@@ -8,10 +8,11 @@
  */
 import { readFileSync, writeFileSync } from 'node:fs';
 import { basename } from 'node:path';
-import { CaptureFormatError, captureChunks, capturePorts, readCapture, type Capture, type CaptureChunk } from '../capture/index.js';
+import { captureChunks, capturePorts, type Capture, type CaptureChunk } from '../capture/index.js';
 import { SpektrumDecoder } from '../decoder/index.js';
 import { diagnosedHealthReport, reportHtml, summarizeCapture } from '../analysis/index.js';
 import { parseCommandLine, UsageError, type Args } from './args.js';
+import { loadCapture } from './input.js';
 import { formatJsonLine, formatCsvHeader, formatCsvLine, formatReportVerdict, formatSummary } from './format.js';
 import { TextOutput } from './output.js';
 
@@ -34,27 +35,6 @@ Exit codes: 0 done (also when the reader of the output stops early, as head does
 holds no frames (on that port) or is not a capture, or the output could not be written (a full
 disk), 2 bad usage or a file that cannot be read.`;
 
-function load(file: string): Capture {
-  let bytes: Uint8Array;
-  try {
-    bytes = readFileSync(file);
-  } catch (error) {
-    const code = (error as NodeJS.ErrnoException).code;
-    const why =
-      code === 'ENOENT'
-        ? 'no such file'
-        : code === 'EISDIR'
-          ? 'it is a directory'
-          : code === 'EACCES'
-            ? 'permission denied'
-            : String(error);
-    throw new UsageError(`cannot read ${file}: ${why}`);
-  }
-  const capture = readCapture(new Uint8Array(bytes.buffer, bytes.byteOffset, bytes.byteLength), basename(file));
-  for (const issue of capture.issues) process.stderr.write(`satscope: ${file}: ${issue.message}\n`);
-  return capture;
-}
-
 async function main(argv: string[]): Promise<number> {
   let args: ReturnType<typeof parseCommandLine>;
   try {
@@ -74,20 +54,13 @@ async function main(argv: string[]): Promise<number> {
     out.text(`${pkg.version}\n`);
     return finish(out, 0);
   }
-  let capture: Capture;
-  try {
-    capture = load(args.file);
-  } catch (error) {
-    if (error instanceof UsageError) {
-      process.stderr.write(`satscope: ${error.message}\n`);
-      return 2;
-    }
-    if (error instanceof CaptureFormatError) {
-      process.stderr.write(`satscope: ${args.file}: ${error.message}\n`);
-      return 1;
-    }
-    throw error;
+  const loaded = loadCapture(args.file);
+  if ('error' in loaded) {
+    process.stderr.write(`satscope: ${loaded.error}\n`);
+    return loaded.exitCode;
   }
+  const { capture } = loaded;
+  for (const issue of capture.issues) process.stderr.write(`satscope: ${args.file}: ${issue.message}\n`);
   if (args.command === 'report') return report(capture, args, out);
   const port = args.port ?? 0;
   const noData = portProblem(capture, args.port);

@@ -570,15 +570,7 @@ export class SpektrumDecoder {
       const bytes = frame.bytes;
       for (let i = 0; i < FRAME_SIZE; i++) bytes[i] = buf[o + i] as number;
     }
-    const empty = decodeSlots(frame, buf, o, resolution, isVtxFrame(buf, o), this.#vtx);
-    const s = this.#stats;
-    s.frames++;
-    s.frameBytes += FRAME_SIZE;
-    s.pendingBytes -= FRAME_SIZE;
-    s.emptySlots += empty;
-    if (frame.vtx !== null) s.vtxFrames++;
-    this.#head = o + FRAME_SIZE;
-    return frame;
+    return this.#counted(frame, o, decodeSlots(frame, buf, o, resolution, isVtxFrame(buf, o), this.#vtx));
   }
 
   /** Whether the header at `o` continues the last emitted frame under the lock's model. */
@@ -779,7 +771,11 @@ export class SpektrumDecoder {
     this.#last1 = b1;
     this.#haveLast = true;
     this.#jumpTrusted = false;
-    const empty = readSlots(frame, buf, o, resolution, isVtxFrame(buf, o), this.#vtx);
+    return this.#counted(frame, o, readSlots(frame, buf, o, resolution, isVtxFrame(buf, o), this.#vtx));
+  }
+
+  /** Counts the frame just filled at `o` (with `empty` 0xFFFF slots) and moves past it: both emit paths end here. */
+  #counted(frame: DecodedFrame, o: number, empty: number): DecodedFrame {
     const s = this.#stats;
     s.frames++;
     s.frameBytes += FRAME_SIZE;
