@@ -19,6 +19,7 @@ import { captureSpan, healthReport, summarizeCapture, timingJitterUs } from '../
 import { preset, simulate } from '../src/simulator/index.js';
 import { Engine } from '../src/worker/engine.js';
 import { ReplaySource, type ReplayClock } from '../src/worker/sources/replay.js';
+import { usbChunks, perByteCapture } from './feeds.js';
 
 const CAPTURES = resolve(import.meta.dirname, '../../shared/captures');
 const present = existsSync(CAPTURES);
@@ -31,36 +32,6 @@ function captureFiles(dir: string): string[] {
     const path = join(dir, name);
     if (statSync(path).isDirectory()) out.push(...captureFiles(path));
     else if (!/\.md$/i.test(name)) out.push(path);
-  }
-  return out;
-}
-
-/** A capture with the time of every byte, as a logic analyser records it. */
-function perByte(sim: { bytes: Uint8Array; timesUs: Float64Array }): Capture {
-  return {
-    kind: 'saleae-csv',
-    meta: {},
-    timing: 'per-byte',
-    bytes: sim.bytes,
-    chunkEnds: Uint32Array.of(sim.bytes.length),
-    chunkTimesUs: Float64Array.of(sim.timesUs[sim.timesUs.length - 1]!),
-    chunkPorts: new Uint8Array(1),
-    byteTimesUs: sim.timesUs,
-    events: [],
-    issues: [],
-  };
-}
-
-/** What a USB adapter delivers from per-byte times: whatever arrived in each 16 ms window, stamped at its end. */
-function usbChunks(bytes: Uint8Array, times: Float64Array): { bytes: Uint8Array; timeUs: number }[] {
-  const out: { bytes: Uint8Array; timeUs: number }[] = [];
-  let start = 0;
-  for (let i = 0; i <= bytes.length; i++) {
-    const deadline = Math.floor(times[start]! / 16_000) * 16_000 + 16_000;
-    if (i === bytes.length || times[i]! >= deadline) {
-      if (i > start) out.push({ bytes: bytes.slice(start, i), timeUs: deadline });
-      start = i;
-    }
   }
   return out;
 }
@@ -251,25 +222,25 @@ const sim = (name: string, seed: number, durationUs: number) => simulate({ ...pr
 const CASES: Case[] = [
   {
     name: 'simulator dropouts-failsafe (per-byte times)',
-    capture: () => perByte(sim('dropouts-failsafe', 3, 4_000_000)),
+    capture: () => perByteCapture(sim('dropouts-failsafe', 3, 4_000_000)),
     live: true,
     expect: { holds: 2, failsafes: 1 },
   },
   {
     name: 'simulator dropouts-and-damage (per-byte times)',
-    capture: () => perByte(sim('dropouts-and-damage', 5, 4_000_000)),
+    capture: () => perByteCapture(sim('dropouts-and-damage', 5, 4_000_000)),
     live: true,
     expect: { holds: 2, failsafes: 1 },
   },
   {
     name: 'simulator damaged-line, 00 00 header: missed frames by count (per-byte times)',
-    capture: () => perByte(sim('damaged-line', 7, 4_000_000)),
+    capture: () => perByteCapture(sim('damaged-line', 7, 4_000_000)),
     live: true,
     expect: { failsafes: 0 },
   },
   {
     name: 'simulator dsm2-22ms-1024-external (per-byte times)',
-    capture: () => perByte(sim('dsm2-22ms-1024-external', 9, 3_000_000)),
+    capture: () => perByteCapture(sim('dsm2-22ms-1024-external', 9, 3_000_000)),
     live: true,
     expect: { holds: 0, failsafes: 0 },
   },

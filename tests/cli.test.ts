@@ -11,6 +11,7 @@ import { CaptureWriter, readCapture } from '../src/capture/index.js';
 import { summarizeCapture } from '../src/analysis/index.js';
 import { preset, simulate } from '../src/simulator/index.js';
 import { concatBytes } from './bytes.js';
+import { usbChunks } from './feeds.js';
 
 const cli = resolve(import.meta.dirname, '../dist/cli/main.js');
 let dir = '';
@@ -27,14 +28,7 @@ beforeAll(() => {
   const writer = new CaptureWriter({ baudRate: 115200, source: 'test' });
   const parts = [writer.header()];
   // As a USB adapter delivers them: what arrived in each 16 ms window, stamped at its end.
-  let start = 0;
-  for (let i = 0; i <= sim.bytes.length; i++) {
-    const deadline = Math.floor(sim.timesUs[start]! / 16_000) * 16_000 + 16_000;
-    if (i === sim.bytes.length || sim.timesUs[i]! >= deadline) {
-      if (i > start) parts.push(writer.data(sim.bytes.subarray(start, i), deadline));
-      start = i;
-    }
-  }
+  for (const c of usbChunks(sim.bytes, sim.timesUs)) parts.push(writer.data(c.bytes, c.timeUs));
   const file = concatBytes(parts);
   writeFileSync(join(dir, 'run.sscap'), file);
   writeFileSync(join(dir, 'cut.sscap'), file.subarray(0, file.length - 30));

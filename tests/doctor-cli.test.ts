@@ -12,6 +12,7 @@ import { doctorCommand } from '../src/cli/doctor.js';
 import { CaptureWriter } from '../src/capture/index.js';
 import { ibusStream, preset, receiveAs, simulate } from '../src/simulator/index.js';
 import { concatBytes } from './bytes.js';
+import { usbChunks } from './feeds.js';
 
 const SECOND = 1_000_000;
 let dir = '';
@@ -27,14 +28,7 @@ function run(...args: string[]): { code: number; out: string; err: string } {
 function recording(bytes: Uint8Array, timesUs: Float64Array): Uint8Array {
   const w = new CaptureWriter({ baudRate: 115200, source: 'test' });
   const parts = [w.header(), w.event('port opened', 0, 0)];
-  let start = 0;
-  for (let i = 0; i <= bytes.length; i++) {
-    const deadline = Math.floor(timesUs[start]! / 16_000) * 16_000 + 16_000;
-    if (i === bytes.length || timesUs[i]! >= deadline) {
-      if (i > start) parts.push(w.data(bytes.subarray(start, i), deadline));
-      start = i;
-    }
-  }
+  for (const c of usbChunks(bytes, timesUs)) parts.push(w.data(c.bytes, c.timeUs));
   return concatBytes(parts);
 }
 

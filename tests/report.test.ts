@@ -28,26 +28,11 @@ import {
   type HealthReport,
 } from '../src/analysis/index.js';
 import { encodeServo2048, preset, simulate, type Scenario, type SimChunk } from '../src/simulator/index.js';
+import { perByteCapture } from './feeds.js';
 
 // ---------------------------------------------------------------------------------------------
 // Captures from the simulator
 // ---------------------------------------------------------------------------------------------
-
-/** A capture with the time of every byte, as a logic analyser records it. */
-function perByte(sim: { bytes: Uint8Array; timesUs: Float64Array }): Capture {
-  return {
-    kind: 'saleae-csv',
-    meta: {},
-    timing: 'per-byte',
-    bytes: sim.bytes,
-    chunkEnds: Uint32Array.of(sim.bytes.length),
-    chunkTimesUs: Float64Array.of(sim.timesUs[sim.timesUs.length - 1]!),
-    chunkPorts: new Uint8Array(1),
-    byteTimesUs: sim.timesUs,
-    events: [],
-    issues: [],
-  };
-}
 
 /** What a USB adapter delivers: whatever arrived in each 16 ms window, stamped at its end. */
 function usbRecords(sim: { bytes: Uint8Array; timesUs: Float64Array }, port = 0): CaptureRecordInput[] {
@@ -118,7 +103,7 @@ function tagProblems(html: string): string[] {
 describe('healthReport: failsafe, holds and lost frames against the simulator', () => {
   const sim = run({ ...preset('dropouts-failsafe'), seed: 3 }, 4_000_000);
   const truth = sim.truth!;
-  const report = healthReport(perByte(sim), { name: 'dropouts.csv' });
+  const report = healthReport(perByteCapture(sim), { name: 'dropouts.csv' });
   const r = report.remotes[0]!;
   const origin = report.timeline.originUs!;
 
@@ -229,7 +214,7 @@ describe('healthReport: failsafe, holds and lost frames against the simulator', 
 describe('healthReport: timing', () => {
   it('gives the jitter of the frame period, as the frame times say (per-byte timing)', () => {
     const sim = run(preset('dsmx-11ms-2048-internal'), 5_000_000);
-    const r = healthReport(perByte(sim)).remotes[0]!;
+    const r = healthReport(perByteCapture(sim)).remotes[0]!;
     const times = intactOf(sim).map((f) => f.timeUs);
     const gapFree = times
       .slice(1)
@@ -251,7 +236,7 @@ describe('healthReport: timing', () => {
     const sim = run(preset('dsmx-22ms-2048-internal'), 4_000_000);
     const times = sim.timesUs.slice();
     for (const f of sim.truth!.frames) if (f.index % 2 === 1) for (let i = 0; i < f.length; i++) times[f.offset + i]! += 3000;
-    const r = healthReport(perByte({ bytes: sim.bytes, timesUs: times })).remotes[0]!;
+    const r = healthReport(perByteCapture({ bytes: sim.bytes, timesUs: times })).remotes[0]!;
     expect(r.nominalPeriodUs).toBe(22_000);
     expect(r.framePeriod!.stdDevUs).toBeGreaterThan(2900);
     expect(r.framePeriod!.stdDevUs).toBeLessThan(3100);
@@ -310,7 +295,7 @@ describe('healthReport: timing', () => {
 describe('healthReport: RSSI', () => {
   it('sums up SPM4649T RSSI (loss reports apart) instead of fades', () => {
     const sim = run(preset('rssi-spm4649t'), 20_000_000);
-    const report = healthReport(perByte(sim));
+    const report = healthReport(perByteCapture(sim));
     const r = report.remotes[0]!;
     const levels = intactOf(sim).map((f) => f.rssi!);
     const real = levels.filter((v) => v !== -128);
@@ -361,7 +346,7 @@ describe('healthReport: glitches', () => {
   for (const i of step) setChannel(sim, i, 9, 1707);
 
   it('finds the single-frame spikes that come back, and nothing else', () => {
-    const report = healthReport(perByte(sim));
+    const report = healthReport(perByteCapture(sim));
     const r = report.remotes[0]!;
     expect(r.glitches.count).toBe(2);
     expect(r.glitches.frames).toBe(2);
@@ -395,9 +380,9 @@ describe('healthReport: glitches', () => {
   });
 
   it('shows empty (0xFFFF) slots and VTX frames where a stream has them, and no such row where it has none', () => {
-    const empty = healthReport(perByte(run(preset('empty-slots-12ch'), 2_000_000)));
-    const vtx = healthReport(perByte(run(preset('vtx'), 2_000_000)));
-    const plain = healthReport(perByte(run(preset('dsmx-11ms-2048-internal'), 2_000_000)));
+    const empty = healthReport(perByteCapture(run(preset('empty-slots-12ch'), 2_000_000)));
+    const vtx = healthReport(perByteCapture(run(preset('vtx'), 2_000_000)));
+    const plain = healthReport(perByteCapture(run(preset('dsmx-11ms-2048-internal'), 2_000_000)));
     expect(empty.remotes[0]!.decoder.emptySlots).toBeGreaterThan(0);
     expect(reportHtml(empty)).toMatch(new RegExp(`${empty.remotes[0]!.decoder.emptySlots} empty \\(0xFFFF\\)`));
     expect(reportHtml(vtx)).toMatch(new RegExp(`${vtx.remotes[0]!.decoder.vtxFrames} VTX frames`));
@@ -406,14 +391,14 @@ describe('healthReport: glitches', () => {
 
   it('finds none in clean streams of every preset without damage', () => {
     for (const name of ['dsm2-22ms-1024-internal', 'dsmx-22ms-2048-external', 'xplus-dx9', 'xplus-8', 'vtx', 'demo']) {
-      const r = healthReport(perByte(run(preset(name), 12_000_000))).remotes[0]!;
+      const r = healthReport(perByteCapture(run(preset(name), 12_000_000))).remotes[0]!;
       expect({ name, glitches: r.glitches.count }).toEqual({ name, glitches: 0 });
     }
   });
 
   it('on a damaged line, puts every glitch on a damaged frame', () => {
     const damaged = run({ ...preset('damaged-line'), damage: { bitFlipRate: 0.05, truncateRate: 0.02, noiseRate: 0.02 } }, 20_000_000);
-    const report = healthReport(perByte(damaged));
+    const report = healthReport(perByteCapture(damaged));
     const r = report.remotes[0]!;
     const origin = report.timeline.originUs!;
     expect(r.glitches.count).toBeGreaterThan(0);

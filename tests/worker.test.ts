@@ -11,36 +11,7 @@ import { preset, simulate } from '../src/simulator/index.js';
 import { Engine, SETTLE_US } from '../src/worker/engine.js';
 import { ReplaySource, type ReplayClock } from '../src/worker/sources/replay.js';
 import { openProblem } from '../src/worker/sources/serial.js';
-
-/** What a USB adapter delivers: whatever arrived in each 16 ms window, stamped at its end. */
-function usbChunks(bytes: Uint8Array, times: Float64Array): { bytes: Uint8Array; timeUs: number }[] {
-  const out: { bytes: Uint8Array; timeUs: number }[] = [];
-  let start = 0;
-  for (let i = 0; i <= bytes.length; i++) {
-    const deadline = Math.floor(times[start]! / 16_000) * 16_000 + 16_000;
-    if (i === bytes.length || times[i]! >= deadline) {
-      if (i > start) out.push({ bytes: bytes.slice(start, i), timeUs: deadline });
-      start = i;
-    }
-  }
-  return out;
-}
-
-/** A capture with the time of every byte in one chunk, as `readCapture` returns a Saleae export. */
-function saleae(sim: { bytes: Uint8Array; timesUs: Float64Array }): Capture {
-  return {
-    kind: 'saleae-csv',
-    meta: {},
-    timing: 'per-byte',
-    bytes: sim.bytes,
-    chunkEnds: Uint32Array.of(sim.bytes.length),
-    chunkTimesUs: Float64Array.of(sim.timesUs[sim.timesUs.length - 1]!),
-    chunkPorts: new Uint8Array(1),
-    byteTimesUs: sim.timesUs,
-    events: [],
-    issues: [],
-  };
-}
+import { usbChunks, perByteCapture } from './feeds.js';
 
 interface Collected {
   series: { t: number[]; fadeRate: number[]; lost: number[]; periodMs: number[] };
@@ -250,7 +221,7 @@ describe("replay runs on the capture's clock", () => {
   const sim = simulate({ ...preset('dropouts-failsafe'), seed: 3 }, 4_000_000);
 
   it('gives a Saleae export (one chunk, per-byte times) its timeline: start, end, 1× pace, seeking and full speed', () => {
-    const capture = saleae(sim);
+    const capture = perByteCapture(sim);
     const { r, clock, positions, engine, ended } = replayOf(capture);
     expect(r.startUs).toBe(sim.timesUs[0]);
     expect(r.endUs).toBe(sim.timesUs.at(-1));
@@ -275,7 +246,7 @@ describe("replay runs on the capture's clock", () => {
   });
 
   it('ends at the last recorded time, never past it, and freezes the state there', () => {
-    const capture = saleae(simulate({ ...preset('dsmx-11ms-2048-internal'), seed: 8 }, 1_500_000));
+    const capture = perByteCapture(simulate({ ...preset('dsmx-11ms-2048-internal'), seed: 8 }, 1_500_000));
     const { r, clock, positions, engine, ended } = replayOf(capture);
     r.play();
     clock.tick(1000);
