@@ -2,7 +2,9 @@
  * The page through Chromium's real WebSerial stack: a managed policy grants the test origin its
  * ports, and a pseudo-terminal standing in for /dev/ttyS0 plays a receiver at real pace (the real
  * PX4 capture when ../shared is here, else the simulator). Covers connect, live bars, recording,
- * unplug (the feeding end closes) with the recording intact, and reconnect without a prompt.
+ * unplug (the feeding end closes) with the recording intact, and reconnect without a prompt; and
+ * a link with real dropouts, whose holds and failsafe must show when they happened. Bytes are
+ * fed while other processes keep both cores busy: delivery delay is not link loss.
  */
 import { existsSync, mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
@@ -11,11 +13,13 @@ import type { Browser, Page } from 'playwright-core';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { importRaw, importSaleaeCsv, parseCapture } from '../../src/capture/index.js';
 import { summarizeCapture } from '../../src/analysis/index.js';
+import { LinkMonitor, SpektrumDecoder, type LinkEpisode } from '../../src/decoder/index.js';
 import { preset, simulate } from '../../src/simulator/index.js';
 import { APP_DIR, SHARED_CAPTURES, barValues, browserUnavailable, shot } from './app-fixture.js';
 import { launchChromium, startStaticServer, type StaticServer } from './harness/browser.js';
+import { loadCpus } from './harness/load.js';
 import { installSerialPolicy, type SerialPolicy } from './harness/policy.js';
-import { fakeSerialUnsupportedReason, openFakeSerialPort, type FakeSerialPort } from './harness/pty-serial.js';
+import { fakeSerialUnsupportedReason, monotonicUs, openFakeSerialPort, type FakeSerialPort } from './harness/pty-serial.js';
 
 const skip = browserUnavailable() ?? fakeSerialUnsupportedReason();
 if (skip !== null) console.warn(`skipping the WebSerial tests: ${skip}`);
@@ -79,14 +83,19 @@ describe.skipIf(skip !== null)('a receiver on a serial port', () => {
     await page.getByRole('button', { name: '● Record' }).click();
     await page.getByRole('button', { name: 'Stop recording' }).waitFor();
     const half = Math.floor(stream.bytes.length / 2 / 16) * 16;
-    await fake.writePaced(stream.bytes.subarray(0, half), stream.timesUs.subarray(0, half));
+    const load = loadCpus();
+    try {
+      await fake.writePaced(stream.bytes.subarray(0, half), stream.timesUs.subarray(0, half));
+    } finally {
+      await load.stop();
+    }
     await linkState(page, 'Live');
     const bars = await barValues(page);
     const expected = summarizeCapture(importRaw(stream.bytes.subarray(0, half)));
     for (const c of expected.channels.filter((ch) => ch.id < 12)) expect(bars[c.name], c.name).toBe(c.lastUs);
-    // A clean capture at real pace through the adapter: no missed frame however the bytes were
-    // batched on the way (the receiver's own fade counter does not move), and no hold but the
-    // one the end of the feed starts.
+    // A clean capture at real pace through the adapter, both cores busy: no missed frame however
+    // the bytes were batched on the way (the receiver's own fade counter does not move), and no
+    // hold but the one the end of the feed starts.
     await expect(page.getByTestId('count-missed').textContent()).resolves.toBe('0');
     await expect(page.locator('.link dd').nth(1).textContent()).resolves.toMatch(/^[01] holds? · 0 failsafes$/);
     await shot(page, 'serial-live');
@@ -119,4 +128,84 @@ describe.skipIf(skip !== null)('a receiver on a serial port', () => {
     expect(errors).toEqual([]);
     await context.close();
   });
+
+  it('shows the holds and failsafe of real dropouts within 1 s of when they happened, with both cores busy', async () => {
+    // A DSMX 11 ms link that drops out for 0.2 s (a hold) and for 1.3 s (a failsafe), then recovers.
+    const sim = simulate(preset('dropouts-failsafe'));
+    const truth = linkTruth(sim.bytes, sim.timesUs);
+    expect(truth.episodes.map((e) => e.kind)).toEqual(['hold', 'hold', 'failsafe']);
+
+    const context = await browser.newContext({ viewport: { width: 1400, height: 1000 } });
+    const page = await context.newPage();
+    const errors: string[] = [];
+    page.on('pageerror', (e) => errors.push(e.message));
+    await page.goto(server.url('/'));
+    await page.getByRole('button', { name: 'Serial port' }).click();
+    await page.getByTestId('source-status').filter({ hasText: 'at 115200 baud' }).waitFor();
+    // Every change of the link state, stamped with the wall clock as it happens in the page.
+    await page.evaluate(() => {
+      const w = window as unknown as { __states: { text: string; ms: number }[] };
+      const el = document.querySelector('[data-testid="link-state"]')!;
+      w.__states = [];
+      new MutationObserver(() => w.__states.push({ text: el.textContent ?? '', ms: Date.now() })).observe(el, {
+        subtree: true,
+        childList: true,
+        characterData: true,
+      });
+    });
+
+    const load = loadCpus();
+    let paced: Awaited<ReturnType<FakeSerialPort['writePaced']>>;
+    try {
+      paced = await fake.writePaced(sim.bytes, sim.timesUs);
+    } finally {
+      await load.stop();
+    }
+    // The last byte went out at paced.endUs (monotonic): place the capture's times on the wall clock.
+    const wallMinusMonoMs = Date.now() - monotonicUs() / 1000;
+    const lastByteUs = sim.timesUs[sim.timesUs.length - 1]!;
+    const wallMs = (captureUs: number) => paced.endUs / 1000 + wallMinusMonoMs - (lastByteUs - captureUs) / 1000;
+
+    // The end of the feed starts a third hold (the receiver went quiet for good).
+    await page.waitForFunction(
+      () => /^3 holds · [12] failsafes$/.test(document.querySelector('.link dd:nth-of-type(2)')?.textContent ?? ''),
+      null,
+      {
+        timeout: 5000,
+      },
+    );
+    const fedUntilMs = wallMs(lastByteUs);
+    const states = await page.evaluate(() => (window as unknown as { __states: { text: string; ms: number }[] }).__states);
+    // Each true episode (two holds, then the long hold's failsafe) shows as that state on the
+    // page within 1 s of its true start; the page goes back to Live after each dropout.
+    let from = 0;
+    for (const e of truth.episodes) {
+      const want = e.kind === 'hold' ? 'Hold' : 'Failsafe';
+      const at = states.findIndex((s, i) => i >= from && s.text === want);
+      expect(at, `${want} at ${(e.startUs - sim.timesUs[0]!) / 1e6} s shown`).toBeGreaterThanOrEqual(0);
+      const lateMs = states[at]!.ms - wallMs(e.startUs);
+      console.info(`${want}: shown ${lateMs.toFixed(0)} ms after it began`);
+      expect(Math.abs(lateMs), `${want} shown ${lateMs.toFixed(0)} ms from the truth`).toBeLessThan(1000);
+      from = at + 1;
+    }
+    // Nothing else while bytes were arriving: one failsafe, and Live after each dropout.
+    const whileFed = states.filter((s) => s.ms < fedUntilMs);
+    expect(whileFed.filter((s) => s.text === 'Failsafe')).toHaveLength(1);
+    expect(whileFed.filter((s) => s.text === 'Hold')).toHaveLength(2);
+    expect(whileFed.at(-1)?.text).toBe('Live');
+    // The frames the dropouts cost, as the receiver's fade counter says.
+    await expect(page.getByTestId('count-missed').textContent()).resolves.toBe(String(truth.missedFrames));
+    expect(errors).toEqual([]);
+    await context.close();
+  });
 });
+
+/** The hold and failsafe episodes and missed frames the library finds in a stream with per-byte times. */
+function linkTruth(bytes: Uint8Array, timesUs: Float64Array): { episodes: LinkEpisode[]; missedFrames: number } {
+  const decoder = new SpektrumDecoder();
+  const link = new LinkMonitor();
+  decoder.push(bytes, timesUs);
+  decoder.end();
+  for (let f = decoder.next(); f !== undefined; f = decoder.next()) link.frame(f);
+  return { episodes: link.episodes.map((e) => ({ ...e })), missedFrames: link.stats.missedFrames };
+}
