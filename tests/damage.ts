@@ -63,7 +63,7 @@ export function damage(clean: Uint8Array, edits: readonly Edit[]): Damaged {
   for (const e of sorted) {
     if (e.at < i) continue;
     for (; i < e.at; i++) {
-      bytes.push(clean[i] as number);
+      bytes.push(clean[i]!);
       origin.push(i);
     }
     if (e.kind === 'delete') {
@@ -74,13 +74,13 @@ export function damage(clean: Uint8Array, edits: readonly Edit[]): Damaged {
       let s = e.seed >>> 0;
       for (let k = 0; k < e.length; k++) {
         s = (Math.imul(s, 1103515245) + 12345) >>> 0;
-        bytes.push(e.copy ? (clean[(e.at + 7 + k) % clean.length] as number) : s >>> 24);
+        bytes.push(e.copy ? clean[(e.at + 7 + k) % clean.length]! : s >>> 24);
         origin.push(-1);
       }
     }
   }
   for (; i < clean.length; i++) {
-    bytes.push(clean[i] as number);
+    bytes.push(clean[i]!);
     origin.push(i);
   }
   return { bytes: Uint8Array.from(bytes), origin: Int32Array.from(origin), places };

@@ -10,6 +10,7 @@ import { join, resolve } from 'node:path';
 import { describe, expect, it } from 'vitest';
 import { SpektrumDecoder, type DecodedFrame } from '../src/decoder/index.js';
 import { importSaleaeCsv } from '../src/capture/index.js';
+import { usbChunks } from './feeds.js';
 
 const dir = resolve(import.meta.dirname, '../../shared/captures/px4');
 const present = existsSync(dir);
@@ -40,7 +41,7 @@ function load(name: string) {
   const bursts: [number, number][] = [];
   let start = 0;
   for (let i = 1; i <= capture.bytes.length; i++) {
-    if (i === capture.bytes.length || (times[i] as number) - (times[i - 1] as number) > 2000) {
+    if (i === capture.bytes.length || times[i]! - times[i - 1]! > 2000) {
       bursts.push([start, i - start]);
       start = i;
     }
@@ -79,16 +80,9 @@ function allFeeds(bytes: Uint8Array, times: Float64Array) {
     }),
     usb16ms: decode(bytes, (d, out) => {
       // What a browser sees through an FTDI adapter: whatever arrived in each 16 ms window, one time per chunk.
-      let start = 0;
-      for (let i = 0; i <= bytes.length; i++) {
-        const deadline = Math.floor((times[start] as number) / 16_000) * 16_000 + 16_000;
-        if (i === bytes.length || (times[i] as number) >= deadline) {
-          if (i > start) {
-            d.push(bytes.subarray(start, i), deadline);
-            drain(d, out);
-          }
-          start = i;
-        }
+      for (const chunk of usbChunks(bytes, times)) {
+        d.push(chunk.bytes, chunk.timeUs);
+        drain(d, out);
       }
     }),
   };

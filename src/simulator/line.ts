@@ -135,7 +135,7 @@ export function lineSignal(tx: Transmission, options: { startUs?: number; endUs?
   const n = tx.bytes.length;
   if (tx.timesUs.length !== n) throw new RangeError(`timesUs has length ${tx.timesUs.length}, bytes ${n}`);
   const idle = f.inverted ? 0 : 1;
-  const first = n > 0 ? (tx.timesUs[0] as number) : 0;
+  const first = tx.timesUs[0] ?? 0;
   const startUs = options.startUs ?? first - 1000;
   const edges: number[] = [];
   let level = idle;
@@ -146,11 +146,13 @@ export function lineSignal(tx: Transmission, options: { startUs?: number; endUs?
       level = l;
     }
   };
-  for (let i = 0; i < n; i++) {
-    const at = tx.timesUs[i] as number;
-    if (!(at >= (i === 0 ? -Infinity : (tx.timesUs[i - 1] as number)))) throw new RangeError(`timesUs[${i}] goes backwards`);
+  let previous = -Infinity;
+  for (const [i, b] of tx.bytes.entries()) {
+    const at = tx.timesUs[i] ?? NaN;
+    if (!(at >= previous)) throw new RangeError(`timesUs[${i}] goes backwards`);
+    previous = at;
     const t0 = Math.max(at, lastEnd);
-    const byte = (tx.bytes[i] as number) & ((1 << f.dataBits) - 1);
+    const byte = b & ((1 << f.dataBits) - 1);
     let bit = 0;
     const put = (logical: number): void => {
       set(f.inverted ? 1 - logical : logical, t0 + bit * f.bitUs);
@@ -172,7 +174,7 @@ class Sampler {
   constructor(readonly signal: LineSignal) {}
   level(t: number): 0 | 1 {
     const e = this.signal.edgesUs;
-    while (this.#k < e.length && (e[this.#k] as number) <= t) this.#k++;
+    while ((e[this.#k] ?? Infinity) <= t) this.#k++;
     return (this.signal.initial ^ (this.#k & 1)) as 0 | 1;
   }
   /** First time ≥ t where the line falls (a high-to-low edge), or Infinity. */
@@ -192,7 +194,7 @@ class Sampler {
   nextEdge(t: number): number {
     this.level(t);
     const e = this.signal.edgesUs;
-    return this.#k < e.length ? (e[this.#k] as number) : Infinity;
+    return e[this.#k] ?? Infinity;
   }
 }
 
@@ -325,12 +327,11 @@ function packetStream(
   const timesUs = new Float64Array(total);
   let k = 0;
   const charUs = f.frameBits * f.bitUs;
-  packets.forEach((p, i) => {
-    for (let j = 0; j < p.length; j++) {
-      bytes[k] = p[j] as number;
-      timesUs[k++] = (starts[i] as number) + j * charUs;
-    }
-  });
+  for (const [i, p] of packets.entries()) {
+    bytes.set(p, k);
+    const start = starts[i] ?? NaN;
+    for (let j = 0; j < p.length; j++) timesUs[k++] = start + j * charUs;
+  }
   return { format, bytes, timesUs };
 }
 
@@ -342,8 +343,8 @@ function stick(i: number, c: number, rng: Prng): number {
 /** CRC-16/XMODEM (poly 0x1021, init 0), as SRXL2 frames carry it. */
 function crc16Xmodem(bytes: Uint8Array, start: number, end: number): number {
   let crc = 0;
-  for (let i = start; i < end; i++) {
-    crc ^= (bytes[i] as number) << 8;
+  for (const byte of bytes.subarray(start, end)) {
+    crc ^= byte << 8;
     for (let b = 0; b < 8; b++) crc = crc & 0x8000 ? ((crc << 1) ^ 0x1021) & 0xffff : (crc << 1) & 0xffff;
   }
   return crc;
@@ -352,8 +353,8 @@ function crc16Xmodem(bytes: Uint8Array, start: number, end: number): number {
 /** CRC-8/DVB-S2 (poly 0xD5, init 0), as CRSF frames carry it over type and payload. */
 function crc8DvbS2(bytes: Uint8Array, start: number, end: number): number {
   let crc = 0;
-  for (let i = start; i < end; i++) {
-    crc ^= bytes[i] as number;
+  for (const byte of bytes.subarray(start, end)) {
+    crc ^= byte;
     for (let b = 0; b < 8; b++) crc = crc & 0x80 ? ((crc << 1) ^ 0xd5) & 0xff : (crc << 1) & 0xff;
   }
   return crc;
@@ -446,7 +447,7 @@ export function ibusStream(options: StreamOptions): Transmission {
       p[3 + 2 * c] = v >> 8;
     }
     let sum = 0;
-    for (let k = 0; k < 30; k++) sum += p[k] as number;
+    for (const byte of p.subarray(0, 30)) sum += byte;
     const check = (0xffff - sum) & 0xffff;
     p[30] = check & 0xff;
     p[31] = check >> 8;
@@ -474,7 +475,7 @@ export function sbusStream(options: StreamOptions): Transmission {
     let bit = 0;
     for (let c = 0; c < 16; c++) {
       const v = 172 + Math.round(stick(i, c, rng) * 1639);
-      for (let b = 0; b < 11; b++, bit++) if ((v >> b) & 1) p[1 + (bit >> 3)] = (p[1 + (bit >> 3)] as number) | (1 << (bit & 7));
+      for (let b = 0; b < 11; b++, bit++) if ((v >> b) & 1) p[1 + (bit >> 3)]! |= 1 << (bit & 7);
     }
     p[23] = 0;
     p[24] = 0;
@@ -505,7 +506,7 @@ export function crsfStream(options: StreamOptions): Transmission {
     let bit = 0;
     for (let c = 0; c < 16; c++) {
       const v = 172 + Math.round(stick(i, c, rng) * 1639);
-      for (let b = 0; b < 11; b++, bit++) if ((v >> b) & 1) p[3 + (bit >> 3)] = (p[3 + (bit >> 3)] as number) | (1 << (bit & 7));
+      for (let b = 0; b < 11; b++, bit++) if ((v >> b) & 1) p[3 + (bit >> 3)]! |= 1 << (bit & 7);
     }
     p[25] = crc8DvbS2(p, 2, 25);
     return p;

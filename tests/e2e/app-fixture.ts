@@ -60,16 +60,4 @@ export function writeCapture(path: string, chunks: { bytes: Uint8Array; timeUs: 
   writeFileSync(path, concatBytes([writer.header(), ...chunks.map((c) => writer.data(c.bytes, c.timeUs))]));
 }
 
-/** Cuts a per-byte-timed stream into what a USB adapter delivers: one chunk per 16 ms window. */
-export function usbChunks(bytes: Uint8Array, timesUs: Float64Array, windowUs = 16_000): { bytes: Uint8Array; timeUs: number }[] {
-  const out: { bytes: Uint8Array; timeUs: number }[] = [];
-  let start = 0;
-  for (let i = 0; i <= bytes.length; i++) {
-    const deadline = Math.floor((timesUs[start] as number) / windowUs) * windowUs + windowUs;
-    if (i === bytes.length || (timesUs[i] as number) >= deadline) {
-      if (i > start) out.push({ bytes: bytes.subarray(start, i), timeUs: deadline });
-      start = i;
-    }
-  }
-  return out;
-}
+export { usbChunks } from '../feeds.js';

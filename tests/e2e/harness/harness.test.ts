@@ -82,7 +82,8 @@ onmessage = async ({ data: cmd }) => {
 };
 `;
 
-type Ev = { type: string; t: number; [k: string]: unknown };
+/** What the page's test script records: every event has a type and a time; 'data' carries bytes. */
+type Ev = { type: string; t: number; bytes?: number[]; [k: string]: unknown };
 
 async function events(page: Page): Promise<Ev[]> {
   return page.evaluate(() => (window as unknown as { events: Ev[] }).events);
@@ -92,9 +93,8 @@ async function events(page: Page): Promise<Ev[]> {
 async function waitFor(page: Page, type: string | string[], from = 0, timeout = 10_000): Promise<Ev> {
   const types = Array.isArray(type) ? type : [type];
   const handle = await page.waitForFunction(
-    ([types, from]) =>
-      (window as unknown as { events: Ev[] }).events.slice(from as number).find((e) => (types as string[]).includes(e.type)),
-    [types, from] as const,
+    ([types, from]: [string[], number]) => (window as unknown as { events: Ev[] }).events.slice(from).find((e) => types.includes(e.type)),
+    [types, from] as [string[], number],
     { timeout, polling: 5 },
   );
   return (await handle.jsonValue()) as Ev;
@@ -115,12 +115,12 @@ async function pageBytes(page: Page, n: number, from: number, timeout = 10_000):
     ([n, from]) =>
       (window as unknown as { events: Ev[] }).events
         .slice(from)
-        .reduce((s, e) => s + (e.type === 'data' ? (e.bytes as number[]).length : 0), 0) >= n,
+        .reduce((s, e) => s + (e.type === 'data' ? (e.bytes?.length ?? 0) : 0), 0) >= n,
     [n, from] as const,
     { timeout, polling: 5 },
   );
   const evs = (await events(page)).slice(from).filter((e) => e.type === 'data');
-  return Uint8Array.from(evs.flatMap((e) => e.bytes as number[]));
+  return Uint8Array.from(evs.flatMap((e) => e.bytes ?? []));
 }
 
 describe.skipIf(!!skipReason)('e2e harness: real WebSerial on a pty in place of /dev/ttyS0', () => {

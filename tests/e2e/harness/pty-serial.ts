@@ -219,7 +219,15 @@ export async function openFakeSerialPort(options: FakeSerialPortOptions = {}): P
   const signalChanges: SignalChange[] = [];
   const received: Uint8Array[] = [];
   let receivedWake: (() => void) | undefined;
-  type Ev = { type: string; [k: string]: unknown };
+  /** What pty-pump.py reports, one JSON object per 'E' message (the pump is ours: trusted). */
+  type Ev =
+    | { type: 'ready'; pts: string }
+    | { type: 'signals'; op: SignalChange['op']; bits: number; t: number }
+    | { type: 'paced'; id: number; ok: true; bytes: number; lateMaxUs: number; t: number }
+    | { type: 'paced'; id: number; ok: false; reason: string }
+    | { type: 'signals-in' }
+    | { type: 'hungup' }
+    | { type: 'error'; message: string };
   const eventWaiters: { match: (e: Ev) => boolean; resolve: (e: Ev) => void; reject: (e: Error) => void }[] = [];
   let exited = false;
   let exitError: Error | undefined;
@@ -248,19 +256,18 @@ export async function openFakeSerialPort(options: FakeSerialPortOptions = {}): P
     });
 
   const onEvent = (e: Ev) => {
-    if (e.type === 'ready') ptsPath = e.pts as string;
+    if (e.type === 'ready') ptsPath = e.pts;
     if (e.type === 'signals') {
-      const bits = e.bits as number;
       const change: SignalChange = {
-        op: e.op as SignalChange['op'],
-        dataTerminalReady: (bits & 0x002) !== 0, // TIOCM_DTR
-        requestToSend: (bits & 0x004) !== 0, // TIOCM_RTS
-        tUs: e.t as number,
+        op: e.op,
+        dataTerminalReady: (e.bits & 0x002) !== 0, // TIOCM_DTR
+        requestToSend: (e.bits & 0x004) !== 0, // TIOCM_RTS
+        tUs: e.t,
       };
       signalChanges.push(change);
       for (const l of signalListeners) l(change);
     }
-    if (e.type === 'error') exitError = new Error(`pty helper: ${e.message as string}`);
+    if (e.type === 'error') exitError = new Error(`pty helper: ${e.message}`);
     for (const w of [...eventWaiters]) {
       if (w.match(e)) {
         eventWaiters.splice(eventWaiters.indexOf(w), 1);
@@ -348,8 +355,9 @@ export async function openFakeSerialPort(options: FakeSerialPortOptions = {}): P
     const done = waitEvent((e) => e.type === 'paced' && e.id === id, `paced write ${id}`, (times[n - 1] ?? 0) / 1000 + 30_000);
     send('P', payload);
     const e = await done;
-    if (!e.ok) throw new Error(`paced write interrupted: ${e.reason as string}`);
-    return { bytes: e.bytes as number, lateMaxUs: e.lateMaxUs as number, endUs: e.t as number };
+    if (e.type !== 'paced') throw new Error(`pty helper: expected a paced write's end, got ${e.type}`);
+    if (!e.ok) throw new Error(`paced write interrupted: ${e.reason}`);
+    return { bytes: e.bytes, lateMaxUs: e.lateMaxUs, endUs: e.t };
   };
 
   const takeReceived = (max = Infinity): Uint8Array => {
