@@ -2,17 +2,19 @@
  * Honest states on the page (issues "one truth" and "the page as an instrument"): a Saleae
  * export replays on its own clock with a timeline, seeking and speeds, and ends frozen at its
  * last recorded time; forcing a resolution that no frame fits says so and counts nothing as
- * link loss. Needs the built page (`npm run build`) and Debian's Chromium.
+ * link loss; a capture with dropouts and line damage replayed in the page ends with the figures
+ * `satscope info` gives for the same file. Needs the built page (`npm run build`) and Debian's
+ * Chromium.
  */
 import { existsSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import type { Page } from 'playwright-core';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
-import { importSaleaeCsv } from '../../src/capture/index.js';
-import { summarizeCapture } from '../../src/analysis/index.js';
+import { importSaleaeCsv, readCapture } from '../../src/capture/index.js';
+import { summarizeCapture, type CaptureSummary } from '../../src/analysis/index.js';
 import { preset, simulate } from '../../src/simulator/index.js';
-import { SHARED_CAPTURES, browserUnavailable, shot, startApp, type AppSession } from './app-fixture.js';
+import { SHARED_CAPTURES, browserUnavailable, shot, startApp, usbChunks, writeCapture, type AppSession } from './app-fixture.js';
 
 const skip = browserUnavailable();
 if (skip !== null) console.warn(`skipping the honest-state page tests: ${skip}`);
@@ -143,4 +145,62 @@ describe.skipIf(skip !== null)('honest states', () => {
     expect(errors).toEqual([]);
     await page.context().close();
   });
+
+  // Simulated links with dropouts (and line damage), recorded as a USB adapter delivers them, and
+  // the real PX4 captures (Saleae exports, per-byte times) when ../shared is here.
+  const simulated = (name: string) => () => {
+    const sim = simulate(preset(name));
+    const path = join(dir, `${name}.sscap`);
+    writeCapture(path, usbChunks(sim.bytes, sim.timesUs));
+    return path;
+  };
+  const real = ['dsm_x_data.txt', 'dsm_x_dx9_data.txt', 'dsm_x_dx9_px4_binding_data.txt']
+    .map((name) => join(SHARED_CAPTURES, name))
+    .filter((path) => existsSync(path));
+  for (const [name, speed, file] of [
+    ['dropouts-failsafe', '1×', simulated('dropouts-failsafe')],
+    ['dropouts-failsafe', 'max', simulated('dropouts-failsafe')],
+    ['dropouts-and-damage', 'max', simulated('dropouts-and-damage')],
+    ...real.map((path) => [path.split('/').pop()!, 'max', () => path] as const),
+  ] as const) {
+    it(`replays ${name} at ${speed} in the page and ends with satscope info's frames, missed frames, episodes and resolution`, async () => {
+      const path = file();
+      const summary = summarizeCapture(readCapture(new Uint8Array(readFileSync(path)), path));
+      if (name.startsWith('dropouts')) expect(summary.link.failsafes).toBe(1);
+
+      const { page, errors } = await open('?demo=0');
+      await page.setInputFiles('input[type=file]', path);
+      await page.locator('section.replay').waitFor();
+      if (speed === 'max') await page.getByRole('radio', { name: 'max' }).click();
+      await page.getByTestId('link-hint').filter({ hasText: 'Replay ended' }).waitFor({ timeout: 20_000 });
+      // The last batch of figures may land a frame after the ended state: the page must settle on the CLI's.
+      const shown = async () => ({
+        frames: await page.getByTestId('count-frames').textContent(),
+        missed: await page.getByTestId('count-missed').textContent(),
+        episodes: await page.locator('.link dd').nth(1).textContent(),
+        resolution: await page.getByTestId('resolution').textContent(),
+      });
+      await expect.poll(shown, { timeout: 2000 }).toEqual({
+        frames: String(summary.decoder.frames),
+        missed: String(summary.link.missedFrames),
+        episodes: `${summary.link.holds} holds · ${summary.link.failsafes} failsafes`,
+        resolution: resolutionChip(summary.format),
+      });
+      expect(errors).toEqual([]);
+      await page.context().close();
+    });
+  }
 });
+
+/** The resolution chip's words for what the library decided (the page's SystemBadge). */
+function resolutionChip(format: CaptureSummary['format']): string {
+  const why =
+    format.resolutionReason === 'channel-ids' || format.resolutionReason === 'system-byte-contradicted'
+      ? ' inferred'
+      : format.resolutionReason === 'internal-remote'
+        ? ' from the internal remote'
+        : format.resolutionReason === 'override'
+          ? ' set by you'
+          : '';
+  return `${format.resolution ?? '?'}${why}`;
+}
