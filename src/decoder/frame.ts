@@ -207,3 +207,28 @@ export function decodeSlots(
   }
   return empty;
 }
+
+/**
+ * The channel 0–19 a slot whose high byte is `hi` carries under `resolution` (X-Plus resolved,
+ * §8.6), or -1 for an ID that does not exist (§8.5). An empty slot (0xFFFF) is the caller's test.
+ */
+export function slotChannel(hi: number, resolution: Resolution): number {
+  return (resolution === 2048 ? CHANNEL_2048 : CHANNEL_1024)[hi & 0xff] ?? -1;
+}
+
+/** §8.1, §8.2, §8.6: the position a slot's word carries for `channel` (X-Plus's 9 bits scaled to 11). */
+export function slotPosition(word: number, channel: number, resolution: Resolution): number {
+  return resolution === 1024 ? word & MASK_1024_SXPOS : channel >= XPLUS_FIRST ? (word & 0x01ff) << 2 : word & MASK_2048_SXPOS;
+}
+
+/** Bytes 12–15 at `o` as Spektrum VTX control, written into `store` (the layout PX4 and Betaflight read). */
+export function readVtxControl(b: Uint8Array, o: number, store: VtxControl): VtxControl {
+  const raw = (((b[o + 12] ?? 0) << 24) | ((b[o + 13] ?? 0) << 16) | ((b[o + 14] ?? 0) << 8) | (b[o + 15] ?? 0)) >>> 0;
+  store.raw = raw;
+  store.band = (raw >>> 21) & 0x07;
+  store.channel = (raw >>> 16) & 0x0f;
+  store.pit = ((raw >>> 4) & 1) === 1;
+  store.region = (raw >>> 3) & 1;
+  store.power = raw & 0x07;
+  return store;
+}
