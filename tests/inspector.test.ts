@@ -194,7 +194,7 @@ describe('InspectorLog', () => {
     const [discard] = log.snapshot(100);
     expect(discard?.kind).toBe('discarded');
     expect(discard?.timeUs).toBeNaN();
-    log.onEvent({ type: 'resync', offset: log.streamBytes - 1 }, 1234);
+    log.onEvent({ type: 'resync', offset: log.streamBytes - 1, timeUs: Number.NaN }, 1234);
     expect(log.snapshot(1)[0]).toMatchObject({ kind: 'resync', timeUs: 1234, bytes: null, length: 0 });
   });
 
