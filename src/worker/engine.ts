@@ -85,8 +85,6 @@ export class Engine {
 
   /** Bytes as they arrived: `time` is the chunk's arrival (or per-byte times). */
   push(bytes: Uint8Array, time: number | Float64Array | undefined, arrivedMs: number): void {
-    // The log first: the decoder's events (fired in next()) take their times from these chunks.
-    this.inspector.onBytes(bytes, time);
     this.tap?.bytes(bytes, time);
     this.decoder.push(bytes, time);
     this.#pushes.push({ end: this.decoder.stats.bytes, time });
