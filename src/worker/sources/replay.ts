@@ -7,20 +7,10 @@
 import { BYTE_TIME_US, FRAME_PERIOD_11MS_US, FRAME_SIZE } from '../../decoder/index.js';
 import { capturePorts, type Capture } from '../../capture/index.js';
 import { captureSpan } from '../../analysis/index.js';
+import { BROWSER_CLOCK, type Clock } from '../host.js';
 
 /** Wall time and ticks, passed in so that tests drive replay with a simulated clock. */
-export interface ReplayClock {
-  /** Milliseconds, monotonic (performance.now()). */
-  now(): number;
-  every(ms: number, fn: () => void): unknown;
-  cancel(handle: unknown): void;
-}
-
-export const REAL_CLOCK: ReplayClock = {
-  now: () => performance.now(),
-  every: (ms, fn) => setInterval(fn, ms),
-  cancel: (handle) => clearInterval(handle as ReturnType<typeof setInterval>),
-};
+export type ReplayClock = Pick<Clock, 'now' | 'every' | 'cancel'>;
 
 export interface ReplayOptions {
   clock?: ReplayClock;
@@ -165,7 +155,7 @@ export class ReplaySource {
     readonly onEnd: () => void,
     options: ReplayOptions = {},
   ) {
-    this.#clock = options.clock ?? REAL_CLOCK;
+    this.#clock = options.clock ?? BROWSER_CLOCK;
     this.ports = capturePorts(capture);
     const span = captureSpan(capture);
     this.recordedTiming = Number.isFinite(span.startUs);
