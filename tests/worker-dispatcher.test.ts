@@ -7,6 +7,7 @@ import { encodeCapture } from '../src/capture/index.js';
 import { preset, simulate } from '../src/simulator/index.js';
 import { Dispatcher } from '../src/worker/dispatcher.js';
 import type { ToWorker } from '../src/worker/protocol.js';
+import type { ReportRequest } from '../src/worker/report-worker.js';
 import { usbChunks } from './feeds.js';
 import { fakeHost } from './worker-fakes.js';
 
@@ -46,15 +47,19 @@ class FakePort {
 
 function setup(findPort?: () => Promise<SerialPort | undefined>) {
   const fake = fakeHost();
+  const reports: ReportRequest[] = [];
   const worker = new Dispatcher(fake.host, {
     findPort,
-    makeReport: async () => ({ data: new TextEncoder().encode('report').buffer as ArrayBuffer }),
+    makeReport: async (request) => {
+      reports.push(request);
+      return { data: new TextEncoder().encode('report').buffer as ArrayBuffer };
+    },
   });
   const send = async (...messages: ToWorker[]): Promise<void> => {
     for (const m of messages) worker.receive(m);
     await worker.queue.idle();
   };
-  return { ...fake, worker, send };
+  return { ...fake, worker, send, reports };
 }
 
 describe('the dispatcher', () => {
@@ -137,7 +142,7 @@ describe('the dispatcher', () => {
   });
 
   it('plays a capture to its end at full speed on the fake clock, then freezes every source there', async () => {
-    const { send, clock, of, worker } = setup();
+    const { send, clock, of, worker, reports } = setup();
     await send({ type: 'replay-open', name: 'two.sscap', data: twoPortCapture() }, { type: 'replay-speed', speed: 0 });
     for (let i = 0; i < 100 && of('replay').at(-1)?.replay?.ended !== true; i++) clock.advance(10);
     const last = of('replay').at(-1)?.replay;
@@ -148,10 +153,13 @@ describe('the dispatcher', () => {
     // The replay's timer is gone (the doctor's last throttled post aside, once).
     clock.advance(1000);
     expect(clock.pending).toBe(0);
-    // A report is made of the file as opened.
+    // A report is made of the capture being replayed (the worker keeps no copy of the file for it).
     await send({ type: 'report', format: 'json' });
     await new Promise((r) => setTimeout(r, 0));
     expect(of('export-ready').at(-1)?.name).toBe('two.report.json');
+    const of0 = reports[0]?.of;
+    expect(of0 !== undefined && 'capture' in of0 && of0.capture).toBe(worker.replay?.source.capture);
+    expect(reports[0]).toMatchObject({ name: 'two.sscap', format: 'json', resolution: 'auto' });
     // Closing ends the replay for the page.
     await send({ type: 'close-all' });
     expect(of('replay').at(-1)?.replay).toBeNull();

@@ -5,6 +5,7 @@
  * gives it the browser's.
  */
 import { USB_CHUNK_JITTER_US } from '../decoder/index.js';
+import type { Capture } from '../capture/index.js';
 import { Batcher } from './batcher.js';
 import { bind } from './binding.js';
 import { Diagnosis } from './diagnosis.js';
@@ -130,10 +131,15 @@ export class Dispatcher {
       }
       case 'report': {
         const replay = this.replay;
-        const bytes = replay !== undefined ? replay.file : await recorder.current();
+        let of: { capture: Capture } | { bytes: Uint8Array } | null = null;
+        if (replay !== undefined) of = { capture: replay.source.capture };
+        else {
+          const bytes = await recorder.current();
+          if (bytes !== null) of = { bytes };
+        }
         const name = replay !== undefined ? replay.name : 'live session';
         // Not awaited: the next commands (and the ports) go on while the helper works.
-        report(host, this.#makeReport, bytes, name, message.format, registry.resolution).catch((error: unknown) =>
+        report(host, this.#makeReport, of, name, message.format, registry.resolution).catch((error: unknown) =>
           notice(host, 'error', 'The report could not be made', String(error)),
         );
         break;

@@ -34,10 +34,10 @@ export class ReplaySession implements Driver {
    */
   static async open(name: string, data: ArrayBuffer, parts: ReplayParts): Promise<ReplaySession | null> {
     const { host, registry, diagnosis } = parts;
-    const file = new Uint8Array(data);
     let capture: Capture;
     try {
-      capture = readCapture(file, name);
+      // The file itself is not kept: the capture holds what replay and a report need.
+      capture = readCapture(new Uint8Array(data), name);
     } catch (error) {
       const why = error instanceof CaptureFormatError ? error.message : String(error);
       notice(host, 'error', `Cannot open ${name}`, why);
@@ -53,7 +53,7 @@ export class ReplaySession implements Driver {
       );
     }
     const { overview, periodUs } = overviewOf(capture, capturePorts(capture), registry.resolution);
-    const session = new ReplaySession(name, file, capture, periodUs, parts);
+    const session = new ReplaySession(name, capture, periodUs, parts);
     const r = session.source;
     await registry.use(session);
     diagnosis.replay(capture, r.startUs);
@@ -73,12 +73,8 @@ export class ReplaySession implements Driver {
     return session;
   }
 
-  /**
-   * @param file the file as opened (kept for a report on it; the capture's columns are read from it)
-   */
   private constructor(
     readonly name: string,
-    readonly file: Uint8Array,
     capture: Capture,
     periodUs: number,
     parts: ReplayParts,

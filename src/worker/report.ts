@@ -4,6 +4,7 @@
  * capture takes a good part of a second, and this worker must keep reading ports meanwhile (a
  * stall shows as a gap in the data and in the recording).
  */
+import type { Capture } from '../capture/index.js';
 import { type Host, notice } from './host.js';
 import type { ReportReply, ReportRequest } from './report-worker.js';
 
@@ -26,18 +27,20 @@ export const WORKER_REPORT_MAKER: ReportMaker = (request, transfer) =>
   });
 
 /**
- * Makes a report of `bytes` (a capture file; copied, the caller keeps its own) and offers it to
- * the page as a download named after `name`; `bytes` null: the user is told there is nothing yet.
+ * Makes a report of `of` and offers it to the page as a download named after `name`: a capture
+ * file's bytes (copied, the caller keeps its own) or a capture being replayed (cloned to the
+ * helper, so the worker keeps no copy of the file for it). `of` null: the user is told there is
+ * nothing yet.
  */
 export async function report(
   host: Host,
   make: ReportMaker,
-  bytes: Uint8Array | null,
+  of: { bytes: Uint8Array } | { capture: Capture } | null,
   name: string,
   format: 'html' | 'json',
   resolution: 'auto' | 1024 | 2048,
 ): Promise<void> {
-  if (bytes === null) {
+  if (of === null) {
     notice(
       host,
       'warning',
@@ -46,9 +49,16 @@ export async function report(
     );
     return;
   }
-  const copy = bytes.slice();
-  const request: ReportRequest = { bytes: copy, name, format, resolution };
-  const reply = await make(request, [copy.buffer]);
+  let request: ReportRequest;
+  let transfer: Transferable[] = [];
+  if ('bytes' in of) {
+    const copy = of.bytes.slice();
+    request = { of: { bytes: copy }, name, format, resolution };
+    transfer = [copy.buffer];
+  } else {
+    request = { of, name, format, resolution };
+  }
+  const reply = await make(request, transfer);
   if (reply.error !== undefined) {
     notice(host, 'error', 'The report could not be made', reply.error);
     return;
