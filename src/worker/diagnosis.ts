@@ -89,10 +89,8 @@ export class Diagnosis {
 
   /** Recorded events up to `timeUs`, in order. */
   #eventsUntil(timeUs: number): void {
-    while (this.#nextEvent < this.#events.length && !((this.#events[this.#nextEvent] as { timeUs: number }).timeUs > timeUs)) {
-      const e = this.#events[this.#nextEvent++] as { port: number; timeUs: number; text: string };
+    for (let e = this.#events[this.#nextEvent]; e !== undefined && !(e.timeUs > timeUs); e = this.#events[++this.#nextEvent])
       doctorEvent(this.#doctor, e.port, e.text, e.timeUs);
-    }
   }
 
   /** A source's engine: its bytes and frames reach the doctor from now on. */
@@ -104,7 +102,7 @@ export class Diagnosis {
     engine.tap = {
       bytes: (bytes, time) => {
         if (this.#mode === 'replay') {
-          const t = time instanceof Float64Array ? (time[0] as number) : time;
+          const t = time instanceof Float64Array ? time[0] : time;
           if (t !== undefined) this.#eventsUntil(t);
         }
         doctor().bytes(id, bytes, time);

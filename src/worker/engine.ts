@@ -148,8 +148,10 @@ export class Engine {
       this.#frames++;
       this.tap?.frame(f);
       for (let i = 0; i < f.count; i++) {
-        const id = f.ids[i] as number;
-        this.#positions[id] = f.positions[i] as number;
+        const id = f.ids[i];
+        const position = f.positions[i];
+        if (id === undefined || position === undefined) break;
+        this.#positions[id] = position;
         // Untimed data (a raw .bin) still marks the channel as seen, at an unknown time.
         this.#seenUs[id] = Number.isFinite(t) ? t : Infinity;
       }
@@ -167,8 +169,9 @@ export class Engine {
     const b = s.bytes - s.pendingBytes;
     let start = NaN;
     for (let i = this.#pushes.length - 1; i >= 0; i--) {
-      const p = this.#pushes[i] as { end: number; time: number | Float64Array | undefined };
-      start = i === 0 ? NaN : (this.#pushes[i - 1] as { end: number }).end;
+      const p = this.#pushes[i];
+      if (p === undefined) break;
+      start = this.#pushes[i - 1]?.end ?? Number.NaN;
       if (i > 0 && b < start) continue;
       if (p.time === undefined) return Number.NaN;
       if (typeof p.time === 'number') return p.time - (p.end - 1 - b) * BYTE_TIME_US;
@@ -288,7 +291,8 @@ export class Engine {
     const all: readonly LinkEpisode[] = this.link.episodes;
     const out: Batch['episodes'] = [];
     for (let i = all.length - 1; i >= 0; i--) {
-      const e = all[i] as LinkEpisode;
+      const e = all[i];
+      if (e === undefined) break;
       const sent = this.#sent.get(e.id);
       if (sent !== undefined && sent.endUs === e.endUs && sent.startUs === e.startUs) {
         if (e.endUs !== null) break;
