@@ -23,14 +23,25 @@ function twoPortCapture(): ArrayBuffer {
   return file.buffer.slice(file.byteOffset, file.byteOffset + file.byteLength) as ArrayBuffer;
 }
 
-/** A SerialPort stand-in: an idle line. */
+/** A SerialPort stand-in: an idle line, until `unplug()`. */
 class FakePort {
   opens = 0;
   closes = 0;
   #readable: ReadableStream<Uint8Array> | null = null;
+  #line: ReadableStreamDefaultController<Uint8Array> | undefined;
   async open(): Promise<void> {
     this.opens++;
-    this.#readable = new ReadableStream<Uint8Array>({ start() {} });
+    this.#readable = new ReadableStream<Uint8Array>({
+      start: (controller) => {
+        this.#line = controller;
+      },
+    });
+  }
+  /** The device goes away: reading fails as WebSerial's does. */
+  unplug(): void {
+    const gone = new Error('The device has been lost.');
+    gone.name = 'NetworkError';
+    this.#line?.error(gone);
   }
   get readable(): ReadableStream<Uint8Array> | null {
     return this.#readable;
@@ -115,6 +126,35 @@ describe('the dispatcher', () => {
     // Nothing is left ticking.
     clock.advance(1000);
     expect(clock.pending).toBe(0);
+    await send({ type: 'close-all' });
+  });
+
+  it('keeps an unplugged adapter as a lost remote, tries it every second, and takes it back as the same remote', async () => {
+    const port = new FakePort();
+    let plugged = true;
+    const { send, worker, clock, of } = setup(async () => (plugged ? (port as unknown as SerialPort) : undefined));
+    await send({ type: 'serial-open', port: { index: 0, usbVendorId: 0x0403, usbProductId: 0x6001 } });
+    const a = worker.registry.get(0);
+    expect(a?.state).toBe('reading');
+    plugged = false;
+    port.unplug();
+    await new Promise((r) => setTimeout(r, 0));
+    expect(a?.state).toBe('lost');
+    // Tries while it is away change nothing.
+    clock.advance(3000);
+    await worker.queue.idle();
+    expect(a?.state).toBe('lost');
+    plugged = true;
+    clock.advance(1000);
+    await worker.queue.idle();
+    expect(worker.registry.get(0)).toBe(a);
+    expect(a?.state).toBe('reading');
+    expect(port.opens).toBe(2);
+    expect(of('notice').map((n) => n.title)).toEqual(['Remote A: the adapter was unplugged', 'Remote A reconnected']);
+    // Back: no more tries.
+    clock.advance(5000);
+    await worker.queue.idle();
+    expect(port.opens).toBe(2);
     await send({ type: 'close-all' });
   });
 
