@@ -346,6 +346,40 @@ describe('a seek', () => {
     expect(firstFed(capture, 2_000_000)).toEqual([0, 1]);
   });
 
+  it("feeds a logic analyser's capture (one chunk of per-byte times a port) from its first byte in the ten minutes, not from its start", () => {
+    // 20 minutes, a byte every 10 ms on each port, every byte timed.
+    const n = 120_000;
+    const byteTimesUs = new Float64Array(2 * n);
+    for (let p = 0; p < 2; p++) for (let j = 0; j < n; j++) byteTimesUs[p * n + j] = 1_000_000 + j * 10_000 + p;
+    const capture: Capture = {
+      kind: 'saleae-csv',
+      meta: {},
+      timing: 'per-byte',
+      bytes: new Uint8Array(2 * n),
+      chunkEnds: Uint32Array.of(n, 2 * n),
+      chunkTimesUs: Float64Array.of(byteTimesUs[n - 1]!, byteTimesUs[2 * n - 1]!),
+      chunkPorts: Uint8Array.of(0, 1),
+      byteTimesUs,
+      events: [],
+      issues: [],
+    };
+    const fed: number[] = [];
+    const r = new ReplaySource(
+      capture,
+      (port, bytes) => {
+        fed[port] ??= bytes.byteOffset;
+      },
+      () => undefined,
+      () => undefined,
+      { clock: new SimulatedClock() },
+    );
+    r.seek(15 * 60e6);
+    const from = 5 * 60e6;
+    const walk = (p: number) => byteTimesUs.findIndex((t, j) => j >= p * n && !(t < from));
+    expect(fed).toEqual([walk(0), walk(1)]);
+    expect(byteTimesUs[fed[0]!]).toBe(from);
+  });
+
   it('finds the same chunks as a walk from the start when recorded times go back', () => {
     // A chunk at 1 min stamped 15 min (a clock that jumped): a walk stops there, and so does the seek.
     const capture = longCapture((t) => {

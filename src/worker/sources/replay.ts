@@ -48,6 +48,8 @@ class PortChunks {
   readonly #bytesBefore: Float64Array | undefined;
   /** Whether the chunks' times never go back (as recorded): a seek then bisects for its chunk. */
   readonly #ordered: boolean;
+  /** Whether the per-byte times inside each chunk never go back: a seek then bisects for its byte. */
+  readonly #bytesOrdered: boolean;
 
   /** @param usPerByte without timing, the pace bytes are played at (µs a byte); NaN with timing */
   constructor(
@@ -75,6 +77,14 @@ class PortChunks {
     let ordered = true;
     for (let k = 1; k < n && ordered; k++) ordered = this.atUs(k) >= this.atUs(k - 1);
     this.#ordered = ordered;
+    const times = capture.byteTimesUs;
+    let bytesOrdered = true;
+    for (let k = 0; k < n && times !== undefined && bytesOrdered; k++) {
+      const i = this.#chunk(k);
+      for (let j = this.#start(i) + 1; j < this.#end(i) && bytesOrdered; j++)
+        bytesOrdered = (times[j] ?? Number.NaN) >= (times[j - 1] ?? Number.NaN);
+    }
+    this.#bytesOrdered = bytesOrdered;
   }
 
   /** The capture's chunk number of this port's chunk k. */
@@ -118,6 +128,34 @@ class PortChunks {
       else hi = mid;
     }
     return lo;
+  }
+
+  /**
+   * Puts the cursor on the first byte a walk from the start finds at or after `fromUs`: the
+   * first chunk that arrives then and, in a chunk with per-byte times (a logic analyser's one
+   * chunk per port), its first byte timed then, so that a seek in a long one feeds only its
+   * history, not everything before it.
+   */
+  seekTo(fromUs: number): void {
+    this.next = this.firstAtOrAfter(fromUs);
+    this.nextByte = 0;
+    const times = this.capture.byteTimesUs;
+    if (times === undefined || this.done) return;
+    const i = this.#chunk(this.next);
+    const start = this.#start(i);
+    const end = this.#end(i);
+    let lo = start;
+    if (this.#bytesOrdered) {
+      let hi = end;
+      while (lo < hi) {
+        const mid = (lo + hi) >>> 1;
+        if ((times[mid] ?? Number.NaN) < fromUs) lo = mid + 1;
+        else hi = mid;
+      }
+    } else {
+      while (lo < end && (times[lo] ?? Number.NaN) < fromUs) lo++;
+    }
+    this.nextByte = lo - start;
   }
 
   get(k: number): Chunk {
@@ -275,10 +313,7 @@ export class ReplaySource {
     this.#lastFedUs = NaN;
     this.#ended = false;
     const from = target - SEEK_HISTORY_US;
-    for (const c of this.#chunks) {
-      c.next = c.firstAtOrAfter(from);
-      c.nextByte = 0;
-    }
+    for (const c of this.#chunks) c.seekTo(from);
     const done = this.#feedUntil(target, Infinity);
     this.#clockUs = target;
     this.#wallMs = this.#clock.now();
