@@ -12,7 +12,7 @@
  * Measurement only: it asserts nothing.
  */
 import { spawnSync } from 'node:child_process';
-import { existsSync, readFileSync, statSync } from 'node:fs';
+import { existsSync, readFileSync, rmSync, statSync } from 'node:fs';
 import { loadavg, tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -76,6 +76,7 @@ async function main() {
     );
   }
   console.log(`load after: ${load()}`);
+  rmSync(bundle, { recursive: true, force: true });
 }
 
 /** Held memory: what the heap and array buffers hold after a full collection. */
