@@ -120,7 +120,9 @@ describe('fade counts', () => {
     expect(frames).toHaveLength(24);
     expect(frames.reduce((s, f) => s + f.fadesDelta, 0)).toBe(0);
     expect(decoder.stats.fadeJumps).toBe(1);
-    expect(events.filter((e) => e.type === 'fade-jump')).toEqual([{ type: 'fade-jump', offset: 192, from: 500, to: 3, counted: false }]);
+    expect(events.filter((e) => e.type === 'fade-jump')).toEqual([
+      { type: 'fade-jump', offset: 192, timeUs: NaN, from: 500, to: 3, counted: false },
+    ]);
   });
 });
 

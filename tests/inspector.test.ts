@@ -51,8 +51,9 @@ function noise(n: number): Uint8Array {
 }
 
 /**
- * Feeds `stream` the way the worker's Engine does: each chunk to the log and the decoder, then
- * every frame next() gives to the log, the decoder's events to the log as they fire.
+ * Feeds `stream` the way the worker's Engine does: each chunk to the decoder, then every frame
+ * next() gives to the log, the decoder's events to the log as they fire. The log sees no bytes
+ * but those the decoder hands it.
  */
 function run(stream: Uint8Array, log = new InspectorLog(), chunk = 37, chunkTimes = true) {
   const decoder = new SpektrumDecoder({ onEvent: (e) => log.onEvent(e) });
@@ -67,7 +68,6 @@ function run(stream: Uint8Array, log = new InspectorLog(), chunk = 37, chunkTime
     const c = stream.subarray(at, Math.min(stream.length, at + chunk));
     // A chunk arrives when its last byte does: 1000 µs plus 86.8 µs a byte.
     const time = chunkTimes ? 1000 + (at + c.length) * 86.8 : undefined;
-    log.onBytes(c, time);
     decoder.push(c, time);
     drain();
   }
@@ -164,7 +164,6 @@ describe('InspectorLog', () => {
     const stream = join([...frames(6), odd, noise(21), ...frames(6, 6)]);
     const log = new InspectorLog();
     const decoder = new SpektrumDecoder({ onEvent: (e) => log.onEvent(e) });
-    log.onBytes(stream, 5000);
     decoder.push(stream, 5000);
     decoder.end();
     for (let f = decoder.next(); f; f = decoder.next()) log.onFrame(f);
@@ -189,16 +188,16 @@ describe('InspectorLog', () => {
     expect(c).toEqual(a);
   });
 
-  it('times events NaN without chunk times, or as given', () => {
+  it('times events NaN without chunk times, or as the decoder gives them', () => {
     const { log } = run(join([noise(20), ...frames(4)]), new InspectorLog(), 16, false);
     const [discard] = log.snapshot(100);
     expect(discard?.kind).toBe('discarded');
     expect(discard?.timeUs).toBeNaN();
-    log.onEvent({ type: 'resync', offset: log.streamBytes - 1 }, 1234);
+    log.onEvent({ type: 'resync', offset: log.streamBytes - 1, timeUs: 1234 });
     expect(log.snapshot(1)[0]).toMatchObject({ kind: 'resync', timeUs: 1234, bytes: null, length: 0 });
   });
 
-  it('drops the oldest entries and bytes when the rings overflow', () => {
+  it('drops the oldest entries, and the bytes of the oldest, when its entries or its byte store overflow', () => {
     const stream = join(frames(10)); // 20 frames
     const log = new InspectorLog(8, 64);
     run(stream, log, 5);
@@ -223,7 +222,7 @@ describe('InspectorLog', () => {
     expect(locked).toMatchObject({ kind: 'locked', offset: 1000 });
   });
 
-  it("a huge chunk keeps only the ring's worth of bytes; reset() starts over", () => {
+  it("a huge chunk keeps only the byte store's worth of frames' bytes; reset() starts over", () => {
     const stream = join(frames(20));
     const log = new InspectorLog(4096, 128);
     run(stream, log, stream.length);
@@ -259,7 +258,25 @@ describe('InspectorLog', () => {
     expect(r[0]).toMatchObject({ remote: 'internal', headerMode: 'rssi', system: 0xb2 });
   });
 
-  it('rejects a capacity or raw size it cannot hold', () => {
+  it('keeps copies of what the decoder lends it, and joins a discard run even when an entry came in between out of order', () => {
+    const log = new InspectorLog();
+    const lent = Uint8Array.from({ length: 20 }, (_, i) => i);
+    log.onEvent({ type: 'discarded', offset: 100, length: 20, timeUs: 5, reason: 'noise', bytes: lent });
+    lent.fill(0xee); // the decoder's buffer moves on
+    // Decided later, earlier in the stream: it sorts before, though its bytes were stored after.
+    log.onEvent({ type: 'discarded', offset: 60, length: 16, timeUs: 1, reason: 'truncated-frame', bytes: new Uint8Array(16).fill(7) });
+    log.onEvent({ type: 'discarded', offset: 120, length: 3, timeUs: 9, reason: 'noise', bytes: Uint8Array.of(50, 51, 52) });
+    const entries = log.snapshot(10);
+    expect(entries.map((e) => [e.offset, e.length, e.timeUs])).toEqual([
+      [60, 16, 1],
+      [100, 23, 5],
+    ]);
+    expect(bytesOf(entries[0] as InspectEntry)).toEqual(Array(16).fill(7));
+    expect(bytesOf(entries[1] as InspectEntry)).toEqual([...Array.from({ length: 20 }, (_, i) => i), 50, 51, 52]);
+    expect(log.streamBytes).toBe(123);
+  });
+
+  it('rejects a capacity or byte store it cannot hold', () => {
     expect(() => new InspectorLog(0)).toThrow(RangeError);
     expect(() => new InspectorLog(16, 8)).toThrow(RangeError);
   });

@@ -293,6 +293,105 @@ describe("replay runs on the capture's clock", () => {
   });
 });
 
+describe('a seek', () => {
+  /** 20 minutes of 4-byte chunks every 100 ms on two ports, read by index: what the replay feeds is what matters here. */
+  function longCapture(times?: (t: Float64Array) => void): Capture {
+    const n = 2 * 12_000;
+    const chunkTimesUs = Float64Array.from({ length: n }, (_, i) => 1_000_000 + Math.floor(i / 2) * 100_000 + (i % 2));
+    times?.(chunkTimesUs);
+    return {
+      kind: 'sscap',
+      meta: {},
+      timing: 'per-chunk',
+      bytes: new Uint8Array(4 * n),
+      chunkEnds: Uint32Array.from({ length: n }, (_, i) => 4 * (i + 1)),
+      chunkTimesUs,
+      chunkPorts: Uint8Array.from({ length: n }, (_, i) => i % 2),
+      events: [],
+      issues: [],
+    };
+  }
+
+  /** The capture's chunk number each port is first fed after a seek to `targetUs`. */
+  function firstFed(capture: Capture, targetUs: number): number[] {
+    const first: number[] = [];
+    const r = new ReplaySource(
+      capture,
+      (port, bytes) => {
+        first[port] ??= bytes.byteOffset / 4;
+      },
+      () => undefined,
+      () => undefined,
+      { clock: new SimulatedClock() },
+    );
+    r.seek(targetUs);
+    return first;
+  }
+
+  /** What a walk from each port's first chunk finds: its first chunk at or after `fromUs`. */
+  function walk(capture: Capture, fromUs: number): number[] {
+    return [0, 1].map((port) => {
+      for (let i = 0; i < capture.chunkPorts.length; i++)
+        if (capture.chunkPorts[i] === port && !(capture.chunkTimesUs[i]! < fromUs)) return i;
+      return -1;
+    });
+  }
+
+  it('feeds each port from its first chunk within the ten minutes before the target', () => {
+    const capture = longCapture();
+    const target = 15 * 60e6;
+    const first = firstFed(capture, target);
+    expect(first).toEqual(walk(capture, target - 10 * 60e6));
+    expect(capture.chunkTimesUs[first[0]!]).toBe(5 * 60e6);
+    expect(firstFed(capture, 2_000_000)).toEqual([0, 1]);
+  });
+
+  it("feeds a logic analyser's capture (one chunk of per-byte times a port) from its first byte in the ten minutes, not from its start", () => {
+    // 20 minutes, a byte every 10 ms on each port, every byte timed.
+    const n = 120_000;
+    const byteTimesUs = new Float64Array(2 * n);
+    for (let p = 0; p < 2; p++) for (let j = 0; j < n; j++) byteTimesUs[p * n + j] = 1_000_000 + j * 10_000 + p;
+    const capture: Capture = {
+      kind: 'saleae-csv',
+      meta: {},
+      timing: 'per-byte',
+      bytes: new Uint8Array(2 * n),
+      chunkEnds: Uint32Array.of(n, 2 * n),
+      chunkTimesUs: Float64Array.of(byteTimesUs[n - 1]!, byteTimesUs[2 * n - 1]!),
+      chunkPorts: Uint8Array.of(0, 1),
+      byteTimesUs,
+      events: [],
+      issues: [],
+    };
+    const fed: number[] = [];
+    const r = new ReplaySource(
+      capture,
+      (port, bytes) => {
+        fed[port] ??= bytes.byteOffset;
+      },
+      () => undefined,
+      () => undefined,
+      { clock: new SimulatedClock() },
+    );
+    r.seek(15 * 60e6);
+    const from = 5 * 60e6;
+    const walk = (p: number) => byteTimesUs.findIndex((t, j) => j >= p * n && !(t < from));
+    expect(fed).toEqual([walk(0), walk(1)]);
+    expect(byteTimesUs[fed[0]!]).toBe(from);
+  });
+
+  it('finds the same chunks as a walk from the start when recorded times go back', () => {
+    // A chunk at 1 min stamped 15 min (a clock that jumped): a walk stops there, and so does the seek.
+    const capture = longCapture((t) => {
+      t[2 * 590] = 15 * 60e6;
+    });
+    const target = 15 * 60e6;
+    const first = firstFed(capture, target);
+    expect(first).toEqual(walk(capture, target - 10 * 60e6));
+    expect(first[0]).toBe(2 * 590);
+  });
+});
+
 describe('port errors', () => {
   it('explains a busy port, a refusal and anything else in terms of what to do', () => {
     const busy = new Error('Failed to open serial port.');

@@ -812,10 +812,11 @@ export class SpektrumDecoder {
   #discard(o: number, length: number, reason: 'before-lock' | 'noise' | 'truncated-frame' | 'end-of-stream'): void {
     this.#stats.discardedBytes += length;
     this.#stats.pendingBytes -= length;
+    // Before the chunk records go: the event is timed by them.
+    this.#event({ type: 'discarded', offset: this.#base + o, length, reason });
     this.#head = o + length;
     // A stream that never locks emits nothing: its chunk records must go with its bytes.
     this.#dropChunksBefore(this.#base + this.#head);
-    this.#event({ type: 'discarded', offset: this.#base + o, length, reason });
   }
 
   // ---- acquisition -------------------------------------------------------------------------
@@ -1174,8 +1175,30 @@ export class SpektrumDecoder {
     }
   }
 
-  #event(event: DecoderEvent): void {
-    if (this.#onEvent !== undefined) this.#onEvent(event);
+  /**
+   * Hands `event` to `onEvent` with its time (that of the byte at its offset, dated as
+   * `#stampTime` dates a frame's first byte) and, for a discard, a view of its bytes (borrowed:
+   * valid during the call). Events are rare: the chunk records are searched here, off the
+   * frame path. The byte at the offset is still held (events come before their bytes are
+   * dropped), or has not arrived yet (NaN).
+   */
+  #event(event: DecoderEvent extends infer E ? (E extends DecoderEvent ? Omit<E, 'timeUs' | 'bytes'> : never) : never): void {
+    const onEvent = this.#onEvent;
+    if (onEvent === undefined) return;
+    const x = event.offset;
+    const o = x - this.#base;
+    let timeUs = Number.NaN;
+    if (o >= 0 && o < this.#tail) {
+      for (let i = this.#chunkHead; i < this.#chunkTail; i++) {
+        const end = this.#chunkEnds[i] ?? 0;
+        if (end <= x) continue;
+        if (this.#chunkPerByte[i] === 1) timeUs = this.#byteTimes?.[o] ?? Number.NaN;
+        else timeUs = (this.#chunkTimes[i] ?? Number.NaN) - (end - 1 - x) * BYTE_TIME_US;
+        break;
+      }
+    }
+    if (event.type === 'discarded') onEvent({ ...event, timeUs, bytes: this.#buf.subarray(o, o + event.length) });
+    else onEvent({ ...event, timeUs });
   }
 
   /** Records a pushed chunk's end (stream offset); returns its index, for the caller to store its time. */

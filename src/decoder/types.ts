@@ -132,14 +132,33 @@ export interface DecoderStats {
   fadeJumps: number;
 }
 
-/** Something the decoder did that an inspector or log may want to show. */
+/**
+ * Something the decoder did that an inspector or log may want to show, at stream offset
+ * `offset`, delivered to `onEvent` as it is decided (in `next()` or `end()`).
+ *
+ * `timeUs` is the time of the byte at `offset` by the rule a frame's time follows: exact with
+ * per-byte times, estimated (chunk time less the bytes after it at 115200 baud) with chunk
+ * times, NaN when no time was given or the byte at `offset` has not arrived (a resync at the
+ * end of what was pushed). Events are few; computing it costs nothing on the frame path.
+ */
 export type DecoderEvent =
-  | { type: 'locked'; offset: number; format: FormatInfo }
-  | { type: 'discarded'; offset: number; length: number; reason: 'before-lock' | 'noise' | 'truncated-frame' | 'end-of-stream' }
-  | { type: 'resync'; offset: number }
-  | { type: 'format-changed'; offset: number; format: FormatInfo }
+  | { type: 'locked'; offset: number; timeUs: number; format: FormatInfo }
+  | {
+      type: 'discarded';
+      offset: number;
+      timeUs: number;
+      length: number;
+      reason: 'before-lock' | 'noise' | 'truncated-frame' | 'end-of-stream';
+      /**
+       * The discarded bytes (`length` of them, from `offset`). Borrowed: a view of the decoder's
+       * buffer, valid only during the `onEvent` call, like a frame's `bytes`; copy what you keep.
+       */
+      bytes: Uint8Array;
+    }
+  | { type: 'resync'; offset: number; timeUs: number }
+  | { type: 'format-changed'; offset: number; timeUs: number; format: FormatInfo }
   /**
    * The fade count jumped across a break in the stream from `from` to `to`. `counted`: it is the
    * same remote's own count going on (it is in `fadesDelta`); otherwise it counts nothing.
    */
-  | { type: 'fade-jump'; offset: number; from: number; to: number; counted: boolean };
+  | { type: 'fade-jump'; offset: number; timeUs: number; from: number; to: number; counted: boolean };

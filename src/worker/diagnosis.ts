@@ -12,6 +12,7 @@
 import { Doctor, doctorEvent, type ConfirmProbe, type DoctorFinding } from '../analysis/index.js';
 import type { Capture } from '../capture/index.js';
 import type { Engine } from './engine.js';
+import { BROWSER_CLOCK, type Clock } from './host.js';
 import type { DiagnosisStatus, FromWorker } from './protocol.js';
 import { SerialSource } from './sources/serial.js';
 
@@ -40,17 +41,19 @@ export class Diagnosis {
   #probing: DiagnosisStatus['probing'] = null;
   #lastKey = '';
   #lastPostMs = -Infinity;
-  #timer: ReturnType<typeof setTimeout> | undefined;
+  #timer: unknown;
 
   /**
    * @param post sends a message to the page
    * @param clockUs the session's clock (live: now; replay: the replay position)
    * @param probeable the live serial sources that could listen at another speed
+   * @param clock wall time and timers (the throttle, the probe's listen)
    */
   constructor(
     readonly post: (message: FromWorker) => void,
     readonly clockUs: () => number,
     readonly probeable: () => number[],
+    readonly clock: Clock = BROWSER_CLOCK,
   ) {}
 
   /** A new live session (every port closed): a fresh doctor, its sentences timed from now. */
@@ -86,10 +89,8 @@ export class Diagnosis {
 
   /** Recorded events up to `timeUs`, in order. */
   #eventsUntil(timeUs: number): void {
-    while (this.#nextEvent < this.#events.length && !((this.#events[this.#nextEvent] as { timeUs: number }).timeUs > timeUs)) {
-      const e = this.#events[this.#nextEvent++] as { port: number; timeUs: number; text: string };
+    for (let e = this.#events[this.#nextEvent]; e !== undefined && !(e.timeUs > timeUs); e = this.#events[++this.#nextEvent])
       doctorEvent(this.#doctor, e.port, e.text, e.timeUs);
-    }
   }
 
   /** A source's engine: its bytes and frames reach the doctor from now on. */
@@ -101,7 +102,7 @@ export class Diagnosis {
     engine.tap = {
       bytes: (bytes, time) => {
         if (this.#mode === 'replay') {
-          const t = time instanceof Float64Array ? (time[0] as number) : time;
+          const t = time instanceof Float64Array ? time[0] : time;
           if (t !== undefined) this.#eventsUntil(t);
         }
         doctor().bytes(id, bytes, time);
@@ -139,14 +140,14 @@ export class Diagnosis {
    * time goes out when it is over). `force`: now, whatever changed.
    */
   tick(force = false): void {
-    const nowMs = performance.now();
+    const nowMs = this.clock.now();
     const wait = this.#lastPostMs + MIN_POST_MS - nowMs;
     if (!force && wait > 0) {
       if (this.#timer === undefined)
-        this.#timer = setTimeout(() => {
+        this.#timer = this.clock.after(wait, () => {
           this.#timer = undefined;
           this.tick();
-        }, wait);
+        });
       return;
     }
     const now = this.clockUs();
@@ -206,7 +207,7 @@ export class Diagnosis {
       this.#doctor.open(id, t, { baudRate: probe.baudRate });
       hooks.event(`port opened at ${probe.baudRate} baud`, t);
       hooks.state('probing', `listening at ${name}`);
-      await new Promise((resolve) => setTimeout(resolve, probe.listenUs / 1000));
+      await new Promise((resolve) => this.clock.after(probe.listenUs / 1000, () => resolve(undefined)));
     } catch (error) {
       problem = `The port could not be opened at ${name}: ${error instanceof Error ? error.message : String(error)}`;
     }

@@ -68,6 +68,7 @@ export class Engine {
 
   constructor(readonly options: EngineOptions) {
     this.decoder = new SpektrumDecoder({ resolution: options.resolution, onEvent: (e) => this.inspector.onEvent(e) });
+    this.#forced = options.resolution !== 'auto';
     // A live view may run for days: keep the newest episodes (the page shows ten minutes).
     this.link = new LinkMonitor({
       jitterUs: options.jitterUs,
@@ -80,17 +81,26 @@ export class Engine {
     });
   }
 
-  /** The last few pushes: the stream offset after each, and its time argument (for `#pendingUs`). */
-  readonly #pushes: { end: number; time: number | Float64Array | undefined }[] = [];
+  /**
+   * The last PUSHES_KEPT pushes, a ring (for `#pendingUs`): the stream offset after each, and its
+   * time argument: a chunk time (NaN for none), or per-byte times.
+   */
+  readonly #pushEnd = new Float64Array(PUSHES_KEPT);
+  readonly #pushTime = new Float64Array(PUSHES_KEPT);
+  readonly #pushTimes = new Array<Float64Array | undefined>(PUSHES_KEPT).fill(undefined);
+  /** Pushes so far. */
+  #pushCount = 0;
+  /** Whether the resolution is forced (only then can it match no frame). */
+  #forced: boolean;
 
   /** Bytes as they arrived: `time` is the chunk's arrival (or per-byte times). */
   push(bytes: Uint8Array, time: number | Float64Array | undefined, arrivedMs: number): void {
-    // The log first: the decoder's events (fired in next()) take their times from these chunks.
-    this.inspector.onBytes(bytes, time);
     this.tap?.bytes(bytes, time);
     this.decoder.push(bytes, time);
-    this.#pushes.push({ end: this.decoder.stats.bytes, time });
-    if (this.#pushes.length > PUSHES_KEPT) this.#pushes.shift();
+    const k = this.#pushCount++ % PUSHES_KEPT;
+    this.#pushEnd[k] = this.decoder.stats.bytes;
+    this.#pushTime[k] = typeof time === 'number' ? time : Number.NaN;
+    this.#pushTimes[k] = typeof time === 'number' ? undefined : time;
     this.#arrivedMs = arrivedMs;
     this.#drain();
   }
@@ -116,6 +126,7 @@ export class Engine {
    */
   setResolution(resolution: 'auto' | 1024 | 2048, nowUs: number, by: 'user' | 'internal-remote' = 'user'): void {
     this.decoder.setResolution(resolution, by);
+    this.#forced = resolution !== 'auto';
     this.link.interrupt(nowUs);
     this.#mismatch = null;
     this.#changed = true;
@@ -130,6 +141,8 @@ export class Engine {
   }
 
   #checkMismatch(): void {
+    // Only a forced resolution can match no frame (and the decoder's format is made afresh on each read).
+    if (!this.#forced && this.#mismatch === null) return;
     // The decoder's word: the forced resolution fits no frame, the other one does.
     const mismatch = this.decoder.format.forcedMismatch;
     if (mismatch !== this.#mismatch) {
@@ -150,8 +163,10 @@ export class Engine {
       this.#frames++;
       this.tap?.frame(f);
       for (let i = 0; i < f.count; i++) {
-        const id = f.ids[i] as number;
-        this.#positions[id] = f.positions[i] as number;
+        const id = f.ids[i];
+        const position = f.positions[i];
+        if (id === undefined || position === undefined) break;
+        this.#positions[id] = position;
         // Untimed data (a raw .bin) still marks the channel as seen, at an unknown time.
         this.#seenUs[id] = Number.isFinite(t) ? t : Infinity;
       }
@@ -167,15 +182,17 @@ export class Engine {
     const s = this.decoder.stats;
     if (s.pendingBytes === 0) return Number.NaN;
     const b = s.bytes - s.pendingBytes;
-    let start = NaN;
-    for (let i = this.#pushes.length - 1; i >= 0; i--) {
-      const p = this.#pushes[i] as { end: number; time: number | Float64Array | undefined };
-      start = i === 0 ? NaN : (this.#pushes[i - 1] as { end: number }).end;
-      if (i > 0 && b < start) continue;
-      if (p.time === undefined) return Number.NaN;
-      if (typeof p.time === 'number') return p.time - (p.end - 1 - b) * BYTE_TIME_US;
-      const j = b - (p.end - p.time.length);
-      return j >= 0 ? (p.time[j] ?? Number.NaN) : Number.NaN;
+    const kept = Math.min(this.#pushCount, PUSHES_KEPT);
+    // Newest first; the oldest kept push is taken when no newer one holds the byte.
+    for (let n = 0; n < kept; n++) {
+      const c = this.#pushCount - 1 - n;
+      const k = c % PUSHES_KEPT;
+      const end = this.#pushEnd[k] ?? Number.NaN;
+      if (n + 1 < kept && b < (this.#pushEnd[(c - 1) % PUSHES_KEPT] ?? Number.NaN)) continue;
+      const times = this.#pushTimes[k];
+      if (times === undefined) return (this.#pushTime[k] ?? Number.NaN) - (end - 1 - b) * BYTE_TIME_US;
+      const j = b - (end - times.length);
+      return j >= 0 ? (times[j] ?? Number.NaN) : Number.NaN;
     }
     return Number.NaN;
   }
@@ -290,7 +307,8 @@ export class Engine {
     const all: readonly LinkEpisode[] = this.link.episodes;
     const out: Batch['episodes'] = [];
     for (let i = all.length - 1; i >= 0; i--) {
-      const e = all[i] as LinkEpisode;
+      const e = all[i];
+      if (e === undefined) break;
       const sent = this.#sent.get(e.id);
       if (sent !== undefined && sent.endUs === e.endUs && sent.startUs === e.startUs) {
         if (e.endUs !== null) break;

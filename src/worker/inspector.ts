@@ -1,15 +1,17 @@
 /**
- * The frame inspector's memory, kept by the worker for each remote: the most recent raw stream
- * bytes and a log of what the decoder made of them (frames, discards, resyncs, locks, format
- * changes), each placed by its stream offset. The page asks for a snapshot when the user wants
- * to look; the log itself costs a few stores per frame and allocates nothing while it runs,
- * because it is fed at the decoder's full rate whether anyone looks or not.
+ * The frame inspector's memory, kept by the worker for each remote: a log of what the decoder
+ * made of the stream (frames, discards, resyncs, locks, format changes), each placed by its
+ * stream offset and time, with a copy of its bytes. It is fed only what the decoder reports:
+ * each frame `next()` returns (its `bytes` and `timeUs`) and each event (its `timeUs`, and a
+ * discard's `bytes`), so the decoder is the one account of where bytes went and when they came.
+ * The page asks for a snapshot when the user wants to look; the log itself costs a few stores
+ * and a 16-byte copy per frame and allocates nothing while it runs, because it is fed at the
+ * decoder's full rate whether anyone looks or not.
  *
  * Stream offsets are the decoder's: 0 is the first byte pushed since the decoder was created or
- * reset. The log must see exactly the bytes the decoder sees (`onBytes` with every `push`), and
- * be `reset()` together with the decoder.
+ * reset. `reset()` the log together with the decoder.
  */
-import { BYTE_TIME_US, FRAME_SIZE, type DecodedFrame, type DecoderEvent } from '../decoder/index.js';
+import { FRAME_SIZE, type DecodedFrame, type DecoderEvent } from '../decoder/index.js';
 
 export type InspectKind = 'frame' | 'discarded' | 'resync' | 'locked' | 'format-changed';
 
@@ -23,8 +25,8 @@ export interface InspectEntry {
   /** Time of the first byte in the source's clock (µs), NaN when unknown. */
   timeUs: number;
   /**
-   * A copy of the bytes (a discard's first `DISCARD_BYTES_CAP` only), or null when they have
-   * scrolled out of the raw ring or the entry covers none. Entries of one snapshot share one
+   * A copy of the bytes (a discard's first `DISCARD_BYTES_CAP` only), or null when the log's
+   * byte store has since been filled by newer entries or the entry covers none. Entries of one snapshot share one
    * ArrayBuffer (one copy for the whole snapshot; transfer `bytes.buffer` once if at all).
    */
   bytes: Uint8Array | null;
@@ -62,9 +64,6 @@ const F_INTERNAL = 4;
 const F_EXTERNAL = 8;
 const F_RSSI = 16;
 
-/** Chunk times remembered for placing events in time (events lie a few chunks behind the newest). */
-const CHUNKS = 1024;
-
 /** Zero-length events sort before a frame or discard at the same offset: a resync or lock names where the next frame starts. */
 function rank(kind: number): number {
   return kind === K_FRAME || kind === K_DISCARDED ? 1 : 0;
@@ -72,7 +71,8 @@ function rank(kind: number): number {
 
 export class InspectorLog {
   readonly capacity: number;
-  readonly rawBytes: number;
+  /** Bytes of entries kept; the oldest entries lose their bytes first. */
+  readonly byteCapacity: number;
 
   // The entry ring, as columns: no object per frame.
   readonly #kind: Uint8Array;
@@ -82,44 +82,46 @@ export class InspectorLog {
   readonly #flags: Uint8Array;
   /** System byte, or -1 for none. */
   readonly #system: Int16Array;
+  /** Where the entry's bytes start in the byte store (a position, see #bytes), and how many there are. */
+  readonly #at: Float64Array;
+  readonly #stored: Uint16Array;
   /** Explanations of locks and format changes (rare; undefined elsewhere). */
   readonly #text: (string | undefined)[];
   /** Ring index of the oldest entry. */
   #first = 0;
   #count = 0;
 
-  // The raw byte ring: stream offset x lives at x % rawBytes while x >= #end - rawBytes.
-  readonly #raw: Uint8Array;
-  /** Per-byte times beside the raw ring, made the first time a chunk brings them (captures). */
-  #rawTime: Float64Array | null = null;
-  /** Stream offset after the last byte seen. */
+  /**
+   * The byte store, a ring: entries' bytes are appended as they come, and position p lives at
+   * p % byteCapacity while p >= #written - byteCapacity.
+   */
+  readonly #bytes: Uint8Array;
+  /** Positions written so far. */
+  #written = 0;
+  /** Stream offset after the last byte an entry covers. */
   #end = 0;
-
-  // Chunk ends (stream offsets) and times, a ring, to time the events.
-  readonly #chunkEnd = new Float64Array(CHUNKS);
-  readonly #chunkTime = new Float64Array(CHUNKS);
-  /** 1 where the chunk came with per-byte times (kept in #rawTime). */
-  readonly #chunkPerByte = new Uint8Array(CHUNKS);
-  #chunks = 0;
 
   /**
    * @param capacity entries kept (frames and events together)
-   * @param rawBytes raw stream bytes kept; entries older than this lose their bytes first
+   * @param byteCapacity bytes of entries kept; entries older than this lose their bytes first
+   * @throws {RangeError} when either cannot hold one frame
    */
-  constructor(capacity = 4096, rawBytes = 1 << 16) {
+  constructor(capacity = 4096, byteCapacity = 1 << 16) {
     if (!Number.isInteger(capacity) || capacity < 1) throw new RangeError(`capacity must be a positive integer, got ${capacity}`);
-    if (!Number.isInteger(rawBytes) || rawBytes < FRAME_SIZE)
-      throw new RangeError(`rawBytes must be an integer ≥ ${FRAME_SIZE}, got ${rawBytes}`);
+    if (!Number.isInteger(byteCapacity) || byteCapacity < FRAME_SIZE)
+      throw new RangeError(`byteCapacity must be an integer ≥ ${FRAME_SIZE}, got ${byteCapacity}`);
     this.capacity = capacity;
-    this.rawBytes = rawBytes;
+    this.byteCapacity = byteCapacity;
     this.#kind = new Uint8Array(capacity);
     this.#offset = new Float64Array(capacity);
     this.#length = new Float64Array(capacity);
     this.#time = new Float64Array(capacity);
     this.#flags = new Uint8Array(capacity);
     this.#system = new Int16Array(capacity);
+    this.#at = new Float64Array(capacity);
+    this.#stored = new Uint16Array(capacity);
     this.#text = new Array<string | undefined>(capacity).fill(undefined);
-    this.#raw = new Uint8Array(rawBytes);
+    this.#bytes = new Uint8Array(byteCapacity);
   }
 
   /** Entries held. */
@@ -127,61 +129,30 @@ export class InspectorLog {
     return this.#count;
   }
 
-  /** Stream offset after the last byte seen (equals the decoder's `stats.bytes`). */
+  /** Stream offset after the last byte a frame or discard covered (the decoder's `stats.bytes` once it decided them all). */
   get streamBytes(): number {
     return this.#end;
   }
 
   /** Forgets everything; call it with `decoder.reset()` (offsets start again at 0). */
   reset(): void {
-    this.#first = this.#count = this.#end = this.#chunks = 0;
+    this.#first = this.#count = this.#end = this.#written = 0;
     this.#text.fill(undefined);
   }
 
-  /**
-   * Every chunk pushed to the decoder, in order, with the time given to `push` (a chunk time:
-   * that of its last byte; or per-byte times, kept beside the bytes). Times only place the
-   * events; frames bring their own.
-   */
-  onBytes(bytes: Uint8Array, time?: number | Float64Array): void {
-    const n = bytes.length;
-    if (n === 0) return;
-    const raw = this.#raw;
-    const size = this.rawBytes;
-    // Only the last `size` bytes of a huge chunk can stay.
-    const skip = n > size ? n - size : 0;
-    const perByte = time instanceof Float64Array;
-    if (perByte && this.#rawTime === null) this.#rawTime = new Float64Array(size);
-    let at = (this.#end + skip) % size;
-    let from = skip;
-    while (from < n) {
-      const take = Math.min(n - from, size - at);
-      raw.set(bytes.subarray(from, from + take), at);
-      if (perByte) (this.#rawTime as Float64Array).set(time.subarray(from, from + take), at);
-      from += take;
-      at = 0;
-    }
-    this.#end += n;
-    const i = this.#chunks++ % CHUNKS;
-    this.#chunkEnd[i] = this.#end;
-    this.#chunkTime[i] = typeof time === 'number' ? time : perByte ? (time[n - 1] as number) : NaN;
-    this.#chunkPerByte[i] = perByte ? 1 : 0;
-  }
-
-  /** Each frame `next()` returns, right away (it is borrowed: only numbers are kept). */
+  /** Each frame `next()` returns, right away (it is borrowed: its numbers and a copy of its bytes are kept). */
   onFrame(frame: DecodedFrame): void {
     let flags = frame.resolution === 2048 ? F_2048 : F_1024;
     flags |= frame.remote === 'internal' ? F_INTERNAL : F_EXTERNAL;
     if (frame.rssi !== null) flags |= F_RSSI;
-    this.#add(K_FRAME, frame.offset, FRAME_SIZE, frame.timeUs, flags, frame.system ?? -1, undefined);
+    const i = this.#add(K_FRAME, frame.offset, FRAME_SIZE, frame.timeUs, flags, frame.system ?? -1, undefined);
+    this.#at[i] = this.#write(frame.bytes);
+    this.#stored[i] = FRAME_SIZE;
   }
 
-  /**
-   * Each decoder event, from the decoder's `onEvent`. `timeUs` overrides the time the log
-   * works out from the chunk times given to `onBytes`.
-   */
-  onEvent(event: DecoderEvent, timeUs?: number): void {
-    const t = timeUs ?? this.#timeAt(event.offset);
+  /** Each decoder event, from the decoder's `onEvent` (a discard's bytes are copied: they are borrowed). */
+  onEvent(event: DecoderEvent): void {
+    const t = event.timeUs;
     switch (event.type) {
       case 'discarded': {
         const reason = REASONS.indexOf(event.reason);
@@ -191,12 +162,17 @@ export class InspectorLog {
           last >= 0 &&
           this.#kind[last] === K_DISCARDED &&
           this.#flags[last] === reason &&
-          (this.#offset[last] as number) + (this.#length[last] as number) === event.offset
+          this.#offsetOf(last) + this.#lengthOf(last) === event.offset
         ) {
-          this.#length[last] = (this.#length[last] as number) + event.length;
+          this.#length[last] = this.#lengthOf(last) + event.length;
+          this.#end = Math.max(this.#end, event.offset + event.length);
+          this.#extend(last, event.bytes);
           return;
         }
-        this.#add(K_DISCARDED, event.offset, event.length, t, reason, -1, undefined);
+        const i = this.#add(K_DISCARDED, event.offset, event.length, t, reason, -1, undefined);
+        const kept = event.bytes.subarray(0, DISCARD_BYTES_CAP);
+        this.#at[i] = this.#write(kept);
+        this.#stored[i] = kept.length;
         return;
       }
       case 'resync':
@@ -211,6 +187,8 @@ export class InspectorLog {
         this.#add(event.type === 'locked' ? K_LOCKED : K_FORMAT, event.offset, 0, t, flags, f.system ?? -1, f.explanation);
         return;
       }
+      case 'fade-jump':
+        return;
     }
   }
 
@@ -222,32 +200,33 @@ export class InspectorLog {
     const n = Number.isNaN(limit) ? 0 : Math.max(0, Math.min(Math.floor(limit), this.#count));
     const cap = this.capacity;
     const start = this.#first + this.#count - n;
-    const oldest = this.#end - this.rawBytes;
     // First pass: how many bytes to copy.
     let total = 0;
     for (let k = 0; k < n; k++) {
       const i = (start + k) % cap;
-      const o = this.#offset[i] as number;
-      const len = Math.min(this.#length[i] as number, DISCARD_BYTES_CAP);
-      if (len > 0 && o >= oldest) total += len;
+      if (this.#held(i)) total += this.#stored[i] ?? 0;
     }
     const pool = new Uint8Array(total);
     let at = 0;
     const out: InspectEntry[] = new Array<InspectEntry>(n);
     for (let k = 0; k < n; k++) {
       const i = (start + k) % cap;
-      const kind = this.#kind[i] as number;
-      const offset = this.#offset[i] as number;
-      const length = this.#length[i] as number;
-      const flags = this.#flags[i] as number;
-      const len = Math.min(length, DISCARD_BYTES_CAP);
+      const kind = this.#kind[i] ?? K_FRAME;
+      const length = this.#lengthOf(i);
+      const flags = this.#flags[i] ?? 0;
       let bytes: Uint8Array | null = null;
-      if (len > 0 && offset >= oldest) {
-        bytes = pool.subarray(at, at + len);
-        this.#copy(offset, bytes);
-        at += len;
+      if (this.#held(i)) {
+        bytes = pool.subarray(at, at + (this.#stored[i] ?? 0));
+        this.#read(this.#at[i] ?? 0, bytes);
+        at += bytes.length;
       }
-      const e: InspectEntry = { kind: KINDS[kind] as InspectKind, offset, length, timeUs: this.#time[i] as number, bytes };
+      const e: InspectEntry = {
+        kind: KINDS[kind] ?? 'frame',
+        offset: this.#offsetOf(i),
+        length,
+        timeUs: this.#time[i] ?? Number.NaN,
+        bytes,
+      };
       if (kind === K_DISCARDED) {
         e.reason = REASONS[flags];
         if (length > DISCARD_BYTES_CAP) e.truncated = true;
@@ -255,7 +234,7 @@ export class InspectorLog {
         if (flags & (F_2048 | F_1024)) e.resolution = flags & F_2048 ? 2048 : 1024;
         if (flags & (F_INTERNAL | F_EXTERNAL)) e.remote = flags & F_INTERNAL ? 'internal' : 'external';
         e.headerMode = flags & F_RSSI ? 'rssi' : 'fades';
-        const system = this.#system[i] as number;
+        const system = this.#system[i] ?? -1;
         e.system = system < 0 ? null : system;
         const text = this.#text[i];
         if (text !== undefined) e.text = text;
@@ -265,8 +244,69 @@ export class InspectorLog {
     return out;
   }
 
-  /** Appends an entry, keeping stream order. */
-  #add(kind: number, offset: number, length: number, timeUs: number, flags: number, system: number, text: string | undefined): void {
+  #offsetOf(i: number): number {
+    return this.#offset[i] ?? 0;
+  }
+
+  #lengthOf(i: number): number {
+    return this.#length[i] ?? 0;
+  }
+
+  /** Whether entry i has bytes still in the store. */
+  #held(i: number): boolean {
+    const n = this.#stored[i] ?? 0;
+    return n > 0 && (this.#at[i] ?? 0) >= this.#written - this.byteCapacity;
+  }
+
+  /**
+   * Appends a merged discard's bytes to entry i's, up to `DISCARD_BYTES_CAP`. They must follow
+   * its bytes in the store: when newer entries were written after them (an entry that came in
+   * out of stream order), the entry's bytes move to the end first (at most the cap, and only
+   * until it is full).
+   */
+  #extend(i: number, bytes: Uint8Array): void {
+    const had = this.#stored[i] ?? 0;
+    const take = Math.min(bytes.length, DISCARD_BYTES_CAP - had);
+    if (take <= 0 || !this.#held(i)) return;
+    let at = this.#at[i] ?? 0;
+    if (at + had !== this.#written) {
+      const copy = new Uint8Array(had);
+      this.#read(at, copy);
+      at = this.#write(copy);
+      this.#at[i] = at;
+    }
+    this.#write(bytes.subarray(0, take));
+    this.#stored[i] = had + take;
+  }
+
+  /** Appends `bytes` to the store; returns the position of the first. A loop, not set(): mostly 16 bytes, and no view made. */
+  #write(bytes: Uint8Array): number {
+    const size = this.byteCapacity;
+    const store = this.#bytes;
+    const n = bytes.length;
+    const start = this.#written;
+    // Only the last `size` bytes can stay.
+    const skip = n > size ? n - size : 0;
+    let at = (start + skip) % size;
+    for (let k = skip; k < n; k++) {
+      store[at] = bytes[k] ?? 0;
+      at = at + 1 === size ? 0 : at + 1;
+    }
+    this.#written = start + n;
+    return start;
+  }
+
+  /** Copies the store's bytes from position `position` into `out` (they must still be held). */
+  #read(position: number, out: Uint8Array): void {
+    const size = this.byteCapacity;
+    const at = position % size;
+    const first = Math.min(out.length, size - at);
+    out.set(this.#bytes.subarray(at, at + first));
+    if (first < out.length) out.set(this.#bytes.subarray(0, out.length - first), first);
+  }
+
+  /** Appends an entry, keeping stream order; returns its ring index (after any move). */
+  #add(kind: number, offset: number, length: number, timeUs: number, flags: number, system: number, text: string | undefined): number {
     const cap = this.capacity;
     let i: number;
     if (this.#count === cap) {
@@ -283,6 +323,9 @@ export class InspectorLog {
     this.#flags[i] = flags;
     this.#system[i] = system;
     this.#text[i] = text;
+    this.#at[i] = 0;
+    this.#stored[i] = 0;
+    if (offset + length > this.#end) this.#end = offset + length;
     // The decoder reports in decision order, not always stream order: after a good frame
     // followed by noise it fires the resync (where frames resume) and the discard (the noise
     // after the frame) before next() hands out the frame itself. Such an entry moves back a few
@@ -291,12 +334,14 @@ export class InspectorLog {
     while (j > 0) {
       const a = (this.#first + j - 1) % cap;
       const b = (this.#first + j) % cap;
-      const oa = this.#offset[a] as number;
-      const ob = this.#offset[b] as number;
-      if (oa < ob || (oa === ob && rank(this.#kind[a] as number) <= rank(this.#kind[b] as number))) break;
+      const oa = this.#offsetOf(a);
+      const ob = this.#offsetOf(b);
+      if (oa < ob || (oa === ob && rank(this.#kind[a] ?? 0) <= rank(this.#kind[b] ?? 0))) break;
       this.#swap(a, b);
+      i = a;
       j--;
     }
+    return i;
   }
 
   #swap(a: number, b: number): void {
@@ -311,37 +356,8 @@ export class InspectorLog {
     sw(this.#time);
     sw(this.#flags);
     sw(this.#system);
+    sw(this.#at);
+    sw(this.#stored);
     sw(this.#text);
-  }
-
-  /** Copies the raw bytes from stream offset `offset` into `out` (they must be in the ring). */
-  #copy(offset: number, out: Uint8Array): void {
-    const size = this.rawBytes;
-    const at = offset % size;
-    const first = Math.min(out.length, size - at);
-    out.set(this.#raw.subarray(at, at + first));
-    if (first < out.length) out.set(this.#raw.subarray(0, out.length - first), first);
-  }
-
-  /**
-   * Time of the byte at stream offset `x`: its own time when it came with one, else its chunk's
-   * time less a byte time for each byte after it, as the decoder times frames. NaN when that
-   * chunk had no time or is no longer remembered.
-   */
-  #timeAt(x: number): number {
-    // The oldest remembered chunk's start is the end of one already overwritten: not usable.
-    const stop = this.#chunks > CHUNKS ? this.#chunks - CHUNKS + 1 : 0;
-    for (let c = this.#chunks - 1; c >= stop; c--) {
-      const i = c % CHUNKS;
-      const end = this.#chunkEnd[i] as number;
-      const prevEnd = c > 0 ? (this.#chunkEnd[(c - 1) % CHUNKS] as number) : 0;
-      if (x >= prevEnd && x < end) {
-        if (this.#chunkPerByte[i] === 1 && this.#rawTime !== null && x >= this.#end - this.rawBytes)
-          return this.#rawTime[x % this.rawBytes] as number;
-        return (this.#chunkTime[i] as number) - (end - 1 - x) * BYTE_TIME_US;
-      }
-      if (x >= end) return NaN;
-    }
-    return NaN;
   }
 }

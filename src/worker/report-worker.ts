@@ -3,11 +3,12 @@
  * worker reading the ports never stalls on it.
  */
 /// <reference lib="webworker" />
-import { readCapture } from '../capture/index.js';
+import { type Capture, readCapture } from '../capture/index.js';
 import { diagnosedHealthReport, reportHtml } from '../analysis/index.js';
 
 export interface ReportRequest {
-  bytes: Uint8Array;
+  /** A capture file's bytes (the live session's recording), or a capture already read (the one being replayed). */
+  of: { bytes: Uint8Array } | { capture: Capture };
   name: string;
   format: 'html' | 'json';
   resolution: 'auto' | 1024 | 2048;
@@ -18,9 +19,10 @@ export type ReportReply = { data: ArrayBuffer; error?: undefined } | { error: st
 const scope = self as unknown as DedicatedWorkerGlobalScope;
 
 scope.addEventListener('message', (event: MessageEvent<ReportRequest>) => {
-  const { bytes, name, format, resolution } = event.data;
+  const { of, name, format, resolution } = event.data;
   try {
-    const report = diagnosedHealthReport(readCapture(bytes, name), { resolution, name });
+    const capture = 'capture' in of ? of.capture : readCapture(of.bytes, name);
+    const report = diagnosedHealthReport(capture, { resolution, name });
     const text = format === 'html' ? reportHtml(report) : `${JSON.stringify(report, null, 2)}\n`;
     const data = new TextEncoder().encode(text).buffer as ArrayBuffer;
     const reply: ReportReply = { data };

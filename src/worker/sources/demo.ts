@@ -5,6 +5,8 @@
  * and B, an external one mounted at 90° whose dropouts come at other times.
  */
 import { Simulator, demoScenario, type Scenario } from '../../simulator/index.js';
+import type { Clock } from '../host.js';
+import type { Driver } from '../registry.js';
 
 const CHUNK_MS = 16;
 const SECOND = 1_000_000;
@@ -26,22 +28,24 @@ function externalDemo(): Scenario {
   };
 }
 
-export class DemoSource {
+export class DemoSource implements Driver {
+  readonly kind = 'demo';
   readonly #sims: Simulator[];
   readonly #offsetUs: number;
-  #timer: ReturnType<typeof setInterval> | undefined;
+  #timer: unknown;
 
   /**
-   * @param nowUs the worker's clock in µs
-   * @param onData called with each remote's batch of bytes and its arrival time on the worker's clock
+   * @param clock the worker's clock
+   * @param onData called with each remote's batch of bytes and its arrival time on the worker's clock, µs
    */
   constructor(
-    readonly nowUs: () => number,
+    readonly clock: Clock,
     readonly onData: (remote: number, bytes: Uint8Array, timeUs: number) => void,
   ) {
-    this.#sims = [new Simulator(demoScenario()), new Simulator(externalDemo())];
+    const a = new Simulator(demoScenario());
+    this.#sims = [a, new Simulator(externalDemo())];
     // Simulator time 0 is now.
-    this.#offsetUs = nowUs() - (this.#sims[0] as Simulator).scenario.timing.startUs;
+    this.#offsetUs = this.clockUs() - a.scenario.timing.startUs;
   }
 
   /** How many remotes the demo has. */
@@ -49,18 +53,34 @@ export class DemoSource {
     return this.#sims.length;
   }
 
+  clockUs(): number {
+    return this.clock.now() * 1000;
+  }
+
+  clockRate(): number {
+    return 1;
+  }
+
+  linkNowUs(): number {
+    return this.clockUs();
+  }
+
   start(): void {
-    this.#timer = setInterval(() => {
-      const now = this.nowUs();
+    if (this.#timer !== undefined) return;
+    this.#timer = this.clock.every(CHUNK_MS, () => {
+      const now = this.clockUs();
       this.#sims.forEach((sim, i) => {
         const chunk = sim.generate(now - this.#offsetUs);
         if (chunk.bytes.length > 0) this.onData(i, chunk.bytes, now);
       });
-    }, CHUNK_MS);
+    });
   }
 
-  stop(): void {
-    clearInterval(this.#timer);
+  async stop(): Promise<void> {
+    this.clock.cancel(this.#timer);
     this.#timer = undefined;
   }
+
+  /** A remote closed on its own: its bytes are dropped by the sink (the simulation goes on, as a receiver would). */
+  async release(): Promise<void> {}
 }

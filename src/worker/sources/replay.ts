@@ -7,20 +7,10 @@
 import { BYTE_TIME_US, FRAME_PERIOD_11MS_US, FRAME_SIZE } from '../../decoder/index.js';
 import { capturePorts, type Capture } from '../../capture/index.js';
 import { captureSpan } from '../../analysis/index.js';
+import { BROWSER_CLOCK, type Clock } from '../host.js';
 
 /** Wall time and ticks, passed in so that tests drive replay with a simulated clock. */
-export interface ReplayClock {
-  /** Milliseconds, monotonic (performance.now()). */
-  now(): number;
-  every(ms: number, fn: () => void): unknown;
-  cancel(handle: unknown): void;
-}
-
-export const REAL_CLOCK: ReplayClock = {
-  now: () => performance.now(),
-  every: (ms, fn) => setInterval(fn, ms),
-  cancel: (handle) => clearInterval(handle as ReturnType<typeof setInterval>),
-};
+export type ReplayClock = Pick<Clock, 'now' | 'every' | 'cancel'>;
 
 export interface ReplayOptions {
   clock?: ReplayClock;
@@ -43,10 +33,12 @@ interface Chunk {
 
 /**
  * The chunks of one port straight from the capture's columns: an hour of USB batches is 225 000
- * chunks, so they are read by index when fed, never turned into objects up front.
+ * chunks, so they are read by index when fed, never turned into objects up front. The index is
+ * the one array of its own a port holds (4 bytes a chunk).
  */
 class PortChunks {
   readonly length: number;
+  /** The capture's chunk number of each of this port's chunks. */
   readonly #index: Uint32Array;
   /** Next chunk to feed, and bytes of it already fed (per-byte-timed chunks go piece by piece). */
   next = 0;
@@ -54,6 +46,10 @@ class PortChunks {
 
   /** Without timing: this port's bytes up to the end of each chunk, for the paced clock. */
   readonly #bytesBefore: Float64Array | undefined;
+  /** Whether the chunks' times never go back (as recorded): a seek then bisects for its chunk. */
+  readonly #ordered: boolean;
+  /** Whether the per-byte times inside each chunk never go back: a seek then bisects for its byte. */
+  readonly #bytesOrdered: boolean;
 
   /** @param usPerByte without timing, the pace bytes are played at (µs a byte); NaN with timing */
   constructor(
@@ -63,42 +59,116 @@ class PortChunks {
   ) {
     const ports = capture.chunkPorts;
     let n = 0;
-    const index = new Uint32Array(ports.length);
-    for (let i = 0; i < ports.length; i++) if (ports[i] === port) index[n++] = i;
-    this.#index = index.subarray(0, n);
+    for (let i = 0; i < ports.length; i++) if (ports[i] === port) n++;
+    const index = new Uint32Array(n);
+    for (let i = 0, k = 0; i < ports.length; i++) if (ports[i] === port) index[k++] = i;
+    this.#index = index;
     this.length = n;
     if (Number.isFinite(usPerByte)) {
       const before = new Float64Array(n);
       let total = 0;
       for (let k = 0; k < n; k++) {
-        const i = this.#index[k] as number;
-        total += (capture.chunkEnds[i] as number) - (i === 0 ? 0 : (capture.chunkEnds[i - 1] as number));
+        const i = this.#chunk(k);
+        total += this.#end(i) - this.#start(i);
         before[k] = total;
       }
       this.#bytesBefore = before;
     }
+    let ordered = true;
+    for (let k = 1; k < n && ordered; k++) ordered = this.atUs(k) >= this.atUs(k - 1);
+    this.#ordered = ordered;
+    const times = capture.byteTimesUs;
+    let bytesOrdered = true;
+    for (let k = 0; k < n && times !== undefined && bytesOrdered; k++) {
+      const i = this.#chunk(k);
+      for (let j = this.#start(i) + 1; j < this.#end(i) && bytesOrdered; j++)
+        bytesOrdered = (times[j] ?? Number.NaN) >= (times[j - 1] ?? Number.NaN);
+    }
+    this.#bytesOrdered = bytesOrdered;
+  }
+
+  /** The capture's chunk number of this port's chunk k. */
+  #chunk(k: number): number {
+    return this.#index[k] ?? 0;
+  }
+
+  /** Where the capture's chunk i starts and ends in its bytes. */
+  #start(i: number): number {
+    return i === 0 ? 0 : (this.capture.chunkEnds[i - 1] ?? 0);
+  }
+
+  #end(i: number): number {
+    return this.capture.chunkEnds[i] ?? 0;
   }
 
   /** Arrival time of chunk k (µs): recorded, or on the paced clock without timing. */
   atUs(k: number): number {
-    if (this.#bytesBefore !== undefined) return (this.#bytesBefore[k] as number) * this.usPerByte;
-    const i = this.#index[k] as number;
+    if (this.#bytesBefore !== undefined) return (this.#bytesBefore[k] ?? Number.NaN) * this.usPerByte;
+    const i = this.#chunk(k);
     const times = this.capture.byteTimesUs;
-    if (times !== undefined) return times[(this.capture.chunkEnds[i] as number) - 1] ?? NaN;
-    return this.capture.chunkTimesUs[i] as number;
+    if (times !== undefined) return times[this.#end(i) - 1] ?? Number.NaN;
+    return this.capture.chunkTimesUs[i] ?? Number.NaN;
+  }
+
+  /**
+   * The first chunk that arrives at or after `timeUs` (`length` when none does), as a walk from
+   * the first chunk finds it; found by bisection when the times never go back.
+   */
+  firstAtOrAfter(timeUs: number): number {
+    if (!this.#ordered) {
+      let k = 0;
+      while (k < this.length && this.atUs(k) < timeUs) k++;
+      return k;
+    }
+    let lo = 0;
+    let hi = this.length;
+    while (lo < hi) {
+      const mid = (lo + hi) >>> 1;
+      if (this.atUs(mid) < timeUs) lo = mid + 1;
+      else hi = mid;
+    }
+    return lo;
+  }
+
+  /**
+   * Puts the cursor on the first byte a walk from the start finds at or after `fromUs`: the
+   * first chunk that arrives then and, in a chunk with per-byte times (a logic analyser's one
+   * chunk per port), its first byte timed then, so that a seek in a long one feeds only its
+   * history, not everything before it.
+   */
+  seekTo(fromUs: number): void {
+    this.next = this.firstAtOrAfter(fromUs);
+    this.nextByte = 0;
+    const times = this.capture.byteTimesUs;
+    if (times === undefined || this.done) return;
+    const i = this.#chunk(this.next);
+    const start = this.#start(i);
+    const end = this.#end(i);
+    let lo = start;
+    if (this.#bytesOrdered) {
+      let hi = end;
+      while (lo < hi) {
+        const mid = (lo + hi) >>> 1;
+        if ((times[mid] ?? Number.NaN) < fromUs) lo = mid + 1;
+        else hi = mid;
+      }
+    } else {
+      while (lo < end && (times[lo] ?? Number.NaN) < fromUs) lo++;
+    }
+    this.nextByte = lo - start;
   }
 
   get(k: number): Chunk {
-    const i = this.#index[k] as number;
+    const i = this.#chunk(k);
     const c = this.capture;
-    const start = i === 0 ? 0 : (c.chunkEnds[i - 1] as number);
-    const end = c.chunkEnds[i] as number;
+    const start = this.#start(i);
+    const end = this.#end(i);
     return { bytes: c.bytes.subarray(start, end), byteTimes: c.byteTimesUs?.subarray(start, end), atUs: this.atUs(k) };
   }
 
   /** Without timing: the port's bytes before chunk k. */
   bytesBeforeChunk(k: number): number {
-    return k === 0 || this.#bytesBefore === undefined ? 0 : (this.#bytesBefore[k - 1] as number);
+    return k === 0 || this.#bytesBefore === undefined ? 0 : (this.#bytesBefore[k - 1] ?? 0);
   }
 
   /** Whether chunk k's bytes are decoded with times (recorded ones); not on the paced clock. */
@@ -116,13 +186,13 @@ class PortChunks {
    * is as early as the decoder dates a frame in it.
    */
   nextByteUs(): number {
-    if (this.done) return Infinity;
-    const i = this.#index[this.next] as number;
+    if (this.done) return Number.POSITIVE_INFINITY;
+    const i = this.#chunk(this.next);
     const c = this.capture;
-    const start = i === 0 ? 0 : (c.chunkEnds[i - 1] as number);
-    if (c.byteTimesUs !== undefined) return c.byteTimesUs[start + this.nextByte] ?? Infinity;
+    const start = this.#start(i);
+    if (c.byteTimesUs !== undefined) return c.byteTimesUs[start + this.nextByte] ?? Number.POSITIVE_INFINITY;
     if (!this.timed) return (this.bytesBeforeChunk(this.next) + this.nextByte + 1) * this.usPerByte;
-    return this.atUs(this.next) - ((c.chunkEnds[i] as number) - start - 1) * BYTE_TIME_US;
+    return this.atUs(this.next) - (this.#end(i) - start - 1) * BYTE_TIME_US;
   }
 }
 
@@ -165,7 +235,7 @@ export class ReplaySource {
     readonly onEnd: () => void,
     options: ReplayOptions = {},
   ) {
-    this.#clock = options.clock ?? REAL_CLOCK;
+    this.#clock = options.clock ?? BROWSER_CLOCK;
     this.ports = capturePorts(capture);
     const span = captureSpan(capture);
     this.recordedTiming = Number.isFinite(span.startUs);
@@ -243,11 +313,7 @@ export class ReplaySource {
     this.#lastFedUs = NaN;
     this.#ended = false;
     const from = target - SEEK_HISTORY_US;
-    for (const c of this.#chunks) {
-      c.next = 0;
-      c.nextByte = 0;
-      while (c.next < c.length && c.atUs(c.next) < from) c.next++;
-    }
+    for (const c of this.#chunks) c.seekTo(from);
     const done = this.#feedUntil(target, Infinity);
     this.#clockUs = target;
     this.#wallMs = this.#clock.now();
@@ -303,9 +369,9 @@ export class ReplaySource {
         const times = chunk.byteTimes;
         const limit = Math.min(times.length, c.nextByte + 4096);
         let end = c.nextByte;
-        while (end < limit && !((times[end] as number) > clockUs)) end++;
+        while (end < limit && !((times[end] ?? Number.POSITIVE_INFINITY) > clockUs)) end++;
         if (end > c.nextByte)
-          this.#feed(c.port, chunk.bytes.subarray(c.nextByte, end), times.subarray(c.nextByte, end), times[end - 1] as number);
+          this.#feed(c.port, chunk.bytes.subarray(c.nextByte, end), times.subarray(c.nextByte, end), times[end - 1] ?? Number.NaN);
         c.nextByte = end;
         if (end === times.length) {
           c.next++;

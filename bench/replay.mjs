@@ -1,0 +1,167 @@
+#!/usr/bin/env node
+/**
+ * Opening and seeking a replay in the worker, in Node (npm run bench:day makes the captures:
+ * `node bench/day.mjs --only 1m,1h` for the small ones). The worker's dispatcher is bundled from
+ * src/ with Rolldown and driven with a fake host whose clock never ticks, so only the work of
+ * `replay-open` and `replay-seek` is timed: reading the file, the overview (each port decoded
+ * once), the replay's chunk index, and a seek's fresh decodes fed the ten minutes before the
+ * target. Each file runs in a child of its own (`--expose-gc`): the heap and array buffers the
+ * worker holds once the capture is open are measured after a collection, against the file size.
+ *
+ * Options: --only 1h,24h (default: 1m,1h,24h, those that exist), --seeks N (default 15).
+ * Measurement only: it asserts nothing.
+ */
+import { spawnSync } from 'node:child_process';
+import { existsSync, readFileSync, rmSync, statSync } from 'node:fs';
+import { loadavg, tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { fileURLToPath } from 'node:url';
+
+const args = process.argv.slice(2);
+const arg = (name, fallback) => (args.includes(name) ? args[args.indexOf(name) + 1] : fallback);
+
+if (args[0] === '--child') {
+  await child(args[1], args[2], Number(args[3]));
+} else {
+  await main();
+}
+
+async function main() {
+  // Rolldown (Vite's bundler) turns the worker's TypeScript into one module Node can run.
+  const { build } = await import('rolldown');
+  const bundle = join(tmpdir(), `satscope-bench-replay-${process.pid}`);
+  await build({
+    input: {
+      dispatcher: fileURLToPath(new URL('../src/worker/dispatcher.ts', import.meta.url)),
+      decoder: fileURLToPath(new URL('../src/decoder/index.ts', import.meta.url)),
+    },
+    platform: 'node',
+    logLevel: 'silent',
+    output: { dir: bundle, format: 'esm', entryFileNames: '[name].mjs' },
+  });
+  const only = arg('--only', '1m,1h,24h').split(',');
+  const seeks = Number(arg('--seeks', '15'));
+  const load = () =>
+    loadavg()
+      .map((x) => x.toFixed(2))
+      .join(' ');
+  console.log(`load before: ${load()}`);
+  console.log(
+    'file | MB | open s | × bare decode | held MB | held/file | seek ms median (min–max) | × bare decode of its history, median (min–max) | seeks',
+  );
+  for (const d of only) {
+    const path = join(tmpdir(), `satscope-bench-day-v1-${d}.sscap`);
+    if (!existsSync(path)) {
+      console.log(`${d}: ${path} missing (node bench/day.mjs --only ${d})`);
+      continue;
+    }
+    const run = spawnSync(
+      process.execPath,
+      ['--expose-gc', '--max-old-space-size=8192', fileURLToPath(import.meta.url), '--child', bundle, path, String(seeks)],
+      {
+        encoding: 'utf8',
+        stdio: ['ignore', 'pipe', 'inherit'],
+      },
+    );
+    if (run.status !== 0) {
+      console.log(`${d}: child failed (${run.status ?? run.signal})`);
+      continue;
+    }
+    const r = JSON.parse(run.stdout.trim().split('\n').at(-1));
+    const mb = (n) => (n / 1e6).toFixed(1);
+    const range = (x, digits) => `${x.median.toFixed(digits)} (${x.min.toFixed(digits)}–${x.max.toFixed(digits)})`;
+    console.log(
+      `${d} | ${mb(r.fileBytes)} | ${r.openS.toFixed(2)} | ${r.openRatio.toFixed(2)} | ${mb(r.heldBytes)} | ${(r.heldBytes / r.fileBytes).toFixed(2)} | ` +
+        `${range(r.seekMs, 0)} | ${range(r.seekRatio, 2)} | ${r.seekMs.n}`,
+    );
+  }
+  console.log(`load after: ${load()}`);
+  rmSync(bundle, { recursive: true, force: true });
+}
+
+/** Held memory: what the heap and array buffers hold after a full collection. */
+function held() {
+  globalThis.gc();
+  globalThis.gc();
+  const m = process.memoryUsage();
+  return m.heapUsed + m.arrayBuffers;
+}
+
+function stats(xs) {
+  const sorted = [...xs].sort((a, b) => a - b);
+  return { median: sorted[Math.floor(sorted.length / 2)], min: sorted[0], max: sorted.at(-1), n: sorted.length };
+}
+
+/**
+ * The baseline: the library's decoder alone (push, next, no link, series, inspector or doctor)
+ * over every chunk of `capture` whose time is in [fromUs, toUs), each port on its own decoder,
+ * ms. What any replay must at least do with those bytes.
+ */
+function bareDecodeMs(SpektrumDecoder, capture, fromUs, toUs) {
+  const started = performance.now();
+  const decoders = new Map();
+  let start = 0;
+  let frames = 0;
+  for (let i = 0; i < capture.chunkEnds.length; i++) {
+    const end = capture.chunkEnds[i];
+    const t = capture.chunkTimesUs[i];
+    if (t >= fromUs && t < toUs) {
+      const port = capture.chunkPorts[i];
+      let d = decoders.get(port);
+      if (d === undefined) decoders.set(port, (d = new SpektrumDecoder()));
+      d.push(capture.bytes.subarray(start, end), t);
+      while (d.next() !== undefined) frames++;
+    }
+    start = end;
+  }
+  if (frames < 0) throw new Error('unreachable');
+  return performance.now() - started;
+}
+
+async function child(bundle, path, seeks) {
+  const { Dispatcher } = await import(join(bundle, 'dispatcher.mjs'));
+  const { SpektrumDecoder } = await import(join(bundle, 'decoder.mjs'));
+  const clock = { now: () => performance.now(), after: () => 0, every: () => 0, cancel: () => undefined };
+  let status = null;
+  const host = {
+    post: (m) => {
+      if (m.type === 'replay' && m.replay !== null) status = m.replay;
+    },
+    clock,
+    timeOriginMs: 0,
+  };
+  const worker = new Dispatcher(host);
+  const base = held();
+  const fileBytes = statSync(path).size;
+  // The page transfers the file's ArrayBuffer: the worker owns its only copy, and nothing else here keeps it.
+  let data = new Uint8Array(fileBytes);
+  data.set(readFileSync(path));
+  const message = { type: 'replay-open', name: path, data: data.buffer };
+  data = null;
+  const t0 = performance.now();
+  await worker.handle(message);
+  const openMs = performance.now() - t0;
+  message.data = null;
+  const heldBytes = held() - base;
+  const capture = worker.replay.source.capture;
+  const openRatio = openMs / bareDecodeMs(SpektrumDecoder, capture, -Infinity, Infinity);
+  const { startUs, endUs } = status;
+  // Seek targets spread over the file in a fixed order (a seeded walk), both ends included.
+  const targets = [startUs, endUs];
+  let x = 7;
+  for (let i = targets.length; i < seeks; i++) {
+    x = (x * 48271) % 2147483647;
+    targets.push(startUs + (x / 2147483647) * (endUs - startUs));
+  }
+  const times = [];
+  const ratios = [];
+  for (const t of targets) {
+    const s = performance.now();
+    await worker.handle({ type: 'replay-seek', timeUs: t });
+    const ms = performance.now() - s;
+    times.push(ms);
+    // The same history (ten minutes before the target) through bare decoders, right after.
+    ratios.push(ms / Math.max(0.01, bareDecodeMs(SpektrumDecoder, capture, t - 600e6, t + 1)));
+  }
+  console.log(JSON.stringify({ fileBytes, openS: openMs / 1000, openRatio, heldBytes, seekMs: stats(times), seekRatio: stats(ratios) }));
+}

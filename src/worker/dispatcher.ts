@@ -1,0 +1,239 @@
+/**
+ * The worker's parts, made once and wired together, and every command from the page dispatched
+ * to them in the order it came (one queue: a command runs to its end before the next starts).
+ * Built with a `Host` (post and clock), so the whole worker runs in Node with fakes; worker.ts
+ * gives it the browser's.
+ */
+import { USB_CHUNK_JITTER_US } from '../decoder/index.js';
+import type { Capture } from '../capture/index.js';
+import { Batcher } from './batcher.js';
+import { bind } from './binding.js';
+import { Diagnosis } from './diagnosis.js';
+import { type Host, notice, nowUs } from './host.js';
+import { type LiveSink, liveSink } from './live.js';
+import type { PortIdentity, ToWorker } from './protocol.js';
+import { TaskQueue } from './queue.js';
+import { Recorder } from './recorder.js';
+import { SourceRegistry } from './registry.js';
+import { ReplaySession } from './replay-session.js';
+import { type ReportMaker, WORKER_REPORT_MAKER, report } from './report.js';
+import { setResolution, shareResolution, tellMismatch } from './resolution.js';
+import { DemoSource } from './sources/demo.js';
+import { SerialPorts } from './sources/serial-ports.js';
+
+/** What the browser provides that tests replace. */
+export interface DispatcherOptions {
+  findPort?: (identity: PortIdentity) => Promise<SerialPort | undefined>;
+  makeReport?: ReportMaker;
+}
+
+export class Dispatcher {
+  readonly queue: TaskQueue;
+  readonly recorder: Recorder;
+  readonly diagnosis: Diagnosis;
+  readonly registry: SourceRegistry;
+  readonly batcher: Batcher;
+  readonly serial: SerialPorts;
+  readonly sink: LiveSink;
+  readonly #makeReport: ReportMaker;
+
+  constructor(
+    readonly host: Host,
+    options: DispatcherOptions = {},
+  ) {
+    this.queue = new TaskQueue((error) => notice(host, 'error', 'Something went wrong in the worker', String(error)));
+    this.recorder = new Recorder((recording) => host.post({ type: 'recording', recording }));
+    this.diagnosis = new Diagnosis(
+      (message) => host.post(message),
+      () => this.registry.clockUs(),
+      () =>
+        this.registry
+          .list()
+          .filter((s) => s.kind === 'serial' && s.state === 'reading')
+          .map((s) => s.id),
+      host.clock,
+    );
+    this.registry = new SourceRegistry(host, this.diagnosis, {
+      closing: () => this.recorder.stop(),
+      empty: () => this.batcher.stop(),
+    });
+    this.batcher = new Batcher(host, this.registry, () => {
+      for (const s of this.registry.list()) tellMismatch(s, this.registry.resolution, host);
+      shareResolution(this.registry, host);
+      this.registry.send();
+      this.diagnosis.tick();
+    });
+    this.sink = liveSink(host, this.registry, this.recorder, this.batcher);
+    this.serial = new SerialPorts({
+      host,
+      registry: this.registry,
+      recorder: this.recorder,
+      diagnosis: this.diagnosis,
+      batcher: this.batcher,
+      sink: this.sink,
+      enqueue: (task) => this.queue.enqueue(task),
+      findPort: options.findPort,
+    });
+    this.#makeReport = options.makeReport ?? WORKER_REPORT_MAKER;
+  }
+
+  /** A message from the page: queued behind those before it. */
+  receive(message: ToWorker): void {
+    this.queue.enqueue(() => this.handle(message));
+  }
+
+  /** The replay being played, if the session is one. */
+  get replay(): ReplaySession | undefined {
+    const d = this.registry.driver;
+    return d instanceof ReplaySession ? d : undefined;
+  }
+
+  async handle(message: ToWorker): Promise<void> {
+    const { host, registry, recorder } = this;
+    switch (message.type) {
+      case 'serial-open':
+        await this.serial.open(message.port);
+        break;
+      case 'serial-close':
+        await registry.remove(message.source);
+        break;
+      case 'close-all':
+      case 'demo-stop':
+        await registry.closeAll();
+        break;
+      case 'demo-start':
+        await this.#startDemo();
+        break;
+      case 'bind':
+        await bind(message, host, registry, this.serial);
+        break;
+      case 'set-label':
+        registry.setLabel(message.source, message.label);
+        break;
+      case 'record-start':
+        await this.#startRecording();
+        break;
+      case 'record-stop':
+        await recorder.stop();
+        break;
+      case 'export': {
+        const result = await recorder.export(message.recording, message.what);
+        if (typeof result === 'string') notice(host, 'warning', 'Nothing to export', result);
+        else host.post({ type: 'export-ready', name: result.name, mime: 'application/octet-stream', data: result.data }, [result.data]);
+        break;
+      }
+      case 'inspect': {
+        const entries = registry.get(message.source)?.engine.inspector.snapshot(message.limit) ?? [];
+        // All entries of a snapshot share one buffer: transfer it once.
+        const buffer = entries.find((e) => e.bytes !== null)?.bytes?.buffer;
+        host.post({ type: 'inspection', source: message.source, entries }, buffer instanceof ArrayBuffer ? [buffer] : []);
+        break;
+      }
+      case 'report': {
+        const replay = this.replay;
+        let of: { capture: Capture } | { bytes: Uint8Array } | null = null;
+        if (replay !== undefined) of = { capture: replay.source.capture };
+        else {
+          const bytes = await recorder.current();
+          if (bytes !== null) of = { bytes };
+        }
+        const name = replay !== undefined ? replay.name : 'live session';
+        // Not awaited: the next commands (and the ports) go on while the helper works.
+        report(host, this.#makeReport, of, name, message.format, registry.resolution).catch((error: unknown) =>
+          notice(host, 'error', 'The report could not be made', String(error)),
+        );
+        break;
+      }
+      case 'diagnosis-confirm':
+        await this.#confirm(message);
+        break;
+      case 'discard-recovered':
+        await recorder.discardRecovered();
+        break;
+      case 'replay-open':
+        await ReplaySession.open(message.name, message.data, { host, registry, diagnosis: this.diagnosis, batcher: this.batcher });
+        break;
+      case 'replay-play':
+        this.replay?.play();
+        break;
+      case 'replay-pause':
+        this.replay?.pause();
+        break;
+      case 'replay-speed':
+        this.replay?.setSpeed(message.speed);
+        break;
+      case 'replay-seek':
+        this.replay?.seek(message.timeUs);
+        break;
+      case 'set-resolution':
+        setResolution(registry, message.resolution);
+        this.batcher.schedule();
+        break;
+      default: {
+        const never: never = message;
+        throw new Error(`unknown message ${JSON.stringify(never)}`);
+      }
+    }
+  }
+
+  async #startDemo(): Promise<void> {
+    const { registry } = this;
+    await registry.closeAll();
+    const demo = new DemoSource(this.host.clock, this.sink);
+    await registry.use(demo);
+    for (let i = 0; i < demo.remotes; i++) {
+      const s = registry.add('demo', i, i === 0 ? 'Demo remote (internal, DSMX 11 ms)' : 'Demo remote (external)', USB_CHUNK_JITTER_US);
+      s.state = 'reading';
+    }
+    demo.start();
+    this.batcher.startTicks();
+    registry.send();
+  }
+
+  async #startRecording(): Promise<void> {
+    const live = this.registry.list().filter((s) => s.kind === 'serial' || s.kind === 'demo');
+    const first = live[0];
+    if (first === undefined) {
+      notice(this.host, 'warning', 'Nothing to record', 'Connect a receiver (or start the demo) first.');
+      return;
+    }
+    // One entry per port number (= source id): the remote's label and its adapter.
+    const ports = Array.from({ length: Math.max(...live.map((s) => s.id)) + 1 }, (_, id) => {
+      const s = this.registry.get(id);
+      return s === undefined
+        ? {}
+        : { name: s.label, baudRate: 115200, usbVendorId: s.identity?.usbVendorId, usbProductId: s.identity?.usbProductId };
+    });
+    await this.recorder.start(
+      {
+        baudRate: 115200,
+        source: first.kind === 'demo' ? 'demo' : 'webserial',
+        usbVendorId: first.identity?.usbVendorId,
+        usbProductId: first.identity?.usbProductId,
+        ports,
+      },
+      new Date(this.host.timeOriginMs + this.host.clock.now()).toISOString(),
+    );
+  }
+
+  async #confirm(message: Extract<ToWorker, { type: 'diagnosis-confirm' }>): Promise<void> {
+    const { host, registry, recorder } = this;
+    const s = registry.get(message.source);
+    if (s?.serial === undefined || s.state !== 'reading') {
+      notice(host, 'warning', 'Cannot listen at another speed', 'Only a connected serial port can (not the demo or a replay).');
+      return;
+    }
+    const problem = await this.diagnosis.confirm(s.id, s.serial, s.signals, message.probe, {
+      nowUs: () => nowUs(host),
+      event: (text, t) => recorder.event(text, t, s.id),
+      data: (bytes, t) => recorder.data(bytes, t, s.id),
+      state: (state, name) =>
+        registry.setState(
+          s,
+          state,
+          name === undefined ? s.name.replace(/ at .*$/, ' at 115200 baud') : s.name.replace(/ at .*$/, ` ${name}`),
+        ),
+    });
+    if (problem !== null) notice(host, 'warning', `Remote ${s.label}: could not listen at ${message.probe.baudRate} baud`, problem);
+  }
+}

@@ -1,0 +1,84 @@
+/**
+ * The replay timeline's overview of a whole capture: every port on one time axis in 1 s bins,
+ * the library's binned link series (the report's) with fades and lost frames summed over the
+ * ports, and the failsafe episodes; also the frame period to pace a capture without timing at.
+ * Each port's bytes are decoded once, when the capture opens.
+ */
+import { FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US, FRAME_SIZE, systemInfo, type FormatInfo } from '../decoder/index.js';
+import type { Capture } from '../capture/index.js';
+import { type LinkSeries, decodeCapture } from '../analysis/index.js';
+import type { Overview } from './protocol.js';
+
+const BIN_US = 1_000_000;
+
+/** The frame period a decoder's format implies (its system byte, or 1024 resolution: 22 ms), NaN when it implies none. */
+function periodOf(format: FormatInfo): number {
+  const info = format.system === null ? undefined : systemInfo(format.system);
+  if (info !== undefined) return info.periodMs === 11 ? FRAME_PERIOD_11MS_US : FRAME_PERIOD_22MS_US;
+  return format.resolution === 1024 ? FRAME_PERIOD_22MS_US : Number.NaN;
+}
+
+/**
+ * Decodes each of `ports` of `capture` once. Without recorded timing, the fades and the
+ * receiver's missed frames go on the paced clock replay plays at (a frame every period from the
+ * first byte): where in the file, not when.
+ */
+export function overviewOf(
+  capture: Capture,
+  ports: readonly number[],
+  resolution: 'auto' | 1024 | 2048,
+): { overview: Overview; periodUs: number } {
+  const untimed = capture.timing === 'none';
+  const all: LinkSeries[] = [];
+  const failsafe: Overview['failsafe'] = [];
+  let periodUs = Number.NaN;
+  // Untimed: each frame's stream offset, fades and missed frames, as columns.
+  const marks: { offset: number[]; fades: number[]; missed: number[] } = { offset: [], fades: [], missed: [] };
+  for (const port of ports) {
+    let missed = 0;
+    const { link, series, decoder } = decodeCapture(capture, { resolution, port, binUs: BIN_US }, (f, l) => {
+      if (untimed) {
+        marks.offset.push(f.offset);
+        marks.fades.push(l.lastFades);
+        marks.missed.push(l.stats.missedFrames - missed);
+      }
+      missed = l.stats.missedFrames;
+    });
+    all.push(series);
+    for (const e of link.episodes) if (e.kind === 'failsafe') failsafe.push({ startUs: e.startUs, endUs: e.endUs ?? e.startUs });
+    if (Number.isNaN(periodUs)) periodUs = periodOf(decoder.format);
+  }
+  if (Number.isNaN(periodUs)) periodUs = FRAME_PERIOD_11MS_US;
+  if (untimed) {
+    const usPerByte = periodUs / FRAME_SIZE;
+    const binOf = (offset: number): number => Math.floor(((offset + FRAME_SIZE) * usPerByte) / BIN_US);
+    let bins = 0;
+    for (const offset of marks.offset) bins = Math.max(bins, binOf(offset) + 1);
+    const t = Float64Array.from({ length: bins }, (_, b) => b * BIN_US);
+    const fades = new Float32Array(bins);
+    const lost = new Float32Array(bins);
+    marks.offset.forEach((offset, k) => {
+      const b = binOf(offset);
+      fades[b] = (fades[b] ?? 0) + (marks.fades[k] ?? 0);
+      lost[b] = (lost[b] ?? 0) + (marks.missed[k] ?? 0);
+    });
+    return { overview: { t, fadeRate: fades, lost, failsafe: [] }, periodUs };
+  }
+  const bins = Math.max(0, ...all.map((x) => x.bins));
+  const origin = all[0]?.originUs ?? Number.NaN;
+  const t = new Float64Array(Number.isNaN(origin) ? 0 : bins);
+  const fades = new Float32Array(t.length);
+  const lost = new Float32Array(t.length);
+  for (let b = 0; b < t.length; b++) {
+    t[b] = origin + b * BIN_US;
+    let f = 0;
+    let l = 0;
+    for (const x of all) {
+      f += x.fades(b);
+      l += x.lost(b);
+    }
+    fades[b] = f;
+    lost[b] = l;
+  }
+  return { overview: { t, fadeRate: fades, lost, failsafe }, periodUs };
+}

@@ -1,0 +1,71 @@
+/** A fake clock and host for driving the worker's parts in Node: time moves only when a test says. */
+import type { Clock, Host } from '../src/worker/host.js';
+import type { FromWorker } from '../src/worker/protocol.js';
+
+interface Timer {
+  at: number;
+  every: number;
+  fn: () => void;
+}
+
+export class FakeClock implements Clock {
+  #now = 1000;
+  #next = 1;
+  readonly #timers = new Map<number, Timer>();
+
+  now(): number {
+    return this.#now;
+  }
+
+  after(ms: number, fn: () => void): number {
+    const id = this.#next++;
+    this.#timers.set(id, { at: this.#now + Math.max(0, ms), every: 0, fn });
+    return id;
+  }
+
+  every(ms: number, fn: () => void): number {
+    const id = this.#next++;
+    this.#timers.set(id, { at: this.#now + ms, every: ms, fn });
+    return id;
+  }
+
+  cancel(handle: unknown): void {
+    if (typeof handle === 'number') this.#timers.delete(handle);
+  }
+
+  /** Timers waiting. */
+  get pending(): number {
+    return this.#timers.size;
+  }
+
+  /** Moves time on by `ms`, running every timer due on the way at its time, in time order. */
+  advance(ms: number): void {
+    const end = this.#now + ms;
+    for (;;) {
+      let due: [number, Timer] | undefined;
+      for (const entry of this.#timers) if (entry[1].at <= end && (due === undefined || entry[1].at < due[1].at)) due = entry;
+      if (due === undefined) break;
+      const [id, t] = due;
+      this.#now = t.at;
+      if (t.every > 0) t.at += t.every;
+      else this.#timers.delete(id);
+      t.fn();
+    }
+    this.#now = end;
+  }
+}
+
+/** A host whose posts are kept, in order, with what they transferred. */
+export function fakeHost(clock = new FakeClock()) {
+  const posts: FromWorker[] = [];
+  const host: Host = {
+    post: (message) => {
+      posts.push(message);
+    },
+    clock,
+    timeOriginMs: 1_700_000_000_000,
+  };
+  const of = <T extends FromWorker['type']>(type: T): Extract<FromWorker, { type: T }>[] =>
+    posts.filter((p): p is Extract<FromWorker, { type: T }> => p.type === type);
+  return { host, clock, posts, of };
+}
