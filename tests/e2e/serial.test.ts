@@ -166,32 +166,26 @@ describe.skipIf(skip !== null)('a receiver on a serial port', () => {
     const lastByteUs = sim.timesUs[sim.timesUs.length - 1]!;
     const wallMs = (captureUs: number) => paced.endUs / 1000 + wallMinusMonoMs - (lastByteUs - captureUs) / 1000;
 
-    // The end of the feed starts a third hold (the receiver went quiet for good).
-    await page.waitForFunction(
-      () => /^3 holds · [12] failsafes$/.test(document.querySelector('.link dd:nth-of-type(2)')?.textContent ?? ''),
-      null,
-      {
-        timeout: 5000,
-      },
-    );
+    // The end of the feed starts a third hold, and a second failsafe 1 s later (the receiver went
+    // quiet for good). A hold the host's stalls caused may show while it lasts, but is withdrawn
+    // once the frames that follow show none was missed: the count settles on the truth.
+    await expect.poll(() => page.locator('.link dd').nth(1).textContent(), { timeout: 5000 }).toBe('3 holds · 2 failsafes');
     const fedUntilMs = wallMs(lastByteUs);
     const states = await page.evaluate(() => (window as unknown as { __states: { text: string; ms: number }[] }).__states);
+    const whileFed = states.filter((s) => s.ms < fedUntilMs);
     // Each true episode (two holds, then the long hold's failsafe) shows as that state on the
-    // page within 1 s of its true start; the page goes back to Live after each dropout.
-    let from = 0;
+    // page within 1 s of its true start.
     for (const e of truth.episodes) {
       const want = e.kind === 'hold' ? 'Hold' : 'Failsafe';
-      const at = states.findIndex((s, i) => i >= from && s.text === want);
-      expect(at, `${want} at ${(e.startUs - sim.timesUs[0]!) / 1e6} s shown`).toBeGreaterThanOrEqual(0);
-      const lateMs = states[at]!.ms - wallMs(e.startUs);
-      console.info(`${want}: shown ${lateMs.toFixed(0)} ms after it began`);
-      expect(Math.abs(lateMs), `${want} shown ${lateMs.toFixed(0)} ms from the truth`).toBeLessThan(1000);
-      from = at + 1;
+      const lateMs = whileFed.filter((s) => s.text === want).map((s) => s.ms - wallMs(e.startUs));
+      const nearest = lateMs.reduce((a, b) => (Math.abs(b) < Math.abs(a) ? b : a), Infinity);
+      console.info(`${want}: shown ${nearest.toFixed(0)} ms after it began`);
+      expect(Math.abs(nearest), `${want} at ${(e.startUs - sim.timesUs[0]!) / 1e6} s shown within 1 s`).toBeLessThan(1000);
     }
-    // Nothing else while bytes were arriving: one failsafe, and Live after each dropout.
-    const whileFed = states.filter((s) => s.ms < fedUntilMs);
+    const extra = whileFed.filter((s) => s.text === 'Hold').length - 2;
+    if (extra > 0) console.info(`${extra} hold(s) shown while the host stalled, then withdrawn`);
+    // One failsafe while bytes arrived (no stall lasts a second), and Live once they resumed.
     expect(whileFed.filter((s) => s.text === 'Failsafe')).toHaveLength(1);
-    expect(whileFed.filter((s) => s.text === 'Hold')).toHaveLength(2);
     expect(whileFed.at(-1)?.text).toBe('Live');
     // The frames the dropouts cost, as the receiver's fade counter says.
     await expect(page.getByTestId('count-missed').textContent()).resolves.toBe(String(truth.missedFrames));
