@@ -317,8 +317,12 @@ export class LinkMonitor {
   #state: LinkState = 'waiting';
   #lastUs = NaN;
   #systemPeriod = NaN;
+  /** The last frame times without a gap, a ring: `#periodCount` of them, the oldest at `#periodOldest` once it is full. */
   readonly #periodTimes = new Float64Array(PERIOD_WINDOW);
   #periodCount = 0;
+  #periodOldest = 0;
+  /** The last system byte seen, and whether `systemInfo` knew it (one lookup per change, not per frame). */
+  #systemByte = -1;
   readonly #rateTimes = new Float64Array(RATE_WINDOW);
   readonly #rateFades = new Float64Array(RATE_WINDOW);
   #rateCount = 0;
@@ -422,9 +426,10 @@ export class LinkMonitor {
       s.rssi = frame.rssi;
       if (!(s.minRssi <= frame.rssi)) s.minRssi = frame.rssi;
     }
-    if (frame.system !== null) {
+    if (frame.system !== null && frame.system !== this.#systemByte) {
       const info = systemInfo(frame.system);
       if (info) {
+        this.#systemByte = frame.system;
         this.#systemPeriod = info.periodMs === 11 ? FRAME_PERIOD_11MS_US : FRAME_PERIOD_22MS_US;
         s.nominalPeriodUs = this.#systemPeriod;
       }
@@ -637,13 +642,14 @@ export class LinkMonitor {
     // Period: the span of the last 32 gap-free intervals, which averages out chunk jitter.
     const times = this.#periodTimes;
     if (this.#periodCount < PERIOD_WINDOW) {
+      if (this.#periodCount === 0) this.#periodOldest = 0;
       times[this.#periodCount++] = t;
     } else {
-      times.copyWithin(0, 1);
-      times[PERIOD_WINDOW - 1] = t;
+      times[this.#periodOldest] = t;
+      this.#periodOldest = this.#periodOldest === PERIOD_WINDOW - 1 ? 0 : this.#periodOldest + 1;
     }
     if (this.#periodCount >= 9) {
-      const span = (times[this.#periodCount - 1] as number) - (times[0] as number);
+      const span = t - (times[this.#periodOldest] as number);
       if (!Number.isFinite(this.#systemPeriod) && (!Number.isFinite(s.nominalPeriodUs) || this.#periodCount === PERIOD_WINDOW)) {
         // Without a system byte: snap the mean interval to 11 or 22 ms, first over 8 intervals,
         // then again over every full window, so a few frames missing early do not stick.
