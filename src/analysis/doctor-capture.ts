@@ -7,6 +7,8 @@
 import { BYTE_TIME_US, LinkMonitor, SpektrumDecoder, USB_CHUNK_JITTER_US, type Resolution } from '../decoder/index.js';
 import { captureChunks, capturePorts, type Capture, type CaptureKind, type CaptureTiming } from '../capture/index.js';
 import { Doctor, type DoctorCode, type DoctorFinding, type Severity } from './doctor.js';
+import { doctorEvent } from './doctor-events.js';
+import { SLICE_BYTES } from './capture-pass.js';
 
 export interface DoctorCaptureOptions {
   /** Resolution override for every port's decoder. Default 'auto'. */
@@ -37,13 +39,6 @@ export interface DoctorReport {
   timeline: DoctorTimelineEntry[];
 }
 
-/** A capture event's text names a WebSerial read error, e.g. "line error: FramingError". */
-const LINE_ERROR = /\b(FramingError|ParityError|BreakError|BufferOverrunError)\b/;
-/** "port opened", "device reconnected", optionally "… at 420000 baud". */
-const OPENED = /\b(port opened|device reconnected)\b/i;
-const CLOSED = /\b(device lost|port closed)\b/i;
-const BAUD = /\b(\d{4,7})\s*baud\b/i;
-
 interface Piece {
   kind: 'data' | 'event';
   port: number;
@@ -56,9 +51,6 @@ interface Piece {
   time?: number | Float64Array;
   text?: string;
 }
-
-/** Bytes of a per-byte chunk fed at once: about 20 ms of a satellite stream, as a USB adapter would deliver it. */
-const SLICE_BYTES = 256;
 
 /**
  * Runs the doctor over every port of a capture and returns the findings at its end and the
@@ -236,18 +228,3 @@ export function doctorCapture(capture: Capture, options: DoctorCaptureOptions = 
 }
 
 const SEVERITY_RANK: Record<Severity, number> = { problem: 0, warning: 1, info: 2 };
-
-/**
- * Feeds one recorded event to a doctor: "port opened" / "device reconnected" (optionally
- * "… at 420000 baud") opens the port, "device lost" / "port closed" closes it, and a text that
- * names a WebSerial read error ("line error: FramingError") is that error. Other texts are
- * ignored. The live worker and `doctorCapture` both use it, so a recording says what was seen.
- */
-export function doctorEvent(doctor: Doctor, port: number, text: string, timeUs: number): void {
-  const error = LINE_ERROR.exec(text);
-  if (error !== null) doctor.lineError(port, error[1] as string, timeUs);
-  else if (OPENED.test(text)) {
-    const baud = BAUD.exec(text);
-    doctor.open(port, timeUs, baud !== null ? { baudRate: Number(baud[1]) } : {});
-  } else if (CLOSED.test(text)) doctor.close(port);
-}

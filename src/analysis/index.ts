@@ -37,7 +37,8 @@ export {
   type Severity,
 } from './doctor.js';
 export { diagnosedHealthReport } from './doctor-report.js';
-export { doctorCapture, doctorEvent, type DoctorCaptureOptions, type DoctorReport, type DoctorTimelineEntry } from './doctor-capture.js';
+export { doctorCapture, type DoctorCaptureOptions, type DoctorReport, type DoctorTimelineEntry } from './doctor-capture.js';
+export { doctorEvent } from './doctor-events.js';
 export {
   ArduPilotGuess,
   ARDUPILOT_GUESS_FRAMES,
@@ -53,16 +54,9 @@ export {
   type StreamFacts,
 } from './doctor-stacks.js';
 export { classifyLine, PacketScanner, PACKET_KINDS, type LineCounts, type LineVerdict, type PacketKind } from './doctor-line.js';
-export {
-  captureSpan,
-  decodeCapture,
-  resolutionKey,
-  summarizeCapture,
-  timingJitterUs,
-  type CaptureSummary,
-  type ChannelSummary,
-  type DecodeCaptureOptions,
-} from './summary.js';
+export { captureSpan, decodeCapture, timingJitterUs, type DecodeCaptureOptions } from './capture-pass.js';
+export { resolutionKey } from './resolution-key.js';
+export { summarizeCapture, type CaptureSummary, type ChannelSummary } from './summary.js';
 export { LinkSeries, monitorWithSeries } from './series.js';
 export {
   healthReport,

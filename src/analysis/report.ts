@@ -9,7 +9,7 @@
  * port), so that the ports of a multi-port capture share one time axis.
  */
 import type { Capture, CaptureKind, CaptureTiming } from '../capture/index.js';
-import { captureChunks, capturePorts } from '../capture/index.js';
+import { capturePorts } from '../capture/index.js';
 import type { LinkEpisode, MissedBasis } from '../decoder/index.js';
 import {
   CHANNEL_COUNT,
@@ -21,8 +21,10 @@ import {
   type Resolution,
   USB_CHUNK_JITTER_US,
 } from '../decoder/index.js';
-import { captureSpan, decodeCapture, resolutionKey } from './summary.js';
-import type { HeaderReading, RemoteKind, ResolutionReason } from '../decoder/index.js';
+import { captureSpan, decodeCapture } from './capture-pass.js';
+import type { Doctor } from './doctor.js';
+import { looksInternal, readPorts } from './resolution-key.js';
+import type { DecoderStats, FormatInfo, HeaderReading, RemoteKind, ResolutionReason } from '../decoder/index.js';
 
 // ---------------------------------------------------------------------------------------------
 // Thresholds
@@ -426,20 +428,49 @@ class Column {
 function percentile(sorted: Float64Array, p: number): number {
   if (sorted.length === 0) return NaN;
   const rank = Math.ceil((p / 100) * sorted.length);
-  return sorted[Math.min(sorted.length - 1, Math.max(0, rank - 1))] as number;
+  return sorted[Math.min(sorted.length - 1, Math.max(0, rank - 1))] ?? NaN;
+}
+
+/** Statistics of the ordinary frame intervals; sorts `intervals` in place. Null without any. */
+function periodStats(intervals: Float64Array, basis: ReportPeriodStats['basis']): ReportPeriodStats | null {
+  if (intervals.length === 0) return null;
+  const iv = intervals.sort();
+  let sum = 0;
+  for (const v of iv) sum += v;
+  const mean = sum / iv.length;
+  let sq = 0;
+  for (const v of iv) sq += (v - mean) * (v - mean);
+  return {
+    intervals: iv.length,
+    meanUs: r1(mean),
+    stdDevUs: r1(Math.sqrt(sq / iv.length)),
+    minUs: r1(iv[0] ?? NaN),
+    maxUs: r1(iv[iv.length - 1] ?? NaN),
+    p50Us: r1(percentile(iv, 50)),
+    p95Us: r1(percentile(iv, 95)),
+    p99Us: r1(percentile(iv, 99)),
+    basis,
+  };
 }
 
 type RawGlitch = Omit<ReportGlitch, 'timeUs'> & { absUs: number };
 
-/** What one port's decode leaves for the report. */
+/** What one port's decode leaves for the report: sums, not a record per frame. */
 interface PortData {
   port: number;
-  /** Per frame: time (µs, capture clock), RSSI (NaN when none). */
-  times: Float64Array;
-  rssi: Float64Array;
-  /** The ordinary frame intervals (the link monitor's `lastIntervalUs`), µs. */
-  intervals: Float64Array;
   remote: ReturnType<typeof decodeCapture>;
+  /** Frames seen, and the first and last one's time (µs, capture clock). */
+  frames: number;
+  firstUs: number;
+  lastUs: number;
+  /** RSSI over the frames that carried a level, and the loss reports (−128). */
+  rssiFrames: number;
+  rssiLoss: number;
+  rssiLo: number;
+  rssiHi: number;
+  rssiTotal: number;
+  /** The ordinary frame intervals' statistics (the link monitor's `lastIntervalUs`). */
+  period: ReportPeriodStats | null;
   channelFrames: Uint32Array;
   channelMin: Float64Array;
   channelMax: Float64Array;
@@ -451,18 +482,35 @@ interface PortData {
   bytes: number;
   /** Whether any frame carried a fade counter other than 0. */
   fadeCounterMoved: boolean;
+  /** For `readPorts`: the decoder's reading and counters. */
+  format: FormatInfo;
+  stats: Readonly<DecoderStats>;
 }
 
-/** Decodes one port, keeping what the report needs per frame, and finds spikes as it goes. */
+/** Where a port's decode starts and ends, and who else listens. */
+interface PortPass {
+  originUs: number;
+  endUs: number;
+  doctor: Doctor | undefined;
+}
+
+/** Decodes one port, summing what the report needs per frame, and finds spikes as it goes. */
 function decodePort(
   capture: Capture,
   port: number,
   resolution: 'auto' | Resolution,
-  resolutionFrom: 'user' | 'internal-remote' = 'user',
+  resolutionFrom: 'user' | 'internal-remote',
+  pass: PortPass,
 ): PortData {
-  const times = new Column();
   const intervals = new Column();
-  const rssi = new Column();
+  let frames = 0;
+  let firstUs = NaN;
+  let lastUs = NaN;
+  let rssiFrames = 0;
+  let rssiLoss = 0;
+  let rssiLo = Infinity;
+  let rssiHi = -Infinity;
+  let rssiTotal = 0;
   const channelFrames = new Uint32Array(CHANNEL_COUNT);
   const channelMin = new Float64Array(CHANNEL_COUNT).fill(Infinity);
   const channelMax = new Float64Array(CHANNEL_COUNT).fill(-Infinity);
@@ -486,36 +534,51 @@ function decodePort(
       resolution,
       resolutionFrom,
       binUs: REPORT_BIN_US,
+      originUs: pass.originUs,
+      endUs: pass.endUs,
+      ...(pass.doctor !== undefined ? { doctor: pass.doctor } : {}),
       onEvent: (e) => {
         if (e.type === 'format-changed') formatChanges++;
       },
     },
     (f, link) => {
-      times.push(f.timeUs);
+      if (frames === 0) firstUs = f.timeUs;
+      lastUs = f.timeUs;
+      frames++;
       if (Number.isFinite(link.lastIntervalUs)) intervals.push(link.lastIntervalUs);
-      rssi.push(f.rssi ?? NaN);
+      const rs = f.rssi;
+      if (rs !== null && !Number.isNaN(rs)) {
+        if (rs === -128) rssiLoss++;
+        else {
+          rssiFrames++;
+          rssiTotal += rs;
+          if (rs < rssiLo) rssiLo = rs;
+          if (rs > rssiHi) rssiHi = rs;
+        }
+      }
       if (f.fades !== null && f.fades !== 0) fadeCounterMoved = true;
       for (let i = 0; i < f.count; i++) {
-        const id = f.ids[i] as number;
+        const id = f.ids[i] ?? 0;
         const res: Resolution = channelResolution(id, f.resolution);
-        const pos = f.positions[i] as number;
+        const pos = f.positions[i] ?? 0;
         const u = servoToMicros(pos, res);
         const p = servoToPercent(pos, res);
-        channelFrames[id] = (channelFrames[id] as number) + 1;
-        if (u < (channelMin[id] as number)) channelMin[id] = u;
-        if (u > (channelMax[id] as number)) channelMax[id] = u;
-        channelSum[id] = (channelSum[id] as number) + u;
+        channelFrames[id] = (channelFrames[id] ?? 0) + 1;
+        if (u < (channelMin[id] ?? Infinity)) channelMin[id] = u;
+        if (u > (channelMax[id] ?? -Infinity)) channelMax[id] = u;
+        channelSum[id] = (channelSum[id] ?? 0) + u;
         const a = 2 * id; // [a] is the older appearance (A), [a + 1] the newer (B); C is this one.
-        const n = seen[id] as number;
+        const n = seen[id] ?? 0;
         if (n >= 2) {
-          const pA = pct[a] as number;
-          const pB = pct[a + 1] as number;
+          const pA = pct[a] ?? NaN;
+          const pB = pct[a + 1] ?? NaN;
+          const atA = at[a] ?? NaN;
           const up = pB - pA;
           const down = pB - p;
           const span =
-            Number.isFinite(f.timeUs) && Number.isFinite(at[a] as number)
-              ? f.timeUs - (at[a] as number) <= SPIKE_WINDOW_US
-              : f.index - (idx[a] as number) <= SPIKE_WINDOW_FRAMES;
+            Number.isFinite(f.timeUs) && Number.isFinite(atA)
+              ? f.timeUs - atA <= SPIKE_WINDOW_US
+              : f.index - (idx[a] ?? NaN) <= SPIKE_WINDOW_FRAMES;
           if (
             span &&
             Math.abs(up) >= SPIKE_MIN_JUMP_PERCENT &&
@@ -524,18 +587,18 @@ function decodePort(
             Math.abs(p - pA) <= SPIKE_RETURN_PERCENT
           ) {
             glitchCount++;
-            const frameIndex = idx[a + 1] as number;
+            const frameIndex = idx[a + 1] ?? NaN;
             if (frameIndex !== lastGlitchFrame) glitchFrames++;
             lastGlitchFrame = frameIndex;
             if (glitchesRaw.length < MAX_LISTED_GLITCHES) {
               glitchesRaw.push({
                 kind: 'spike',
-                absUs: at[a + 1] as number,
+                absUs: at[a + 1] ?? NaN,
                 frameIndex,
                 channel: id,
                 name: channelName(id),
-                beforeUs: us[a] as number,
-                spikeUs: us[a + 1] as number,
+                beforeUs: us[a] ?? NaN,
+                spikeUs: us[a + 1] ?? NaN,
                 afterUs: u,
                 jumpPercent: r1(up),
               });
@@ -543,10 +606,10 @@ function decodePort(
           }
         }
         if (n >= 1) {
-          pct[a] = pct[a + 1] as number;
-          us[a] = us[a + 1] as number;
-          at[a] = at[a + 1] as number;
-          idx[a] = idx[a + 1] as number;
+          pct[a] = pct[a + 1] ?? NaN;
+          us[a] = us[a + 1] ?? NaN;
+          at[a] = at[a + 1] ?? NaN;
+          idx[a] = idx[a + 1] ?? NaN;
         }
         pct[a + 1] = p;
         us[a + 1] = u;
@@ -556,14 +619,19 @@ function decodePort(
       }
     },
   );
-  let bytes = 0;
-  for (const chunk of captureChunks(capture, port)) bytes += chunk.bytes.length;
+  const stats = remote.decoder.stats;
   return {
     port,
-    times: times.view(),
-    rssi: rssi.view(),
-    intervals: intervals.view(),
     remote,
+    frames,
+    firstUs,
+    lastUs,
+    rssiFrames,
+    rssiLoss,
+    rssiLo,
+    rssiHi,
+    rssiTotal,
+    period: periodStats(intervals.view(), capture.timing === 'per-byte' ? 'per-byte' : 'per-chunk'),
     channelFrames,
     channelMin,
     channelMax,
@@ -572,8 +640,10 @@ function decodePort(
     glitchCount,
     glitchFrames,
     formatChanges,
-    bytes,
+    bytes: stats.bytes,
     fadeCounterMoved,
+    format: remote.decoder.format,
+    stats,
   };
 }
 
@@ -756,29 +826,32 @@ function statusOf(findings: readonly ReportFinding[], frames: number): ReportSta
 
 /**
  * The health report of every port of a capture (one remote receiver per port). Decodes each
- * port with `decodeCapture`; never throws on the capture's content.
+ * port once where it can (`readPorts`); never throws on the capture's content.
  */
 export function healthReport(capture: Capture, options: HealthReportOptions = {}): HealthReport {
+  return healthReportFeeding(capture, options, undefined);
+}
+
+/**
+ * `healthReport`, with `doctor` (when given, for a timed capture) fed every port's bytes, events
+ * and frames from the same decode: `diagnosedHealthReport` asks it for its findings after.
+ */
+export function healthReportFeeding(capture: Capture, options: HealthReportOptions, doctor: Doctor | undefined): HealthReport {
   const ports = capturePorts(capture);
   const timed = capture.timing !== 'none';
-  let decoded = ports.map((p) => decodePort(capture, p, options.resolution ?? 'auto'));
-  // §8: the internal remote holds the key for every remote; external ports take its resolution.
-  if ((options.resolution ?? 'auto') === 'auto' && ports.length > 1) {
-    const key = resolutionKey(decoded.map((d) => d.remote.decoder.format));
-    if (key !== undefined) {
-      decoded = decoded.map((d, i) => {
-        if (d.remote.decoder.format.remote === 'internal') return d;
-        // Kept only if it reads at least as many frames: a port of another system (or a
-        // capture put together from unrelated receivers) keeps its own reading.
-        const keyed = decodePort(capture, ports[i] as number, key, 'internal-remote');
-        return keyed.remote.decoder.stats.frames >= d.remote.decoder.stats.frames ? keyed : d;
-      });
-    }
-  }
-
-  // The shared clock: from the earliest to the latest time recorded on any port (decodeCapture
-  // bins from the same origin and ends each link there).
+  // The shared clock: from the earliest to the latest time recorded on any port (each port's
+  // series bins from the same origin and its link ends there).
   const span = captureSpan(capture);
+  const pass: PortPass = { originUs: span.startUs, endUs: span.endUs, doctor };
+  // §8: the internal remote holds the key for every remote; external ports take its resolution.
+  const read = readPorts(
+    ports,
+    options.resolution ?? 'auto',
+    (port) => looksInternal(capture, port),
+    (port, resolution, from, final) => decodePort(capture, port, resolution, from, final ? pass : { ...pass, doctor: undefined }),
+  );
+  const decoded = ports.map((p) => read.get(p) as PortData);
+
   const hasClock = timed && Number.isFinite(span.startUs) && Number.isFinite(span.endUs);
   const origin = hasClock ? span.startUs : NaN;
   const end = hasClock ? span.endUs : NaN;
@@ -789,9 +862,9 @@ export function healthReport(capture: Capture, options: HealthReportOptions = {}
     const stats = decoder.stats;
     const format = decoder.format;
     const ls = link.stats;
-    const n = d.times.length;
-    const first = n > 0 ? (d.times[0] as number) : NaN;
-    const last = n > 0 ? (d.times[n - 1] as number) : NaN;
+    const n = d.frames;
+    const first = d.firstUs;
+    const last = d.lastUs;
     const period = ls.nominalPeriodUs;
     const havePeriod = hasClock && Number.isFinite(period) && n > 0;
     // The receiver's own count needs no clock: a file without timing still has it.
@@ -814,46 +887,10 @@ export function healthReport(capture: Capture, options: HealthReportOptions = {}
       const low = series.rssiMin(b);
       rssiMinS[b] = Number.isNaN(low) ? null : low;
     }
-    let rssiFrames = 0;
-    let rssiLoss = 0;
-    let rssiLo = Infinity;
-    let rssiHi = -Infinity;
-    let rssiTotal = 0;
-    for (let i = 0; i < n; i++) {
-      const rs = d.rssi[i] as number;
-      if (Number.isNaN(rs)) continue;
-      if (rs === -128) rssiLoss++;
-      else {
-        rssiFrames++;
-        rssiTotal += rs;
-        if (rs < rssiLo) rssiLo = rs;
-        if (rs > rssiHi) rssiHi = rs;
-      }
-    }
+    const { rssiFrames, rssiLoss, rssiLo, rssiHi, rssiTotal } = d;
     const fadesTotal = ls.fades;
     const fadeJumps = stats.fadeJumps;
-    const intervals = d.intervals;
-
-    let framePeriod: ReportPeriodStats | null = null;
-    if (havePeriod && intervals.length > 0) {
-      const iv = intervals.slice().sort();
-      let sum = 0;
-      for (const v of iv) sum += v;
-      const mean = sum / iv.length;
-      let sq = 0;
-      for (const v of iv) sq += (v - mean) * (v - mean);
-      framePeriod = {
-        intervals: iv.length,
-        meanUs: r1(mean),
-        stdDevUs: r1(Math.sqrt(sq / iv.length)),
-        minUs: r1(iv[0] as number),
-        maxUs: r1(iv[iv.length - 1] as number),
-        p50Us: r1(percentile(iv, 50)),
-        p95Us: r1(percentile(iv, 95)),
-        p99Us: r1(percentile(iv, 99)),
-        basis: capture.timing === 'per-byte' ? 'per-byte' : 'per-chunk',
-      };
-    }
+    const framePeriod = havePeriod ? d.period : null;
 
     const episodes = link.episodes;
     const failsafes = hasClock ? episodes.filter((e) => e.kind === 'failsafe').map((e) => episodeOf(e, origin, end)) : [];
