@@ -332,6 +332,8 @@ export class LinkMonitor {
   #nextEpisode = 0;
   #open: LinkEpisode | null = null;
   readonly #ledger: FrameLedger;
+  /** `#missedByCount` bound once, for the ledger (no closure made per frame). */
+  readonly #missed = (fromUs: number, toUs: number, count: number): void => this.#missedByCount(fromUs, toUs, count);
   /**
    * Holds not yet confirmed, with the receiver's fade count when each began: a hold whose
    * silence the next punctual frame shows held no missing frame was the adapter holding bytes
@@ -458,7 +460,7 @@ export class LinkMonitor {
       }
       this.#lastUs = t;
       this.#measure(t, fades);
-      this.#ledger.frame(t, s.nominalPeriodUs, (a, b, n) => this.#missedByCount(a, b, n));
+      this.#ledger.frame(t, s.nominalPeriodUs, this.#missed);
       this.#confirmHolds();
       s.deliveryDelayUs = this.#ledger.delayUs;
       s.deliveryJitterUs = this.#ledger.jitterUs;
@@ -578,7 +580,7 @@ export class LinkMonitor {
     if (silence > grace && silence > s.longestGapUs) s.longestGapUs = silence;
     if (this.#counting) {
       // The receiver never got to report these: frames due in a silence longer than a hold.
-      this.#ledger.finish(endUs, Infinity, (a, b, n) => this.#missedByCount(a, b, n));
+      this.#ledger.finish(endUs, Infinity, this.#missed);
       this.#confirmHolds();
       if (silence > grace) {
         const p = s.nominalPeriodUs;
@@ -590,7 +592,7 @@ export class LinkMonitor {
         }
       }
     } else {
-      this.#ledger.finish(endUs, silence > grace ? this.jitterUs : Infinity, (a, b, n) => this.#missedByCount(a, b, n));
+      this.#ledger.finish(endUs, silence > grace ? this.jitterUs : Infinity, this.#missed);
       this.#confirmHolds();
     }
     return state;
