@@ -24,21 +24,38 @@ const SBUS_LENGTH = 25;
 const HISTORY = 128;
 const MAX_PENDING = 16;
 
-function crc16Xmodem(ring: Uint8Array, start: number, length: number): number {
-  let crc = 0;
-  for (let i = 0; i < length; i++) {
-    crc ^= (ring[(start + i) & (HISTORY - 1)] as number) << 8;
-    for (let b = 0; b < 8; b++) crc = crc & 0x8000 ? ((crc << 1) ^ 0x1021) & 0xffff : (crc << 1) & 0xffff;
+/** CRC-16/XMODEM (poly 0x1021) and CRC-8/DVB-S2 (poly 0xD5), MSB first: one table lookup a byte. */
+let crcTables: { c16: Uint16Array; c8: Uint8Array } | undefined;
+
+/** Built on first use, so importing the module does no work. */
+function buildCrcTables(): { c16: Uint16Array; c8: Uint8Array } {
+  const c16 = new Uint16Array(256);
+  const c8 = new Uint8Array(256);
+  for (let n = 0; n < 256; n++) {
+    let a = n << 8;
+    let b = n;
+    for (let k = 0; k < 8; k++) {
+      a = a & 0x8000 ? ((a << 1) ^ 0x1021) & 0xffff : (a << 1) & 0xffff;
+      b = b & 0x80 ? ((b << 1) ^ 0xd5) & 0xff : (b << 1) & 0xff;
+    }
+    c16[n] = a;
+    c8[n] = b;
   }
+  return { c16, c8 };
+}
+
+function crc16Xmodem(ring: Uint8Array, start: number, length: number): number {
+  const table = (crcTables ??= buildCrcTables()).c16;
+  let crc = 0;
+  for (let i = 0; i < length; i++)
+    crc = ((crc << 8) & 0xffff) ^ (table[((crc >>> 8) ^ (ring[(start + i) & (HISTORY - 1)] ?? 0)) & 0xff] ?? 0);
   return crc;
 }
 
 function crc8DvbS2(ring: Uint8Array, start: number, length: number): number {
+  const table = (crcTables ??= buildCrcTables()).c8;
   let crc = 0;
-  for (let i = 0; i < length; i++) {
-    crc ^= ring[(start + i) & (HISTORY - 1)] as number;
-    for (let b = 0; b < 8; b++) crc = crc & 0x80 ? ((crc << 1) ^ 0xd5) & 0xff : (crc << 1) & 0xff;
-  }
+  for (let i = 0; i < length; i++) crc = table[(crc ^ (ring[(start + i) & (HISTORY - 1)] ?? 0)) & 0xff] ?? 0;
   return crc;
 }
 
