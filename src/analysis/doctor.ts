@@ -495,12 +495,12 @@ export class Doctor {
     if (f.fades !== null) p.prevFades = f.fades;
     p.prevFrameUs = t;
     // The format a remote was bound in; a change after that is a rebind (or another receiver).
-    const snap: FormatSnapshot = { system: f.system, resolution: f.resolution, remote: f.remote, timeUs: t };
+    // (A snapshot is made only when it is kept: nothing is allocated per frame.)
     const ref = p.changes.length > 0 ? (p.changes[p.changes.length - 1] as { to: FormatSnapshot }).to : p.first;
     if (ref === null) {
-      if (p.frames >= 2) p.first = snap; // the decoder may revise its first reading once
-    } else if (ref.system !== snap.system || ref.resolution !== snap.resolution || ref.remote !== snap.remote) {
-      p.changes.push({ timeUs: t, from: ref, to: snap });
+      if (p.frames >= 2) p.first = { system: f.system, resolution: f.resolution, remote: f.remote, timeUs: t }; // the decoder may revise its first reading once
+    } else if (ref.system !== f.system || ref.resolution !== f.resolution || ref.remote !== f.remote) {
+      p.changes.push({ timeUs: t, from: ref, to: { system: f.system, resolution: f.resolution, remote: f.remote, timeUs: t } });
     }
   }
 
