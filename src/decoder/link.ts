@@ -546,7 +546,9 @@ export class LinkMonitor {
     if (this.#state === 'waiting' || !Number.isFinite(last) || !Number.isFinite(nowUs)) return this.#state;
     const gap = nowUs - last;
     const s = this.#stats;
-    if (gap > this.holdAfterUs && this.#state === 'live') {
+    // No hold threshold is below HOLD_MIN_US (or the holdAfterUs option): the common short gap
+    // is decided without working the threshold out.
+    if (this.#state === 'live' && gap > (this.#holdOption ?? HOLD_MIN_US) && gap > this.holdAfterUs) {
       this.#state = 'hold';
       s.holds++;
       // The hold began when the next frame was due, whenever it was noticed.
