@@ -10,7 +10,8 @@
  */
 import type { Capture } from '../capture/index.js';
 import { capturePorts } from '../capture/index.js';
-import { healthReportFeeding, type HealthReport, type HealthReportOptions } from './report.js';
+import { healthReportFeeding } from './report.js';
+import type { HealthReport, HealthReportOptions } from './report-types.js';
 import { captureSpan, decodeCapture } from './capture-pass.js';
 import { doctorCapture } from './doctor-capture.js';
 import { Doctor, type DoctorFinding } from './doctor.js';

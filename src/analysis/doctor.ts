@@ -21,7 +21,8 @@ import {
   type Resolution,
   type SpektrumDecoder,
 } from '../decoder/index.js';
-import { plural, REPORT_THRESHOLDS } from './report.js';
+import { REPORT_THRESHOLDS } from './report-thresholds.js';
+import { plural } from './report-text.js';
 import { BurstClock, classifyLine, PACKET_KINDS, PacketScanner, type LineVerdict, type PacketKind } from './doctor-line.js';
 import {
   ArduPilotGuess,

@@ -58,26 +58,22 @@ export { captureSpan, decodeCapture, timingJitterUs, type DecodeCaptureOptions }
 export { resolutionKey } from './resolution-key.js';
 export { summarizeCapture, type CaptureSummary, type ChannelSummary } from './summary.js';
 export { LinkSeries, monitorWithSeries } from './series.js';
-export {
-  healthReport,
-  formatClock,
-  formatDuration,
-  REPORT_BIN_US,
-  REPORT_THRESHOLDS,
-  SPIKE_MIN_JUMP_PERCENT,
-  type FindingCode,
-  type FindingLevel,
-  type HealthReport,
-  type HealthReportOptions,
-  type RemoteReport,
-  type ReportChannel,
-  type ReportEpisode,
-  type ReportFinding,
-  type ReportGlitch,
-  type ReportPeriodStats,
-  type ReportSeries,
-  type ReportStatus,
-  type ReportDiagnosis,
-  type ReportThresholds,
-} from './report.js';
+export { healthReport } from './report.js';
+export { formatClock, formatDuration } from './report-text.js';
+export { REPORT_BIN_US, REPORT_THRESHOLDS, SPIKE_MIN_JUMP_PERCENT, type ReportThresholds } from './report-thresholds.js';
+export type {
+  FindingCode,
+  FindingLevel,
+  HealthReport,
+  HealthReportOptions,
+  RemoteReport,
+  ReportChannel,
+  ReportEpisode,
+  ReportFinding,
+  ReportGlitch,
+  ReportPeriodStats,
+  ReportSeries,
+  ReportStatus,
+  ReportDiagnosis,
+} from './report-types.js';
 export { escapeHtml, reportHtml } from './report-html.js';

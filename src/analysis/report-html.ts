@@ -3,8 +3,9 @@
  * fetched, one printed page. Rendering only: the figures come from `healthReport`.
  */
 import { XPLUS_FIRST, channelName, type ResolutionReason } from '../decoder/index.js';
-import { RSSI_LOW_DBM, formatClock, formatDuration, pctText, plural, rate } from './report.js';
-import type { FindingLevel, HealthReport, RemoteReport, ReportStatus } from './report.js';
+import { RSSI_LOW_DBM } from './report-thresholds.js';
+import { formatClock, formatDuration, pctText, plural, rate } from './report-text.js';
+import type { FindingLevel, HealthReport, RemoteReport, ReportStatus } from './report-types.js';
 
 /** Escapes text for HTML content and attribute values. */
 export function escapeHtml(text: string): string {
