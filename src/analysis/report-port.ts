@@ -48,31 +48,88 @@ class Column {
   }
 }
 
-/** Nearest-rank percentile of sorted values. */
-function percentile(sorted: Float64Array, p: number): number {
-  if (sorted.length === 0) return NaN;
-  const rank = Math.ceil((p / 100) * sorted.length);
-  return sorted[Math.min(sorted.length - 1, Math.max(0, rank - 1))] ?? NaN;
+/** Distinct intervals counted by value before the tally keeps every value instead. */
+const MAX_DISTINCT_INTERVALS = 4096;
+
+/**
+ * The ordinary frame intervals. Chunk-timed frames take few distinct intervals (a day of
+ * DSMX 11 ms through a USB adapter: about 120), so they are counted by value and a day costs a
+ * small map; past `MAX_DISTINCT_INTERVALS` values (a logic analyser's times) every value is kept.
+ */
+class IntervalTally {
+  #counts: Map<number, number> | null = new Map();
+  #column: Column | null = null;
+
+  add(v: number): void {
+    const counts = this.#counts;
+    if (counts === null) {
+      this.#column?.push(v);
+      return;
+    }
+    const c = counts.get(v);
+    if (c !== undefined) counts.set(v, c + 1);
+    else if (counts.size < MAX_DISTINCT_INTERVALS) counts.set(v, 1);
+    else {
+      const column = new Column();
+      for (const [value, count] of counts) for (let k = 0; k < count; k++) column.push(value);
+      column.push(v);
+      this.#column = column;
+      this.#counts = null;
+    }
+  }
+
+  /** The statistics, as over the values sorted. Null without any. */
+  stats(basis: ReportPeriodStats['basis']): ReportPeriodStats | null {
+    if (this.#counts === null) {
+      const sorted = (this.#column as Column).view().sort();
+      return periodStats(sorted, null, basis);
+    }
+    const values = Float64Array.from(this.#counts.keys()).sort();
+    const counts = Float64Array.from(values, (v) => this.#counts?.get(v) ?? 0);
+    return periodStats(values, counts, basis);
+  }
 }
 
-/** Statistics of the ordinary frame intervals; sorts `intervals` in place. Null without any. */
-function periodStats(intervals: Float64Array, basis: ReportPeriodStats['basis']): ReportPeriodStats | null {
-  if (intervals.length === 0) return null;
-  const iv = intervals.sort();
+/**
+ * Statistics of sorted intervals: `values` ascending, each `counts[i]` times (once each without
+ * `counts`). Sums run over the values in ascending order one by one, so counting by value gives
+ * the very numbers the sorted list of every interval gives. Null without any.
+ */
+function periodStats(values: Float64Array, counts: Float64Array | null, basis: ReportPeriodStats['basis']): ReportPeriodStats | null {
+  const countOf = (i: number): number => (counts === null ? 1 : (counts[i] ?? 0));
+  let n = 0;
+  for (let i = 0; i < values.length; i++) n += countOf(i);
+  if (n === 0) return null;
   let sum = 0;
-  for (const v of iv) sum += v;
-  const mean = sum / iv.length;
+  for (let i = 0; i < values.length; i++) {
+    const v = values[i] ?? 0;
+    for (let k = countOf(i); k > 0; k--) sum += v;
+  }
+  const mean = sum / n;
   let sq = 0;
-  for (const v of iv) sq += (v - mean) * (v - mean);
+  for (let i = 0; i < values.length; i++) {
+    const d = (values[i] ?? 0) - mean;
+    for (let k = countOf(i); k > 0; k--) sq += d * d;
+  }
+  /** Nearest-rank percentile. */
+  const percentile = (p: number): number => {
+    const rank = Math.min(n - 1, Math.max(0, Math.ceil((p / 100) * n) - 1));
+    let below = 0;
+    for (let i = 0; i < values.length; i++) {
+      below += countOf(i);
+      if (rank < below) return values[i] ?? NaN;
+    }
+    return NaN;
+  };
   return {
-    intervals: iv.length,
+    intervals: n,
     meanUs: r1(mean),
-    stdDevUs: r1(Math.sqrt(sq / iv.length)),
-    minUs: r1(iv[0] ?? NaN),
-    maxUs: r1(iv[iv.length - 1] ?? NaN),
-    p50Us: r1(percentile(iv, 50)),
-    p95Us: r1(percentile(iv, 95)),
-    p99Us: r1(percentile(iv, 99)),
+    stdDevUs: r1(Math.sqrt(sq / n)),
+    minUs: r1(values[0] ?? NaN),
+    maxUs: r1(values[values.length - 1] ?? NaN),
+    p50Us: r1(percentile(50)),
+    p95Us: r1(percentile(95)),
+    p99Us: r1(percentile(99)),
     basis,
   };
 }
@@ -132,7 +189,7 @@ class PortTally {
   rssiHi = -Infinity;
   rssiTotal = 0;
   fadeCounterMoved = false;
-  readonly intervals = new Column();
+  readonly intervals = new IntervalTally();
   readonly channelFrames = new Uint32Array(CHANNEL_COUNT);
   readonly channelMin = new Float64Array(CHANNEL_COUNT).fill(Infinity);
   readonly channelMax = new Float64Array(CHANNEL_COUNT).fill(-Infinity);
@@ -144,6 +201,9 @@ class PortTally {
   readonly #at = new Float64Array(CHANNEL_COUNT * 2);
   readonly #idx = new Float64Array(CHANNEL_COUNT * 2);
   readonly #seen = new Uint32Array(CHANNEL_COUNT);
+  /** Each channel's last position and the resolution it was read at. */
+  readonly #lastPos = new Float64Array(CHANNEL_COUNT).fill(-1);
+  readonly #lastRes = new Uint16Array(CHANNEL_COUNT);
   readonly glitchesRaw: RawGlitch[] = [];
   glitchCount = 0;
   glitchFrames = 0;
@@ -155,7 +215,7 @@ class PortTally {
     this.lastUs = t;
     this.frames++;
     const interval = link.lastIntervalUs;
-    if (Number.isFinite(interval)) this.intervals.push(interval);
+    if (Number.isFinite(interval)) this.intervals.add(interval);
     const rs = f.rssi;
     if (rs !== null && !Number.isNaN(rs)) {
       if (rs === -128) this.rssiLoss++;
@@ -174,6 +234,25 @@ class PortTally {
 
   #channel(id: number, pos: number, linkResolution: Resolution, t: number, timed: boolean, index: number): void {
     const res = channelResolution(id, linkResolution);
+    const a = 2 * id;
+    const n = this.#seen[id] ?? 0;
+    if (n >= 1 && pos === this.#lastPos[id] && res === this.#lastRes[id]) {
+      // The value B had (about half of all appearances in a flight): the same µs and % travel,
+      // already within the channel's range, and no spike, since C returns exactly to B.
+      const u = this.#us[a + 1] ?? NaN;
+      this.channelFrames[id] = (this.channelFrames[id] ?? 0) + 1;
+      this.channelSum[id] = (this.channelSum[id] ?? 0) + u;
+      this.#pct[a] = this.#pct[a + 1] ?? NaN;
+      this.#us[a] = u;
+      this.#at[a] = this.#at[a + 1] ?? NaN;
+      this.#idx[a] = this.#idx[a + 1] ?? NaN;
+      this.#at[a + 1] = t;
+      this.#idx[a + 1] = index;
+      this.#seen[id] = n + 1;
+      return;
+    }
+    this.#lastPos[id] = pos;
+    this.#lastRes[id] = res;
     const u = servoToMicros(pos, res);
     const p = servoToPercent(pos, res);
     this.channelFrames[id] = (this.channelFrames[id] ?? 0) + 1;
@@ -184,8 +263,6 @@ class PortTally {
     const us = this.#us;
     const at = this.#at;
     const idx = this.#idx;
-    const a = 2 * id;
-    const n = this.#seen[id] ?? 0;
     if (n >= 2) {
       const pA = pct[a] ?? NaN;
       const pB = pct[a + 1] ?? NaN;
@@ -271,7 +348,7 @@ export function decodePort(
     rssiLo: tally.rssiLo,
     rssiHi: tally.rssiHi,
     rssiTotal: tally.rssiTotal,
-    period: periodStats(tally.intervals.view(), capture.timing === 'per-byte' ? 'per-byte' : 'per-chunk'),
+    period: tally.intervals.stats(capture.timing === 'per-byte' ? 'per-byte' : 'per-chunk'),
     channelFrames: tally.channelFrames,
     channelMin: tally.channelMin,
     channelMax: tally.channelMax,
