@@ -5,7 +5,7 @@
 import type { Capture, CaptureIssue } from '../capture/index.js';
 import type { LinkEpisode, LinkStats } from '../decoder/index.js';
 import { channelName, channelResolution, CHANNEL_COUNT, servoToMicros } from '../decoder/index.js';
-import type { DecoderStats, FormatInfo } from '../decoder/index.js';
+import type { DecodedFrame, DecoderStats, FormatInfo } from '../decoder/index.js';
 import { decodeCapture, type DecodeCaptureOptions } from './capture-pass.js';
 
 export interface ChannelSummary {
@@ -34,14 +34,51 @@ export interface CaptureSummary {
   issues: readonly CaptureIssue[];
 }
 
+/** Each channel's frames and pulse widths (µs), frame by frame; fields, not a closure over mutable locals, for the per-frame loop. */
+class ChannelRanges {
+  readonly frames = new Uint32Array(CHANNEL_COUNT);
+  readonly min = new Float64Array(CHANNEL_COUNT).fill(Infinity);
+  readonly max = new Float64Array(CHANNEL_COUNT).fill(-Infinity);
+  readonly last = new Float64Array(CHANNEL_COUNT);
+  firstUs = NaN;
+  lastUs = NaN;
+
+  frame(f: DecodedFrame): void {
+    if (Number.isNaN(this.firstUs)) this.firstUs = f.timeUs;
+    this.lastUs = f.timeUs;
+    const { ids, positions } = f;
+    for (let i = 0; i < f.count; i++) {
+      const id = ids[i] ?? 0;
+      const us = servoToMicros(positions[i] ?? 0, channelResolution(id, f.resolution));
+      this.frames[id] = (this.frames[id] ?? 0) + 1;
+      if (us < (this.min[id] ?? Infinity)) this.min[id] = us;
+      if (us > (this.max[id] ?? -Infinity)) this.max[id] = us;
+      this.last[id] = us;
+    }
+  }
+
+  /** The channels that appeared, in ID order. */
+  channels(): ChannelSummary[] {
+    const out: ChannelSummary[] = [];
+    for (let id = 0; id < CHANNEL_COUNT; id++) {
+      const n = this.frames[id] ?? 0;
+      if (n > 0)
+        out.push({
+          id,
+          name: channelName(id),
+          frames: n,
+          minUs: this.min[id] ?? Infinity,
+          maxUs: this.max[id] ?? -Infinity,
+          lastUs: this.last[id] ?? 0,
+        });
+    }
+    return out;
+  }
+}
+
 /** Decodes a capture (one port) and sums it up. */
 export function summarizeCapture(capture: Capture, options: DecodeCaptureOptions = {}): CaptureSummary {
-  const frames = new Uint32Array(CHANNEL_COUNT);
-  const min = new Float64Array(CHANNEL_COUNT).fill(Infinity);
-  const max = new Float64Array(CHANNEL_COUNT).fill(-Infinity);
-  const last = new Float64Array(CHANNEL_COUNT);
-  let firstUs = NaN;
-  let lastUs = NaN;
+  const ranges = new ChannelRanges();
   let formatChanges = 0;
   const userEvent = options.onEvent;
   const { decoder, link } = decodeCapture(
@@ -53,44 +90,20 @@ export function summarizeCapture(capture: Capture, options: DecodeCaptureOptions
         userEvent?.(e);
       },
     },
-    (f) => {
-      if (Number.isNaN(firstUs)) firstUs = f.timeUs;
-      lastUs = f.timeUs;
-      for (let i = 0; i < f.count; i++) {
-        const id = f.ids[i] as number;
-        const us = servoToMicros(f.positions[i] as number, channelResolution(id, f.resolution));
-        frames[id] = (frames[id] as number) + 1;
-        if (us < (min[id] as number)) min[id] = us;
-        if (us > (max[id] as number)) max[id] = us;
-        last[id] = us;
-      }
-    },
+    (f) => ranges.frame(f),
   );
-  const channels: ChannelSummary[] = [];
-  for (let id = 0; id < CHANNEL_COUNT; id++) {
-    const n = frames[id] as number;
-    if (n > 0)
-      channels.push({
-        id,
-        name: channelName(id),
-        frames: n,
-        minUs: min[id] as number,
-        maxUs: max[id] as number,
-        lastUs: last[id] as number,
-      });
-  }
   const port = options.port ?? 0;
   return {
     kind: capture.kind,
     timing: capture.timing,
     port,
     bytes: decoder.stats.bytes,
-    durationUs: lastUs - firstUs,
+    durationUs: ranges.lastUs - ranges.firstUs,
     format: decoder.format,
     decoder: { ...decoder.stats },
     link: { ...link.stats },
     episodes: link.episodes.map((e) => ({ ...e })),
-    channels,
+    channels: ranges.channels(),
     formatChanges,
     issues: capture.issues,
   };
