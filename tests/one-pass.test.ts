@@ -260,3 +260,56 @@ describe('the one-pass report agrees with separate passes', () => {
     expect(healthReport(raw).remotes[0]!.frames).toBe(decodeAlone(raw, 0, 'auto', 'user').decoder.stats.frames);
   });
 });
+
+describe('the frame period statistics', () => {
+  /** The ordinary intervals the link monitor saw, every one, sorted: what the report's figures are taken over. */
+  function fromEveryInterval(capture: Capture) {
+    const decoder = new SpektrumDecoder();
+    const link = new LinkMonitor({ jitterUs: timingJitterUs(capture.timing) });
+    const intervals: number[] = [];
+    const take = () => {
+      for (let f = decoder.next(); f; f = decoder.next()) {
+        link.frame(f);
+        if (Number.isFinite(link.lastIntervalUs)) intervals.push(link.lastIntervalUs);
+      }
+    };
+    for (const chunk of captureChunks(capture)) {
+      decoder.push(chunk.bytes, chunk.time);
+      take();
+    }
+    decoder.end();
+    take();
+    const iv = Float64Array.from(intervals).sort();
+    let sum = 0;
+    for (const v of iv) sum += v;
+    const mean = sum / iv.length;
+    let sq = 0;
+    for (const v of iv) sq += (v - mean) * (v - mean);
+    const r1 = (x: number) => Math.round(x * 10) / 10;
+    const rank = (p: number) => iv[Math.min(iv.length - 1, Math.max(0, Math.ceil((p / 100) * iv.length) - 1))]!;
+    return {
+      intervals: iv.length,
+      meanUs: r1(mean),
+      stdDevUs: r1(Math.sqrt(sq / iv.length)),
+      minUs: r1(iv[0]!),
+      maxUs: r1(iv[iv.length - 1]!),
+      p50Us: r1(rank(50)),
+      p95Us: r1(rank(95)),
+      p99Us: r1(rank(99)),
+      distinct: new Set(iv).size,
+    };
+  }
+
+  it('are those of every interval sorted, whether the intervals repeat (USB chunks) or never do (a logic analyser)', () => {
+    const sim = simulate(preset('dsmx-11ms-2048-internal'), 70_000_000);
+    // Each frame moved by its own fraction of 400 µs: no two intervals alike.
+    const jittered = Float64Array.from(sim.timesUs, (t, i) => t + ((Math.floor(i / 16) * 0.6180339887) % 1) * 400);
+    for (const capture of [usbCapture([sim]), perByteCapture({ bytes: sim.bytes, timesUs: jittered })]) {
+      const { distinct, ...expected } = fromEveryInterval(capture);
+      const period = healthReport(capture).remotes[0]!.framePeriod!;
+      expect({ ...period, basis: undefined }).toEqual({ ...expected, basis: undefined });
+      if (capture.timing === 'per-byte') expect(distinct).toBeGreaterThan(4096);
+      else expect(distinct).toBeLessThan(4096);
+    }
+  });
+});
