@@ -87,8 +87,8 @@ export function doctorCapture(capture: Capture, options: DoctorCaptureOptions = 
           kind: 'data',
           port: chunk.port,
           order: order++,
-          timeUs: times[times.length - 1] as number,
-          firstUs: times[0] as number,
+          timeUs: times[times.length - 1] ?? NaN,
+          firstUs: times[0] ?? NaN,
           bytes: chunk.bytes.subarray(s, s + SLICE_BYTES),
           time: times,
         });

@@ -298,14 +298,14 @@ export class BurstClock {
   periodUs(sinceUs = -Infinity): number {
     const starts: number[] = [];
     for (let i = 0; i < this.#count; i++) {
-      const t = this.#starts[(this.#next - this.#count + i + 64) & 63] as number;
+      const t = this.#starts[(this.#next - this.#count + i + 64) & 63] ?? NaN;
       if (t >= sinceUs) starts.push(t);
     }
     if (starts.length < 6) return NaN;
     const iv: number[] = [];
-    for (let i = 1; i < starts.length; i++) iv.push((starts[i] as number) - (starts[i - 1] as number));
+    for (let i = 1; i < starts.length; i++) iv.push((starts[i] ?? NaN) - (starts[i - 1] ?? NaN));
     iv.sort((a, b) => a - b);
-    const median = iv[iv.length >> 1] as number;
+    const median = iv[iv.length >> 1] ?? NaN;
     const close = iv.filter((x) => Math.abs(x - median) <= 0.1 * median).length;
     return close >= 0.7 * iv.length ? median : NaN;
   }

@@ -182,19 +182,19 @@ class Bins {
     const s = Math.floor(timeUs / 1e6);
     const slot = ((s % BIN_COUNT) + BIN_COUNT) % BIN_COUNT;
     if (this.#second[slot] !== s) {
-      if (s < (this.#second[slot] as number)) return; // older than the window
+      if (s < (this.#second[slot] ?? NaN)) return; // older than the window
       this.#second[slot] = s;
       this.#data.fill(0, slot * METRICS, slot * METRICS + METRICS);
     }
-    this.#data[slot * METRICS + metric] = (this.#data[slot * METRICS + metric] as number) + n;
+    this.#data[slot * METRICS + metric] = (this.#data[slot * METRICS + metric] ?? 0) + n;
   }
 
   /** Sum over the seconds fromS…toS (inclusive). */
   sum(metric: number, fromS: number, toS: number): number {
     let total = 0;
     for (let slot = 0; slot < BIN_COUNT; slot++) {
-      const s = this.#second[slot] as number;
-      if (s >= fromS && s <= toS) total += this.#data[slot * METRICS + metric] as number;
+      const s = this.#second[slot] ?? NaN;
+      if (s >= fromS && s <= toS) total += this.#data[slot * METRICS + metric] ?? 0;
     }
     return total;
   }
@@ -202,7 +202,7 @@ class Bins {
   /** The value of one second. */
   at(metric: number, s: number): number {
     const slot = ((s % BIN_COUNT) + BIN_COUNT) % BIN_COUNT;
-    return this.#second[slot] === s ? (this.#data[slot * METRICS + metric] as number) : 0;
+    return this.#second[slot] === s ? (this.#data[slot * METRICS + metric] ?? 0) : 0;
   }
 
   clear(): void {
@@ -418,11 +418,11 @@ export class Doctor {
     let t: number;
     if (time instanceof Float64Array) {
       if (time.length !== bytes.length) throw new TypeError(`per-byte times have length ${time.length}, bytes ${bytes.length}`);
-      t = time[time.length - 1] as number;
-      if (this.#precise) for (let i = 0; i < time.length; i++) p.burst.event(time[i] as number);
+      t = time[time.length - 1] ?? NaN;
+      if (this.#precise) for (let i = 0; i < time.length; i++) p.burst.event(time[i] ?? NaN);
       // Book per second: bytes of a chunk rarely straddle more than one.
-      for (let i = 0; i < time.length; i++) p.bins.add(M_BYTES, time[i] as number, 1);
-      this.#activity(p, time[0] as number, 0);
+      for (let i = 0; i < time.length; i++) p.bins.add(M_BYTES, time[i] ?? NaN, 1);
+      this.#activity(p, time[0] ?? NaN, 0);
     } else {
       t = time ?? p.lastTimeUs;
       p.bins.add(M_BYTES, t, bytes.length);
@@ -455,7 +455,7 @@ export class Doctor {
     p.bins.add(M_FRAME_BYTES, t, FRAME_SIZE);
     p.guess.frame(f.bytes);
     for (let i = 0; i < f.count; i++) {
-      const id = f.ids[i] as number;
+      const id = f.ids[i] ?? 0;
       if (id >= 12) {
         if (p.xplusMask === 0) p.xplusFirstUs = t;
         p.xplusMask |= 1 << (id - 12);
@@ -532,7 +532,7 @@ export class Doctor {
       seen.add(key);
       const first = this.#since.get(key);
       if (first === undefined || first > nowUs) this.#since.set(key, Math.min(f.sinceUs, nowUs));
-      f.sinceUs = this.#since.get(key) as number;
+      f.sinceUs = this.#since.get(key) ?? f.sinceUs;
     }
     for (const key of [...this.#since.keys()]) if (!seen.has(key)) this.#since.delete(key);
     out.sort(

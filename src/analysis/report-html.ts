@@ -66,7 +66,7 @@ function pool(values: readonly (number | null)[], group: number, pick: (a: numbe
 function timeTicks(durationUs: number): number[] {
   const s = durationUs / 1e6;
   const steps = [0.5, 1, 2, 5, 10, 15, 30, 60, 120, 300, 600, 900, 1800, 3600, 7200, 14_400, 28_800];
-  let step = steps[steps.length - 1] as number;
+  let step = steps[steps.length - 1] ?? NaN;
   for (const c of steps) {
     if (s / c <= 10) {
       step = c;
@@ -343,14 +343,9 @@ function channelList(r: RemoteReport): string {
   const ids = r.channels.map((c) => c.id);
   for (let i = 0; i < ids.length; ) {
     let j = i;
-    while (
-      j + 1 < ids.length &&
-      ids[j + 1] === (ids[j] as number) + 1 &&
-      (ids[j + 1] as number) < XPLUS_FIRST === (ids[i] as number) < XPLUS_FIRST
-    )
-      j++;
-    const a = ids[i] as number;
-    const b = ids[j] as number;
+    while (j + 1 < ids.length && ids[j + 1] === (ids[j] ?? 0) + 1 && (ids[j + 1] ?? 0) < XPLUS_FIRST === (ids[i] ?? 0) < XPLUS_FIRST) j++;
+    const a = ids[i] ?? 0;
+    const b = ids[j] ?? 0;
     const name = (id: number): string => (id >= XPLUS_FIRST ? channelName(id) : String(id));
     runs.push(a === b ? name(a) : `${name(a)}–${name(b)}`);
     i = j + 1;

@@ -118,15 +118,15 @@ export function healthReportFeeding(capture: Capture, options: HealthReportOptio
 
     const channels: ReportChannel[] = [];
     for (let id = 0; id < CHANNEL_COUNT; id++) {
-      const c = d.channelFrames[id] as number;
+      const c = d.channelFrames[id] ?? 0;
       if (c > 0) {
         channels.push({
           id,
           name: channelName(id),
           frames: c,
-          minUs: d.channelMin[id] as number,
-          maxUs: d.channelMax[id] as number,
-          meanUs: r1((d.channelSum[id] as number) / c),
+          minUs: d.channelMin[id] ?? NaN,
+          maxUs: d.channelMax[id] ?? NaN,
+          meanUs: r1((d.channelSum[id] ?? NaN) / c),
         });
       }
     }

@@ -88,6 +88,6 @@ export function crcShift(n: number): number {
     return t;
   })());
   let p = 0x80000000; // x^0
-  for (let k = 3; n > 0; k++, n = Math.floor(n / 2)) if (n % 2 === 1) p = mulModPoly(powers[k & 31] as number, p);
+  for (let k = 3; n > 0; k++, n = Math.floor(n / 2)) if (n % 2 === 1) p = mulModPoly(powers[k & 31] ?? 0, p);
   return p;
 }

@@ -45,7 +45,7 @@ const MAX_MAGIC_BIT_ERRORS = 2;
 function magicBitErrors(bytes: Uint8Array): number {
   let errors = 0;
   for (let i = 0; i < MAGIC_SIZE; i++) {
-    let x = ((bytes[i] ?? 0) ^ (MAGIC[i] as number)) & 0xff;
+    let x = ((bytes[i] ?? 0) ^ (MAGIC[i] ?? 0)) & 0xff;
     for (; x !== 0; x &= x - 1) errors++;
   }
   return errors;
@@ -165,7 +165,7 @@ class RecordProbe {
     const k = Math.floor(i / CRC_INDEX_STEP);
     const from = k * CRC_INDEX_STEP;
     this.#work.crcBytes += i - from;
-    return (crcRun((index[k] as number) ^ 0xffffffff, this.#bytes, from, i) ^ 0xffffffff) >>> 0;
+    return (crcRun((index[k] ?? 0) ^ 0xffffffff, this.#bytes, from, i) ^ 0xffffffff) >>> 0;
   }
 
   #buildIndex(): Uint32Array {
@@ -516,7 +516,7 @@ function readSscap(bytes: Uint8Array, work: CaptureReaderWork): ParsedCapture {
       const len = result - RECORD_OVERHEAD;
       const payload = p + RECORD_HEADER_SIZE;
       const timeUs = view.getFloat64(p + REC_OFF_TIME, true);
-      const port = bytes[p + REC_OFF_PORT] as number;
+      const port = bytes[p + REC_OFF_PORT] ?? 0;
       if (bytes[p + REC_OFF_TYPE] === RECORD_TYPE_DATA) {
         if (chunks === chunkEnds.length || dataLength + len > data.length) {
           // Not in a closure: the columns stay plain locals of this loop.
@@ -526,7 +526,7 @@ function readSscap(bytes: Uint8Array, work: CaptureReaderWork): ParsedCapture {
           chunkPorts = grown(new Uint8Array(maxRecords), chunkPorts);
         }
         // Short chunks (the usual case) are copied by hand: cheaper than making a subarray.
-        if (len <= 64) for (let k = 0; k < len; k++) data[dataLength + k] = bytes[payload + k] as number;
+        if (len <= 64) for (let k = 0; k < len; k++) data[dataLength + k] = bytes[payload + k] ?? 0;
         else data.set(bytes.subarray(payload, payload + len), dataLength);
         dataLength += len;
         chunkEnds[chunks] = dataLength;
