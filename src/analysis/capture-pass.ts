@@ -98,15 +98,20 @@ export function decodeCapture(
   onFrame: (frame: DecodedFrame, link: LinkMonitor) => void,
 ): { decoder: SpektrumDecoder; link: LinkMonitor; series: LinkSeries } {
   const { port = 0, binUs = 1_000_000, originUs, endUs, doctor, ...decoderOptions } = options;
-  const span = originUs === undefined || endUs === undefined ? captureSpan(capture) : undefined;
-  const end = endUs ?? (span as { endUs: number }).endUs;
+  const span = originUs === undefined || endUs === undefined ? captureSpan(capture) : { startUs: originUs, endUs };
+  const end = endUs ?? span.endUs;
   const decoder = new SpektrumDecoder(decoderOptions);
-  const series = new LinkSeries(binUs, originUs ?? (span as { startUs: number }).startUs);
+  const series = new LinkSeries(binUs, originUs ?? span.startUs);
   const link = monitorWithSeries({ jitterUs: timingJitterUs(capture.timing) }, series);
   if (doctor !== undefined && capture.timing === 'none')
     throw new TypeError('decodeCapture: a doctor needs a timed capture (doctorCapture gives an untimed one a clock)');
   const events = doctor !== undefined ? portEvents(capture, port) : [];
   let nextEvent = 0;
+  /** Feeds the doctor this port's events recorded before chunk `upTo` (all that are left: Infinity). */
+  const eventsBefore = (upTo: number): void => {
+    for (let e = events[nextEvent]; e !== undefined && e.chunkIndex <= upTo; e = events[++nextEvent])
+      if (doctor !== undefined) doctorEvent(doctor, port, e.text, e.timeUs);
+  };
   if (doctor !== undefined) {
     const label = capture.meta.ports?.[port]?.name;
     doctor.detach(port);
@@ -130,10 +135,7 @@ export function decodeCapture(
   for (let i = 0; i < chunkEnds.length; i++) {
     const to = chunkEnds[i] ?? from;
     if (chunkPorts[i] === port) {
-      while (nextEvent < events.length && (events[nextEvent] as CaptureEvent).chunkIndex <= i) {
-        const e = events[nextEvent++] as CaptureEvent;
-        doctorEvent(doctor as Doctor, port, e.text, e.timeUs);
-      }
+      eventsBefore(i);
       if (byteTimesUs !== undefined) {
         for (let s = from; s < to; s += SLICE_BYTES) {
           const e = Math.min(s + SLICE_BYTES, to);
@@ -146,10 +148,7 @@ export function decodeCapture(
     }
     from = to;
   }
-  for (; nextEvent < events.length; nextEvent++) {
-    const e = events[nextEvent] as CaptureEvent;
-    doctorEvent(doctor as Doctor, port, e.text, e.timeUs);
-  }
+  eventsBefore(Infinity);
   decoder.end();
   drain();
   link.finish(end);

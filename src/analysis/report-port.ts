@@ -80,10 +80,7 @@ class IntervalTally {
 
   /** The statistics, as over the values sorted. Null without any. */
   stats(basis: ReportPeriodStats['basis']): ReportPeriodStats | null {
-    if (this.#counts === null) {
-      const sorted = (this.#column as Column).view().sort();
-      return periodStats(sorted, null, basis);
-    }
+    if (this.#counts === null) return periodStats(this.#column?.view().sort() ?? new Float64Array(0), null, basis);
     const values = Float64Array.from(this.#counts.keys()).sort();
     const counts = Float64Array.from(values, (v) => this.#counts?.get(v) ?? 0);
     return periodStats(values, counts, basis);

@@ -14,7 +14,7 @@ import { CHANNEL_COUNT, channelName, systemInfo, type LinkEpisode } from '../dec
 import { captureSpan } from './capture-pass.js';
 import type { Doctor } from './doctor.js';
 import { looksInternal, readPorts } from './resolution-key.js';
-import { decodePort, type PortData, type PortPass } from './report-port.js';
+import { decodePort, type PortPass } from './report-port.js';
 import { LEVEL_ORDER, remoteFindings, statusOf } from './report-findings.js';
 import { MAX_LISTED_HOLDS, REPORT_BIN_US, REPORT_THRESHOLDS } from './report-thresholds.js';
 import { finite, plural, r1, r1n, r3 } from './report-text.js';
@@ -65,7 +65,7 @@ export function healthReportFeeding(capture: Capture, options: HealthReportOptio
     (port) => looksInternal(capture, port),
     (port, resolution, from, final) => decodePort(capture, port, resolution, from, final ? pass : { ...pass, doctor: undefined }),
   );
-  const decoded = ports.map((p) => read.get(p) as PortData);
+  const decoded = ports.flatMap((p) => read.get(p) ?? []);
 
   const hasClock = timed && Number.isFinite(span.startUs) && Number.isFinite(span.endUs);
   const origin = hasClock ? span.startUs : NaN;

@@ -90,7 +90,7 @@ export function readPorts<T extends PortReading>(
   const order = [...lead, ...ports.filter((p) => !lead.includes(p))];
   const own = new Map<number, T>();
   const keyed = new Map<number, T>();
-  const keyOf = (): Resolution | undefined => resolutionKey(ports.filter((p) => own.has(p)).map((p) => (own.get(p) as T).format));
+  const keyOf = (): Resolution | undefined => resolutionKey(ports.flatMap((p) => own.get(p)?.format ?? []));
   let key: Resolution | undefined;
   for (const p of order) {
     if (key === undefined || lead.includes(p)) {
@@ -131,7 +131,8 @@ function asWritten<T extends PortReading>(ports: readonly number[], decode: Port
   const key = resolutionKey(own.map((r) => r.format));
   const out = new Map<number, T>();
   ports.forEach((p, i) => {
-    const mine = own[i] as T;
+    const mine = own[i];
+    if (mine === undefined) return;
     if (key === undefined || mine.format.remote === 'internal') {
       out.set(p, decode(p, 'auto', 'user', true));
       return;
