@@ -6,7 +6,8 @@
  */
 import { BYTE_TIME_US, LinkMonitor, SpektrumDecoder, USB_CHUNK_JITTER_US, type Resolution } from '../decoder/index.js';
 import { capturePorts, type Capture, type CaptureKind, type CaptureTiming } from '../capture/index.js';
-import { Doctor, type DoctorCode, type DoctorFinding, type Severity } from './doctor.js';
+import { Doctor } from './doctor.js';
+import type { DoctorCode, DoctorFinding, Severity } from './doctor-types.js';
 import { doctorEvent } from './doctor-events.js';
 import { SLICE_BYTES } from './capture-pass.js';
 

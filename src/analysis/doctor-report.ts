@@ -14,7 +14,8 @@ import { healthReportFeeding } from './report.js';
 import type { HealthReport, HealthReportOptions } from './report-types.js';
 import { captureSpan, decodeCapture } from './capture-pass.js';
 import { doctorCapture } from './doctor-capture.js';
-import { Doctor, type DoctorFinding } from './doctor.js';
+import { Doctor } from './doctor.js';
+import type { DoctorFinding } from './doctor-types.js';
 
 /** `healthReport(capture, options)` with `diagnosis` filled in. Pure, like both. */
 export function diagnosedHealthReport(capture: Capture, options: HealthReportOptions = {}): HealthReport {

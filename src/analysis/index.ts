@@ -22,20 +22,18 @@
  * A whole capture: `doctorCapture(capture)`; the health report with the findings in it:
  * `diagnosedHealthReport(capture)`.
  */
-export {
-  Doctor,
-  NOTHING_AFTER_US,
-  NOTHING_CERTAIN_US,
-  LINE_WINDOW_BINS,
-  type Confidence,
-  type ConfirmProbe,
-  type DoctorCode,
-  type DoctorFinding,
-  type DoctorOptions,
-  type DoctorPortSource,
-  type Evidence,
-  type Severity,
-} from './doctor.js';
+export { Doctor } from './doctor.js';
+export { LINE_WINDOW_BINS, NOTHING_AFTER_US, NOTHING_CERTAIN_US } from './doctor-state.js';
+export type {
+  Confidence,
+  ConfirmProbe,
+  DoctorCode,
+  DoctorFinding,
+  DoctorOptions,
+  DoctorPortSource,
+  Evidence,
+  Severity,
+} from './doctor-types.js';
 export { diagnosedHealthReport } from './doctor-report.js';
 export { doctorCapture, type DoctorCaptureOptions, type DoctorReport, type DoctorTimelineEntry } from './doctor-capture.js';
 export { doctorEvent } from './doctor-events.js';
