@@ -101,7 +101,7 @@ console.log(`satscope on day-long captures: node ${process.version}, ${cpus().le
 const idle = measure(['--version']);
 console.log(`node + satscope --version alone: ${idle.wallS.toFixed(2)} s, peak ${idle.peakMB.toFixed(0)} MB\n`);
 console.log(
-  `${'capture'.padEnd(8)} ${'file MB'.padStart(8)} ${'command'.padEnd(8)} ${'wall s'.padStart(7)} ${'cpu s'.padStart(7)} ${'peak MB'.padStart(8)} ${'peak/file'.padStart(9)} ${'s per file GB'.padStart(13)}`,
+  `${'capture'.padEnd(8)} ${'file MB'.padStart(8)} ${'command'.padEnd(8)} ${'wall s'.padStart(7)} ${'cpu s'.padStart(7)} ${'peak MB'.padStart(8)} ${'peak/file'.padStart(9)} ${'s per file GB'.padStart(13)} ${'cpu s per GB'.padStart(12)}`,
 );
 const rows = [];
 for (const name of only) {
@@ -123,7 +123,7 @@ for (const name of only) {
     if (r.status !== 0) console.log(`  ${command} exited with ${r.status}: ${r.stderr.trim().split('\n').slice(-3).join(' / ')}`);
     rows.push({ name, command, fileMB, ...r });
     console.log(
-      `${name.padEnd(8)} ${fileMB.toFixed(1).padStart(8)} ${command.padEnd(8)} ${r.wallS.toFixed(2).padStart(7)} ${r.cpuS.toFixed(2).padStart(7)} ${r.peakMB.toFixed(0).padStart(8)} ${(r.peakMB / fileMB).toFixed(2).padStart(9)} ${(r.wallS / (fileMB / 1024)).toFixed(1).padStart(13)}`,
+      `${name.padEnd(8)} ${fileMB.toFixed(1).padStart(8)} ${command.padEnd(8)} ${r.wallS.toFixed(2).padStart(7)} ${r.cpuS.toFixed(2).padStart(7)} ${r.peakMB.toFixed(0).padStart(8)} ${(r.peakMB / fileMB).toFixed(2).padStart(9)} ${(r.wallS / (fileMB / 1024)).toFixed(1).padStart(13)} ${(r.cpuS / (fileMB / 1024)).toFixed(1).padStart(12)}`,
     );
   }
   if (!args.includes('--keep-html')) rmSync(html, { force: true });

@@ -5,8 +5,11 @@
  * Pure: same capture, same findings.
  */
 import { BYTE_TIME_US, LinkMonitor, SpektrumDecoder, USB_CHUNK_JITTER_US, type Resolution } from '../decoder/index.js';
-import { captureChunks, capturePorts, type Capture, type CaptureKind, type CaptureTiming } from '../capture/index.js';
-import { Doctor, type DoctorCode, type DoctorFinding, type Severity } from './doctor.js';
+import { capturePorts, type Capture, type CaptureKind, type CaptureTiming } from '../capture/index.js';
+import { Doctor } from './doctor.js';
+import type { DoctorCode, DoctorFinding, Severity } from './doctor-types.js';
+import { doctorEvent } from './doctor-events.js';
+import { SLICE_BYTES } from './capture-pass.js';
 
 export interface DoctorCaptureOptions {
   /** Resolution override for every port's decoder. Default 'auto'. */
@@ -37,28 +40,80 @@ export interface DoctorReport {
   timeline: DoctorTimelineEntry[];
 }
 
-/** A capture event's text names a WebSerial read error, e.g. "line error: FramingError". */
-const LINE_ERROR = /\b(FramingError|ParityError|BreakError|BufferOverrunError)\b/;
-/** "port opened", "device reconnected", optionally "… at 420000 baud". */
-const OPENED = /\b(port opened|device reconnected)\b/i;
-const CLOSED = /\b(device lost|port closed)\b/i;
-const BAUD = /\b(\d{4,7})\s*baud\b/i;
+/** One piece of what arrived, as `arrival` hands it over: data (with `bytes`) or an event (with `text`). */
+type Visit = (
+  port: number,
+  /** The time of its last byte (data) or the event's time. */
+  timeUs: number,
+  /** The earliest time anything in it can carry: its first byte's (estimated for a chunk). */
+  firstUs: number,
+  bytes: Uint8Array | null,
+  time: number | Float64Array | undefined,
+  text: string,
+) => void;
 
 interface Piece {
-  kind: 'data' | 'event';
   port: number;
   order: number;
-  /** The time of its last byte (data) or the event's time. */
   timeUs: number;
-  /** The earliest time anything in it can carry: its first byte's (estimated for a chunk). */
   firstUs: number;
-  bytes?: Uint8Array;
-  time?: number | Float64Array;
-  text?: string;
+  bytes: Uint8Array | null;
+  time: number | Float64Array | undefined;
+  text: string;
 }
 
-/** Bytes of a per-byte chunk fed at once: about 20 ms of a satellite stream, as a USB adapter would deliver it. */
-const SLICE_BYTES = 256;
+/**
+ * Everything a capture holds in arrival order, data and events, walked as often as asked. Chunk
+ * timing (and none) is the file's order, read straight from the chunk columns: no object per
+ * chunk, so a day-long capture costs nothing here. A per-byte capture holds one chunk per port,
+ * cut into slices and put back in time order across ports (such captures are small).
+ */
+function arrival(capture: Capture): { each: (visit: Visit) => void; bytes: number } {
+  const timed = capture.timing !== 'none';
+  const events = [...capture.events].sort((a, b) => a.chunkIndex - b.chunkIndex);
+  const { bytes, chunkEnds, chunkTimesUs, chunkPorts, byteTimesUs } = capture;
+  const walk = (visit: Visit): void => {
+    let e = 0;
+    const eventsBefore = (upTo: number): void => {
+      for (let ev = events[e]; ev !== undefined && ev.chunkIndex <= upTo; ev = events[++e])
+        visit(ev.port, ev.timeUs, ev.timeUs, null, undefined, ev.text);
+    };
+    let from = 0;
+    for (let i = 0; i < chunkEnds.length; i++) {
+      eventsBefore(i);
+      const to = chunkEnds[i] ?? from;
+      const port = chunkPorts[i] ?? 0;
+      if (byteTimesUs !== undefined) {
+        for (let s = from; s < to; s += SLICE_BYTES) {
+          const end = Math.min(s + SLICE_BYTES, to);
+          const times = byteTimesUs.subarray(s, end);
+          visit(port, times[times.length - 1] ?? NaN, times[0] ?? NaN, bytes.subarray(s, end), times, '');
+        }
+      } else {
+        const chunkTime = chunkTimesUs[i] ?? NaN;
+        // Untimed: as if the bytes came back to back at 115200.
+        const t = timed ? chunkTime : to * BYTE_TIME_US;
+        // A decoder dates a chunk's frames back from its arrival at 115200: none is earlier than this.
+        const first = t - (to - from - 1) * BYTE_TIME_US;
+        visit(port, t, first, bytes.subarray(from, to), timed ? (Number.isNaN(chunkTime) ? undefined : chunkTime) : t, '');
+      }
+      from = to;
+    }
+    eventsBefore(Infinity);
+  };
+  if (capture.timing !== 'per-byte') return { each: walk, bytes: bytes.length };
+  const pieces: Piece[] = [];
+  walk((port, timeUs, firstUs, data, time, text) => {
+    pieces.push({ port, order: pieces.length, timeUs, firstUs, bytes: data, time, text });
+  });
+  pieces.sort((a, b) => (Number.isFinite(a.timeUs) && Number.isFinite(b.timeUs) ? a.timeUs - b.timeUs : 0) || a.order - b.order);
+  return {
+    each: (visit) => {
+      for (const p of pieces) visit(p.port, p.timeUs, p.firstUs, p.bytes, p.time, p.text);
+    },
+    bytes: bytes.length,
+  };
+}
 
 /**
  * Runs the doctor over every port of a capture and returns the findings at its end and the
@@ -73,59 +128,13 @@ export function doctorCapture(capture: Capture, options: DoctorCaptureOptions = 
   const sorted = [...ports].sort((a, b) => a - b);
 
   // Everything in arrival order: data pieces and events.
-  const pieces: Piece[] = [];
-  let order = 0;
-  let offset = 0;
-  let events = 0;
-  const evs = [...capture.events].sort((a, b) => a.chunkIndex - b.chunkIndex);
-  const pushEvents = (upTo: number): void => {
-    while (events < evs.length && (evs[events] as (typeof evs)[number]).chunkIndex <= upTo) {
-      const e = evs[events++] as (typeof evs)[number];
-      pieces.push({ kind: 'event', port: e.port, order: order++, timeUs: e.timeUs, firstUs: e.timeUs, text: e.text });
-    }
-  };
-  let bytes = 0;
-  for (const chunk of captureChunks(capture)) {
-    pushEvents(chunk.index);
-    bytes += chunk.bytes.length;
-    if (chunk.byteTimesUs !== undefined) {
-      for (let s = 0; s < chunk.bytes.length; s += SLICE_BYTES) {
-        const times = chunk.byteTimesUs.subarray(s, s + SLICE_BYTES);
-        pieces.push({
-          kind: 'data',
-          port: chunk.port,
-          order: order++,
-          timeUs: times[times.length - 1] as number,
-          firstUs: times[0] as number,
-          bytes: chunk.bytes.subarray(s, s + SLICE_BYTES),
-          time: times,
-        });
-      }
-    } else {
-      // Untimed: as if the bytes came back to back at 115200.
-      offset += chunk.bytes.length;
-      const t = timed ? chunk.timeUs : offset * BYTE_TIME_US;
-      // A decoder dates a chunk's frames back from its arrival at 115200: none is earlier than this.
-      const first = t - (chunk.bytes.length - 1) * BYTE_TIME_US;
-      pieces.push({
-        kind: 'data',
-        port: chunk.port,
-        order: order++,
-        timeUs: t,
-        firstUs: first,
-        bytes: chunk.bytes,
-        time: timed ? chunk.time : t,
-      });
-    }
-  }
-  pushEvents(Infinity);
-  // Per-byte captures hold one chunk per port: put the ports' slices back in time order.
-  if (capture.timing === 'per-byte')
-    pieces.sort((a, b) => (Number.isFinite(a.timeUs) && Number.isFinite(b.timeUs) ? a.timeUs - b.timeUs : 0) || a.order - b.order);
-
+  const pieces = arrival(capture);
+  const bytes = pieces.bytes;
   // Time zero of the evidence sentences: the capture's first time, as in the health report.
   let origin = Infinity;
-  for (const piece of pieces) if (piece.firstUs < origin) origin = piece.firstUs;
+  pieces.each((_port, _t, firstUs) => {
+    if (firstUs < origin) origin = firstUs;
+  });
   const doctor = new Doctor({
     timing: capture.timing === 'per-byte' ? 'per-byte' : 'per-chunk',
     memoryUs: Infinity,
@@ -178,35 +187,34 @@ export function doctorCapture(capture: Capture, options: DoctorCaptureOptions = 
   let start = NaN;
   let now = NaN;
   let nextSample = NaN;
-  for (const piece of pieces) {
-    const t = piece.timeUs;
+  pieces.each((port, t, firstUs, data, time, text) => {
     if (Number.isFinite(t)) {
       if (Number.isNaN(start)) {
         start = t;
-        nextSample = Math.floor(piece.firstUs / step) * step + step;
+        nextSample = Math.floor(firstUs / step) * step + step;
       }
       // Take the findings at each step this piece starts after: everything before it has been
       // fed, so no link monitor is advanced past a frame it has not seen yet.
-      while (piece.firstUs >= nextSample) {
+      while (firstUs >= nextSample) {
         for (const s of sources.values()) s.link.update(nextSample);
         sample(nextSample);
         nextSample += step;
       }
       if (!(now >= t)) now = t;
     }
-    if (piece.kind === 'event') {
-      doctorEvent(doctor, piece.port, piece.text ?? '', t);
-      continue;
+    if (data === null) {
+      doctorEvent(doctor, port, text, t);
+      return;
     }
-    const source = sources.get(piece.port) as { decoder: SpektrumDecoder; link: LinkMonitor };
-    const data = piece.bytes as Uint8Array;
-    doctor.bytes(piece.port, data, piece.time);
-    source.decoder.push(data, piece.time);
+    const source = sources.get(port);
+    if (source === undefined) return;
+    doctor.bytes(port, data, time);
+    source.decoder.push(data, time);
     for (let f = source.decoder.next(); f !== undefined; f = source.decoder.next()) {
       source.link.frame(f);
-      doctor.frame(piece.port, f);
+      doctor.frame(port, f);
     }
-  }
+  });
   for (const [port, s] of sources) {
     s.decoder.end();
     for (let f = s.decoder.next(); f !== undefined; f = s.decoder.next()) {
@@ -236,18 +244,3 @@ export function doctorCapture(capture: Capture, options: DoctorCaptureOptions = 
 }
 
 const SEVERITY_RANK: Record<Severity, number> = { problem: 0, warning: 1, info: 2 };
-
-/**
- * Feeds one recorded event to a doctor: "port opened" / "device reconnected" (optionally
- * "… at 420000 baud") opens the port, "device lost" / "port closed" closes it, and a text that
- * names a WebSerial read error ("line error: FramingError") is that error. Other texts are
- * ignored. The live worker and `doctorCapture` both use it, so a recording says what was seen.
- */
-export function doctorEvent(doctor: Doctor, port: number, text: string, timeUs: number): void {
-  const error = LINE_ERROR.exec(text);
-  if (error !== null) doctor.lineError(port, error[1] as string, timeUs);
-  else if (OPENED.test(text)) {
-    const baud = BAUD.exec(text);
-    doctor.open(port, timeUs, baud !== null ? { baudRate: Number(baud[1]) } : {});
-  } else if (CLOSED.test(text)) doctor.close(port);
-}

@@ -24,21 +24,38 @@ const SBUS_LENGTH = 25;
 const HISTORY = 128;
 const MAX_PENDING = 16;
 
-function crc16Xmodem(ring: Uint8Array, start: number, length: number): number {
-  let crc = 0;
-  for (let i = 0; i < length; i++) {
-    crc ^= (ring[(start + i) & (HISTORY - 1)] as number) << 8;
-    for (let b = 0; b < 8; b++) crc = crc & 0x8000 ? ((crc << 1) ^ 0x1021) & 0xffff : (crc << 1) & 0xffff;
+/** CRC-16/XMODEM (poly 0x1021) and CRC-8/DVB-S2 (poly 0xD5), MSB first: one table lookup a byte. */
+let crcTables: { c16: Uint16Array; c8: Uint8Array } | undefined;
+
+/** Built on first use, so importing the module does no work. */
+function buildCrcTables(): { c16: Uint16Array; c8: Uint8Array } {
+  const c16 = new Uint16Array(256);
+  const c8 = new Uint8Array(256);
+  for (let n = 0; n < 256; n++) {
+    let a = n << 8;
+    let b = n;
+    for (let k = 0; k < 8; k++) {
+      a = a & 0x8000 ? ((a << 1) ^ 0x1021) & 0xffff : (a << 1) & 0xffff;
+      b = b & 0x80 ? ((b << 1) ^ 0xd5) & 0xff : (b << 1) & 0xff;
+    }
+    c16[n] = a;
+    c8[n] = b;
   }
+  return { c16, c8 };
+}
+
+function crc16Xmodem(ring: Uint8Array, start: number, length: number): number {
+  const table = (crcTables ??= buildCrcTables()).c16;
+  let crc = 0;
+  for (let i = 0; i < length; i++)
+    crc = ((crc << 8) & 0xffff) ^ (table[((crc >>> 8) ^ (ring[(start + i) & (HISTORY - 1)] ?? 0)) & 0xff] ?? 0);
   return crc;
 }
 
 function crc8DvbS2(ring: Uint8Array, start: number, length: number): number {
+  const table = (crcTables ??= buildCrcTables()).c8;
   let crc = 0;
-  for (let i = 0; i < length; i++) {
-    crc ^= ring[(start + i) & (HISTORY - 1)] as number;
-    for (let b = 0; b < 8; b++) crc = crc & 0x80 ? ((crc << 1) ^ 0xd5) & 0xff : (crc << 1) & 0xff;
-  }
+  for (let i = 0; i < length; i++) crc = table[(crc ^ (ring[(start + i) & (HISTORY - 1)] ?? 0)) & 0xff] ?? 0;
   return crc;
 }
 
@@ -62,80 +79,86 @@ export class PacketScanner {
   constructor(readonly onPacket: (kind: PacketKind, endIndex: number) => void) {}
 
   push(bytes: Uint8Array): void {
+    // The state in locals for the loop (written back at the end): this runs on every byte.
     const ring = this.#ring;
     const mask = HISTORY - 1;
-    for (let i = 0; i < bytes.length; i++) {
-      const b = bytes[i] as number;
-      const k = this.#n++;
+    const pendingAt = this.#pendingAt;
+    const pendingKind = this.#pendingKind;
+    let pending = this.#pending;
+    let k = this.#n;
+    for (let i = 0; i < bytes.length; i++, k++) {
+      const b = bytes[i] ?? 0;
       ring[k & mask] = b;
       // IBUS ends here?
       if (k >= IBUS_LENGTH - 1) {
         const s = k - (IBUS_LENGTH - 1);
         if (ring[s & mask] === 0x20 && ring[(s + 1) & mask] === 0x40) {
           let sum = 0;
-          for (let j = 0; j < IBUS_LENGTH - 2; j++) sum += ring[(s + j) & mask] as number;
-          const check = (ring[(k - 1) & mask] as number) | ((ring[k & mask] as number) << 8);
+          for (let j = 0; j < IBUS_LENGTH - 2; j++) sum += ring[(s + j) & mask] ?? 0;
+          const check = (ring[(k - 1) & mask] ?? 0) | ((ring[k & mask] ?? 0) << 8);
           if (((0xffff - sum) & 0xffff) === check) this.onPacket('ibus', k);
         }
       }
       // SBUS: a 0x0F 25 bytes back, a footer just before this byte, and this byte the next 0x0F.
       if (b === 0x0f && k >= SBUS_LENGTH) {
         const s = k - SBUS_LENGTH;
-        const footer = ring[(k - 1) & mask] as number;
+        const footer = ring[(k - 1) & mask] ?? 0;
         if (ring[s & mask] === 0x0f && (footer === 0x00 || (footer & 0xcf) === 0x04)) this.onPacket('sbus', k - 1);
       }
       // Packets announced by a length byte: check the ones that end here.
       let w = 0;
-      for (let p = 0; p < this.#pending; p++) {
-        const at = this.#pendingAt[p] as number;
-        const kind = this.#pendingKind[p] as number;
+      for (let p = 0; p < pending; p++) {
+        const at = pendingAt[p] ?? 0;
+        const kind = pendingKind[p] ?? 0;
         const lengthAt = at + (kind === 2 ? 1 : 2);
         let keep = true;
         if (kind === 0) {
           // SRXL v1 has no length byte: a fixed 18 bytes.
           if (k === at + SRXL_V1_LENGTH - 1) {
             keep = false;
-            const crc = ((ring[(k - 1) & mask] as number) << 8) | (ring[k & mask] as number);
+            const crc = ((ring[(k - 1) & mask] ?? 0) << 8) | (ring[k & mask] ?? 0);
             if (crc16Xmodem(ring, at, SRXL_V1_LENGTH - 2) === crc) this.onPacket('srxl-v1', k);
           }
         } else if (k === lengthAt) {
-          const length = ring[k & mask] as number;
+          const length = ring[k & mask] ?? 0;
           keep = kind === 2 ? length >= 2 && length <= CRSF_MAX_LENGTH : length >= SRXL_MIN_LENGTH && length <= SRXL_MAX_LENGTH;
         } else if (k > lengthAt) {
-          const length = ring[lengthAt & mask] as number;
+          const length = ring[lengthAt & mask] ?? 0;
           const total = kind === 2 ? length + 2 : length;
           if (k === at + total - 1) {
             keep = false;
             if (kind === 2) {
               if (crc8DvbS2(ring, at + 2, total - 3) === ring[k & mask]) this.onPacket('crsf', k);
             } else {
-              const crc = ((ring[(k - 1) & mask] as number) << 8) | (ring[k & mask] as number);
+              const crc = ((ring[(k - 1) & mask] ?? 0) << 8) | (ring[k & mask] ?? 0);
               if (crc16Xmodem(ring, at, total - 2) === crc) {
-                this.lastSrxl2Type = ring[(at + 1) & mask] as number;
+                this.lastSrxl2Type = ring[(at + 1) & mask] ?? 0;
                 this.onPacket('srxl2', k);
               }
             }
           }
         }
         if (keep && k - at < HISTORY - 1) {
-          this.#pendingAt[w] = at;
-          this.#pendingKind[w] = kind;
+          pendingAt[w] = at;
+          pendingKind[w] = kind;
           w++;
         }
       }
-      this.#pending = w;
+      pending = w;
       const start = b === 0xa5 ? 0 : b === 0xa6 ? 1 : b === 0xc8 || b === 0xee || b === 0xea ? 2 : -1;
       if (start >= 0) {
-        if (this.#pending === MAX_PENDING) {
-          this.#pendingAt.copyWithin(0, 1);
-          this.#pendingKind.copyWithin(0, 1);
-          this.#pending--;
+        if (pending === MAX_PENDING) {
+          pendingAt.copyWithin(0, 1);
+          pendingKind.copyWithin(0, 1);
+          pending--;
         }
-        this.#pendingAt[this.#pending] = k;
-        this.#pendingKind[this.#pending] = start;
-        this.#pending++;
+        pendingAt[pending] = k;
+        pendingKind[pending] = start;
+        pending++;
       }
     }
+    this.#pending = pending;
+    this.#n = k;
   }
 }
 
@@ -275,14 +298,14 @@ export class BurstClock {
   periodUs(sinceUs = -Infinity): number {
     const starts: number[] = [];
     for (let i = 0; i < this.#count; i++) {
-      const t = this.#starts[(this.#next - this.#count + i + 64) & 63] as number;
+      const t = this.#starts[(this.#next - this.#count + i + 64) & 63] ?? NaN;
       if (t >= sinceUs) starts.push(t);
     }
     if (starts.length < 6) return NaN;
     const iv: number[] = [];
-    for (let i = 1; i < starts.length; i++) iv.push((starts[i] as number) - (starts[i - 1] as number));
+    for (let i = 1; i < starts.length; i++) iv.push((starts[i] ?? NaN) - (starts[i - 1] ?? NaN));
     iv.sort((a, b) => a - b);
-    const median = iv[iv.length >> 1] as number;
+    const median = iv[iv.length >> 1] ?? NaN;
     const close = iv.filter((x) => Math.abs(x - median) <= 0.1 * median).length;
     return close >= 0.7 * iv.length ? median : NaN;
   }

@@ -1,16 +1,48 @@
 /**
  * The health report with the doctor's findings in it: `healthReport` (the link's figures) plus
- * `doctorCapture`'s findings at the end of the capture, which `reportHtml` shows in a section
- * of their own. The CLI's `satscope report` and the page's Report use it.
+ * the doctor's findings at the end of the capture, which `reportHtml` shows in a section of their
+ * own. The CLI's `satscope report` and the page's Report use it.
+ *
+ * The doctor listens to the report's own decode of every port (one pass: the same frames, the
+ * same link monitors, finished at the capture's end), so the diagnosis and the figures beside it
+ * rest on one reading. A capture without timing is the exception: the doctor reads it on a clock
+ * of its own (bytes back to back at 115200, `doctorCapture`), which the report does not use.
  */
 import type { Capture } from '../capture/index.js';
-import { healthReport, type HealthReport, type HealthReportOptions } from './report.js';
+import { capturePorts } from '../capture/index.js';
+import { healthReportFeeding } from './report.js';
+import type { HealthReport, HealthReportOptions } from './report-types.js';
+import { captureSpan, decodeCapture } from './capture-pass.js';
 import { doctorCapture } from './doctor-capture.js';
+import { Doctor } from './doctor.js';
+import type { DoctorFinding } from './doctor-types.js';
 
 /** `healthReport(capture, options)` with `diagnosis` filled in. Pure, like both. */
 export function diagnosedHealthReport(capture: Capture, options: HealthReportOptions = {}): HealthReport {
-  const report = healthReport(capture, options);
-  const { findings } = doctorCapture(capture, options.resolution !== undefined ? { resolution: options.resolution } : {});
+  let report: HealthReport;
+  let findings: DoctorFinding[];
+  if (capture.timing === 'none') {
+    report = healthReportFeeding(capture, options, undefined);
+    findings = doctorCapture(capture, options.resolution !== undefined ? { resolution: options.resolution } : {}).findings;
+  } else {
+    const span = captureSpan(capture);
+    const doctor = new Doctor({
+      timing: capture.timing === 'per-byte' ? 'per-byte' : 'per-chunk',
+      memoryUs: Infinity,
+      originUs: Number.isFinite(span.startUs) ? span.startUs : 0,
+    });
+    report = healthReportFeeding(capture, options, doctor);
+    // Ports with events but no data (opened, and nothing came): the doctor hears their events.
+    const data = new Set(capturePorts(capture));
+    const quiet = [...new Set(capture.events.map((e) => e.port))].filter((p) => !data.has(p)).sort((a, b) => a - b);
+    for (const port of quiet)
+      decodeCapture(
+        capture,
+        { port, doctor, resolution: options.resolution ?? 'auto', originUs: span.startUs, endUs: span.endUs },
+        () => {},
+      );
+    findings = doctor.findings(Number.isFinite(span.endUs) ? span.endUs : 0);
+  }
   return {
     ...report,
     diagnosis: findings.map((f) => ({

@@ -181,11 +181,11 @@ export class ArduPilotGuess {
   /** One frame's 16 bytes. */
   frame(b: ArrayLike<number>): void {
     const vtx =
-      ((((b[12] as number) << 24) | ((b[13] as number) << 16) | ((b[14] as number) << 8) | (b[15] as number)) & VTX_MASK) >>> 0 ===
-        VTX_MARKER && ((b[2] as number) & 0x80) === 0;
+      ((((b[12] ?? 0) << 24) | ((b[13] ?? 0) << 16) | ((b[14] ?? 0) << 8) | (b[15] ?? 0)) & VTX_MASK) >>> 0 === VTX_MARKER &&
+      ((b[2] ?? 0) & 0x80) === 0;
     const slots = vtx ? 5 : 7;
     for (let i = 0; i < slots; i++) {
-      const raw = ((b[2 + 2 * i] as number) << 8) | (b[3 + 2 * i] as number);
+      const raw = ((b[2 + 2 * i] ?? 0) << 8) | (b[3 + 2 * i] ?? 0);
       if (raw === 0xffff) continue;
       this.#cs10 |= 1 << ((raw >> 10) & 0xf);
       this.#cs11 |= 1 << ((raw >> 11) & 0xf);

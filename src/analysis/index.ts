@@ -22,22 +22,21 @@
  * A whole capture: `doctorCapture(capture)`; the health report with the findings in it:
  * `diagnosedHealthReport(capture)`.
  */
-export {
-  Doctor,
-  NOTHING_AFTER_US,
-  NOTHING_CERTAIN_US,
-  LINE_WINDOW_BINS,
-  type Confidence,
-  type ConfirmProbe,
-  type DoctorCode,
-  type DoctorFinding,
-  type DoctorOptions,
-  type DoctorPortSource,
-  type Evidence,
-  type Severity,
-} from './doctor.js';
+export { Doctor } from './doctor.js';
+export { LINE_WINDOW_BINS, NOTHING_AFTER_US, NOTHING_CERTAIN_US } from './doctor-state.js';
+export type {
+  Confidence,
+  ConfirmProbe,
+  DoctorCode,
+  DoctorFinding,
+  DoctorOptions,
+  DoctorPortSource,
+  Evidence,
+  Severity,
+} from './doctor-types.js';
 export { diagnosedHealthReport } from './doctor-report.js';
-export { doctorCapture, doctorEvent, type DoctorCaptureOptions, type DoctorReport, type DoctorTimelineEntry } from './doctor-capture.js';
+export { doctorCapture, type DoctorCaptureOptions, type DoctorReport, type DoctorTimelineEntry } from './doctor-capture.js';
+export { doctorEvent } from './doctor-events.js';
 export {
   ArduPilotGuess,
   ARDUPILOT_GUESS_FRAMES,
@@ -53,37 +52,26 @@ export {
   type StreamFacts,
 } from './doctor-stacks.js';
 export { classifyLine, PacketScanner, PACKET_KINDS, type LineCounts, type LineVerdict, type PacketKind } from './doctor-line.js';
-export {
-  captureSpan,
-  decodeCapture,
-  resolutionKey,
-  summarizeCapture,
-  timingJitterUs,
-  type CaptureSummary,
-  type ChannelSummary,
-  type DecodeCaptureOptions,
-} from './summary.js';
+export { captureSpan, decodeCapture, timingJitterUs, type DecodeCaptureOptions } from './capture-pass.js';
+export { resolutionKey } from './resolution-key.js';
+export { summarizeCapture, type CaptureSummary, type ChannelSummary } from './summary.js';
 export { LinkSeries, monitorWithSeries } from './series.js';
-export {
-  healthReport,
-  formatClock,
-  formatDuration,
-  REPORT_BIN_US,
-  REPORT_THRESHOLDS,
-  SPIKE_MIN_JUMP_PERCENT,
-  type FindingCode,
-  type FindingLevel,
-  type HealthReport,
-  type HealthReportOptions,
-  type RemoteReport,
-  type ReportChannel,
-  type ReportEpisode,
-  type ReportFinding,
-  type ReportGlitch,
-  type ReportPeriodStats,
-  type ReportSeries,
-  type ReportStatus,
-  type ReportDiagnosis,
-  type ReportThresholds,
-} from './report.js';
+export { healthReport } from './report.js';
+export { formatClock, formatDuration } from './report-text.js';
+export { REPORT_BIN_US, REPORT_THRESHOLDS, SPIKE_MIN_JUMP_PERCENT, type ReportThresholds } from './report-thresholds.js';
+export type {
+  FindingCode,
+  FindingLevel,
+  HealthReport,
+  HealthReportOptions,
+  RemoteReport,
+  ReportChannel,
+  ReportEpisode,
+  ReportFinding,
+  ReportGlitch,
+  ReportPeriodStats,
+  ReportSeries,
+  ReportStatus,
+  ReportDiagnosis,
+} from './report-types.js';
 export { escapeHtml, reportHtml } from './report-html.js';

@@ -3,8 +3,9 @@
  * fetched, one printed page. Rendering only: the figures come from `healthReport`.
  */
 import { XPLUS_FIRST, channelName, type ResolutionReason } from '../decoder/index.js';
-import { RSSI_LOW_DBM, formatClock, formatDuration, pctText, plural, rate } from './report.js';
-import type { FindingLevel, HealthReport, RemoteReport, ReportStatus } from './report.js';
+import { RSSI_LOW_DBM } from './report-thresholds.js';
+import { formatClock, formatDuration, pctText, plural, rate } from './report-text.js';
+import type { FindingLevel, HealthReport, RemoteReport, ReportStatus } from './report-types.js';
 
 /** Escapes text for HTML content and attribute values. */
 export function escapeHtml(text: string): string {
@@ -65,7 +66,7 @@ function pool(values: readonly (number | null)[], group: number, pick: (a: numbe
 function timeTicks(durationUs: number): number[] {
   const s = durationUs / 1e6;
   const steps = [0.5, 1, 2, 5, 10, 15, 30, 60, 120, 300, 600, 900, 1800, 3600, 7200, 14_400, 28_800];
-  let step = steps[steps.length - 1] as number;
+  let step = steps[steps.length - 1] ?? NaN;
   for (const c of steps) {
     if (s / c <= 10) {
       step = c;
@@ -342,14 +343,9 @@ function channelList(r: RemoteReport): string {
   const ids = r.channels.map((c) => c.id);
   for (let i = 0; i < ids.length; ) {
     let j = i;
-    while (
-      j + 1 < ids.length &&
-      ids[j + 1] === (ids[j] as number) + 1 &&
-      (ids[j + 1] as number) < XPLUS_FIRST === (ids[i] as number) < XPLUS_FIRST
-    )
-      j++;
-    const a = ids[i] as number;
-    const b = ids[j] as number;
+    while (j + 1 < ids.length && ids[j + 1] === (ids[j] ?? 0) + 1 && (ids[j + 1] ?? 0) < XPLUS_FIRST === (ids[i] ?? 0) < XPLUS_FIRST) j++;
+    const a = ids[i] ?? 0;
+    const b = ids[j] ?? 0;
     const name = (id: number): string => (id >= XPLUS_FIRST ? channelName(id) : String(id));
     runs.push(a === b ? name(a) : `${name(a)}–${name(b)}`);
     i = j + 1;

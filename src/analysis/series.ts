@@ -135,7 +135,7 @@ export class LinkSeries {
   /** Mean RSSI of bin `i` (loss reports of −128 left out), NaN without. */
   rssiMean(i: number): number {
     const n = this.#rssiN.data[i] ?? 0;
-    return n > 0 ? (this.#rssiSum.data[i] as number) / n : NaN;
+    return n > 0 ? (this.#rssiSum.data[i] ?? 0) / n : NaN;
   }
   /** Lowest RSSI of bin `i`, NaN without. */
   rssiMin(i: number): number {
@@ -145,7 +145,7 @@ export class LinkSeries {
   /** Mean ordinary frame interval of bin `i`, µs, NaN without one. */
   intervalMean(i: number): number {
     const n = this.#intervalN.data[i] ?? 0;
-    return n > 0 ? (this.#intervalSum.data[i] as number) / n : NaN;
+    return n > 0 ? (this.#intervalSum.data[i] ?? 0) / n : NaN;
   }
 }
 

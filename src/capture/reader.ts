@@ -45,7 +45,7 @@ const MAX_MAGIC_BIT_ERRORS = 2;
 function magicBitErrors(bytes: Uint8Array): number {
   let errors = 0;
   for (let i = 0; i < MAGIC_SIZE; i++) {
-    let x = ((bytes[i] ?? 0) ^ (MAGIC[i] as number)) & 0xff;
+    let x = ((bytes[i] ?? 0) ^ (MAGIC[i] ?? 0)) & 0xff;
     for (; x !== 0; x &= x - 1) errors++;
   }
   return errors;
@@ -165,7 +165,7 @@ class RecordProbe {
     const k = Math.floor(i / CRC_INDEX_STEP);
     const from = k * CRC_INDEX_STEP;
     this.#work.crcBytes += i - from;
-    return (crcRun((index[k] as number) ^ 0xffffffff, this.#bytes, from, i) ^ 0xffffffff) >>> 0;
+    return (crcRun((index[k] ?? 0) ^ 0xffffffff, this.#bytes, from, i) ^ 0xffffffff) >>> 0;
   }
 
   #buildIndex(): Uint32Array {
@@ -405,10 +405,40 @@ export function parseCaptureCounting(bytes: Uint8Array): { capture: ParsedCaptur
   return { capture: readSscap(bytes, work), work };
 }
 
-/** `array`, or a view of its first `length` elements when that wastes little, else a trimmed copy. */
+/** `array` when it is `length` long, a view of its first `length` elements when that wastes little, else a trimmed copy. */
 function trimTo<T extends Uint8Array | Uint32Array | Float64Array>(array: T, length: number): T {
+  if (array.length === length) return array;
   // A view avoids holding the file's data twice at the peak; a copy frees a mostly empty buffer.
   return (length >= array.length * 0.75 ? array.subarray(0, length) : array.slice(0, length)) as T;
+}
+
+/** `to` with `from` copied to its start. */
+function grown<T extends Uint8Array | Uint32Array | Float64Array>(to: T, from: T): T {
+  to.set(from);
+  return to;
+}
+
+/**
+ * The data records and payload bytes of a file whose record headers lead from one to the next
+ * right to its end (sync marker, type, a length that fits), or null when they do not: read from
+ * the headers alone, before any CRC is checked.
+ */
+function plannedSizes(bytes: Uint8Array, view: DataView, headerLength: number): { records: number; data: number } | null {
+  const n = bytes.length;
+  let records = 0;
+  let data = 0;
+  let p = headerLength;
+  while (p + RECORD_OVERHEAD <= n && bytes[p] === SYNC0 && bytes[p + 1] === SYNC1) {
+    const type = bytes[p + REC_OFF_TYPE];
+    const len = view.getUint32(p + REC_OFF_LENGTH, true);
+    if ((type !== RECORD_TYPE_DATA && type !== RECORD_TYPE_EVENT) || len > MAX_RECORD_PAYLOAD || p + RECORD_OVERHEAD + len > n) return null;
+    if (type === RECORD_TYPE_DATA) {
+      records++;
+      data += len;
+    }
+    p += RECORD_OVERHEAD + len;
+  }
+  return p === n ? { records, data } : null;
 }
 
 function readSscap(bytes: Uint8Array, work: CaptureReaderWork): ParsedCapture {
@@ -420,13 +450,18 @@ function readSscap(bytes: Uint8Array, work: CaptureReaderWork): ParsedCapture {
   const n = bytes.length;
 
   // Every record takes at least RECORD_OVERHEAD bytes and its payload is part of the file, so
-  // these sizes are upper bounds: allocate once, trim once, no growth in the loop.
+  // these sizes are upper bounds. A file whose records follow each other to its end (the usual
+  // case) is sized exactly from its record headers first, so nothing is allocated twice its
+  // need or copied to trim it; should the checks then find more (records inside a damaged one),
+  // the columns grow once to the bounds.
   const room = n - headerLength;
   const maxRecords = Math.floor(room / RECORD_OVERHEAD);
-  const data = new Uint8Array(Math.max(0, room - RECORD_OVERHEAD));
-  const chunkEnds = new Uint32Array(maxRecords);
-  const chunkTimes = new Float64Array(maxRecords);
-  const chunkPorts = new Uint8Array(maxRecords);
+  const maxData = Math.max(0, room - RECORD_OVERHEAD);
+  const planned = plannedSizes(bytes, view, headerLength);
+  let data = new Uint8Array(planned?.data ?? maxData);
+  let chunkEnds = new Uint32Array(planned?.records ?? maxRecords);
+  let chunkTimes = new Float64Array(planned?.records ?? maxRecords);
+  let chunkPorts = new Uint8Array(planned?.records ?? maxRecords);
   const events: CaptureEvent[] = [];
   let dataLength = 0;
   let chunks = 0;
@@ -481,10 +516,17 @@ function readSscap(bytes: Uint8Array, work: CaptureReaderWork): ParsedCapture {
       const len = result - RECORD_OVERHEAD;
       const payload = p + RECORD_HEADER_SIZE;
       const timeUs = view.getFloat64(p + REC_OFF_TIME, true);
-      const port = bytes[p + REC_OFF_PORT] as number;
+      const port = bytes[p + REC_OFF_PORT] ?? 0;
       if (bytes[p + REC_OFF_TYPE] === RECORD_TYPE_DATA) {
+        if (chunks === chunkEnds.length || dataLength + len > data.length) {
+          // Not in a closure: the columns stay plain locals of this loop.
+          data = grown(new Uint8Array(maxData), data);
+          chunkEnds = grown(new Uint32Array(maxRecords), chunkEnds);
+          chunkTimes = grown(new Float64Array(maxRecords), chunkTimes);
+          chunkPorts = grown(new Uint8Array(maxRecords), chunkPorts);
+        }
         // Short chunks (the usual case) are copied by hand: cheaper than making a subarray.
-        if (len <= 64) for (let k = 0; k < len; k++) data[dataLength + k] = bytes[payload + k] as number;
+        if (len <= 64) for (let k = 0; k < len; k++) data[dataLength + k] = bytes[payload + k] ?? 0;
         else data.set(bytes.subarray(payload, payload + len), dataLength);
         dataLength += len;
         chunkEnds[chunks] = dataLength;

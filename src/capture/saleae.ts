@@ -178,7 +178,7 @@ function secondsToNs(bytes: Uint8Array, s: number, e: number): number {
   let whole = 0;
   let digits = 0;
   for (; i < e; i++, digits++) {
-    const d = (bytes[i] as number) - ZERO;
+    const d = (bytes[i] ?? 0) - ZERO;
     if (d < 0 || d > 9) break;
     whole = whole * 10 + d;
   }
@@ -187,7 +187,7 @@ function secondsToNs(bytes: Uint8Array, s: number, e: number): number {
   let roundUp = 0;
   if (i < e && bytes[i] === DOT) {
     for (i++; i < e; i++, digits++, fracDigits++) {
-      const d = (bytes[i] as number) - ZERO;
+      const d = (bytes[i] ?? 0) - ZERO;
       if (d < 0 || d > 9) break;
       if (fracDigits < 9) frac = frac * 10 + d;
       else if (fracDigits === 9) roundUp = d >= 5 ? 1 : 0;
@@ -213,7 +213,7 @@ function byteValue(bytes: Uint8Array, s: number, e: number): number {
   if (e <= s) return -1;
   let radix = 10;
   if (e - s > 2 && bytes[s] === ZERO) {
-    const p = (bytes[s + 1] as number) | 0x20;
+    const p = (bytes[s + 1] ?? 0) | 0x20;
     if (p === 0x78)
       radix = 16; // x
     else if (p === 0x62) radix = 2; // b
@@ -221,7 +221,7 @@ function byteValue(bytes: Uint8Array, s: number, e: number): number {
   }
   let v = 0;
   for (let i = s; i < e; i++) {
-    const d = hexDigit(bytes[i] as number);
+    const d = hexDigit(bytes[i] ?? 0);
     if (d < 0 || d >= radix) return -1;
     v = v * radix + d;
     if (v > 0xff) return -1;

@@ -5,8 +5,7 @@ import { channelResolution, servoToMicros, systemInfo, CHANNEL_COUNT } from '../
 import type { DecodedFrame } from '../decoder/types.js';
 
 const seconds = (us: number): string => (Number.isFinite(us) ? String(us / 1e6) : 'null');
-const usOf = (f: DecodedFrame, i: number): number =>
-  servoToMicros(f.positions[i] as number, channelResolution(f.ids[i] as number, f.resolution));
+const usOf = (f: DecodedFrame, i: number): number => servoToMicros(f.positions[i] ?? 0, channelResolution(f.ids[i] ?? 0, f.resolution));
 
 /**
  * One frame as the documented JSONL line:
@@ -16,7 +15,7 @@ export function formatJsonLine(f: DecodedFrame): string {
   let channels = '';
   for (let i = 0; i < f.count; i++) {
     if (i > 0) channels += ', ';
-    channels += `{"id": ${f.ids[i] as number}, "pos": ${f.positions[i] as number}, "us": ${usOf(f, i)}}`;
+    channels += `{"id": ${f.ids[i] ?? 0}, "pos": ${f.positions[i] ?? 0}, "us": ${usOf(f, i)}}`;
   }
   return `{"t": ${seconds(f.timeUs)}, "remote": "${f.remote}", "system": ${f.system ?? 'null'}, "resolution": ${f.resolution}, "fades": ${f.fades ?? 'null'}, "rssi": ${f.rssi ?? 'null'}, "channels": [${channels}]}`;
 }
@@ -30,7 +29,7 @@ export function formatCsvHeader(): string {
 /** One frame as a CSV row: pulse widths in µs per channel ID, empty where the frame has none. */
 export function formatCsvLine(f: DecodedFrame): string {
   const cells: string[] = new Array<string>(CHANNEL_COUNT).fill('');
-  for (let i = 0; i < f.count; i++) cells[f.ids[i] as number] = String(usOf(f, i));
+  for (let i = 0; i < f.count; i++) cells[f.ids[i] ?? 0] = String(usOf(f, i));
   const t = Number.isFinite(f.timeUs) ? String(f.timeUs / 1e6) : '';
   return [t, f.remote, f.system ?? '', f.resolution, f.fades ?? '', f.rssi ?? '', ...cells].join(',');
 }

@@ -317,8 +317,12 @@ export class LinkMonitor {
   #state: LinkState = 'waiting';
   #lastUs = NaN;
   #systemPeriod = NaN;
+  /** The last frame times without a gap, a ring: `#periodCount` of them, the oldest at `#periodOldest` once it is full. */
   readonly #periodTimes = new Float64Array(PERIOD_WINDOW);
   #periodCount = 0;
+  #periodOldest = 0;
+  /** The last system byte seen, and whether `systemInfo` knew it (one lookup per change, not per frame). */
+  #systemByte = -1;
   readonly #rateTimes = new Float64Array(RATE_WINDOW);
   readonly #rateFades = new Float64Array(RATE_WINDOW);
   #rateCount = 0;
@@ -328,6 +332,8 @@ export class LinkMonitor {
   #nextEpisode = 0;
   #open: LinkEpisode | null = null;
   readonly #ledger: FrameLedger;
+  /** `#missedByCount` bound once, for the ledger (no closure made per frame). */
+  readonly #missed = (fromUs: number, toUs: number, count: number): void => this.#missedByCount(fromUs, toUs, count);
   /**
    * Holds not yet confirmed, with the receiver's fade count when each began: a hold whose
    * silence the next punctual frame shows held no missing frame was the adapter holding bytes
@@ -422,9 +428,10 @@ export class LinkMonitor {
       s.rssi = frame.rssi;
       if (!(s.minRssi <= frame.rssi)) s.minRssi = frame.rssi;
     }
-    if (frame.system !== null) {
+    if (frame.system !== null && frame.system !== this.#systemByte) {
       const info = systemInfo(frame.system);
       if (info) {
+        this.#systemByte = frame.system;
         this.#systemPeriod = info.periodMs === 11 ? FRAME_PERIOD_11MS_US : FRAME_PERIOD_22MS_US;
         s.nominalPeriodUs = this.#systemPeriod;
       }
@@ -453,7 +460,7 @@ export class LinkMonitor {
       }
       this.#lastUs = t;
       this.#measure(t, fades);
-      this.#ledger.frame(t, s.nominalPeriodUs, (a, b, n) => this.#missedByCount(a, b, n));
+      this.#ledger.frame(t, s.nominalPeriodUs, this.#missed);
       this.#confirmHolds();
       s.deliveryDelayUs = this.#ledger.delayUs;
       s.deliveryJitterUs = this.#ledger.jitterUs;
@@ -539,7 +546,9 @@ export class LinkMonitor {
     if (this.#state === 'waiting' || !Number.isFinite(last) || !Number.isFinite(nowUs)) return this.#state;
     const gap = nowUs - last;
     const s = this.#stats;
-    if (gap > this.holdAfterUs && this.#state === 'live') {
+    // No hold threshold is below HOLD_MIN_US (or the holdAfterUs option): the common short gap
+    // is decided without working the threshold out.
+    if (this.#state === 'live' && gap > (this.#holdOption ?? HOLD_MIN_US) && gap > this.holdAfterUs) {
       this.#state = 'hold';
       s.holds++;
       // The hold began when the next frame was due, whenever it was noticed.
@@ -573,7 +582,7 @@ export class LinkMonitor {
     if (silence > grace && silence > s.longestGapUs) s.longestGapUs = silence;
     if (this.#counting) {
       // The receiver never got to report these: frames due in a silence longer than a hold.
-      this.#ledger.finish(endUs, Infinity, (a, b, n) => this.#missedByCount(a, b, n));
+      this.#ledger.finish(endUs, Infinity, this.#missed);
       this.#confirmHolds();
       if (silence > grace) {
         const p = s.nominalPeriodUs;
@@ -585,7 +594,7 @@ export class LinkMonitor {
         }
       }
     } else {
-      this.#ledger.finish(endUs, silence > grace ? this.jitterUs : Infinity, (a, b, n) => this.#missedByCount(a, b, n));
+      this.#ledger.finish(endUs, silence > grace ? this.jitterUs : Infinity, this.#missed);
       this.#confirmHolds();
     }
     return state;
@@ -637,13 +646,14 @@ export class LinkMonitor {
     // Period: the span of the last 32 gap-free intervals, which averages out chunk jitter.
     const times = this.#periodTimes;
     if (this.#periodCount < PERIOD_WINDOW) {
+      if (this.#periodCount === 0) this.#periodOldest = 0;
       times[this.#periodCount++] = t;
     } else {
-      times.copyWithin(0, 1);
-      times[PERIOD_WINDOW - 1] = t;
+      times[this.#periodOldest] = t;
+      this.#periodOldest = this.#periodOldest === PERIOD_WINDOW - 1 ? 0 : this.#periodOldest + 1;
     }
     if (this.#periodCount >= 9) {
-      const span = (times[this.#periodCount - 1] as number) - (times[0] as number);
+      const span = t - (times[this.#periodOldest] as number);
       if (!Number.isFinite(this.#systemPeriod) && (!Number.isFinite(s.nominalPeriodUs) || this.#periodCount === PERIOD_WINDOW)) {
         // Without a system byte: snap the mean interval to 11 or 22 ms, first over 8 intervals,
         // then again over every full window, so a few frames missing early do not stick.

@@ -1,0 +1,157 @@
+/**
+ * One decoding pass over one port of a capture: the bytes go once through the port's decoder,
+ * and each frame, once, to everything that reads it (the link monitor, its binned series, the
+ * caller's own reading, and the doctor when one listens). `satscope info`, `satscope report`,
+ * the report's diagnosis and the page's replay overview all decode through here, so a port's
+ * frames, missed frames and episodes are the same on every surface, and a report decodes each
+ * port once.
+ *
+ * Chunks are read straight from the capture's columns (no object per chunk), and the capture's
+ * span (`captureSpan`) is one pass over its chunk times, taken once by the caller.
+ */
+import type { Capture, CaptureEvent, CaptureTiming } from '../capture/index.js';
+import { BYTE_TIME_US, SpektrumDecoder, USB_CHUNK_JITTER_US, type DecodedFrame, type DecoderOptions } from '../decoder/index.js';
+import type { LinkMonitor } from '../decoder/index.js';
+import type { Doctor } from './doctor.js';
+import { doctorEvent } from './doctor-events.js';
+import { LinkSeries, monitorWithSeries } from './series.js';
+
+export interface DecodeCaptureOptions extends DecoderOptions {
+  /** Which serial port of a multi-port capture to decode. Default 0. */
+  port?: number;
+  /** Width of the bins of the returned `series`, µs. Default 1 s. */
+  binUs?: number;
+  /** Start of the series' bin 0, µs. Default: the capture's first recorded time (`captureSpan`). */
+  originUs?: number;
+  /** Where the capture ends, µs: the link is finished there. Default: the capture's last recorded time (`captureSpan`). */
+  endUs?: number;
+  /**
+   * A doctor to feed this port to as well (its bytes, its recorded events, its frames after the
+   * link monitor counted them), attached under the port's name from the metadata. A timed
+   * capture only: without timing the doctor needs a clock of its own (`doctorCapture`).
+   */
+  doctor?: Doctor;
+}
+
+/** The delivery jitter to assume for a capture's timing until it is measured: USB batching for chunk times, none for a logic analyser's. */
+export function timingJitterUs(timing: CaptureTiming): number {
+  return timing === 'per-chunk' ? USB_CHUNK_JITTER_US : 0;
+}
+
+/**
+ * Bytes of a per-byte chunk pushed at once: about 20 ms of a satellite stream, as a USB adapter
+ * would deliver it. The decoder's frames do not depend on it; the doctor books what it scans at
+ * the time of each piece's last byte, so the doctor's own replay (`doctorCapture`) cuts the same.
+ */
+export const SLICE_BYTES = 256;
+
+/**
+ * The earliest and latest time recorded in a capture on any port (data bytes and events), on
+ * the capture's clock, µs; NaN for both without timing. Every surface starts and ends a capture
+ * here: the report's time zero, replay's timeline, the end at which the link's state is judged.
+ * One pass over the chunk columns.
+ */
+export function captureSpan(capture: Capture): { startUs: number; endUs: number } {
+  const { chunkEnds, chunkTimesUs, byteTimesUs } = capture;
+  let start = Infinity;
+  let end = -Infinity;
+  let from = 0;
+  for (let i = 0; i < chunkEnds.length; i++) {
+    const to = chunkEnds[i] ?? from;
+    if (to > from) {
+      let first: number;
+      let last: number;
+      if (byteTimesUs !== undefined) {
+        first = byteTimesUs[from] ?? NaN;
+        last = byteTimesUs[to - 1] ?? NaN;
+      } else {
+        last = chunkTimesUs[i] ?? NaN;
+        first = last - (to - from - 1) * BYTE_TIME_US;
+      }
+      if (first < start) start = first;
+      if (last > end) end = last;
+    }
+    from = to;
+  }
+  for (const e of capture.events) {
+    if (e.timeUs < start) start = e.timeUs;
+    if (e.timeUs > end) end = e.timeUs;
+  }
+  return start <= end ? { startUs: start, endUs: end } : { startUs: NaN, endUs: NaN };
+}
+
+/** The capture's events on `port`, in the order they were recorded among the chunks. */
+function portEvents(capture: Capture, port: number): CaptureEvent[] {
+  return capture.events.filter((e) => e.port === port).sort((a, b) => a.chunkIndex - b.chunkIndex);
+}
+
+/**
+ * Feeds one port of a capture through a decoder and a link monitor, chunk by chunk with the
+ * chunk's recorded time, as live data would arrive, and ends the link at the capture's end
+ * (`captureSpan`), as replay does. `onFrame` gets each borrowed frame and the link monitor,
+ * which has already counted it (and so has the doctor, when one listens). `series` holds the
+ * link's binned series.
+ */
+export function decodeCapture(
+  capture: Capture,
+  options: DecodeCaptureOptions,
+  onFrame: (frame: DecodedFrame, link: LinkMonitor) => void,
+): { decoder: SpektrumDecoder; link: LinkMonitor; series: LinkSeries } {
+  const { port = 0, binUs = 1_000_000, originUs, endUs, doctor, ...decoderOptions } = options;
+  const span = originUs === undefined || endUs === undefined ? captureSpan(capture) : { startUs: originUs, endUs };
+  const end = endUs ?? span.endUs;
+  const decoder = new SpektrumDecoder(decoderOptions);
+  const series = new LinkSeries(binUs, originUs ?? span.startUs);
+  const link = monitorWithSeries({ jitterUs: timingJitterUs(capture.timing) }, series);
+  if (doctor !== undefined && capture.timing === 'none')
+    throw new TypeError('decodeCapture: a doctor needs a timed capture (doctorCapture gives an untimed one a clock)');
+  const events = doctor !== undefined ? portEvents(capture, port) : [];
+  let nextEvent = 0;
+  /** Feeds the doctor this port's events recorded before chunk `upTo` (all that are left: Infinity). */
+  const eventsBefore = (upTo: number): void => {
+    for (let e = events[nextEvent]; e !== undefined && e.chunkIndex <= upTo; e = events[++nextEvent])
+      if (doctor !== undefined) doctorEvent(doctor, port, e.text, e.timeUs);
+  };
+  if (doctor !== undefined) {
+    const label = capture.meta.ports?.[port]?.name;
+    doctor.detach(port);
+    doctor.attach(port, { decoder, link, label: typeof label === 'string' && label !== '' ? label : `Port ${port}` });
+  }
+  const drain = (): void => {
+    for (let f = decoder.next(); f !== undefined; f = decoder.next()) {
+      link.frame(f);
+      series.frame(f, link);
+      doctor?.frame(port, f);
+      onFrame(f, link);
+    }
+  };
+  const push = (bytes: Uint8Array, time: number | Float64Array | undefined): void => {
+    doctor?.bytes(port, bytes, time);
+    decoder.push(bytes, time);
+    drain();
+  };
+  const { bytes, chunkEnds, chunkTimesUs, chunkPorts, byteTimesUs } = capture;
+  let from = 0;
+  for (let i = 0; i < chunkEnds.length; i++) {
+    const to = chunkEnds[i] ?? from;
+    if (chunkPorts[i] === port) {
+      eventsBefore(i);
+      if (byteTimesUs !== undefined) {
+        for (let s = from; s < to; s += SLICE_BYTES) {
+          const e = Math.min(s + SLICE_BYTES, to);
+          push(bytes.subarray(s, e), byteTimesUs.subarray(s, e));
+        }
+      } else {
+        const t = chunkTimesUs[i] ?? NaN;
+        push(bytes.subarray(from, to), Number.isNaN(t) ? undefined : t);
+      }
+    }
+    from = to;
+  }
+  eventsBefore(Infinity);
+  decoder.end();
+  drain();
+  link.finish(end);
+  series.extendTo(end);
+  return { decoder, link, series };
+}

@@ -1,0 +1,309 @@
+/**
+ * The doctor's rules about one satellite: the flight controller's settings, the mode it was
+ * bound in, what its frames carry, and how weak its link is (failsafes, holds, fades, RSSI,
+ * rebinds, restarts).
+ */
+import { systemInfo, type FormatInfo, type Resolution } from '../decoder/index.js';
+import { REPORT_THRESHOLDS } from './report-thresholds.js';
+import { plural } from './report-text.js';
+import { ARDUPILOT_GUESS_FRAMES, bindPulses, channelSetText, satelliteSettings } from './doctor-stacks.js';
+import { dur, GUESS_MIN_DECISIONS, M_FADES, MIN_FADES, type FormatSnapshot, type PortState } from './doctor-state.js';
+import type { AddFinding, Confidence, DoctorPortSource, Evidence, RuleContext } from './doctor-types.js';
+
+/** Advice from spec §5 for a weak link. */
+export const LINK_ADVICE = [
+  'Give the weak remote line of sight to the transmitter in every attitude; move it away from carbon fibre, metal, batteries and wiring (spec §5).',
+  "Add a second remote mounted 90° from the first: each covers the other's blind orientation (spec §5).",
+  'Check the antennas: undamaged, not touching carbon or metal, the two elements of a satellite at right angles.',
+  'Do a range check with the transmitter in range-test mode before flying again.',
+];
+
+export function satelliteFindings(p: PortState, now: number, ctx: RuleContext, add: AddFinding): void {
+  const source = p.source as DoctorPortSource;
+  const format: FormatInfo = source.decoder.format;
+  const link = source.link;
+  if (!format.locked || format.resolution === null || format.remote === null) return;
+  const resolution = format.resolution;
+  const remote = format.remote;
+  const period = link.stats.nominalPeriodUs;
+  const info = format.system !== null ? systemInfo(format.system) : undefined;
+  const sure: Confidence = format.resolutionReason === 'channel-ids' ? 'likely' : 'certain';
+  const protocolText =
+    info !== undefined ? info.name : `${resolution}, ${Number.isFinite(period) ? `${period / 1000} ms` : 'period not yet measured'}`;
+
+  // What to set.
+  const guessNote = guessNotes(p, resolution);
+  add({
+    code: 'fc-settings',
+    ports: [p.port],
+    severity: 'info',
+    confidence: sure,
+    title: `${p.label}: flight controller settings for this ${protocolText} ${remote} remote`,
+    evidence: [{ text: format.explanation, timeUs: null }],
+    todo: [`Betaflight / iNav: serialrx_provider = ${resolution === 2048 ? 'SPEK2048' : 'SPEK1024'} (lines below).`],
+    settings: [
+      ...satelliteSettings({ resolution, periodUs: period, remote, system: format.system }),
+      { stack: 'ArduPilot', lines: [], note: guessNote.ardupilot },
+      { stack: 'PX4', lines: [], note: guessNote.px4 },
+    ],
+    confirm: null,
+  });
+
+  // The mode it was bound in, against §7.2's recommendation.
+  const slow = Number.isFinite(period) && period > 16_500;
+  if (resolution === 1024 || slow || (info !== undefined && info.protocol === 'DSM2')) {
+    const pulses = bindPulses('DSMX', 11, remote);
+    add({
+      code: 'bind-mode',
+      ports: [p.port],
+      severity: resolution === 1024 ? 'warning' : 'info',
+      confidence: sure,
+      title: `${p.label}: bound in ${protocolText}; DSMX 11 ms is better`,
+      evidence: [
+        {
+          text: `${resolution === 1024 ? 'Servo positions have 1024 steps (DSM2 22 ms, spec §8.1), half the precision of 2048. ' : ''}${slow ? `A frame every ${(link.stats.periodUs / 1000 || period / 1000).toFixed(1)} ms, twice the latency of 11 ms. ` : ''}Spec §7.2 recommends binding DSMX 11 ms: 9 pulses internal, 10 external.`,
+          timeUs: null,
+        },
+      ],
+      todo: [
+        `Bind again in DSMX 11 ms, ${remote}: ${pulses} pulses (Betaflight/iNav \`set spektrum_sat_bind = ${pulses}\`, save, power-cycle, bind, set it back to 0; or SatScope's Bind panel).`,
+        'A DSM2-only satellite (SPM9545) cannot bind DSMX; a DSM2-only transmitter falls back to DSM2 by itself when bound in a DSMX mode (spec §7.2).',
+        resolution === 1024
+          ? 'Until then the flight controller must use SPEK1024, or every channel reads wrong.'
+          : 'Until then SPEK2048 reads it correctly.',
+      ],
+      settings: [],
+      confirm: null,
+    });
+  }
+
+  if (format.resolutionReason === 'system-byte-contradicted') {
+    add({
+      code: 'system-byte-contradicted',
+      ports: [p.port],
+      severity: 'warning',
+      confidence: 'certain',
+      title: `${p.label}: the system byte names one resolution, the data is in the other`,
+      evidence: [{ text: format.explanation, timeUs: null }],
+      todo: [
+        `Set Betaflight/iNav to ${resolution === 2048 ? 'SPEK2048' : 'SPEK1024'}, what the data is, not what the system byte says.`,
+        'ArduPilot and PX4 ignore the system byte and guess the resolution from the channel IDs, so they are not misled by it; stacks or tools that trust byte 1 are.',
+        'This is a clone or a misbehaving receiver: a genuine Spektrum remote sends a system byte that matches its data (spec §8.3).',
+      ],
+      settings: [],
+      confirm: null,
+    });
+  }
+
+  if (p.xplusMask !== 0) {
+    const names = [];
+    for (let i = 0; i < 8; i++) if ((p.xplusMask >> i) & 1) names.push(`X+${i + 1}`);
+    add({
+      code: 'xplus-channels',
+      ports: [p.port],
+      severity: 'warning',
+      confidence: 'certain',
+      title: `${p.label}: X-Plus channels ${names.join(', ')} are sent; flight controllers drop or mix them`,
+      evidence: [
+        { text: `X-Plus channels (ID 12 with a sub-ID, spec §8.6) seen since ${ctx.at(p.xplusFirstUs)}.`, timeUs: p.xplusFirstUs },
+      ],
+      todo: [
+        'Betaflight and iNav read channel IDs 0–11 only (SPEKTRUM_MAX_SUPPORTED_CHANNEL_COUNT 12): X-Plus channels are dropped.',
+        'ArduPilot (AP_RCProtocol_DSM.cpp) takes every X-Plus word as channel 13, whatever its sub-ID, and reports 13 channels as 12. PX4 reads them as channels 13 and up (its tests expect 16 channels from a DX9 with X+1…X+4).',
+        'Put functions the flight controller needs on channels 1–12, and turn X-Plus off in the transmitter if nothing uses it.',
+      ],
+      settings: [],
+      confirm: null,
+    });
+  }
+
+  if (p.vtxFrames > 0) {
+    add({
+      code: 'vtx-frames',
+      ports: [p.port],
+      severity: 'info',
+      confidence: 'certain',
+      title: `${p.label}: the transmitter sends VTX control in the channel slots`,
+      evidence: [
+        {
+          text: `${plural(p.vtxFrames, 'frame')} carried Spektrum VTX control in bytes 12–15 (0xE… 0xE…), first at ${ctx.at(p.vtxFirstUs)}.`,
+          timeUs: p.vtxFirstUs,
+        },
+      ],
+      todo: [
+        "Betaflight (spektrum.c, with USE_SPEKTRUM_VTX_CONTROL) and ArduPilot (AP_RCProtocol_DSM.cpp) take these frames' last two slots out of the channel data and set the VTX from them; a stack or build without Spektrum VTX support reads the two words as channel data.",
+        'Turn VTX control off in the transmitter if the flight controller does not use it.',
+      ],
+      settings: [],
+      confirm: null,
+    });
+  }
+
+  const g = p.guess.outcomes;
+  const tries = g[10] + g[11] + g.none;
+  const want = resolution === 2048 ? 11 : 10;
+  if (tries >= GUESS_MIN_DECISIONS && g[want] < tries / 2) {
+    add({
+      code: 'autopilot-detection',
+      ports: [p.port],
+      severity: 'warning',
+      confidence: 'likely',
+      title: `${p.label}: ArduPilot may not read this stream by itself`,
+      evidence: [
+        {
+          text: `Channel IDs in ${ARDUPILOT_GUESS_FRAMES} frames read as 11-bit: ${channelSetText(p.guess.last11)}; as 10-bit: ${channelSetText(p.guess.last10)}.`,
+          timeUs: null,
+        },
+        { text: guessNote.ardupilot, timeUs: null },
+      ],
+      todo: [
+        'ArduPilot guesses 10- or 11-bit from the channel numbers, not from the system byte, and needs exactly one reading to give channels 0…n−1 (5 to 16 of them). Change the number of channels the transmitter sends, or bind in DSMX 11 ms (2048), which it tells apart easily.',
+        "Check the result on ArduPilot's radio calibration page: every stick must move one bar.",
+      ],
+      settings: [],
+      confirm: null,
+    });
+  }
+
+  // The link.
+  const s = link.stats;
+  const memoryStart = now - ctx.memoryUs;
+  const episodes = link.episodes.filter((e) => (e.endUs ?? now) >= memoryStart);
+  const failsafes = episodes.filter((e) => e.kind === 'failsafe');
+  // Holds that line damage explains (the frame that ended them came after discarded bytes) are
+  // the line's, not the link's.
+  const byLine = (e: { lastFrameUs: number; endUs: number | null }) =>
+    e.endUs !== null && p.damagedAtUs.some((d) => d > e.lastFrameUs && d <= e.endUs! + 50_000);
+  const holds = episodes.filter((e) => e.kind === 'hold' && !failsafes.some((f) => f.lastFrameUs === e.lastFrameUs) && !byLine(e));
+  const fadesPerMin = s.fadeRate * 60;
+  // A rate needs a few fades behind it: one corrupted header is not a weak link.
+  const recentFades = p.bins.sum(M_FADES, Math.floor(now / 1e6) - 9, Math.floor(now / 1e6));
+  const fadeHigh = format.headerMode === 'fades' && fadesPerMin > REPORT_THRESHOLDS.fadeRateHighPerMin && recentFades >= MIN_FADES;
+  const rssiLow = Number.isFinite(s.minRssi) && s.minRssi < REPORT_THRESHOLDS.rssiLowDbm;
+  if (failsafes.length > 0 || holds.length > 0 || fadeHigh || rssiLow) {
+    const evidence: Evidence[] = [];
+    for (const e of failsafes.slice(-5))
+      evidence.push({
+        text: `Failsafe: no frame for over 1 s after ${ctx.at(e.lastFrameUs)}${e.endUs === null ? ', still now' : `, back at ${ctx.at(e.endUs)}`} (spec §7.1).`,
+        timeUs: e.startUs,
+      });
+    if (holds.length > 0) {
+      const last = holds[holds.length - 1] as (typeof holds)[number];
+      evidence.push({
+        text: `${plural(holds.length, 'hold')} (frames stopped, last values held, recovered), the last at ${ctx.at(last.startUs)}.`,
+        timeUs: last.startUs,
+      });
+    }
+    if (fadeHigh)
+      evidence.push({
+        text: `Fade rate ${fadesPerMin.toFixed(0)} a minute over the last ~500 frames (over ${REPORT_THRESHOLDS.fadeRateHighPerMin} a minute is high).`,
+        timeUs: null,
+      });
+    if (rssiLow)
+      evidence.push({
+        text: `RSSI down to ${s.minRssi} dBm (below ${REPORT_THRESHOLDS.rssiLowDbm} dBm leaves little margin).`,
+        timeUs: null,
+      });
+    add({
+      code: 'weak-link',
+      ports: [p.port],
+      severity: failsafes.length > 0 ? 'problem' : 'warning',
+      confidence: failsafes.length > 0 || fadeHigh || rssiLow || ctx.precise ? 'certain' : 'likely',
+      title: `${p.label}: the link is weak${failsafes.length > 0 ? ': failsafe' : holds.length > 0 ? ': frames lost' : ''}`,
+      evidence,
+      todo: LINK_ADVICE,
+      settings: [],
+      confirm: null,
+    });
+  }
+
+  // Setup, per remote.
+  const changes = p.changes.filter((c) => c.timeUs >= memoryStart);
+  if (changes.length > 0) {
+    const c = changes[changes.length - 1] as (typeof changes)[number];
+    const name = (f: FormatSnapshot): string =>
+      `${f.system !== null ? (systemInfo(f.system)?.name ?? `system 0x${f.system.toString(16)}`) : `${f.resolution}`} ${f.remote}`;
+    add({
+      code: 'rebind',
+      ports: [p.port],
+      severity: 'warning',
+      confidence: 'certain',
+      title: `${p.label}: the receiver changed mode mid-session (a rebind?)`,
+      evidence: [{ text: `From ${name(c.from)} to ${name(c.to)} at ${ctx.at(c.timeUs)}.`, timeUs: c.timeUs }],
+      todo: [
+        'A satellite changes mode only when it is bound again: check that the flight controller does not send bind pulses at every power-up (Betaflight/iNav: spektrum_sat_bind back to 0, or spektrum_sat_bind_autoreset on).',
+        `Set the flight controller for the new mode: ${c.to.resolution === 2048 ? 'SPEK2048' : 'SPEK1024'}.`,
+      ],
+      settings: [],
+      confirm: null,
+      sinceUs: c.timeUs,
+    });
+  }
+  const restarts = p.restarts.filter((r) => r.timeUs >= memoryStart);
+  if (restarts.length > 0) {
+    const r = restarts[restarts.length - 1] as (typeof restarts)[number];
+    add({
+      code: 'receiver-restart',
+      ports: [p.port],
+      severity: 'warning',
+      confidence: 'likely',
+      title: `${p.label}: the receiver restarted (power dip?)`,
+      evidence: [
+        {
+          text: `${plural(restarts.length, 'restart')}: the fade counter went from ${r.from} back to ${r.to} after ${dur(r.gapUs)} without frames, at ${ctx.at(r.timeUs)}; a counter only starts again from 0 at power-up.`,
+          timeUs: r.timeUs,
+        },
+      ],
+      todo: [
+        'Check the 3.3 V supply (orange) under load: a brown-out restarts the satellite; power it from a regulator that does not sag when motors or servos draw current.',
+        'Check the connector and wires for an intermittent contact.',
+      ],
+      settings: [],
+      confirm: null,
+      sinceUs: r.timeUs,
+    });
+  }
+  if (format.headerMode === 'rssi') {
+    add({
+      code: 'rssi-receiver',
+      ports: [p.port],
+      severity: 'info',
+      confidence: 'certain',
+      title: `${p.label}: byte 0 carries RSSI (SPM4649T), not a fade count`,
+      evidence: [
+        {
+          text: `Byte 0 is a signed dBm value (spec §8.3.1)${Number.isFinite(s.rssi) ? `: now ${s.rssi} dBm, lowest ${s.minRssi} dBm` : ''}; −128 marks a lost frame.`,
+          timeUs: null,
+        },
+      ],
+      todo: [
+        'Judge this remote by RSSI and lost frames, not by fades: it counts none.',
+        'PX4 reads a negative byte 0 as RSSI (dsm.cpp); stacks that read byte 0 as fades, or ignore it, show no RSSI for it.',
+      ],
+      settings: [],
+      confirm: null,
+    });
+  }
+}
+
+/** What ArduPilot's guess makes of this remote's frames, and what is known of PX4, as sentences. */
+function guessNotes(p: PortState, resolution: Resolution): { ardupilot: string; px4: string } {
+  const d = p.guess.outcomes;
+  const want = resolution === 2048 ? 11 : 10;
+  const other = want === 11 ? 10 : 11;
+  const n = d[10] + d[11] + d.none;
+  const where = 'AP_RCProtocol_DSM.cpp, replayed';
+  let ardupilot =
+    n === 0
+      ? `Detects the DSM protocol by itself (${where}: not enough frames yet).`
+      : d[want] === n
+        ? `Detects it by itself: its 10/11-bit guess settles on ${want}-bit (${resolution}) (${where}).`
+        : d.none === n
+          ? `Its 10/11-bit guess never settles (${n} tries), so it would output no channels (${where}).`
+          : `Its 10/11-bit guess settled on ${want}-bit in ${d[want]} of ${n} tries${d[other] > 0 ? `, on the wrong ${other}-bit reading in ${d[other]}` : ''} (${where}).`;
+  if (p.xplusMask !== 0)
+    ardupilot +=
+      ' It takes every X-Plus word as channel 13 whatever its sub-ID, and reports 13 channels as 12: X-Plus channels are not usable.';
+  const px4 = `rc_input detects DSM by itself and guesses the resolution from the channel IDs (src/lib/rc/dsm.cpp)${p.xplusMask !== 0 ? '; its tests expect X-Plus channels as channels 13 and up (rc_tests/RCTest.cpp, 16 channels from a DX9)' : ''}.`;
+  return { ardupilot, px4 };
+}

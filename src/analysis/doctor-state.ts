@@ -1,0 +1,127 @@
+/**
+ * What the doctor keeps per port: its thresholds, one-second bins of counters over the last
+ * 64 seconds, and the state its rules read (activity, packets, frames, formats, restarts).
+ */
+import type { Resolution } from '../decoder/index.js';
+import { type BurstClock, PACKET_KINDS, type PacketKind, type PacketScanner } from './doctor-line.js';
+import type { ArduPilotGuess, ForeignProtocol } from './doctor-stacks.js';
+import type { DoctorPortSource } from './doctor-types.js';
+
+/** Silence after the port opened before "nothing arrives": a linked satellite sends every 11 or 22 ms, so 1 s is 45 missed frames. */
+export const NOTHING_AFTER_US = 1_000_000;
+/** …and after this long it is certain. */
+export const NOTHING_CERTAIN_US = 3_000_000;
+/** Line findings look at the last 3 one-second bins. */
+export const LINE_WINDOW_BINS = 3;
+/** A fade-counter drop after a gap this long is a restart, not a wrap. */
+export const RESTART_MIN_GAP_US = 100_000;
+/** Seconds with fades on two remotes or more, out of the seconds with fades on any, above which they fade together. */
+export const TOGETHER_RATIO = 0.6;
+export const TOGETHER_MIN_SECONDS = 3;
+/** Clean bytes that decode as nothing are judged only after this long (a satellite locks within a few frames). */
+export const UNKNOWN_AFTER_US = 1_500_000;
+/** Fades in the last 10 s before a fade rate is judged. */
+export const MIN_FADES = 5;
+/** Frames a remote must have sent before its format counts for setup findings. */
+export const SETUP_MIN_FRAMES = 20;
+/** Guess decisions before predicting ArduPilot's or PX4's outcome. */
+export const GUESS_MIN_DECISIONS = 3;
+
+export const BIN_COUNT = 64;
+export const M_BYTES = 0;
+export const M_FRAME_BYTES = 1;
+export const M_CHAR_ERRORS = 2;
+export const M_BREAKS = 3;
+export const M_OVERRUNS = 4;
+export const M_FADES = 5;
+export const M_MISSED = 6;
+export const M_PACKETS = 7; // + index in PACKET_KINDS
+export const METRICS = M_PACKETS + PACKET_KINDS.length;
+
+/** Counters in one-second bins, the last 64 seconds. */
+export class Bins {
+  readonly #data = new Float64Array(BIN_COUNT * METRICS);
+  readonly #second = new Float64Array(BIN_COUNT).fill(NaN);
+
+  add(metric: number, timeUs: number, n: number): void {
+    if (!Number.isFinite(timeUs)) return;
+    const s = Math.floor(timeUs / 1e6);
+    const slot = ((s % BIN_COUNT) + BIN_COUNT) % BIN_COUNT;
+    if (this.#second[slot] !== s) {
+      if (s < (this.#second[slot] ?? NaN)) return; // older than the window
+      this.#second[slot] = s;
+      this.#data.fill(0, slot * METRICS, slot * METRICS + METRICS);
+    }
+    this.#data[slot * METRICS + metric] = (this.#data[slot * METRICS + metric] ?? 0) + n;
+  }
+
+  /** Sum over the seconds fromS…toS (inclusive). */
+  sum(metric: number, fromS: number, toS: number): number {
+    let total = 0;
+    for (let slot = 0; slot < BIN_COUNT; slot++) {
+      const s = this.#second[slot] ?? NaN;
+      if (s >= fromS && s <= toS) total += this.#data[slot * METRICS + metric] ?? 0;
+    }
+    return total;
+  }
+
+  /** The value of one second. */
+  at(metric: number, s: number): number {
+    const slot = ((s % BIN_COUNT) + BIN_COUNT) % BIN_COUNT;
+    return this.#second[slot] === s ? (this.#data[slot * METRICS + metric] ?? 0) : 0;
+  }
+
+  clear(): void {
+    this.#second.fill(NaN);
+  }
+}
+
+export interface FormatSnapshot {
+  system: number | null;
+  resolution: Resolution;
+  remote: 'internal' | 'external';
+  timeUs: number;
+}
+
+export interface PortState {
+  port: number;
+  label: string;
+  source: DoctorPortSource | null;
+  openUs: number;
+  baudRate: number;
+  /** First byte or error since the port opened. */
+  firstActivityUs: number;
+  lastActivityUs: number;
+  /** Bytes and errors since the port opened. */
+  activity: number;
+  /** Time of the latest data: a chunk without a time takes it. */
+  lastTimeUs: number;
+  bins: Bins;
+  scanner: PacketScanner;
+  /** Time to book the scanner's packets at (the chunk being scanned). */
+  scanTimeUs: number;
+  burst: BurstClock;
+  /** A protocol recognised at another speed while probing, kept until a satellite shows up. */
+  confirmed: { protocol: ForeignProtocol; timeUs: number; packets: number; baudRate: number } | null;
+  probePackets: Record<PacketKind, number>;
+  // Frames
+  frames: number;
+  guess: ArduPilotGuess;
+  xplusMask: number;
+  xplusFirstUs: number;
+  vtxFrames: number;
+  vtxFirstUs: number;
+  prevFades: number | null;
+  prevFrameUs: number;
+  prevMissed: number;
+  /** Decoder's discarded bytes at the last frame, and the frame times that came after a discard (line damage). */
+  prevDiscarded: number;
+  damagedAtUs: number[];
+  first: FormatSnapshot | null;
+  changes: { timeUs: number; from: FormatSnapshot; to: FormatSnapshot }[];
+  restarts: { timeUs: number; from: number; to: number; gapUs: number }[];
+  rssiFrames: number;
+}
+
+/** "2.4 s" */
+export const dur = (us: number): string => `${(us / 1e6).toFixed(1)} s`;
