@@ -25,17 +25,7 @@
  * (emitted unconditionally): so `next()` always returns after bounded work.
  */
 import { BYTE_TIME_US, FRAME_SIZE, systemInfo, type Resolution } from './spec.js';
-import {
-  createFrame,
-  createVtx,
-  countZeroWords,
-  decodeSlots,
-  INVALID,
-  isVtxFrame,
-  layoutChannels,
-  readSlots,
-  slotLayout,
-} from './frame.js';
+import { byteAt, countZeroWords, createFrame, FrameSlots, INVALID, layoutChannels, readFrame, showSlots, slotLayout } from './frame.js';
 import type {
   DecodedFrame,
   DecoderEvent,
@@ -144,7 +134,7 @@ export class SpektrumDecoder {
   readonly #onEvent: ((event: DecoderEvent) => void) | undefined;
 
   #buf = new Uint8Array(INITIAL_CAPACITY);
-  /** #buf as 32-bit words: the fast path copies a frame that starts at a multiple of 4 in four moves. */
+  /** #buf as 32-bit words: a frame that starts at a multiple of 4 is copied in four moves. */
   #buf32 = new Uint32Array(this.#buf.buffer);
   /**
    * Times are kept per pushed chunk, not per byte (filling a time for every byte cost a third of
@@ -192,9 +182,15 @@ export class SpektrumDecoder {
   #layoutCount = 0;
   #layoutNext = 0;
 
-  readonly #frame = createFrame();
-  readonly #frameBytes32 = new Uint32Array(this.#frame.bytes.buffer, this.#frame.bytes.byteOffset, FRAME_SIZE / 4);
-  readonly #vtx = createVtx();
+  /**
+   * Two sets of slot arrays: the one #frame shows, and one that holds the frame at stream
+   * offset #stagedAt (-1: none), decoded by the fast path while it confirmed the frame before.
+   * Emitting that frame then swaps the sets instead of decoding it again.
+   */
+  #shown = new FrameSlots();
+  #staged = new FrameSlots();
+  #stagedAt = -1;
+  readonly #frame = createFrame(this.#shown);
   readonly #stats: DecoderStats = {
     bytes: 0,
     frames: 0,
@@ -340,6 +336,7 @@ export class SpektrumDecoder {
     this.#locked = this.#everLocked = false;
     this.#confirmedUntil = 0;
     this.#nextAt = -1;
+    this.#stagedAt = -1;
     this.#resolution = null;
     this.#reason = 'unknown';
     this.#remote = this.#system = null;
@@ -380,10 +377,16 @@ export class SpektrumDecoder {
    * or `reset()`.
    */
   next(): DecodedFrame | undefined {
+    // Kept small, so that it is inlined into the caller's loop beside push().
     if (this.#fastPath && this.#locked) {
       const frame = this.#nextFast();
       if (frame !== null) return frame;
     }
+    return this.#nextGeneral();
+  }
+
+  /** next() on the general path: every rule, every case. */
+  #nextGeneral(): DecodedFrame | undefined {
     for (;;) {
       if (!this.#locked) {
         if (!this.#acquire()) return undefined;
@@ -489,55 +492,63 @@ export class SpektrumDecoder {
    * behind; its header continues the last frame's with a fade step the general path would count
    * without an event; and the whole next frame is in, valid, and continues it. Then it is
    * emitted exactly as the general path would emit it. Anything else returns null and the
-   * general path decides (it finds the same state: nothing here is changed before emitting).
+   * general path decides (it finds the same state: nothing it reads is changed before emitting).
+   *
+   * Each byte is read once: validating the next frame decodes it into the spare slot arrays
+   * (#staged), which the frame shows when that one is emitted in turn.
    */
   #nextFast(): DecodedFrame | null {
     const o = this.#head;
-    if (this.#tail - o < 2 * FRAME_SIZE) return null;
+    const n = o + FRAME_SIZE;
+    const resolution = this.#resolution;
+    if (n + FRAME_SIZE > this.#tail || resolution === null) return null;
     const at = this.#base + o;
     if (at !== this.#nextAt || at < this.#confirmedUntil || !this.#haveLast) return null;
     const layout = this.#nextLayout;
-    if (layout === INVALID) return null;
+    if (layout === INVALID || !this.#knownLayout(layout)) return null;
     const buf = this.#buf;
-    const b0 = buf[o] as number;
-    const b1 = buf[o + 1] as number;
-    const n = o + FRAME_SIZE;
+    const b0 = byteAt(buf, o);
+    const b1 = byteAt(buf, o + 1);
+    const internal = this.#remote === 'internal';
     let delta = 0;
-    if (this.#remote === 'internal') {
+    if (internal) {
       const mode = this.#b0Mode;
       const system = this.#system;
       if (b1 !== system || buf[n + 1] !== system) return null;
       if (mode === B0_FADES) {
         // #fitsLast and #follows with FADE_STEP, and #fadeDelta's rise without an event.
         delta = (b0 - this.#last0) & 0xff;
-        if (delta >= FADE_STEP || (((buf[n] as number) - b0) & 0xff) >= FADE_STEP) return null;
+        if (delta >= FADE_STEP || ((byteAt(buf, n) - b0) & 0xff) >= FADE_STEP) return null;
       } else if (mode === B0_RSSI) {
-        if (!plausibleRssi(b0) || !plausibleRssi(buf[n] as number)) return null;
+        if (!plausibleRssi(b0) || !plausibleRssi(byteAt(buf, n))) return null;
       } else if (mode !== B0_RSSI_FORCED) {
         return null; // B0_UNKNOWN: emitting may decide byte 0 (an event), the general path's job.
       }
     } else {
       const count = (b0 << 8) | b1;
       delta = (count - ((this.#last0 << 8) | this.#last1)) & 0xffff;
-      if (delta >= FADE_STEP || (((((buf[n] as number) << 8) | (buf[n + 1] as number)) - count) & 0xffff) >= FADE_STEP) return null;
+      if (delta >= FADE_STEP || ((((byteAt(buf, n) << 8) | byteAt(buf, n + 1)) - count) & 0xffff) >= FADE_STEP) return null;
     }
-    const next = slotLayout(buf, n, this.#resolution as Resolution);
-    if (next === INVALID || !this.#knownLayout(layout)) return null;
+    // This frame's slots: staged while the one before was confirmed, else decoded now.
+    const slots = this.#staged;
+    if (this.#stagedAt !== at) readFrame(buf, this.#buf32, o, resolution, slots);
+    const spare = this.#shown;
+    const next = readFrame(buf, this.#buf32, n, resolution, spare);
+    if (next === INVALID) {
+      this.#stagedAt = at;
+      return null;
+    }
+    this.#shown = slots;
+    this.#staged = spare;
+    this.#stagedAt = at + FRAME_SIZE;
     this.#nextAt = at + FRAME_SIZE;
     this.#nextLayout = next;
-    return this.#emitFast(o, b0, b1, delta);
-  }
-
-  /** #emit for a frame #nextFast vouched for: a known layout, a fade step without an event, byte 0's reading settled. */
-  #emitFast(o: number, b0: number, b1: number, delta: number): DecodedFrame {
-    const buf = this.#buf;
     const frame = this.#frame;
-    const resolution = this.#resolution as Resolution;
     frame.index++;
-    frame.offset = this.#base + o;
+    frame.offset = at;
     this.#stampTime(frame, o);
     frame.resolution = resolution;
-    if (this.#remote === 'internal') {
+    if (internal) {
       frame.remote = 'internal';
       frame.system = b1;
       if (this.#b0Mode === B0_FADES) {
@@ -557,20 +568,8 @@ export class SpektrumDecoder {
     this.#last0 = b0;
     this.#last1 = b1;
     this.#jumpTrusted = false;
-    if ((o & 3) === 0) {
-      // A raw copy in the platform's byte order both ways: the same 16 bytes.
-      const from = this.#buf32;
-      const to = this.#frameBytes32;
-      const k = o >> 2;
-      to[0] = from[k] as number;
-      to[1] = from[k + 1] as number;
-      to[2] = from[k + 2] as number;
-      to[3] = from[k + 3] as number;
-    } else {
-      const bytes = frame.bytes;
-      for (let i = 0; i < FRAME_SIZE; i++) bytes[i] = buf[o + i] as number;
-    }
-    return this.#counted(frame, o, decodeSlots(frame, buf, o, resolution, isVtxFrame(buf, o), this.#vtx));
+    showSlots(frame, slots);
+    return this.#counted(frame, o, slots);
   }
 
   /** Whether the header at `o` continues the last emitted frame under the lock's model. */
@@ -716,6 +715,7 @@ export class SpektrumDecoder {
     this.#locked = false;
     this.#confirmedUntil = 0;
     this.#nextAt = -1;
+    this.#stagedAt = -1;
   }
 
   #knownLayout(layout: number): boolean {
@@ -771,17 +771,20 @@ export class SpektrumDecoder {
     this.#last1 = b1;
     this.#haveLast = true;
     this.#jumpTrusted = false;
-    return this.#counted(frame, o, readSlots(frame, buf, o, resolution, isVtxFrame(buf, o), this.#vtx));
+    const slots = this.#shown;
+    readFrame(buf, this.#buf32, o, resolution, slots);
+    showSlots(frame, slots);
+    return this.#counted(frame, o, slots);
   }
 
-  /** Counts the frame just filled at `o` (with `empty` 0xFFFF slots) and moves past it: both emit paths end here. */
-  #counted(frame: DecodedFrame, o: number, empty: number): DecodedFrame {
+  /** Counts the frame just filled at `o` from `slots` and moves past it: both emit paths end here. */
+  #counted(frame: DecodedFrame, o: number, slots: FrameSlots): DecodedFrame {
     const s = this.#stats;
     s.frames++;
     s.frameBytes += FRAME_SIZE;
     s.pendingBytes -= FRAME_SIZE;
-    s.emptySlots += empty;
-    if (frame.vtx !== null) s.vtxFrames++;
+    s.emptySlots += slots.empty;
+    if (slots.hasVtx) s.vtxFrames++;
     this.#head = o + FRAME_SIZE;
     return frame;
   }
