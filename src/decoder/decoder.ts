@@ -123,6 +123,11 @@ function byte0Follows(prev: number, next: number, mode: number, step = FADE_STEP
   return rise || (plausibleRssi(prev) && plausibleRssi(next));
 }
 
+/** `t[i]` at an index the caller knows is inside `t`: a typed read (an index past the end, a bug, reads as NaN). */
+function timeAt(t: Float64Array, i: number): number {
+  return t[i] ?? NaN;
+}
+
 /** Whether an external remote's UINT16 fade count can go from `prev` to `next` between consecutive frames. */
 function countFollows(prev: number, next: number, step = FADE_STEP): boolean {
   return step === ACQUIRE_FADE_STEP ? next >= prev && next - prev < step : ((next - prev) & 0xffff) < step;
@@ -159,9 +164,11 @@ export class SpektrumDecoder {
   #everLocked = false;
   /** Stream offset up to which acquisition has confirmed frames: they are emitted as they stand. */
   #confirmedUntil = 0;
-  #resolution: Resolution | null = null;
+  /** The lock's resolution (the last one locked on; `format` shows null until #everLocked). */
+  #resolution: Resolution = 2048;
   #reason: ResolutionReason = 'unknown';
-  #remote: RemoteKind | null = null;
+  /** The lock's remote kind (as #resolution). */
+  #remote: RemoteKind = 'external';
   /** The internal remote's system byte (valid or not), or null. */
   #system: number | null = null;
   /** B0_* : how byte 0 of an internal remote is read. */
@@ -324,7 +331,7 @@ export class SpektrumDecoder {
       this.#layoutCount = 0;
       this.#reason = 'unknown';
     } else {
-      this.#setReason(this.#resolution as Resolution);
+      this.#setReason(this.#resolution);
     }
   }
 
@@ -337,9 +344,10 @@ export class SpektrumDecoder {
     this.#confirmedUntil = 0;
     this.#nextAt = -1;
     this.#stagedAt = -1;
-    this.#resolution = null;
+    this.#resolution = 2048;
     this.#reason = 'unknown';
-    this.#remote = this.#system = null;
+    this.#remote = 'external';
+    this.#system = null;
     this.#b0Mode = B0_FADES;
     this.#forcedMismatch = null;
     this.#haveLast = false;
@@ -360,10 +368,10 @@ export class SpektrumDecoder {
   get format(): FormatInfo {
     return {
       locked: this.#locked,
-      resolution: this.#resolution,
+      resolution: this.#everLocked ? this.#resolution : null,
       resolutionReason: this.#reason,
       explanation: this.#explain(),
-      remote: this.#remote,
+      remote: this.#everLocked ? this.#remote : null,
       system: this.#system,
       systemValid: this.#system !== null && systemInfo(this.#system) !== undefined,
       headerMode: this.#headerReading(),
@@ -398,7 +406,7 @@ export class SpektrumDecoder {
         if (this.#ended && avail > 0) this.#discard(o, avail, 'end-of-stream');
         return undefined;
       }
-      const resolution = this.#resolution as Resolution;
+      const resolution = this.#resolution;
       const at = this.#base + o;
       const layout = at === this.#nextAt ? this.#nextLayout : slotLayout(this.#buf, o, resolution);
       // Frames acquisition confirmed go out as they stand.
@@ -500,12 +508,12 @@ export class SpektrumDecoder {
   #nextFast(): DecodedFrame | null {
     const o = this.#head;
     const n = o + FRAME_SIZE;
-    const resolution = this.#resolution;
-    if (n + FRAME_SIZE > this.#tail || resolution === null) return null;
+    if (n + FRAME_SIZE > this.#tail) return null;
     const at = this.#base + o;
     if (at !== this.#nextAt || at < this.#confirmedUntil || !this.#haveLast) return null;
     const layout = this.#nextLayout;
     if (layout === INVALID || !this.#knownLayout(layout)) return null;
+    const resolution = this.#resolution;
     const buf = this.#buf;
     const b0 = byteAt(buf, o);
     const b1 = byteAt(buf, o + 1);
@@ -575,8 +583,8 @@ export class SpektrumDecoder {
   /** Whether the header at `o` continues the last emitted frame under the lock's model. */
   #fitsLast(o: number): boolean {
     const b = this.#buf;
-    const b0 = b[o] as number;
-    const b1 = b[o + 1] as number;
+    const b0 = byteAt(b, o);
+    const b1 = byteAt(b, o + 1);
     if (this.#remote === 'internal') {
       if (b1 !== this.#system) return false;
       return this.#haveLast ? byte0Follows(this.#last0, b0, this.#b0Mode) : this.#b0Mode !== B0_RSSI || b0 >= 0x80;
@@ -589,9 +597,9 @@ export class SpektrumDecoder {
   #follows(a: number, b: number): boolean {
     const buf = this.#buf;
     if (this.#remote === 'internal') {
-      return buf[b + 1] === this.#system && byte0Follows(buf[a] as number, buf[b] as number, this.#b0Mode);
+      return buf[b + 1] === this.#system && byte0Follows(byteAt(buf, a), byteAt(buf, b), this.#b0Mode);
     }
-    return countFollows(((buf[a] as number) << 8) | (buf[a + 1] as number), ((buf[b] as number) << 8) | (buf[b + 1] as number));
+    return countFollows((byteAt(buf, a) << 8) | byteAt(buf, a + 1), (byteAt(buf, b) << 8) | byteAt(buf, b + 1));
   }
 
   /**
@@ -603,10 +611,10 @@ export class SpektrumDecoder {
     // An external count has no system byte to vouch for it: a jump there may be an internal
     // remote taking over (`00 00` then `00 B2`), which acquisition decides.
     if (this.#remote !== 'internal' || !this.#knownLayout(layout) || o + 2 * FRAME_SIZE > this.#tail) return false;
-    if (buf[o + 1] !== this.#system || (this.#b0Mode === B0_RSSI && !plausibleRssi(buf[o] as number))) return false;
+    if (buf[o + 1] !== this.#system || (this.#b0Mode === B0_RSSI && !plausibleRssi(byteAt(buf, o)))) return false;
     // Fades rise: a fall is something else (a restarted receiver, RSSI), for acquisition to read.
-    if (this.#b0Mode !== B0_RSSI && this.#haveLast && (((buf[o] as number) - this.#last0) & 0xff) >= 0x80) return false;
-    return slotLayout(buf, o + FRAME_SIZE, this.#resolution as Resolution) !== INVALID && this.#follows(o, o + FRAME_SIZE);
+    if (this.#b0Mode !== B0_RSSI && this.#haveLast && ((byteAt(buf, o) - this.#last0) & 0xff) >= 0x80) return false;
+    return slotLayout(buf, o + FRAME_SIZE, this.#resolution) !== INVALID && this.#follows(o, o + FRAME_SIZE);
   }
 
   /**
@@ -616,7 +624,7 @@ export class SpektrumDecoder {
    * that have not arrived.
    */
   #search(from: number, to: number): number {
-    const resolution = this.#resolution as Resolution;
+    const resolution = this.#resolution;
     const buf = this.#buf;
     let alone = NOT_FOUND;
     let aloneLayout = INVALID;
@@ -649,7 +657,7 @@ export class SpektrumDecoder {
     const buf = this.#buf;
     const n = o + FRAME_SIZE;
     // An external count (often `00 00`) is too weak a header to stand on: zero bytes abound in slots.
-    return this.#remote === 'internal' && buf[n + 1] === this.#system && byte0Follows(buf[o] as number, buf[n] as number, this.#b0Mode);
+    return this.#remote === 'internal' && buf[n + 1] === this.#system && byte0Follows(byteAt(buf, o), byteAt(buf, n), this.#b0Mode);
   }
 
   /**
@@ -661,12 +669,7 @@ export class SpektrumDecoder {
   #lastOfItsKind(o: number, layout: number): boolean {
     if (!this.#knownLayout(layout)) return false;
     const a = o + FRAME_SIZE;
-    if (
-      this.#haveLast &&
-      a + FRAME_SIZE <= this.#tail &&
-      slotLayout(this.#buf, a, this.#resolution as Resolution) !== INVALID &&
-      this.#fitsLast(a)
-    )
+    if (this.#haveLast && a + FRAME_SIZE <= this.#tail && slotLayout(this.#buf, a, this.#resolution) !== INVALID && this.#fitsLast(a))
       return false;
     return this.#chainStartsAt(a) === 1;
   }
@@ -679,13 +682,13 @@ export class SpektrumDecoder {
     const buf = this.#buf;
     const b = a + FRAME_SIZE;
     if (b + FRAME_SIZE > this.#tail) return false;
-    const resolution = this.#resolution as Resolution;
+    const resolution = this.#resolution;
     return (
       buf[a + 1] === this.#system &&
       buf[b + 1] === this.#system &&
       slotLayout(buf, a, resolution) !== INVALID &&
       slotLayout(buf, b, resolution) !== INVALID &&
-      byte0Follows(buf[a] as number, buf[b] as number, this.#b0Mode)
+      byte0Follows(byteAt(buf, a), byteAt(buf, b), this.#b0Mode)
     );
   }
 
@@ -735,15 +738,15 @@ export class SpektrumDecoder {
     this.#learnLayout(layout);
     const buf = this.#buf;
     const frame = this.#frame;
-    const resolution = this.#resolution as Resolution;
+    const resolution = this.#resolution;
     frame.index++;
     frame.offset = this.#base + o;
     this.#stampTime(frame, o);
     frame.resolution = resolution;
-    const remote = this.#remote as RemoteKind;
+    const remote = this.#remote;
     frame.remote = remote;
-    const b0 = buf[o] as number;
-    const b1 = buf[o + 1] as number;
+    const b0 = byteAt(buf, o);
+    const b1 = byteAt(buf, o + 1);
     let delta = 0;
     if (remote === 'internal') {
       frame.system = b1;
@@ -869,7 +872,7 @@ export class SpektrumDecoder {
       this.#resolution === resolution;
     let b0Mode = this.#candB0;
     // The same remote going on keeps what its byte 0 was shown to be, if byte 0 goes on too.
-    if (internal && b0Mode === B0_UNKNOWN && sameRemote && byte0Follows(this.#last0, this.#buf[o] as number, this.#b0Mode))
+    if (internal && b0Mode === B0_UNKNOWN && sameRemote && byte0Follows(this.#last0, byteAt(this.#buf, o), this.#b0Mode))
       b0Mode = this.#b0Mode;
     if (internal && b0Mode === B0_UNKNOWN) {
       // Byte 0 has only been a plausible RSSI and never fallen: read further along the chain before deciding.
@@ -926,13 +929,9 @@ export class SpektrumDecoder {
       return false;
     if (internal) {
       const mode = this.#options.headerMode === 'rssi' ? B0_RSSI_FORCED : this.#options.headerMode === 'fades' ? B0_FADES : B0_UNKNOWN;
-      return buf[a + 1] === system && buf[b + 1] === system && byte0Follows(buf[a] as number, buf[b] as number, mode, ACQUIRE_FADE_STEP);
+      return buf[a + 1] === system && buf[b + 1] === system && byte0Follows(byteAt(buf, a), byteAt(buf, b), mode, ACQUIRE_FADE_STEP);
     }
-    return countFollows(
-      ((buf[a] as number) << 8) | (buf[a + 1] as number),
-      ((buf[b] as number) << 8) | (buf[b + 1] as number),
-      ACQUIRE_FADE_STEP,
-    );
+    return countFollows((byteAt(buf, a) << 8) | byteAt(buf, a + 1), (byteAt(buf, b) << 8) | byteAt(buf, b + 1), ACQUIRE_FADE_STEP);
   }
 
   /** The best-scoring start among the next ACQUIRE_SHIFTS offsets, at one resolution or (0) both. */
@@ -976,11 +975,11 @@ export class SpektrumDecoder {
    */
   #byte0Evidence(o: number, resolution: Resolution, system: number): number {
     const buf = this.#buf;
-    let prev = buf[o] as number;
+    let prev = byteAt(buf, o);
     for (let k = 1; k < HEADER_EVIDENCE_FRAMES; k++) {
       const f = o + k * FRAME_SIZE;
       if (f + FRAME_SIZE > this.#tail) return this.#ended ? B0_UNKNOWN : NEED_MORE;
-      const b0 = buf[f] as number;
+      const b0 = byteAt(buf, f);
       if (buf[f + 1] !== system || slotLayout(buf, f, resolution) === INVALID || !byte0Follows(prev, b0, B0_UNKNOWN, ACQUIRE_FADE_STEP))
         return B0_UNKNOWN;
       if (!plausibleRssi(b0)) return B0_FADES;
@@ -1000,7 +999,7 @@ export class SpektrumDecoder {
   #score(o: number, resolution: Resolution, frames: number): number {
     const buf = this.#buf;
     const { remote, headerMode } = this.#options;
-    const s = buf[o + 1] as number;
+    const s = byteAt(buf, o + 1);
     const forcedB0 = headerMode === 'rssi' ? B0_RSSI_FORCED : headerMode === 'fades' ? B0_FADES : B0_UNKNOWN;
     // How far each header reading carries the chain.
     let chainI = remote === 'external' ? 0 : frames;
@@ -1022,17 +1021,13 @@ export class SpektrumDecoder {
       if (k === 0) continue;
       const p = f - FRAME_SIZE;
       if (chainI > k) {
-        if (buf[f + 1] === s && byte0Follows(buf[good] as number, buf[f] as number, forcedB0, ACQUIRE_FADE_STEP)) good = f;
+        if (buf[f + 1] === s && byte0Follows(byteAt(buf, good), byteAt(buf, f), forcedB0, ACQUIRE_FADE_STEP)) good = f;
         else if (damaged < 0 && info !== undefined && k < frames - 1) damaged = k;
         else chainI = k;
       }
       if (
         chainE > k &&
-        !countFollows(
-          ((buf[p] as number) << 8) | (buf[p + 1] as number),
-          ((buf[f] as number) << 8) | (buf[f + 1] as number),
-          ACQUIRE_FADE_STEP,
-        )
+        !countFollows((byteAt(buf, p) << 8) | byteAt(buf, p + 1), (byteAt(buf, f) << 8) | byteAt(buf, f + 1), ACQUIRE_FADE_STEP)
       )
         chainE = k;
       if (chainI <= k && chainE <= k) break;
@@ -1046,8 +1041,8 @@ export class SpektrumDecoder {
     // A header that continues the last one as a rising count is that count moving, though.
     const countGoesOn =
       this.#haveLast &&
-      countFollows((this.#last0 << 8) | this.#last1, ((buf[o] as number) << 8) | s) &&
-      (((buf[o] as number) << 8) | s) !== ((this.#last0 << 8) | this.#last1);
+      countFollows((this.#last0 << 8) | this.#last1, (byteAt(buf, o) << 8) | s) &&
+      ((byteAt(buf, o) << 8) | s) !== ((this.#last0 << 8) | this.#last1);
     const preferInternal =
       remote === 'internal' || info !== undefined || (s !== 0 && !zeroByte0 && !countGoesOn && this.#remote === 'internal');
     const internal = chainI > chainE || (chainI === chainE && preferInternal);
@@ -1072,9 +1067,9 @@ export class SpektrumDecoder {
     for (let k = 0; k < length; k++) {
       const f = o + k * FRAME_SIZE;
       const layout = slotLayout(buf, f, resolution);
-      const b0 = buf[f] as number;
+      const b0 = byteAt(buf, f);
       if (!plausibleRssi(b0)) positive = true;
-      else if (k > 0 && b0 < (buf[f - FRAME_SIZE] as number)) fell = true;
+      else if (k > 0 && b0 < byteAt(buf, f - FRAME_SIZE)) fell = true;
       if (layout === layout2) recurring++;
       layout2 = layout1;
       layout1 = layout;
@@ -1090,11 +1085,11 @@ export class SpektrumDecoder {
       // A §8.3 system byte in every frame is strong evidence of an internal remote.
       if (info !== undefined) score += 8;
       if (info?.resolution === resolution) score += 2;
-    } else if ((((buf[o] as number) << 8) | s) < 256) {
+    } else if (((byteAt(buf, o) << 8) | s) < 256) {
       score += 1;
     }
     // A header of 0xFFFF is an empty slot's filler more often than a fade count at its limit.
-    if ((((buf[o] as number) << 8) | s) === 0xffff) score -= 3;
+    if (((byteAt(buf, o) << 8) | s) === 0xffff) score -= 3;
     // Transmitters send channels 0…N-1: a contiguous set is the signature of the right reading.
     if ((channels & (channels + 1)) === 0) score += 2;
     this.#candInternal = internal;
@@ -1115,7 +1110,7 @@ export class SpektrumDecoder {
   #readsInternalLate(o: number, resolution: Resolution, length: number): boolean {
     const buf = this.#buf;
     for (let i = 0; i < 7; i++) {
-      const system = buf[o + 3 + 2 * i] as number;
+      const system = byteAt(buf, o + 3 + 2 * i);
       if (systemInfo(system) === undefined) continue;
       let agree = 0;
       for (let h = o + 2 + 2 * i - FRAME_SIZE; h + FRAME_SIZE <= this.#tail && h < o + length * FRAME_SIZE; h += FRAME_SIZE) {
@@ -1147,7 +1142,7 @@ export class SpektrumDecoder {
     if (other !== null) {
       return `Forced ${this.#options.resolution}: no frame matches; the stream looks like ${other}.`;
     }
-    if (this.#resolution === null) return 'Not locked on to frames yet.';
+    if (!this.#everLocked) return 'Not locked on to frames yet.';
     if (!this.#locked) return 'Looking for frames again: the format changed or the frames stopped making sense.';
     const res = this.#resolution;
     const sys = this.#system === null ? undefined : systemInfo(this.#system);
@@ -1241,15 +1236,20 @@ export class SpektrumDecoder {
    */
   #stampTime(frame: DecodedFrame, o: number): void {
     const x = this.#base + o;
-    this.#dropChunksBefore(x);
-    const i = this.#chunkHead;
-    if (this.#chunkPerByte[i] === 1) frame.timeUs = (this.#byteTimes as Float64Array)[o] as number;
-    else frame.timeUs = (this.#chunkTimes[i] as number) - ((this.#chunkEnds[i] as number) - 1 - x) * BYTE_TIME_US;
+    const i = this.#dropChunksBefore(x);
+    const byteTimes = this.#byteTimes;
+    if (this.#chunkPerByte[i] === 1 && byteTimes !== null) frame.timeUs = timeAt(byteTimes, o);
+    else frame.timeUs = timeAt(this.#chunkTimes, i) - (timeAt(this.#chunkEnds, i) - 1 - x) * BYTE_TIME_US;
   }
 
-  /** Forgets the records of chunks that end at or before stream offset `x` (keeps the last one). */
-  #dropChunksBefore(x: number): void {
-    while (this.#chunkHead < this.#chunkTail - 1 && (this.#chunkEnds[this.#chunkHead] as number) <= x) this.#chunkHead++;
+  /** Forgets the records of chunks that end at or before stream offset `x` (keeps the last one); returns the first kept. */
+  #dropChunksBefore(x: number): number {
+    const ends = this.#chunkEnds;
+    const last = this.#chunkTail - 1;
+    let i = this.#chunkHead;
+    while (i < last && timeAt(ends, i) <= x) i++;
+    this.#chunkHead = i;
+    return i;
   }
 
   /** Makes room for `n` more bytes: compacts first, grows (doubling) only when full. */

@@ -211,11 +211,10 @@ export function readFrame(b: Uint8Array, b32: Uint32Array, o: number, resolution
   let layout = 0;
   let count = 0;
   let empty = 0;
-  for (let i = 0; i < 7; i++) {
+  for (let i = 0; i < slots; i++) {
     const hi = b[o + 2 + 2 * i]!;
     const word = (hi << 8) | b[o + 3 + 2 * i]!;
     words[i] = word;
-    if (i >= slots) continue;
     if (word === 0xffff) {
       layout |= 13 << (4 * i); // EMPTY_SLOT: code 13
       empty++;
@@ -238,7 +237,7 @@ export function readFrame(b: Uint8Array, b32: Uint32Array, o: number, resolution
   copyBytes(b, b32, o, into.bytes, into.bytes32);
   if (vtx) {
     layout |= VTX_CODES;
-    readVtx(b, o, into.vtx);
+    readVtx(b, o, into);
   }
   return (b[o + 2]! & 0x80) !== 0 ? layout | (1 << 28) : layout; // LAYOUT_PHASE_BIT
 }
@@ -257,9 +256,14 @@ function copyBytes(b: Uint8Array, b32: Uint32Array, o: number, bytes: Uint8Array
   }
 }
 
-/** Spektrum VTX control from bytes 12–15 of the frame at `o` (the fields PX4 and Betaflight read). */
-function readVtx(b: Uint8Array, o: number, store: VtxControl): void {
-  const raw = ((byteAt(b, o + 12) << 24) | (byteAt(b, o + 13) << 16) | (byteAt(b, o + 14) << 8) | byteAt(b, o + 15)) >>> 0;
+/** Spektrum VTX control from bytes 12–15 of the frame at `o` (the fields PX4 and Betaflight read), and those two words. */
+function readVtx(b: Uint8Array, o: number, into: FrameSlots): void {
+  const high = (byteAt(b, o + 12) << 8) | byteAt(b, o + 13);
+  const low = (byteAt(b, o + 14) << 8) | byteAt(b, o + 15);
+  into.words[5] = high;
+  into.words[6] = low;
+  const raw = ((high << 16) | low) >>> 0;
+  const store = into.vtx;
   store.raw = raw;
   store.band = (raw >>> 21) & 0x07;
   store.channel = (raw >>> 16) & 0x0f;
