@@ -149,7 +149,7 @@ export class FrameSlots {
   /** `bytes` as four 32-bit words, for a copy in four moves. */
   readonly bytes32 = new Uint32Array(this.bytes.buffer);
   /** The VTX record this set fills; shown only when `hasVtx`. */
-  readonly vtx: VtxControl = { raw: 0, band: 0, channel: 0, power: 0, region: 0, pit: false };
+  readonly vtx: VtxControl = createVtx();
   /** Channel values in `ids` and `positions`. */
   count = 0;
   /** Slots that held 0xFFFF. */
@@ -256,20 +256,16 @@ function copyBytes(b: Uint8Array, b32: Uint32Array, o: number, bytes: Uint8Array
   }
 }
 
-/** Spektrum VTX control from bytes 12–15 of the frame at `o` (the fields PX4 and Betaflight read), and those two words. */
+/** The VTX words (slots 5 and 6) and record of the VTX frame at `o`. */
 function readVtx(b: Uint8Array, o: number, into: FrameSlots): void {
-  const high = (byteAt(b, o + 12) << 8) | byteAt(b, o + 13);
-  const low = (byteAt(b, o + 14) << 8) | byteAt(b, o + 15);
-  into.words[5] = high;
-  into.words[6] = low;
-  const raw = ((high << 16) | low) >>> 0;
-  const store = into.vtx;
-  store.raw = raw;
-  store.band = (raw >>> 21) & 0x07;
-  store.channel = (raw >>> 16) & 0x0f;
-  store.pit = ((raw >>> 4) & 1) === 1;
-  store.region = (raw >>> 3) & 1;
-  store.power = raw & 0x07;
+  into.words[5] = (byteAt(b, o + 12) << 8) | byteAt(b, o + 13);
+  into.words[6] = (byteAt(b, o + 14) << 8) | byteAt(b, o + 15);
+  readVtxControl(b, o, into.vtx);
+}
+
+/** A fresh VTX record whose fields `readVtxControl` overwrites. */
+export function createVtx(): VtxControl {
+  return { raw: 0, band: 0, channel: 0, power: 0, region: 0, pit: false };
 }
 
 /**
@@ -277,17 +273,22 @@ function readVtx(b: Uint8Array, o: number, into: FrameSlots): void {
  * §8.6), or -1 for an ID that does not exist (§8.5). An empty slot (0xFFFF) is the caller's test.
  */
 export function slotChannel(hi: number, resolution: Resolution): number {
-  return (resolution === 2048 ? CHANNEL_2048 : CHANNEL_1024)[hi & 0xff] ?? -1;
+  const entry = (resolution === 2048 ? SLOT_2048 : SLOT_1024)[hi & 0xff] ?? NO_SLOT;
+  return entry === NO_SLOT ? -1 : (entry >> ENTRY_CHANNEL_SHIFT) & 0x1f;
 }
 
-/** §8.1, §8.2, §8.6: the position a slot's word carries for `channel` (X-Plus's 9 bits scaled to 11). */
-export function slotPosition(word: number, channel: number, resolution: Resolution): number {
-  return resolution === 1024 ? word & MASK_1024_SXPOS : channel >= XPLUS_FIRST ? (word & 0x01ff) << 2 : word & MASK_2048_SXPOS;
+/**
+ * §8.1, §8.2, §8.6: the position a slot's word carries (X-Plus's 9 bits scaled to 11), or -1
+ * for an ID that does not exist.
+ */
+export function slotPosition(word: number, resolution: Resolution): number {
+  const entry = (resolution === 2048 ? SLOT_2048 : SLOT_1024)[(word >> 8) & 0xff] ?? NO_SLOT;
+  return entry === NO_SLOT ? -1 : (word & (entry >> ENTRY_MASK_SHIFT)) << ((entry >> ENTRY_POSITION_SHIFT) & 0x03);
 }
 
 /** Bytes 12–15 at `o` as Spektrum VTX control, written into `store` (the layout PX4 and Betaflight read). */
 export function readVtxControl(b: Uint8Array, o: number, store: VtxControl): VtxControl {
-  const raw = (((b[o + 12] ?? 0) << 24) | ((b[o + 13] ?? 0) << 16) | ((b[o + 14] ?? 0) << 8) | (b[o + 15] ?? 0)) >>> 0;
+  const raw = ((byteAt(b, o + 12) << 24) | (byteAt(b, o + 13) << 16) | (byteAt(b, o + 14) << 8) | byteAt(b, o + 15)) >>> 0;
   store.raw = raw;
   store.band = (raw >>> 21) & 0x07;
   store.channel = (raw >>> 16) & 0x0f;
