@@ -843,8 +843,9 @@ export class SpektrumDecoder {
     if (best.score < 0 || (best.shift >= ACQUIRE_COMMIT && avail >= window)) {
       if (best.score < 0 && forced !== 'auto') {
         // Say so when the bytes are frames, only not at the resolution the caller forced.
+        // (Once said, it stands until a lock or a new setting clears it: no need to score again.)
         const other: Resolution = forced === 2048 ? 1024 : 2048;
-        if (this.#best(p, avail, other).score >= 0) this.#forcedMismatch = other;
+        if (this.#forcedMismatch !== other && this.#best(p, avail, other).score >= 0) this.#forcedMismatch = other;
       }
       // No alignment starting in these 16 bytes works (or the best starts too late to commit).
       this.#discard(p, Math.min(FRAME_SIZE, avail), lost);
