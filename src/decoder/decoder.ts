@@ -263,7 +263,7 @@ export class SpektrumDecoder {
     if (this.#ended) throw new TypeError('push() after end(): call reset() to decode a new stream');
     // push() is kept small so that it is inlined into the caller's loop, and the time is stored
     // here rather than passed on: a double handed from there to a call that is not inlined, or
-    // to `instanceof`, is boxed (a 16-byte heap number every push).
+    // to `instanceof`, is boxed (a 16-byte heap number every push). See #append.
     if (typeof time === 'number') {
       const i = this.#append(bytes, null);
       if (i >= 0) this.#chunkTimes[i] = time;
@@ -278,20 +278,70 @@ export class SpektrumDecoder {
   }
 
   /**
-   * Copies pushed bytes (and their per-byte times) into the buffer and records the chunk.
-   * Returns the chunk's index, for the caller to store its time, or -1 for no bytes.
+   * Takes a pushed chunk: copies its bytes (and per-byte times) into the buffer, compacting it
+   * first and growing it (doubling) only when full, and records the chunk's end. Returns the
+   * chunk's index, for the caller to store its time, or -1 for no bytes.
+   *
+   * One method, not three: V8 inlines a function into its callers only below 460 bytes of
+   * bytecode, counting what its optimised code has inlined itself. push() must be inlined into
+   * the caller's loop (a double time handed to a call that is not inlined is boxed, 16 bytes a
+   * push), and it stays small enough only while this, its one callee, is never inlined into it.
    */
   #append(bytes: Uint8Array, byteTimes: Float64Array | null): number {
     const n = bytes.length;
     if (n === 0) return -1;
-    this.#reserve(n);
+    let times = this.#byteTimes;
+    if (this.#head > 0 && (this.#tail + n > this.#buf.length || this.#head >= this.#buf.length >> 1)) {
+      this.#buf.copyWithin(0, this.#head, this.#tail);
+      times?.copyWithin(0, this.#head, this.#tail);
+      this.#base += this.#head;
+      this.#tail -= this.#head;
+      this.#head = 0;
+    }
+    if (this.#tail + n > this.#buf.length) {
+      let capacity = this.#buf.length * 2;
+      while (capacity < this.#tail + n) capacity *= 2;
+      const buf = new Uint8Array(capacity);
+      buf.set(this.#buf.subarray(0, this.#tail));
+      this.#buf = buf;
+      this.#buf32 = new Uint32Array(buf.buffer);
+      if (times !== null) {
+        const grown = new Float64Array(capacity);
+        grown.set(times.subarray(0, this.#tail));
+        this.#byteTimes = times = grown;
+      }
+    }
     const at = this.#tail;
     this.#buf.set(bytes, at);
     if (byteTimes !== null) {
-      if (this.#byteTimes === null) this.#byteTimes = new Float64Array(this.#buf.length);
-      this.#byteTimes.set(byteTimes, at);
+      if (times === null) this.#byteTimes = times = new Float64Array(this.#buf.length);
+      times.set(byteTimes, at);
     }
-    const i = this.#addChunk(this.#base + at + n, byteTimes !== null);
+    // The chunk record: compacted when the arrays are full and mostly done with, else grown.
+    if (this.#chunkTail === this.#chunkEnds.length) {
+      const live = this.#chunkTail - this.#chunkHead;
+      if (this.#chunkHead >= live) {
+        this.#chunkEnds.copyWithin(0, this.#chunkHead, this.#chunkTail);
+        this.#chunkTimes.copyWithin(0, this.#chunkHead, this.#chunkTail);
+        this.#chunkPerByte.copyWithin(0, this.#chunkHead, this.#chunkTail);
+      } else {
+        const size = this.#chunkEnds.length * 2;
+        const ends = new Float64Array(size);
+        const chunkTimes = new Float64Array(size);
+        const perBytes = new Uint8Array(size);
+        ends.set(this.#chunkEnds.subarray(this.#chunkHead, this.#chunkTail));
+        chunkTimes.set(this.#chunkTimes.subarray(this.#chunkHead, this.#chunkTail));
+        perBytes.set(this.#chunkPerByte.subarray(this.#chunkHead, this.#chunkTail));
+        this.#chunkEnds = ends;
+        this.#chunkTimes = chunkTimes;
+        this.#chunkPerByte = perBytes;
+      }
+      this.#chunkTail = live;
+      this.#chunkHead = 0;
+    }
+    const i = this.#chunkTail++;
+    this.#chunkEnds[i] = this.#base + at + n;
+    this.#chunkPerByte[i] = byteTimes !== null ? 1 : 0;
     this.#tail = at + n;
     this.#stats.bytes += n;
     this.#stats.pendingBytes += n;
@@ -1200,35 +1250,6 @@ export class SpektrumDecoder {
     else onEvent({ ...event, timeUs });
   }
 
-  /** Records a pushed chunk's end (stream offset); returns its index, for the caller to store its time. */
-  #addChunk(end: number, perByte: boolean): number {
-    if (this.#chunkTail === this.#chunkEnds.length) {
-      const live = this.#chunkTail - this.#chunkHead;
-      if (this.#chunkHead >= live) {
-        this.#chunkEnds.copyWithin(0, this.#chunkHead, this.#chunkTail);
-        this.#chunkTimes.copyWithin(0, this.#chunkHead, this.#chunkTail);
-        this.#chunkPerByte.copyWithin(0, this.#chunkHead, this.#chunkTail);
-      } else {
-        const size = this.#chunkEnds.length * 2;
-        const ends = new Float64Array(size);
-        const times = new Float64Array(size);
-        const perBytes = new Uint8Array(size);
-        ends.set(this.#chunkEnds.subarray(this.#chunkHead, this.#chunkTail));
-        times.set(this.#chunkTimes.subarray(this.#chunkHead, this.#chunkTail));
-        perBytes.set(this.#chunkPerByte.subarray(this.#chunkHead, this.#chunkTail));
-        this.#chunkEnds = ends;
-        this.#chunkTimes = times;
-        this.#chunkPerByte = perBytes;
-      }
-      this.#chunkTail = live;
-      this.#chunkHead = 0;
-    }
-    const i = this.#chunkTail++;
-    this.#chunkEnds[i] = end;
-    this.#chunkPerByte[i] = perByte ? 1 : 0;
-    return i;
-  }
-
   /**
    * Sets `frame.timeUs` to the time of the byte at buffer index `o`: its own time, or its
    * chunk's time less one byte time for each byte after it in the chunk. Frames are emitted in
@@ -1251,30 +1272,5 @@ export class SpektrumDecoder {
     while (i < last && timeAt(ends, i) <= x) i++;
     this.#chunkHead = i;
     return i;
-  }
-
-  /** Makes room for `n` more bytes: compacts first, grows (doubling) only when full. */
-  #reserve(n: number): void {
-    const need = this.#tail - this.#head + n;
-    const byteTimes = this.#byteTimes;
-    if (this.#head > 0 && (this.#tail + n > this.#buf.length || this.#head >= this.#buf.length >> 1)) {
-      this.#buf.copyWithin(0, this.#head, this.#tail);
-      byteTimes?.copyWithin(0, this.#head, this.#tail);
-      this.#base += this.#head;
-      this.#tail -= this.#head;
-      this.#head = 0;
-    }
-    if (this.#tail + n <= this.#buf.length) return;
-    let capacity = this.#buf.length * 2;
-    while (capacity < need) capacity *= 2;
-    const buf = new Uint8Array(capacity);
-    buf.set(this.#buf.subarray(0, this.#tail));
-    this.#buf = buf;
-    this.#buf32 = new Uint32Array(buf.buffer);
-    if (byteTimes !== null) {
-      const times = new Float64Array(capacity);
-      times.set(byteTimes.subarray(0, this.#tail));
-      this.#byteTimes = times;
-    }
   }
 }
