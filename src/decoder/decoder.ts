@@ -152,6 +152,8 @@ export class SpektrumDecoder {
   #chunkHead = 0;
   #chunkTail = 0;
   #byteTimes: Float64Array | null = null;
+  /** What #dateByte dates: a Float64Array slot, so the double is never boxed between calls. */
+  readonly #when = new Float64Array(1);
   /** Index in #buf of the first byte not yet decided. */
   #head = 0;
   /** Index in #buf after the last byte pushed. */
@@ -1241,8 +1243,8 @@ export class SpektrumDecoder {
       for (let i = this.#chunkHead; i < this.#chunkTail; i++) {
         const end = this.#chunkEnds[i] ?? 0;
         if (end <= x) continue;
-        if (this.#chunkPerByte[i] === 1) timeUs = this.#byteTimes?.[o] ?? Number.NaN;
-        else timeUs = (this.#chunkTimes[i] ?? Number.NaN) - (end - 1 - x) * BYTE_TIME_US;
+        this.#dateByte(x, i);
+        timeUs = timeAt(this.#when, 0);
         break;
       }
     }
@@ -1258,10 +1260,21 @@ export class SpektrumDecoder {
    */
   #stampTime(frame: DecodedFrame, o: number): void {
     const x = this.#base + o;
-    const i = this.#dropChunksBefore(x);
+    this.#dateByte(x, this.#dropChunksBefore(x));
+    frame.timeUs = timeAt(this.#when, 0);
+  }
+
+  /**
+   * Dates the byte at stream offset `x`, held in chunk `i`, into #when[0]: its own time, or its
+   * chunk's time less one byte time for each byte after it in the chunk (NaN without times).
+   * The one rule for frames and events.
+   */
+  #dateByte(x: number, i: number): void {
     const byteTimes = this.#byteTimes;
-    if (this.#chunkPerByte[i] === 1 && byteTimes !== null) frame.timeUs = timeAt(byteTimes, o);
-    else frame.timeUs = timeAt(this.#chunkTimes, i) - (timeAt(this.#chunkEnds, i) - 1 - x) * BYTE_TIME_US;
+    this.#when[0] =
+      this.#chunkPerByte[i] === 1 && byteTimes !== null
+        ? timeAt(byteTimes, x - this.#base)
+        : timeAt(this.#chunkTimes, i) - (timeAt(this.#chunkEnds, i) - 1 - x) * BYTE_TIME_US;
   }
 
   /** Forgets the records of chunks that end at or before stream offset `x` (keeps the last one); returns the first kept. */
