@@ -24,6 +24,8 @@ const HOUR_US = 3600e6;
 const ROUNDS = Number(process.env.BENCH_ROUNDS ?? 15);
 const WARMUP = Number(process.env.BENCH_WARMUP ?? 3);
 const CHUNK = 64;
+/** Measured runs of the heap-growth child; the least is printed (a late (de)optimisation allocates once, in one run). */
+const RUNS = 5;
 const FRAME_SIZE = 16;
 
 /** The streams: about 5.2 MB each (an hour at 11 ms, two at 22 ms). */
@@ -155,7 +157,7 @@ function perByteTimes(s) {
 // ---- the heap-growth child ------------------------------------------------------------------
 
 if (process.argv[2] === '--alloc') {
-  // Decode the stream twice so the JIT has settled. Then, three times, on a decoder that has
+  // Decode the stream twice so the JIT has settled. Then, five times, on a decoder that has
   // already locked (its first 1000 chunks fed beforehand: acquiring allocates once, about
   // 26 kB, none of it per frame), measure heap growth over the rest of the stream with no
   // garbage collection in between. A late optimisation or deoptimisation allocates on the heap
@@ -201,7 +203,7 @@ if (process.argv[2] === '--alloc') {
   });
   obs.observe({ entryTypes: ['gc'] });
   const runs = [];
-  for (let r = 0; r < 3; r++) {
+  for (let r = 0; r < RUNS; r++) {
     const d = new SpektrumDecoder();
     run(d, 0, SETTLE);
     globalThis.gc();
@@ -322,7 +324,7 @@ for (const c of CASES) {
 console.log(`load average after: ${load()}`);
 
 const self = fileURLToPath(import.meta.url);
-console.log('\nheap growth in steady state (no GC during the run; locked decoder, the least of 3 runs after 2 warm-up runs):');
+console.log(`\nheap growth in steady state (no GC during the run; locked decoder, the least of ${RUNS} runs after 2 warm-up runs):`);
 for (const [mode, stream] of [
   ['chunk', '2048'],
   ['per-byte', '2048'],
@@ -338,6 +340,6 @@ for (const [mode, stream] of [
     mode
   ];
   console.log(
-    `  ${`${stream}, ${what}`.padEnd(44)} ${(alloc.bytes / alloc.frames).toFixed(2).padStart(6)} bytes/frame = ${(alloc.bytes / alloc.pushes).toFixed(2).padStart(6)} bytes/push over ${alloc.frames} frames in ${alloc.pushes} pushes (${alloc.gcs} GCs; bytes in 3 runs: ${alloc.all.join(', ')})`,
+    `  ${`${stream}, ${what}`.padEnd(44)} ${(alloc.bytes / alloc.frames).toFixed(2).padStart(6)} bytes/frame = ${(alloc.bytes / alloc.pushes).toFixed(2).padStart(6)} bytes/push over ${alloc.frames} frames in ${alloc.pushes} pushes (${alloc.gcs} GCs; bytes in ${RUNS} runs: ${alloc.all.join(', ')})`,
   );
 }
