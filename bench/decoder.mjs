@@ -24,6 +24,8 @@ const HOUR_US = 3600e6;
 const ROUNDS = Number(process.env.BENCH_ROUNDS ?? 15);
 const WARMUP = Number(process.env.BENCH_WARMUP ?? 3);
 const CHUNK = 64;
+/** Measured runs of the heap-growth child; the least is printed (a late (de)optimisation allocates once, in one run). */
+const RUNS = 5;
 const FRAME_SIZE = 16;
 
 /** The streams: about 5.2 MB each (an hour at 11 ms, two at 22 ms). */
@@ -155,7 +157,7 @@ function perByteTimes(s) {
 // ---- the heap-growth child ------------------------------------------------------------------
 
 if (process.argv[2] === '--alloc') {
-  // Decode the stream twice so the JIT has settled. Then, three times, on a decoder that has
+  // Decode the stream twice so the JIT has settled. Then, five times, on a decoder that has
   // already locked (its first 1000 chunks fed beforehand: acquiring allocates once, about
   // 26 kB, none of it per frame), measure heap growth over the rest of the stream with no
   // garbage collection in between. A late optimisation or deoptimisation allocates on the heap
@@ -201,7 +203,7 @@ if (process.argv[2] === '--alloc') {
   });
   obs.observe({ entryTypes: ['gc'] });
   const runs = [];
-  for (let r = 0; r < 3; r++) {
+  for (let r = 0; r < RUNS; r++) {
     const d = new SpektrumDecoder();
     run(d, 0, SETTLE);
     globalThis.gc();
@@ -228,12 +230,17 @@ if (process.argv[2] === '--alloc') {
 
 const only = process.env.BENCH_ONLY ?? '';
 const streams = Object.fromEntries(Object.keys(STREAMS).map((k) => [k, makeStream(k)]));
-/** Each case: name, the stream, the function, the baseline it is compared with (null for a baseline). */
+/**
+ * Each case: name, the stream, the function, the baseline it is compared with (null for a
+ * baseline), and `vs`: the decoder case it is also compared with (other streams and timings
+ * against the 2048 chunk-times case, which carry the targets' "within 25 %").
+ */
+const CHUNK_CASE = '64-byte chunks, chunk times';
 const CASES = [
   { name: 'baseline JS loop, 2048 internal', stream: '2048', run: (s) => baseline(s.bytes, s.resolution), base: null },
   { name: 'whole buffer, no times', stream: '2048', run: whole, base: 'baseline JS loop, 2048 internal' },
-  { name: '64-byte chunks, chunk times', stream: '2048', run: chunkTimes, base: 'baseline JS loop, 2048 internal' },
-  { name: '64-byte chunks, per-byte times', stream: '2048', run: perByteTimes, base: 'baseline JS loop, 2048 internal' },
+  { name: CHUNK_CASE, stream: '2048', run: chunkTimes, base: 'baseline JS loop, 2048 internal' },
+  { name: '64-byte chunks, per-byte times', stream: '2048', run: perByteTimes, base: 'baseline JS loop, 2048 internal', vs: CHUNK_CASE },
   {
     name: '64-byte chunks, chunk times, general path',
     stream: '2048',
@@ -241,11 +248,25 @@ const CASES = [
     base: 'baseline JS loop, 2048 internal',
   },
   { name: 'baseline JS loop, 1024 internal', stream: '1024', run: (s) => baseline(s.bytes, s.resolution), base: null },
-  { name: '1024 mode, 64-byte chunks, chunk times', stream: '1024', run: chunkTimes, base: 'baseline JS loop, 1024 internal' },
+  {
+    name: '1024 mode, 64-byte chunks, chunk times',
+    stream: '1024',
+    run: chunkTimes,
+    base: 'baseline JS loop, 1024 internal',
+    vs: CHUNK_CASE,
+  },
   { name: 'baseline JS loop, 2048 external', stream: 'external', run: (s) => baseline(s.bytes, s.resolution), base: null },
-  { name: 'external remote, 64-byte chunks, chunk times', stream: 'external', run: chunkTimes, base: 'baseline JS loop, 2048 external' },
-].filter((c, _i, all) => only === '' || c.name.includes(only) || all.some((x) => x.base === c.name && x.name.includes(only)));
-// (A baseline stays in whenever a case compared with it does.)
+  {
+    name: 'external remote, 64-byte chunks, chunk times',
+    stream: 'external',
+    run: chunkTimes,
+    base: 'baseline JS loop, 2048 external',
+    vs: CHUNK_CASE,
+  },
+].filter(
+  (c, _i, all) => only === '' || c.name.includes(only) || all.some((x) => (x.base === c.name || x.vs === c.name) && x.name.includes(only)),
+);
+// (A baseline, or the case others are compared with, stays in whenever a case compared with it does.)
 
 const load = () =>
   loadavg()
@@ -259,14 +280,21 @@ for (const s of Object.values(streams))
 console.log(`${ROUNDS} rounds interleaving ${CASES.length} cases after ${WARMUP} warm-up rounds; min / median / max`);
 
 const ms = new Map(CASES.map((c) => [c.name, []]));
+/** CPU time (user + system) of the same runs: what the run itself cost, whatever else ran on the cores. */
+const cpuMs = new Map(CASES.map((c) => [c.name, []]));
 const frames = new Map();
 for (let r = 0; r < WARMUP + ROUNDS; r++) {
   for (const c of CASES) {
     const s = streams[c.stream];
+    const cpu0 = process.cpuUsage();
     const t0 = performance.now();
     const n = c.run(s);
     const t = performance.now() - t0;
-    if (r >= WARMUP) ms.get(c.name).push(t);
+    const cpu = process.cpuUsage(cpu0);
+    if (r >= WARMUP) {
+      ms.get(c.name).push(t);
+      cpuMs.get(c.name).push((cpu.user + cpu.system) / 1000);
+    }
     if (frames.has(c.name) && frames.get(c.name) !== n) throw new Error(`${c.name}: ${n} frames, before ${frames.get(c.name)}`);
     frames.set(c.name, n);
   }
@@ -278,23 +306,25 @@ const stats = (xs) => {
   return [v[0], v[v.length >> 1], v[v.length - 1]];
 };
 const fmt = (v, digits) => v.map((x) => x.toFixed(digits).padStart(digits === 0 ? 5 : 5)).join(' /');
-console.log(`\n${'case'.padEnd(46)} ${'MB/s min / median / max'.padEnd(24)} ${'× baseline (same round)'.padEnd(24)} frames`);
+/** Per round: `other`'s time over this case's time (1.0: as fast; 0.5: half as fast); min / median / max. */
+const ratioTo = (c, other) =>
+  other !== undefined && other !== null && ms.has(other) ? fmt(stats(ms.get(c.name).map((t, i) => ms.get(other)[i] / t)), 2) : '';
+console.log(
+  `\n${'case'.padEnd(46)} ${'MB/s min / median / max'.padEnd(24)} ${'× baseline (same round)'.padEnd(24)} ${'× 2048 chunk times'.padEnd(24)} ${'CPU MB/s'.padEnd(9)} frames`,
+);
 for (const c of CASES) {
   const s = streams[c.stream];
-  const mbs = ms.get(c.name).map((t) => s.bytes.length / 1e6 / (t / 1000));
-  const [lo, mid, hi] = stats(mbs);
-  let ratio = '';
-  if (c.base !== null && ms.has(c.base)) {
-    const base = ms.get(c.base);
-    // Per round: the baseline's time over this case's time (1.0: as fast as the baseline).
-    ratio = fmt(stats(ms.get(c.name).map((t, i) => base[i] / t)), 2);
-  }
-  console.log(`${c.name.padEnd(46)} ${fmt([lo, mid, hi], 0).padEnd(24)} ${ratio.padEnd(24)} ${frames.get(c.name)}`);
+  const mb = s.bytes.length / 1e6;
+  const [lo, mid, hi] = stats(ms.get(c.name).map((t) => mb / (t / 1000)));
+  const cpu = stats(cpuMs.get(c.name).map((t) => mb / (t / 1000)))[1];
+  console.log(
+    `${c.name.padEnd(46)} ${fmt([lo, mid, hi], 0).padEnd(24)} ${ratioTo(c, c.base).padEnd(24)} ${ratioTo(c, c.vs).padEnd(24)} ${cpu.toFixed(0).padStart(8)}  ${frames.get(c.name)}`,
+  );
 }
 console.log(`load average after: ${load()}`);
 
 const self = fileURLToPath(import.meta.url);
-console.log('\nheap growth in steady state (no GC during the run; locked decoder, the least of 3 runs after 2 warm-up runs):');
+console.log(`\nheap growth in steady state (no GC during the run; locked decoder, the least of ${RUNS} runs after 2 warm-up runs):`);
 for (const [mode, stream] of [
   ['chunk', '2048'],
   ['per-byte', '2048'],
@@ -310,6 +340,6 @@ for (const [mode, stream] of [
     mode
   ];
   console.log(
-    `  ${`${stream}, ${what}`.padEnd(44)} ${(alloc.bytes / alloc.frames).toFixed(2).padStart(6)} bytes/frame = ${(alloc.bytes / alloc.pushes).toFixed(2).padStart(6)} bytes/push over ${alloc.frames} frames in ${alloc.pushes} pushes (${alloc.gcs} GCs; bytes in 3 runs: ${alloc.all.join(', ')})`,
+    `  ${`${stream}, ${what}`.padEnd(44)} ${(alloc.bytes / alloc.frames).toFixed(2).padStart(6)} bytes/frame = ${(alloc.bytes / alloc.pushes).toFixed(2).padStart(6)} bytes/push over ${alloc.frames} frames in ${alloc.pushes} pushes (${alloc.gcs} GCs; bytes in ${RUNS} runs: ${alloc.all.join(', ')})`,
   );
 }

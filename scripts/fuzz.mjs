@@ -6,7 +6,9 @@
  * - never throws,
  * - never hangs (each input runs in a worker thread under a watchdog),
  * - accounts for every byte (framed or discarded, none left pending after end()),
- * - gives the same frames and counters whether the bytes come whole or in random chunks.
+ * - gives the same frames and counters whether the bytes come whole or in random chunks,
+ * - gives the same frames (every field), counters and events with its fast path off
+ *   (`fastPath: false`, the general path only) as with it on.
  *
  * `npm run fuzz` runs 1,000,000 inputs on every core; `npm test` runs a short run through
  * `runFuzz` (tests/decoder.fuzz.test.ts). A failure prints the input's number and seed, enough
@@ -67,15 +69,19 @@ function makeInput(n, pool) {
   return { bytes, options, timing, splits };
 }
 
-function decode(SpektrumDecoder, input, chunked) {
+function decode(SpektrumDecoder, input, chunked, fastPath = true) {
   const { bytes, options, timing, splits } = input;
-  const d = new SpektrumDecoder(options);
+  const events = [];
+  const d = new SpektrumDecoder({ ...options, fastPath, onEvent: (e) => events.push(JSON.stringify(e)) });
   const out = [];
+  // What chunking may change (frame times follow the chunks' times), for the fast/general comparison.
+  const more = [];
   const drain = () => {
     for (let f = d.next(); f; f = d.next()) {
       out.push(
         `${f.offset}|${f.remote}|${f.system}|${f.resolution}|${f.fades}|${f.fadesDelta}|${f.rssi}|${f.ids.subarray(0, f.count)}|${f.positions.subarray(0, f.count)}|${f.vtx?.raw ?? ''}`,
       );
+      more.push(`${f.index}|${f.timeUs}|${f.words}|${f.bytes}|${JSON.stringify(d.stats)}`);
     }
   };
   let k = 0;
@@ -89,16 +95,18 @@ function decode(SpektrumDecoder, input, chunked) {
   }
   d.end();
   drain();
-  return { frames: out, stats: { ...d.stats } };
+  return { frames: out, more, events, stats: { ...d.stats } };
 }
 
 /** Checks one input; returns a failure message or null. */
 function check(SpektrumDecoder, input) {
   let whole;
   let chunked;
+  let general;
   try {
     whole = decode(SpektrumDecoder, input, false);
     chunked = decode(SpektrumDecoder, input, true);
+    general = decode(SpektrumDecoder, input, false, false);
   } catch (e) {
     return `threw ${e instanceof Error ? e.stack : String(e)}`;
   }
@@ -110,6 +118,13 @@ function check(SpektrumDecoder, input) {
   }
   if (JSON.stringify(s) !== JSON.stringify(chunked.stats))
     return `chunking changed the counters: ${JSON.stringify(s)} vs ${JSON.stringify(chunked.stats)}`;
+  for (const k of ['frames', 'more', 'events']) {
+    const i = Math.max(whole[k].length, general[k].length) === 0 ? -1 : whole[k].findIndex((x, j) => x !== general[k][j]);
+    if (whole[k].length !== general[k].length || i >= 0)
+      return `the fast path changed ${k} at ${i < 0 ? whole[k].length : i}: ${whole[k][i]} vs general ${general[k][i]}`;
+  }
+  if (JSON.stringify(s) !== JSON.stringify(general.stats))
+    return `the fast path changed the counters: ${JSON.stringify(s)} vs general ${JSON.stringify(general.stats)}`;
   return null;
 }
 
@@ -197,7 +212,7 @@ if (!isMainThread) {
       process.exitCode = 1;
     } else {
       console.log(
-        `${count} inputs from ${from}, every option and timing: 0 throws, 0 hangs, every byte accounted for, same frames however chunked (${s} s)`,
+        `${count} inputs from ${from}, every option and timing: 0 throws, 0 hangs, every byte accounted for, same frames however chunked, same frames, counters and events with the fast path off (${s} s)`,
       );
     }
   } catch (e) {

@@ -25,17 +25,7 @@
  * (emitted unconditionally): so `next()` always returns after bounded work.
  */
 import { BYTE_TIME_US, FRAME_SIZE, systemInfo, type Resolution } from './spec.js';
-import {
-  createFrame,
-  createVtx,
-  countZeroWords,
-  decodeSlots,
-  INVALID,
-  isVtxFrame,
-  layoutChannels,
-  readSlots,
-  slotLayout,
-} from './frame.js';
+import { byteAt, countZeroWords, createFrame, FrameSlots, INVALID, layoutChannels, readFrame, showSlots, slotLayout } from './frame.js';
 import type {
   DecodedFrame,
   DecoderEvent,
@@ -133,6 +123,11 @@ function byte0Follows(prev: number, next: number, mode: number, step = FADE_STEP
   return rise || (plausibleRssi(prev) && plausibleRssi(next));
 }
 
+/** `t[i]` at an index the caller knows is inside `t`: a typed read (an index past the end, a bug, reads as NaN). */
+function timeAt(t: Float64Array, i: number): number {
+  return t[i] ?? NaN;
+}
+
 /** Whether an external remote's UINT16 fade count can go from `prev` to `next` between consecutive frames. */
 function countFollows(prev: number, next: number, step = FADE_STEP): boolean {
   return step === ACQUIRE_FADE_STEP ? next >= prev && next - prev < step : ((next - prev) & 0xffff) < step;
@@ -144,7 +139,7 @@ export class SpektrumDecoder {
   readonly #onEvent: ((event: DecoderEvent) => void) | undefined;
 
   #buf = new Uint8Array(INITIAL_CAPACITY);
-  /** #buf as 32-bit words: the fast path copies a frame that starts at a multiple of 4 in four moves. */
+  /** #buf as 32-bit words: a frame that starts at a multiple of 4 is copied in four moves. */
   #buf32 = new Uint32Array(this.#buf.buffer);
   /**
    * Times are kept per pushed chunk, not per byte (filling a time for every byte cost a third of
@@ -157,6 +152,8 @@ export class SpektrumDecoder {
   #chunkHead = 0;
   #chunkTail = 0;
   #byteTimes: Float64Array | null = null;
+  /** What #dateByte dates: a Float64Array slot, so the double is never boxed between calls. */
+  readonly #when = new Float64Array(1);
   /** Index in #buf of the first byte not yet decided. */
   #head = 0;
   /** Index in #buf after the last byte pushed. */
@@ -169,9 +166,11 @@ export class SpektrumDecoder {
   #everLocked = false;
   /** Stream offset up to which acquisition has confirmed frames: they are emitted as they stand. */
   #confirmedUntil = 0;
-  #resolution: Resolution | null = null;
+  /** The lock's resolution (the last one locked on; `format` shows null until #everLocked). */
+  #resolution: Resolution = 2048;
   #reason: ResolutionReason = 'unknown';
-  #remote: RemoteKind | null = null;
+  /** The lock's remote kind (as #resolution). */
+  #remote: RemoteKind = 'external';
   /** The internal remote's system byte (valid or not), or null. */
   #system: number | null = null;
   /** B0_* : how byte 0 of an internal remote is read. */
@@ -192,9 +191,15 @@ export class SpektrumDecoder {
   #layoutCount = 0;
   #layoutNext = 0;
 
-  readonly #frame = createFrame();
-  readonly #frameBytes32 = new Uint32Array(this.#frame.bytes.buffer, this.#frame.bytes.byteOffset, FRAME_SIZE / 4);
-  readonly #vtx = createVtx();
+  /**
+   * Two sets of slot arrays: the one #frame shows, and one that holds the frame at stream
+   * offset #stagedAt (-1: none), decoded by the fast path while it confirmed the frame before.
+   * Emitting that frame then swaps the sets instead of decoding it again.
+   */
+  #shown = new FrameSlots();
+  #staged = new FrameSlots();
+  #stagedAt = -1;
+  readonly #frame = createFrame(this.#shown);
   readonly #stats: DecoderStats = {
     bytes: 0,
     frames: 0,
@@ -260,7 +265,7 @@ export class SpektrumDecoder {
     if (this.#ended) throw new TypeError('push() after end(): call reset() to decode a new stream');
     // push() is kept small so that it is inlined into the caller's loop, and the time is stored
     // here rather than passed on: a double handed from there to a call that is not inlined, or
-    // to `instanceof`, is boxed (a 16-byte heap number every push).
+    // to `instanceof`, is boxed (a 16-byte heap number every push). See #append.
     if (typeof time === 'number') {
       const i = this.#append(bytes, null);
       if (i >= 0) this.#chunkTimes[i] = time;
@@ -275,20 +280,70 @@ export class SpektrumDecoder {
   }
 
   /**
-   * Copies pushed bytes (and their per-byte times) into the buffer and records the chunk.
-   * Returns the chunk's index, for the caller to store its time, or -1 for no bytes.
+   * Takes a pushed chunk: copies its bytes (and per-byte times) into the buffer, compacting it
+   * first and growing it (doubling) only when full, and records the chunk's end. Returns the
+   * chunk's index, for the caller to store its time, or -1 for no bytes.
+   *
+   * One method, not three: V8 inlines a function into its callers only below 460 bytes of
+   * bytecode, counting what its optimised code has inlined itself. push() must be inlined into
+   * the caller's loop (a double time handed to a call that is not inlined is boxed, 16 bytes a
+   * push), and it stays small enough only while this, its one callee, is never inlined into it.
    */
   #append(bytes: Uint8Array, byteTimes: Float64Array | null): number {
     const n = bytes.length;
     if (n === 0) return -1;
-    this.#reserve(n);
+    let times = this.#byteTimes;
+    if (this.#head > 0 && (this.#tail + n > this.#buf.length || this.#head >= this.#buf.length >> 1)) {
+      this.#buf.copyWithin(0, this.#head, this.#tail);
+      times?.copyWithin(0, this.#head, this.#tail);
+      this.#base += this.#head;
+      this.#tail -= this.#head;
+      this.#head = 0;
+    }
+    if (this.#tail + n > this.#buf.length) {
+      let capacity = this.#buf.length * 2;
+      while (capacity < this.#tail + n) capacity *= 2;
+      const buf = new Uint8Array(capacity);
+      buf.set(this.#buf.subarray(0, this.#tail));
+      this.#buf = buf;
+      this.#buf32 = new Uint32Array(buf.buffer);
+      if (times !== null) {
+        const grown = new Float64Array(capacity);
+        grown.set(times.subarray(0, this.#tail));
+        this.#byteTimes = times = grown;
+      }
+    }
     const at = this.#tail;
     this.#buf.set(bytes, at);
     if (byteTimes !== null) {
-      if (this.#byteTimes === null) this.#byteTimes = new Float64Array(this.#buf.length);
-      this.#byteTimes.set(byteTimes, at);
+      if (times === null) this.#byteTimes = times = new Float64Array(this.#buf.length);
+      times.set(byteTimes, at);
     }
-    const i = this.#addChunk(this.#base + at + n, byteTimes !== null);
+    // The chunk record: compacted when the arrays are full and mostly done with, else grown.
+    if (this.#chunkTail === this.#chunkEnds.length) {
+      const live = this.#chunkTail - this.#chunkHead;
+      if (this.#chunkHead >= live) {
+        this.#chunkEnds.copyWithin(0, this.#chunkHead, this.#chunkTail);
+        this.#chunkTimes.copyWithin(0, this.#chunkHead, this.#chunkTail);
+        this.#chunkPerByte.copyWithin(0, this.#chunkHead, this.#chunkTail);
+      } else {
+        const size = this.#chunkEnds.length * 2;
+        const ends = new Float64Array(size);
+        const chunkTimes = new Float64Array(size);
+        const perBytes = new Uint8Array(size);
+        ends.set(this.#chunkEnds.subarray(this.#chunkHead, this.#chunkTail));
+        chunkTimes.set(this.#chunkTimes.subarray(this.#chunkHead, this.#chunkTail));
+        perBytes.set(this.#chunkPerByte.subarray(this.#chunkHead, this.#chunkTail));
+        this.#chunkEnds = ends;
+        this.#chunkTimes = chunkTimes;
+        this.#chunkPerByte = perBytes;
+      }
+      this.#chunkTail = live;
+      this.#chunkHead = 0;
+    }
+    const i = this.#chunkTail++;
+    this.#chunkEnds[i] = this.#base + at + n;
+    this.#chunkPerByte[i] = byteTimes !== null ? 1 : 0;
     this.#tail = at + n;
     this.#stats.bytes += n;
     this.#stats.pendingBytes += n;
@@ -328,7 +383,7 @@ export class SpektrumDecoder {
       this.#layoutCount = 0;
       this.#reason = 'unknown';
     } else {
-      this.#setReason(this.#resolution as Resolution);
+      this.#setReason(this.#resolution);
     }
   }
 
@@ -340,9 +395,11 @@ export class SpektrumDecoder {
     this.#locked = this.#everLocked = false;
     this.#confirmedUntil = 0;
     this.#nextAt = -1;
-    this.#resolution = null;
+    this.#stagedAt = -1;
+    this.#resolution = 2048;
     this.#reason = 'unknown';
-    this.#remote = this.#system = null;
+    this.#remote = 'external';
+    this.#system = null;
     this.#b0Mode = B0_FADES;
     this.#forcedMismatch = null;
     this.#haveLast = false;
@@ -363,10 +420,10 @@ export class SpektrumDecoder {
   get format(): FormatInfo {
     return {
       locked: this.#locked,
-      resolution: this.#resolution,
+      resolution: this.#everLocked ? this.#resolution : null,
       resolutionReason: this.#reason,
       explanation: this.#explain(),
-      remote: this.#remote,
+      remote: this.#everLocked ? this.#remote : null,
       system: this.#system,
       systemValid: this.#system !== null && systemInfo(this.#system) !== undefined,
       headerMode: this.#headerReading(),
@@ -380,10 +437,16 @@ export class SpektrumDecoder {
    * or `reset()`.
    */
   next(): DecodedFrame | undefined {
+    // Kept small, so that it is inlined into the caller's loop beside push().
     if (this.#fastPath && this.#locked) {
       const frame = this.#nextFast();
       if (frame !== null) return frame;
     }
+    return this.#nextGeneral();
+  }
+
+  /** next() on the general path: every rule, every case. */
+  #nextGeneral(): DecodedFrame | undefined {
     for (;;) {
       if (!this.#locked) {
         if (!this.#acquire()) return undefined;
@@ -395,7 +458,7 @@ export class SpektrumDecoder {
         if (this.#ended && avail > 0) this.#discard(o, avail, 'end-of-stream');
         return undefined;
       }
-      const resolution = this.#resolution as Resolution;
+      const resolution = this.#resolution;
       const at = this.#base + o;
       const layout = at === this.#nextAt ? this.#nextLayout : slotLayout(this.#buf, o, resolution);
       // Frames acquisition confirmed go out as they stand.
@@ -489,55 +552,63 @@ export class SpektrumDecoder {
    * behind; its header continues the last frame's with a fade step the general path would count
    * without an event; and the whole next frame is in, valid, and continues it. Then it is
    * emitted exactly as the general path would emit it. Anything else returns null and the
-   * general path decides (it finds the same state: nothing here is changed before emitting).
+   * general path decides (it finds the same state: nothing it reads is changed before emitting).
+   *
+   * Each byte is read once: validating the next frame decodes it into the spare slot arrays
+   * (#staged), which the frame shows when that one is emitted in turn.
    */
   #nextFast(): DecodedFrame | null {
     const o = this.#head;
-    if (this.#tail - o < 2 * FRAME_SIZE) return null;
+    const n = o + FRAME_SIZE;
+    if (n + FRAME_SIZE > this.#tail) return null;
     const at = this.#base + o;
     if (at !== this.#nextAt || at < this.#confirmedUntil || !this.#haveLast) return null;
     const layout = this.#nextLayout;
-    if (layout === INVALID) return null;
+    if (layout === INVALID || !this.#knownLayout(layout)) return null;
+    const resolution = this.#resolution;
     const buf = this.#buf;
-    const b0 = buf[o] as number;
-    const b1 = buf[o + 1] as number;
-    const n = o + FRAME_SIZE;
+    const b0 = byteAt(buf, o);
+    const b1 = byteAt(buf, o + 1);
+    const internal = this.#remote === 'internal';
     let delta = 0;
-    if (this.#remote === 'internal') {
+    if (internal) {
       const mode = this.#b0Mode;
       const system = this.#system;
       if (b1 !== system || buf[n + 1] !== system) return null;
       if (mode === B0_FADES) {
         // #fitsLast and #follows with FADE_STEP, and #fadeDelta's rise without an event.
         delta = (b0 - this.#last0) & 0xff;
-        if (delta >= FADE_STEP || (((buf[n] as number) - b0) & 0xff) >= FADE_STEP) return null;
+        if (delta >= FADE_STEP || ((byteAt(buf, n) - b0) & 0xff) >= FADE_STEP) return null;
       } else if (mode === B0_RSSI) {
-        if (!plausibleRssi(b0) || !plausibleRssi(buf[n] as number)) return null;
+        if (!plausibleRssi(b0) || !plausibleRssi(byteAt(buf, n))) return null;
       } else if (mode !== B0_RSSI_FORCED) {
         return null; // B0_UNKNOWN: emitting may decide byte 0 (an event), the general path's job.
       }
     } else {
       const count = (b0 << 8) | b1;
       delta = (count - ((this.#last0 << 8) | this.#last1)) & 0xffff;
-      if (delta >= FADE_STEP || (((((buf[n] as number) << 8) | (buf[n + 1] as number)) - count) & 0xffff) >= FADE_STEP) return null;
+      if (delta >= FADE_STEP || ((((byteAt(buf, n) << 8) | byteAt(buf, n + 1)) - count) & 0xffff) >= FADE_STEP) return null;
     }
-    const next = slotLayout(buf, n, this.#resolution as Resolution);
-    if (next === INVALID || !this.#knownLayout(layout)) return null;
+    // This frame's slots: staged while the one before was confirmed, else decoded now.
+    const slots = this.#staged;
+    if (this.#stagedAt !== at) readFrame(buf, this.#buf32, o, resolution, slots);
+    const spare = this.#shown;
+    const next = readFrame(buf, this.#buf32, n, resolution, spare);
+    if (next === INVALID) {
+      this.#stagedAt = at;
+      return null;
+    }
+    this.#shown = slots;
+    this.#staged = spare;
+    this.#stagedAt = at + FRAME_SIZE;
     this.#nextAt = at + FRAME_SIZE;
     this.#nextLayout = next;
-    return this.#emitFast(o, b0, b1, delta);
-  }
-
-  /** #emit for a frame #nextFast vouched for: a known layout, a fade step without an event, byte 0's reading settled. */
-  #emitFast(o: number, b0: number, b1: number, delta: number): DecodedFrame {
-    const buf = this.#buf;
     const frame = this.#frame;
-    const resolution = this.#resolution as Resolution;
     frame.index++;
-    frame.offset = this.#base + o;
+    frame.offset = at;
     this.#stampTime(frame, o);
     frame.resolution = resolution;
-    if (this.#remote === 'internal') {
+    if (internal) {
       frame.remote = 'internal';
       frame.system = b1;
       if (this.#b0Mode === B0_FADES) {
@@ -557,27 +628,15 @@ export class SpektrumDecoder {
     this.#last0 = b0;
     this.#last1 = b1;
     this.#jumpTrusted = false;
-    if ((o & 3) === 0) {
-      // A raw copy in the platform's byte order both ways: the same 16 bytes.
-      const from = this.#buf32;
-      const to = this.#frameBytes32;
-      const k = o >> 2;
-      to[0] = from[k] as number;
-      to[1] = from[k + 1] as number;
-      to[2] = from[k + 2] as number;
-      to[3] = from[k + 3] as number;
-    } else {
-      const bytes = frame.bytes;
-      for (let i = 0; i < FRAME_SIZE; i++) bytes[i] = buf[o + i] as number;
-    }
-    return this.#counted(frame, o, decodeSlots(frame, buf, o, resolution, isVtxFrame(buf, o), this.#vtx));
+    showSlots(frame, slots);
+    return this.#counted(frame, o, slots);
   }
 
   /** Whether the header at `o` continues the last emitted frame under the lock's model. */
   #fitsLast(o: number): boolean {
     const b = this.#buf;
-    const b0 = b[o] as number;
-    const b1 = b[o + 1] as number;
+    const b0 = byteAt(b, o);
+    const b1 = byteAt(b, o + 1);
     if (this.#remote === 'internal') {
       if (b1 !== this.#system) return false;
       return this.#haveLast ? byte0Follows(this.#last0, b0, this.#b0Mode) : this.#b0Mode !== B0_RSSI || b0 >= 0x80;
@@ -590,9 +649,9 @@ export class SpektrumDecoder {
   #follows(a: number, b: number): boolean {
     const buf = this.#buf;
     if (this.#remote === 'internal') {
-      return buf[b + 1] === this.#system && byte0Follows(buf[a] as number, buf[b] as number, this.#b0Mode);
+      return buf[b + 1] === this.#system && byte0Follows(byteAt(buf, a), byteAt(buf, b), this.#b0Mode);
     }
-    return countFollows(((buf[a] as number) << 8) | (buf[a + 1] as number), ((buf[b] as number) << 8) | (buf[b + 1] as number));
+    return countFollows((byteAt(buf, a) << 8) | byteAt(buf, a + 1), (byteAt(buf, b) << 8) | byteAt(buf, b + 1));
   }
 
   /**
@@ -604,10 +663,10 @@ export class SpektrumDecoder {
     // An external count has no system byte to vouch for it: a jump there may be an internal
     // remote taking over (`00 00` then `00 B2`), which acquisition decides.
     if (this.#remote !== 'internal' || !this.#knownLayout(layout) || o + 2 * FRAME_SIZE > this.#tail) return false;
-    if (buf[o + 1] !== this.#system || (this.#b0Mode === B0_RSSI && !plausibleRssi(buf[o] as number))) return false;
+    if (buf[o + 1] !== this.#system || (this.#b0Mode === B0_RSSI && !plausibleRssi(byteAt(buf, o)))) return false;
     // Fades rise: a fall is something else (a restarted receiver, RSSI), for acquisition to read.
-    if (this.#b0Mode !== B0_RSSI && this.#haveLast && (((buf[o] as number) - this.#last0) & 0xff) >= 0x80) return false;
-    return slotLayout(buf, o + FRAME_SIZE, this.#resolution as Resolution) !== INVALID && this.#follows(o, o + FRAME_SIZE);
+    if (this.#b0Mode !== B0_RSSI && this.#haveLast && ((byteAt(buf, o) - this.#last0) & 0xff) >= 0x80) return false;
+    return slotLayout(buf, o + FRAME_SIZE, this.#resolution) !== INVALID && this.#follows(o, o + FRAME_SIZE);
   }
 
   /**
@@ -617,7 +676,7 @@ export class SpektrumDecoder {
    * that have not arrived.
    */
   #search(from: number, to: number): number {
-    const resolution = this.#resolution as Resolution;
+    const resolution = this.#resolution;
     const buf = this.#buf;
     let alone = NOT_FOUND;
     let aloneLayout = INVALID;
@@ -650,7 +709,7 @@ export class SpektrumDecoder {
     const buf = this.#buf;
     const n = o + FRAME_SIZE;
     // An external count (often `00 00`) is too weak a header to stand on: zero bytes abound in slots.
-    return this.#remote === 'internal' && buf[n + 1] === this.#system && byte0Follows(buf[o] as number, buf[n] as number, this.#b0Mode);
+    return this.#remote === 'internal' && buf[n + 1] === this.#system && byte0Follows(byteAt(buf, o), byteAt(buf, n), this.#b0Mode);
   }
 
   /**
@@ -662,12 +721,7 @@ export class SpektrumDecoder {
   #lastOfItsKind(o: number, layout: number): boolean {
     if (!this.#knownLayout(layout)) return false;
     const a = o + FRAME_SIZE;
-    if (
-      this.#haveLast &&
-      a + FRAME_SIZE <= this.#tail &&
-      slotLayout(this.#buf, a, this.#resolution as Resolution) !== INVALID &&
-      this.#fitsLast(a)
-    )
+    if (this.#haveLast && a + FRAME_SIZE <= this.#tail && slotLayout(this.#buf, a, this.#resolution) !== INVALID && this.#fitsLast(a))
       return false;
     return this.#chainStartsAt(a) === 1;
   }
@@ -680,13 +734,13 @@ export class SpektrumDecoder {
     const buf = this.#buf;
     const b = a + FRAME_SIZE;
     if (b + FRAME_SIZE > this.#tail) return false;
-    const resolution = this.#resolution as Resolution;
+    const resolution = this.#resolution;
     return (
       buf[a + 1] === this.#system &&
       buf[b + 1] === this.#system &&
       slotLayout(buf, a, resolution) !== INVALID &&
       slotLayout(buf, b, resolution) !== INVALID &&
-      byte0Follows(buf[a] as number, buf[b] as number, this.#b0Mode)
+      byte0Follows(byteAt(buf, a), byteAt(buf, b), this.#b0Mode)
     );
   }
 
@@ -716,6 +770,7 @@ export class SpektrumDecoder {
     this.#locked = false;
     this.#confirmedUntil = 0;
     this.#nextAt = -1;
+    this.#stagedAt = -1;
   }
 
   #knownLayout(layout: number): boolean {
@@ -735,15 +790,15 @@ export class SpektrumDecoder {
     this.#learnLayout(layout);
     const buf = this.#buf;
     const frame = this.#frame;
-    const resolution = this.#resolution as Resolution;
+    const resolution = this.#resolution;
     frame.index++;
     frame.offset = this.#base + o;
     this.#stampTime(frame, o);
     frame.resolution = resolution;
-    const remote = this.#remote as RemoteKind;
+    const remote = this.#remote;
     frame.remote = remote;
-    const b0 = buf[o] as number;
-    const b1 = buf[o + 1] as number;
+    const b0 = byteAt(buf, o);
+    const b1 = byteAt(buf, o + 1);
     let delta = 0;
     if (remote === 'internal') {
       frame.system = b1;
@@ -771,17 +826,20 @@ export class SpektrumDecoder {
     this.#last1 = b1;
     this.#haveLast = true;
     this.#jumpTrusted = false;
-    return this.#counted(frame, o, readSlots(frame, buf, o, resolution, isVtxFrame(buf, o), this.#vtx));
+    const slots = this.#shown;
+    readFrame(buf, this.#buf32, o, resolution, slots);
+    showSlots(frame, slots);
+    return this.#counted(frame, o, slots);
   }
 
-  /** Counts the frame just filled at `o` (with `empty` 0xFFFF slots) and moves past it: both emit paths end here. */
-  #counted(frame: DecodedFrame, o: number, empty: number): DecodedFrame {
+  /** Counts the frame just filled at `o` from `slots` and moves past it: both emit paths end here. */
+  #counted(frame: DecodedFrame, o: number, slots: FrameSlots): DecodedFrame {
     const s = this.#stats;
     s.frames++;
     s.frameBytes += FRAME_SIZE;
     s.pendingBytes -= FRAME_SIZE;
-    s.emptySlots += empty;
-    if (frame.vtx !== null) s.vtxFrames++;
+    s.emptySlots += slots.empty;
+    if (slots.hasVtx) s.vtxFrames++;
     this.#head = o + FRAME_SIZE;
     return frame;
   }
@@ -837,8 +895,9 @@ export class SpektrumDecoder {
     if (best.score < 0 || (best.shift >= ACQUIRE_COMMIT && avail >= window)) {
       if (best.score < 0 && forced !== 'auto') {
         // Say so when the bytes are frames, only not at the resolution the caller forced.
+        // (Once said, it stands until a lock or a new setting clears it: no need to score again.)
         const other: Resolution = forced === 2048 ? 1024 : 2048;
-        if (this.#best(p, avail, other).score >= 0) this.#forcedMismatch = other;
+        if (this.#forcedMismatch !== other && this.#best(p, avail, other).score >= 0) this.#forcedMismatch = other;
       }
       // No alignment starting in these 16 bytes works (or the best starts too late to commit).
       this.#discard(p, Math.min(FRAME_SIZE, avail), lost);
@@ -866,7 +925,7 @@ export class SpektrumDecoder {
       this.#resolution === resolution;
     let b0Mode = this.#candB0;
     // The same remote going on keeps what its byte 0 was shown to be, if byte 0 goes on too.
-    if (internal && b0Mode === B0_UNKNOWN && sameRemote && byte0Follows(this.#last0, this.#buf[o] as number, this.#b0Mode))
+    if (internal && b0Mode === B0_UNKNOWN && sameRemote && byte0Follows(this.#last0, byteAt(this.#buf, o), this.#b0Mode))
       b0Mode = this.#b0Mode;
     if (internal && b0Mode === B0_UNKNOWN) {
       // Byte 0 has only been a plausible RSSI and never fallen: read further along the chain before deciding.
@@ -923,13 +982,9 @@ export class SpektrumDecoder {
       return false;
     if (internal) {
       const mode = this.#options.headerMode === 'rssi' ? B0_RSSI_FORCED : this.#options.headerMode === 'fades' ? B0_FADES : B0_UNKNOWN;
-      return buf[a + 1] === system && buf[b + 1] === system && byte0Follows(buf[a] as number, buf[b] as number, mode, ACQUIRE_FADE_STEP);
+      return buf[a + 1] === system && buf[b + 1] === system && byte0Follows(byteAt(buf, a), byteAt(buf, b), mode, ACQUIRE_FADE_STEP);
     }
-    return countFollows(
-      ((buf[a] as number) << 8) | (buf[a + 1] as number),
-      ((buf[b] as number) << 8) | (buf[b + 1] as number),
-      ACQUIRE_FADE_STEP,
-    );
+    return countFollows((byteAt(buf, a) << 8) | byteAt(buf, a + 1), (byteAt(buf, b) << 8) | byteAt(buf, b + 1), ACQUIRE_FADE_STEP);
   }
 
   /** The best-scoring start among the next ACQUIRE_SHIFTS offsets, at one resolution or (0) both. */
@@ -973,11 +1028,11 @@ export class SpektrumDecoder {
    */
   #byte0Evidence(o: number, resolution: Resolution, system: number): number {
     const buf = this.#buf;
-    let prev = buf[o] as number;
+    let prev = byteAt(buf, o);
     for (let k = 1; k < HEADER_EVIDENCE_FRAMES; k++) {
       const f = o + k * FRAME_SIZE;
       if (f + FRAME_SIZE > this.#tail) return this.#ended ? B0_UNKNOWN : NEED_MORE;
-      const b0 = buf[f] as number;
+      const b0 = byteAt(buf, f);
       if (buf[f + 1] !== system || slotLayout(buf, f, resolution) === INVALID || !byte0Follows(prev, b0, B0_UNKNOWN, ACQUIRE_FADE_STEP))
         return B0_UNKNOWN;
       if (!plausibleRssi(b0)) return B0_FADES;
@@ -997,7 +1052,7 @@ export class SpektrumDecoder {
   #score(o: number, resolution: Resolution, frames: number): number {
     const buf = this.#buf;
     const { remote, headerMode } = this.#options;
-    const s = buf[o + 1] as number;
+    const s = byteAt(buf, o + 1);
     const forcedB0 = headerMode === 'rssi' ? B0_RSSI_FORCED : headerMode === 'fades' ? B0_FADES : B0_UNKNOWN;
     // How far each header reading carries the chain.
     let chainI = remote === 'external' ? 0 : frames;
@@ -1019,17 +1074,13 @@ export class SpektrumDecoder {
       if (k === 0) continue;
       const p = f - FRAME_SIZE;
       if (chainI > k) {
-        if (buf[f + 1] === s && byte0Follows(buf[good] as number, buf[f] as number, forcedB0, ACQUIRE_FADE_STEP)) good = f;
+        if (buf[f + 1] === s && byte0Follows(byteAt(buf, good), byteAt(buf, f), forcedB0, ACQUIRE_FADE_STEP)) good = f;
         else if (damaged < 0 && info !== undefined && k < frames - 1) damaged = k;
         else chainI = k;
       }
       if (
         chainE > k &&
-        !countFollows(
-          ((buf[p] as number) << 8) | (buf[p + 1] as number),
-          ((buf[f] as number) << 8) | (buf[f + 1] as number),
-          ACQUIRE_FADE_STEP,
-        )
+        !countFollows((byteAt(buf, p) << 8) | byteAt(buf, p + 1), (byteAt(buf, f) << 8) | byteAt(buf, f + 1), ACQUIRE_FADE_STEP)
       )
         chainE = k;
       if (chainI <= k && chainE <= k) break;
@@ -1043,8 +1094,8 @@ export class SpektrumDecoder {
     // A header that continues the last one as a rising count is that count moving, though.
     const countGoesOn =
       this.#haveLast &&
-      countFollows((this.#last0 << 8) | this.#last1, ((buf[o] as number) << 8) | s) &&
-      (((buf[o] as number) << 8) | s) !== ((this.#last0 << 8) | this.#last1);
+      countFollows((this.#last0 << 8) | this.#last1, (byteAt(buf, o) << 8) | s) &&
+      ((byteAt(buf, o) << 8) | s) !== ((this.#last0 << 8) | this.#last1);
     const preferInternal =
       remote === 'internal' || info !== undefined || (s !== 0 && !zeroByte0 && !countGoesOn && this.#remote === 'internal');
     const internal = chainI > chainE || (chainI === chainE && preferInternal);
@@ -1069,9 +1120,9 @@ export class SpektrumDecoder {
     for (let k = 0; k < length; k++) {
       const f = o + k * FRAME_SIZE;
       const layout = slotLayout(buf, f, resolution);
-      const b0 = buf[f] as number;
+      const b0 = byteAt(buf, f);
       if (!plausibleRssi(b0)) positive = true;
-      else if (k > 0 && b0 < (buf[f - FRAME_SIZE] as number)) fell = true;
+      else if (k > 0 && b0 < byteAt(buf, f - FRAME_SIZE)) fell = true;
       if (layout === layout2) recurring++;
       layout2 = layout1;
       layout1 = layout;
@@ -1087,11 +1138,11 @@ export class SpektrumDecoder {
       // A §8.3 system byte in every frame is strong evidence of an internal remote.
       if (info !== undefined) score += 8;
       if (info?.resolution === resolution) score += 2;
-    } else if ((((buf[o] as number) << 8) | s) < 256) {
+    } else if (((byteAt(buf, o) << 8) | s) < 256) {
       score += 1;
     }
     // A header of 0xFFFF is an empty slot's filler more often than a fade count at its limit.
-    if ((((buf[o] as number) << 8) | s) === 0xffff) score -= 3;
+    if (((byteAt(buf, o) << 8) | s) === 0xffff) score -= 3;
     // Transmitters send channels 0…N-1: a contiguous set is the signature of the right reading.
     if ((channels & (channels + 1)) === 0) score += 2;
     this.#candInternal = internal;
@@ -1112,7 +1163,7 @@ export class SpektrumDecoder {
   #readsInternalLate(o: number, resolution: Resolution, length: number): boolean {
     const buf = this.#buf;
     for (let i = 0; i < 7; i++) {
-      const system = buf[o + 3 + 2 * i] as number;
+      const system = byteAt(buf, o + 3 + 2 * i);
       if (systemInfo(system) === undefined) continue;
       let agree = 0;
       for (let h = o + 2 + 2 * i - FRAME_SIZE; h + FRAME_SIZE <= this.#tail && h < o + length * FRAME_SIZE; h += FRAME_SIZE) {
@@ -1144,7 +1195,7 @@ export class SpektrumDecoder {
     if (other !== null) {
       return `Forced ${this.#options.resolution}: no frame matches; the stream looks like ${other}.`;
     }
-    if (this.#resolution === null) return 'Not locked on to frames yet.';
+    if (!this.#everLocked) return 'Not locked on to frames yet.';
     if (!this.#locked) return 'Looking for frames again: the format changed or the frames stopped making sense.';
     const res = this.#resolution;
     const sys = this.#system === null ? undefined : systemInfo(this.#system);
@@ -1192,42 +1243,13 @@ export class SpektrumDecoder {
       for (let i = this.#chunkHead; i < this.#chunkTail; i++) {
         const end = this.#chunkEnds[i] ?? 0;
         if (end <= x) continue;
-        if (this.#chunkPerByte[i] === 1) timeUs = this.#byteTimes?.[o] ?? Number.NaN;
-        else timeUs = (this.#chunkTimes[i] ?? Number.NaN) - (end - 1 - x) * BYTE_TIME_US;
+        this.#dateByte(x, i);
+        timeUs = timeAt(this.#when, 0);
         break;
       }
     }
     if (event.type === 'discarded') onEvent({ ...event, timeUs, bytes: this.#buf.subarray(o, o + event.length) });
     else onEvent({ ...event, timeUs });
-  }
-
-  /** Records a pushed chunk's end (stream offset); returns its index, for the caller to store its time. */
-  #addChunk(end: number, perByte: boolean): number {
-    if (this.#chunkTail === this.#chunkEnds.length) {
-      const live = this.#chunkTail - this.#chunkHead;
-      if (this.#chunkHead >= live) {
-        this.#chunkEnds.copyWithin(0, this.#chunkHead, this.#chunkTail);
-        this.#chunkTimes.copyWithin(0, this.#chunkHead, this.#chunkTail);
-        this.#chunkPerByte.copyWithin(0, this.#chunkHead, this.#chunkTail);
-      } else {
-        const size = this.#chunkEnds.length * 2;
-        const ends = new Float64Array(size);
-        const times = new Float64Array(size);
-        const perBytes = new Uint8Array(size);
-        ends.set(this.#chunkEnds.subarray(this.#chunkHead, this.#chunkTail));
-        times.set(this.#chunkTimes.subarray(this.#chunkHead, this.#chunkTail));
-        perBytes.set(this.#chunkPerByte.subarray(this.#chunkHead, this.#chunkTail));
-        this.#chunkEnds = ends;
-        this.#chunkTimes = times;
-        this.#chunkPerByte = perBytes;
-      }
-      this.#chunkTail = live;
-      this.#chunkHead = 0;
-    }
-    const i = this.#chunkTail++;
-    this.#chunkEnds[i] = end;
-    this.#chunkPerByte[i] = perByte ? 1 : 0;
-    return i;
   }
 
   /**
@@ -1238,39 +1260,30 @@ export class SpektrumDecoder {
    */
   #stampTime(frame: DecodedFrame, o: number): void {
     const x = this.#base + o;
-    this.#dropChunksBefore(x);
-    const i = this.#chunkHead;
-    if (this.#chunkPerByte[i] === 1) frame.timeUs = (this.#byteTimes as Float64Array)[o] as number;
-    else frame.timeUs = (this.#chunkTimes[i] as number) - ((this.#chunkEnds[i] as number) - 1 - x) * BYTE_TIME_US;
+    this.#dateByte(x, this.#dropChunksBefore(x));
+    frame.timeUs = timeAt(this.#when, 0);
   }
 
-  /** Forgets the records of chunks that end at or before stream offset `x` (keeps the last one). */
-  #dropChunksBefore(x: number): void {
-    while (this.#chunkHead < this.#chunkTail - 1 && (this.#chunkEnds[this.#chunkHead] as number) <= x) this.#chunkHead++;
-  }
-
-  /** Makes room for `n` more bytes: compacts first, grows (doubling) only when full. */
-  #reserve(n: number): void {
-    const need = this.#tail - this.#head + n;
+  /**
+   * Dates the byte at stream offset `x`, held in chunk `i`, into #when[0]: its own time, or its
+   * chunk's time less one byte time for each byte after it in the chunk (NaN without times).
+   * The one rule for frames and events.
+   */
+  #dateByte(x: number, i: number): void {
     const byteTimes = this.#byteTimes;
-    if (this.#head > 0 && (this.#tail + n > this.#buf.length || this.#head >= this.#buf.length >> 1)) {
-      this.#buf.copyWithin(0, this.#head, this.#tail);
-      byteTimes?.copyWithin(0, this.#head, this.#tail);
-      this.#base += this.#head;
-      this.#tail -= this.#head;
-      this.#head = 0;
-    }
-    if (this.#tail + n <= this.#buf.length) return;
-    let capacity = this.#buf.length * 2;
-    while (capacity < need) capacity *= 2;
-    const buf = new Uint8Array(capacity);
-    buf.set(this.#buf.subarray(0, this.#tail));
-    this.#buf = buf;
-    this.#buf32 = new Uint32Array(buf.buffer);
-    if (byteTimes !== null) {
-      const times = new Float64Array(capacity);
-      times.set(byteTimes.subarray(0, this.#tail));
-      this.#byteTimes = times;
-    }
+    this.#when[0] =
+      this.#chunkPerByte[i] === 1 && byteTimes !== null
+        ? timeAt(byteTimes, x - this.#base)
+        : timeAt(this.#chunkTimes, i) - (timeAt(this.#chunkEnds, i) - 1 - x) * BYTE_TIME_US;
+  }
+
+  /** Forgets the records of chunks that end at or before stream offset `x` (keeps the last one); returns the first kept. */
+  #dropChunksBefore(x: number): number {
+    const ends = this.#chunkEnds;
+    const last = this.#chunkTail - 1;
+    let i = this.#chunkHead;
+    while (i < last && timeAt(ends, i) <= x) i++;
+    this.#chunkHead = i;
+    return i;
   }
 }

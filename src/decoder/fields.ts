@@ -115,7 +115,7 @@ export function readFrameFields(bytes: Uint8Array, resolution: Resolution, remot
       continue;
     }
     s.channel = channel;
-    s.position = slotPosition(word, channel, resolution);
+    s.position = slotPosition(word, resolution);
     s.us = servoToMicros(s.position, channel >= XPLUS_FIRST ? 2048 : resolution);
     if (channel >= XPLUS_FIRST) {
       s.kind = 'xplus';

@@ -1,54 +1,77 @@
 /**
  * Reading one 16-byte frame: slot validation (used to find frames without a sync byte) and
- * filling the reusable `DecodedFrame`. Pure functions over a byte array and an offset.
+ * decoding into the arrays a `DecodedFrame` shows. Pure functions over a byte array and an offset.
  */
 import {
-  EMPTY_SLOT,
+  FRAME_SIZE,
+  MASK_1024_CHANID,
   MASK_1024_SXPOS,
+  MASK_2048_CHANID,
   MASK_2048_PHASE,
   MASK_2048_SXPOS,
+  MASK_XPLUS_POS,
   MAX_NORMAL_CHANNEL,
   SLOTS_PER_FRAME,
   XPLUS_CHANNEL_ID,
   XPLUS_FIRST,
+  XPLUS_POSITION_SHIFT,
   type Resolution,
 } from './spec.js';
 import type { DecodedFrame, VtxControl } from './types.js';
 
-/** Slot codes inside a layout: 0–11 a channel ID, then these. */
-const CODE_XPLUS = 12;
-const CODE_EMPTY = 13;
-const CODE_VTX = 14;
-const CODE_BITS = 4;
-/** Bit 28 of a layout: the phase bit of the first slot (frames of a pair differ there). */
-const LAYOUT_PHASE_BIT = 1 << 28;
+/**
+ * `b[i]` at an index the caller knows is inside `b`: a typed read under noUncheckedIndexedAccess
+ * (an index past the end, a bug, reads as 0). Optimised code inlines it to the plain load.
+ */
+export function byteAt(b: Uint8Array, i: number): number {
+  return b[i] ?? 0;
+}
 
 /**
- * A slot's channel and layout code depend on its high byte alone (the ID bits, and for X-Plus
- * the two extra ID bits and the phase bit, all lie in bits 15–9), so each resolution has a
- * table: the channel 0–19 the high byte names, or -1 for an impossible ID (§8.5, §8.6), and its
- * code in a layout. 0xFFFF (both bytes) is an empty slot and is tested before the table.
+ * A layout holds a 4-bit code per slot (slot i in bits 4i…4i+3): 0–11 a channel ID, then
+ * CODE_XPLUS, 13 for an empty slot (EMPTY_SLOT) and CODE_VTX; bit 28 is the first slot's phase
+ * bit (frames of a pair differ there). `slotLayout` and `readFrame` write these numbers out.
  */
-const CHANNEL_2048 = new Int8Array(256);
-const CODE_2048 = new Int8Array(256);
-const CHANNEL_1024 = new Int8Array(256);
-const CODE_1024 = new Int8Array(256);
+const CODE_XPLUS = 12;
+const CODE_VTX = 14;
+const CODE_BITS = 4;
+const CODE_MASK = 0x0f;
+/** Slots 6 and 7 (indices 5 and 6) of a VTX frame. */
+const VTX_CODES = (CODE_VTX << (CODE_BITS * 5)) | (CODE_VTX << (CODE_BITS * 6));
+
+/**
+ * A slot's channel, layout code and position bits depend on its high byte alone (the ID bits,
+ * and for X-Plus the two extra ID bits and the phase bit, all lie in bits 15–9), so each
+ * resolution has a table with one entry per high byte: -1 for an impossible ID (§8.5, §8.6),
+ * else the slot's code in a layout (bits 0–3), its channel 0–19 (bits 4–8), and where its
+ * position lies in the word: `(word & mask) << shift` with the shift in bits 9–10 and the mask
+ * from bit 11 (§8.1, §8.2; §8.6 scales X-Plus's 9 bits to the 2047 scale). 0xFFFF (both bytes)
+ * is an empty slot and is tested before the table. Validation and decoding both read these.
+ */
+const SLOT_2048 = new Int32Array(256);
+const SLOT_1024 = new Int32Array(256);
+const ENTRY_CHANNEL_SHIFT = 4;
+const ENTRY_POSITION_SHIFT = 9;
+const ENTRY_MASK_SHIFT = 11;
+const NO_SLOT = -1;
+
+function slotEntry(code: number, channel: number, mask: number, shift: number): number {
+  return code | (channel << ENTRY_CHANNEL_SHIFT) | (shift << ENTRY_POSITION_SHIFT) | (mask << ENTRY_MASK_SHIFT);
+}
+
 for (let hi = 0; hi < 256; hi++) {
   const word = hi << 8;
-  const id = (word >> 11) & 0x0f;
+  const id = (word & MASK_2048_CHANID) >> 11;
   if (id <= MAX_NORMAL_CHANNEL) {
-    CHANNEL_2048[hi] = id;
-    CODE_2048[hi] = id;
+    SLOT_2048[hi] = slotEntry(id, id, MASK_2048_SXPOS, 0);
   } else if (id === XPLUS_CHANNEL_ID) {
-    CHANNEL_2048[hi] = XPLUS_FIRST + ((word >> 9) & 0x03) + ((word & MASK_2048_PHASE) !== 0 ? 4 : 0);
-    CODE_2048[hi] = CODE_XPLUS;
+    const channel = XPLUS_FIRST + ((word >> 9) & 0x03) + ((word & MASK_2048_PHASE) !== 0 ? 4 : 0);
+    SLOT_2048[hi] = slotEntry(CODE_XPLUS, channel, MASK_XPLUS_POS, XPLUS_POSITION_SHIFT);
   } else {
-    CHANNEL_2048[hi] = -1;
-    CODE_2048[hi] = -1;
+    SLOT_2048[hi] = NO_SLOT;
   }
-  const id1024 = word >> 10;
-  CHANNEL_1024[hi] = id1024 <= MAX_NORMAL_CHANNEL ? id1024 : -1;
-  CODE_1024[hi] = id1024 <= MAX_NORMAL_CHANNEL ? id1024 : -1;
+  const id1024 = (word & MASK_1024_CHANID) >> 10;
+  SLOT_1024[hi] = id1024 <= MAX_NORMAL_CHANNEL ? slotEntry(id1024, id1024, MASK_1024_SXPOS, 0) : NO_SLOT;
 }
 
 /** A layout that is not one: the slots do not form a valid frame. */
@@ -60,7 +83,7 @@ export const INVALID = -1;
  * test keeps apart two X-Plus words X+5…X+8 (also 0xE…, but only sent in phase-1 frames).
  */
 export function isVtxFrame(b: Uint8Array, o: number): boolean {
-  return ((b[o + 12] as number) & 0xf0) === 0xe0 && ((b[o + 14] as number) & 0xf0) === 0xe0 && ((b[o + 2] as number) & 0x80) === 0;
+  return (byteAt(b, o + 12) & 0xf0) === 0xe0 && (byteAt(b, o + 14) & 0xf0) === 0xe0 && (byteAt(b, o + 2) & 0x80) === 0;
 }
 
 /**
@@ -69,30 +92,30 @@ export function isVtxFrame(b: Uint8Array, o: number): boolean {
  * bit, or `INVALID` when a slot holds an impossible ID or an ID repeats. A frame of seven
  * empty slots is valid: a receiver sends it, and reading it as anything else (its next frame's
  * header as a slot) invents a channel. Frames of one transmitter repeat a few layouts, so a known layout is strong evidence
- * that the decoder is aligned.
+ * that the decoder is aligned. `readFrame` gives the same layout and decodes the slots too.
  */
 export function slotLayout(b: Uint8Array, o: number, resolution: Resolution): number {
+  // Numbers written out as in readFrame, for the same reason.
   const vtx = isVtxFrame(b, o);
-  const slots = vtx ? SLOTS_PER_FRAME - 2 : SLOTS_PER_FRAME;
-  const channels = resolution === 2048 ? CHANNEL_2048 : CHANNEL_1024;
-  const codes = resolution === 2048 ? CODE_2048 : CODE_1024;
+  const slots = vtx ? 5 : 7; // SLOTS_PER_FRAME less the two VTX slots
+  const table = resolution === 2048 ? SLOT_2048 : SLOT_1024;
   let seen = 0;
   let layout = 0;
   for (let i = 0; i < slots; i++) {
-    const hi = b[o + 2 + 2 * i] as number;
+    const hi = byteAt(b, o + 2 + 2 * i);
     if (hi === 0xff && b[o + 3 + 2 * i] === 0xff) {
-      layout |= CODE_EMPTY << (CODE_BITS * i); // EMPTY_SLOT
+      layout |= 13 << (4 * i); // EMPTY_SLOT: CODE_EMPTY
       continue;
     }
-    const channel = channels[hi] as number;
-    if (channel < 0) return INVALID;
-    const bit = 1 << channel;
-    if ((seen & bit) !== 0) return INVALID;
+    const entry = table[hi] ?? -1;
+    if (entry === -1) return -1; // NO_SLOT: INVALID
+    const bit = 1 << ((entry >> 4) & 0x1f);
+    if ((seen & bit) !== 0) return -1; // INVALID
     seen |= bit;
-    layout |= (codes[hi] as number) << (CODE_BITS * i);
+    layout |= (entry & 0x0f) << (4 * i);
   }
-  if (vtx) layout |= (CODE_VTX << (CODE_BITS * 5)) | (CODE_VTX << (CODE_BITS * 6));
-  if (((b[o + 2] as number) & 0x80) !== 0) layout |= LAYOUT_PHASE_BIT;
+  if (vtx) layout |= VTX_CODES;
+  if ((byteAt(b, o + 2) & 0x80) !== 0) layout |= 1 << 28; // LAYOUT_PHASE_BIT
   return layout;
 }
 
@@ -100,7 +123,7 @@ export function slotLayout(b: Uint8Array, o: number, resolution: Resolution): nu
 export function layoutChannels(layout: number): number {
   let mask = 0;
   for (let i = 0; i < SLOTS_PER_FRAME; i++) {
-    const code = (layout >> (CODE_BITS * i)) & 0x0f;
+    const code = (layout >> (CODE_BITS * i)) & CODE_MASK;
     if (code <= MAX_NORMAL_CHANNEL) mask |= 1 << code;
   }
   return mask;
@@ -113,8 +136,29 @@ export function countZeroWords(b: Uint8Array, o: number): number {
   return n;
 }
 
-/** A fresh, empty `DecodedFrame` whose arrays the decoder reuses. */
-export function createFrame(): DecodedFrame {
+/**
+ * One frame's decoded slots: the arrays a `DecodedFrame` shows. The decoder keeps two and
+ * swaps them into its frame, so that a frame can be decoded while the one before it is still
+ * shown (see `readFrame`).
+ */
+export class FrameSlots {
+  readonly ids = new Uint8Array(SLOTS_PER_FRAME);
+  readonly positions = new Uint16Array(SLOTS_PER_FRAME);
+  readonly words = new Uint16Array(SLOTS_PER_FRAME);
+  readonly bytes = new Uint8Array(FRAME_SIZE);
+  /** `bytes` as four 32-bit words, for a copy in four moves. */
+  readonly bytes32 = new Uint32Array(this.bytes.buffer);
+  /** The VTX record this set fills; shown only when `hasVtx`. */
+  readonly vtx: VtxControl = createVtx();
+  /** Channel values in `ids` and `positions`. */
+  count = 0;
+  /** Slots that held 0xFFFF. */
+  empty = 0;
+  hasVtx = false;
+}
+
+/** A fresh, empty `DecodedFrame` showing `slots`' arrays. */
+export function createFrame(slots: FrameSlots): DecodedFrame {
   return {
     index: -1,
     offset: 0,
@@ -126,86 +170,102 @@ export function createFrame(): DecodedFrame {
     fadesDelta: 0,
     rssi: null,
     count: 0,
-    ids: new Uint8Array(SLOTS_PER_FRAME),
-    positions: new Uint16Array(SLOTS_PER_FRAME),
-    words: new Uint16Array(SLOTS_PER_FRAME),
+    ids: slots.ids,
+    positions: slots.positions,
+    words: slots.words,
     vtx: null,
-    bytes: new Uint8Array(16),
+    bytes: slots.bytes,
   };
 }
 
-/** A fresh VTX record whose fields the decoder overwrites. */
-export function createVtx(): VtxControl {
-  return { raw: 0, band: 0, channel: 0, power: 0, region: 0, pit: false };
+/** Makes `frame` show the slots (arrays, count and VTX record) of `slots`. */
+export function showSlots(frame: DecodedFrame, slots: FrameSlots): void {
+  frame.ids = slots.ids;
+  frame.positions = slots.positions;
+  frame.words = slots.words;
+  frame.bytes = slots.bytes;
+  frame.count = slots.count;
+  frame.vtx = slots.hasVtx ? slots.vtx : null;
 }
 
 /**
- * Fills the slots of `frame` from the 16 bytes at `o` of `b` (header fields are the caller's).
- * The slots must have passed `slotLayout` under the same resolution; `vtx` is what
- * `isVtxFrame` said. Returns the number of empty slots.
+ * `slotLayout` and decoding in one pass: the frame's layout under `resolution` (or INVALID),
+ * with its 16 raw bytes, slot words, channel IDs and positions, empty slots and VTX control
+ * written to `into`. `b32`, when given, is `b` as 32-bit words (`b.byteOffset` 0): a frame at
+ * a multiple of 4 is copied in four moves. On INVALID `into` is left part written. This is the decoder's hottest
+ * function: plain byte arithmetic on the Uint8Array and one table lookup per slot, small
+ * enough for V8 to inline (VTX control, rare, is read in a function of its own).
+ *
+ * Its numbers are written out, each beside the constant it is: optimised code reads a
+ * module's constants from the module's context with a check each time, and named here they
+ * cost a quarter of this function's time (measured, node 20). The slot tables' entries: code
+ * in bits 0–3, channel in bits 4–8 (ENTRY_CHANNEL_SHIFT), position shift in bits 9–10
+ * (ENTRY_POSITION_SHIFT), mask from bit 11 (ENTRY_MASK_SHIFT); -1 is NO_SLOT.
  */
-export function readSlots(
-  frame: DecodedFrame,
-  b: Uint8Array,
-  o: number,
-  resolution: Resolution,
-  vtx: boolean,
-  vtxStore: VtxControl,
-): number {
-  const bytes = frame.bytes;
-  for (let i = 0; i < 16; i++) bytes[i] = b[o + i] as number;
-  return decodeSlots(frame, b, o, resolution, vtx, vtxStore);
-}
-
-/**
- * `readSlots` without copying the raw bytes to `frame.bytes` (the caller has). This is the
- * decoder's hottest function: plain byte arithmetic on the Uint8Array and table lookups, no
- * DataView calls.
- */
-export function decodeSlots(
-  frame: DecodedFrame,
-  b: Uint8Array,
-  o: number,
-  resolution: Resolution,
-  vtx: boolean,
-  vtxStore: VtxControl,
-): number {
-  const { ids, positions, words } = frame;
-  const channels = resolution === 2048 ? CHANNEL_2048 : CHANNEL_1024;
-  const slots = vtx ? SLOTS_PER_FRAME - 2 : SLOTS_PER_FRAME;
+export function readFrame(b: Uint8Array, b32: Uint32Array, o: number, resolution: Resolution, into: FrameSlots): number {
+  const table = resolution === 2048 ? SLOT_2048 : SLOT_1024;
+  const { ids, positions, words } = into;
+  const vtx = isVtxFrame(b, o);
+  const slots = vtx ? 5 : 7; // SLOTS_PER_FRAME less the two VTX slots
+  let seen = 0;
+  let layout = 0;
   let count = 0;
   let empty = 0;
-  for (let i = 0; i < SLOTS_PER_FRAME; i++) {
-    const hi = b[o + 2 + 2 * i] as number;
-    const word = (hi << 8) | (b[o + 3 + 2 * i] as number);
+  for (let i = 0; i < slots; i++) {
+    const hi = b[o + 2 + 2 * i]!;
+    const word = (hi << 8) | b[o + 3 + 2 * i]!;
     words[i] = word;
-    if (i >= slots) continue;
-    if (word === EMPTY_SLOT) {
+    if (word === 0xffff) {
+      layout |= 13 << (4 * i); // EMPTY_SLOT: code 13
       empty++;
       continue;
     }
-    const channel = channels[hi] as number;
+    const entry = table[hi]!;
+    if (entry === -1) return -1; // NO_SLOT: INVALID
+    const channel = (entry >> 4) & 0x1f;
+    const bit = 1 << channel;
+    if ((seen & bit) !== 0) return -1; // INVALID
+    seen |= bit;
+    layout |= (entry & 0x0f) << (4 * i);
     ids[count] = channel;
-    // §8.6: an X-Plus slot's 9 bits scale to 11; otherwise the position is the low 10 or 11 bits.
-    positions[count] =
-      resolution === 1024 ? word & MASK_1024_SXPOS : channel >= XPLUS_FIRST ? (word & 0x01ff) << 2 : word & MASK_2048_SXPOS;
+    positions[count] = (word & (entry >> 11)) << ((entry >> 9) & 0x03);
     count++;
   }
-  frame.count = count;
+  into.count = count;
+  into.empty = empty;
+  into.hasVtx = vtx;
+  copyBytes(b, b32, o, into.bytes, into.bytes32);
   if (vtx) {
-    const raw =
-      (((b[o + 12] as number) << 24) | ((b[o + 13] as number) << 16) | ((b[o + 14] as number) << 8) | (b[o + 15] as number)) >>> 0;
-    vtxStore.raw = raw;
-    vtxStore.band = (raw >>> 21) & 0x07;
-    vtxStore.channel = (raw >>> 16) & 0x0f;
-    vtxStore.pit = ((raw >>> 4) & 1) === 1;
-    vtxStore.region = (raw >>> 3) & 1;
-    vtxStore.power = raw & 0x07;
-    frame.vtx = vtxStore;
-  } else {
-    frame.vtx = null;
+    layout |= VTX_CODES;
+    readVtx(b, o, into);
   }
-  return empty;
+  return (b[o + 2]! & 0x80) !== 0 ? layout | (1 << 28) : layout; // LAYOUT_PHASE_BIT
+}
+
+/** Copies the frame at `o` to `bytes` (`bytes32` its 32-bit view): four 32-bit moves when `o` is a multiple of 4. */
+function copyBytes(b: Uint8Array, b32: Uint32Array, o: number, bytes: Uint8Array, bytes32: Uint32Array): void {
+  if ((o & 3) === 0) {
+    // In the platform's byte order both ways: the same 16 bytes.
+    const k = o >> 2;
+    bytes32[0] = b32[k]!;
+    bytes32[1] = b32[k + 1]!;
+    bytes32[2] = b32[k + 2]!;
+    bytes32[3] = b32[k + 3]!;
+  } else {
+    for (let i = 0; i < 16; i++) bytes[i] = b[o + i]!; // FRAME_SIZE
+  }
+}
+
+/** The VTX words (slots 5 and 6) and record of the VTX frame at `o`. */
+function readVtx(b: Uint8Array, o: number, into: FrameSlots): void {
+  into.words[5] = (byteAt(b, o + 12) << 8) | byteAt(b, o + 13);
+  into.words[6] = (byteAt(b, o + 14) << 8) | byteAt(b, o + 15);
+  readVtxControl(b, o, into.vtx);
+}
+
+/** A fresh VTX record whose fields `readVtxControl` overwrites. */
+export function createVtx(): VtxControl {
+  return { raw: 0, band: 0, channel: 0, power: 0, region: 0, pit: false };
 }
 
 /**
@@ -213,17 +273,22 @@ export function decodeSlots(
  * §8.6), or -1 for an ID that does not exist (§8.5). An empty slot (0xFFFF) is the caller's test.
  */
 export function slotChannel(hi: number, resolution: Resolution): number {
-  return (resolution === 2048 ? CHANNEL_2048 : CHANNEL_1024)[hi & 0xff] ?? -1;
+  const entry = (resolution === 2048 ? SLOT_2048 : SLOT_1024)[hi & 0xff] ?? NO_SLOT;
+  return entry === NO_SLOT ? -1 : (entry >> ENTRY_CHANNEL_SHIFT) & 0x1f;
 }
 
-/** §8.1, §8.2, §8.6: the position a slot's word carries for `channel` (X-Plus's 9 bits scaled to 11). */
-export function slotPosition(word: number, channel: number, resolution: Resolution): number {
-  return resolution === 1024 ? word & MASK_1024_SXPOS : channel >= XPLUS_FIRST ? (word & 0x01ff) << 2 : word & MASK_2048_SXPOS;
+/**
+ * §8.1, §8.2, §8.6: the position a slot's word carries (X-Plus's 9 bits scaled to 11), or -1
+ * for an ID that does not exist.
+ */
+export function slotPosition(word: number, resolution: Resolution): number {
+  const entry = (resolution === 2048 ? SLOT_2048 : SLOT_1024)[(word >> 8) & 0xff] ?? NO_SLOT;
+  return entry === NO_SLOT ? -1 : (word & (entry >> ENTRY_MASK_SHIFT)) << ((entry >> ENTRY_POSITION_SHIFT) & 0x03);
 }
 
 /** Bytes 12–15 at `o` as Spektrum VTX control, written into `store` (the layout PX4 and Betaflight read). */
 export function readVtxControl(b: Uint8Array, o: number, store: VtxControl): VtxControl {
-  const raw = (((b[o + 12] ?? 0) << 24) | ((b[o + 13] ?? 0) << 16) | ((b[o + 14] ?? 0) << 8) | (b[o + 15] ?? 0)) >>> 0;
+  const raw = ((byteAt(b, o + 12) << 24) | (byteAt(b, o + 13) << 16) | (byteAt(b, o + 14) << 8) | byteAt(b, o + 15)) >>> 0;
   store.raw = raw;
   store.band = (raw >>> 21) & 0x07;
   store.channel = (raw >>> 16) & 0x0f;

@@ -34,9 +34,11 @@ export interface FrameSnapshot {
 /** Copies a borrowed frame into a snapshot you own. */
 export function copyFrame(frame: DecodedFrame): FrameSnapshot {
   const channels: ChannelValue[] = [];
+  const { ids, positions } = frame;
   for (let i = 0; i < frame.count; i++) {
-    const id = frame.ids[i] as number;
-    const pos = frame.positions[i] as number;
+    const id = ids[i];
+    const pos = positions[i];
+    if (id === undefined || pos === undefined) break; // count is at most the arrays' length (7)
     channels.push({ id, pos, us: servoToMicros(pos, channelResolution(id, frame.resolution)) });
   }
   return {

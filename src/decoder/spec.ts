@@ -37,6 +37,9 @@ export const MASK_2048_SXPOS = 0x07ff;
 export const XPLUS_CHANNEL_ID = 12;
 export const XPLUS_FIRST = 12;
 export const XPLUS_LAST = 19;
+/** §8.6: an X-Plus slot's position is its low 9 bits, scaled to the 2047 scale (× 4). */
+export const MASK_XPLUS_POS = 0x01ff;
+export const XPLUS_POSITION_SHIFT = 2;
 /** §8.5: IDs 0–11 are ordinary channels. */
 export const MAX_NORMAL_CHANNEL = 11;
 /** Channels 0–19 (12 normal + 8 X-Plus). */

@@ -34,7 +34,9 @@ export interface VtxControl {
 /**
  * One decoded frame. The decoder hands out the same object each time: it is a borrowed view,
  * valid until the next call to `next()`, `push()`, `end()` or `reset()`. Copy what you keep
- * (`copyFrame()` does it for you).
+ * (`copyFrame()` does it for you). Its arrays are borrowed too, and may be other arrays in the
+ * next frame (the decoder fills one set while the frame shows the other): read them through
+ * the frame each time rather than keep them.
  */
 export interface DecodedFrame {
   /** Sequence number of the frame since the decoder was created or last reset (0, 1, 2, …). */
