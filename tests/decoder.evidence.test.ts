@@ -7,7 +7,7 @@ import { describe, expect, it } from 'vitest';
 import { SpektrumDecoder, copyFrame, type DecoderEvent, type DecoderOptions, type FrameSnapshot } from '../src/decoder/index.js';
 import { importRaw, importSaleaeCsv } from '../src/capture/index.js';
 import { healthReport, summarizeCapture } from '../src/analysis/index.js';
-import { encodeExternalFrame, encodeInternalFrame, encodeServo2048 } from '../src/simulator/encode.js';
+import { encodeExternalFrame, encodeInternalFrame, encodeServo2048 } from '../src/simulator/index.js';
 import { concatBytes as join } from './bytes.js';
 import { runBounded } from './bounded.js';
 

@@ -16,7 +16,7 @@ import {
   encodeServo2048,
   encodeXPlus,
   vtxWords,
-} from '../src/simulator/encode.js';
+} from '../src/simulator/index.js';
 import { concatBytes as join } from './bytes.js';
 
 /** Decodes bytes fed in one piece, then end(): owned snapshots. */

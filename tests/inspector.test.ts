@@ -8,7 +8,7 @@ import {
   encodeServo2048,
   encodeXPlus,
   vtxWords,
-} from '../src/simulator/encode.js';
+} from '../src/simulator/index.js';
 import { DISCARD_BYTES_CAP, InspectorLog, type InspectEntry } from '../src/worker/inspector.js';
 import { concatBytes as join } from './bytes.js';
 
