@@ -290,7 +290,7 @@ class FrameLedger {
     // the least late of them is the evidence there will be.
     let tailMin = Infinity;
     for (let i = 0; i < Math.min(TAIL_FRAMES, this.#tailCount); i++) {
-      const late = (this.#tailUs[i] as number) - this.#refUs - ((this.#tailSlot[i] as number) - this.#refSlot) * p;
+      const late = (this.#tailUs[i] ?? NaN) - this.#refUs - ((this.#tailSlot[i] ?? NaN) - this.#refSlot) * p;
       if (late < tailMin) tailMin = late;
     }
     const after = Number.isFinite(tailMin) ? Math.max(0, Math.round((tailMin - this.#winMinL) / p)) : 0;
@@ -653,7 +653,7 @@ export class LinkMonitor {
       this.#periodOldest = this.#periodOldest === PERIOD_WINDOW - 1 ? 0 : this.#periodOldest + 1;
     }
     if (this.#periodCount >= 9) {
-      const span = t - (times[this.#periodOldest] as number);
+      const span = t - (times[this.#periodOldest] ?? NaN);
       if (!Number.isFinite(this.#systemPeriod) && (!Number.isFinite(s.nominalPeriodUs) || this.#periodCount === PERIOD_WINDOW)) {
         // Without a system byte: snap the mean interval to 11 or 22 ms, first over 8 intervals,
         // then again over every full window, so a few frames missing early do not stick.
@@ -666,13 +666,13 @@ export class LinkMonitor {
     }
     // Fade rate over a window of recent frames.
     const i = this.#rateNext;
-    const prev = this.#rateCount === 0 ? 0 : (this.#rateFades[(i + RATE_WINDOW - 1) % RATE_WINDOW] as number);
+    const prev = this.#rateCount === 0 ? 0 : (this.#rateFades[(i + RATE_WINDOW - 1) % RATE_WINDOW] ?? 0);
     this.#rateTimes[i] = t;
     this.#rateFades[i] = prev + fadesDelta;
     this.#rateNext = (i + 1) % RATE_WINDOW;
     if (this.#rateCount < RATE_WINDOW) this.#rateCount++;
     const oldest = this.#rateCount < RATE_WINDOW ? 0 : this.#rateNext;
-    const span = t - (this.#rateTimes[oldest] as number);
-    s.fadeRate = span > 0 ? (((this.#rateFades[i] as number) - (this.#rateFades[oldest] as number)) / span) * 1e6 : 0;
+    const span = t - (this.#rateTimes[oldest] ?? NaN);
+    s.fadeRate = span > 0 ? (((this.#rateFades[i] ?? 0) - (this.#rateFades[oldest] ?? 0)) / span) * 1e6 : 0;
   }
 }
