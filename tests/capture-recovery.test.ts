@@ -31,7 +31,7 @@ function record(capture: Capture, note: string): Uint8Array {
   const times = capture.byteTimesUs;
   for (let at = 0; at < capture.bytes.length; at += 16) {
     const end = Math.min(at + 16, capture.bytes.length);
-    parts.push(writer.data(capture.bytes.subarray(at, end), times ? (times[end - 1] as number) : NaN));
+    parts.push(writer.data(capture.bytes.subarray(at, end), times?.[end - 1] ?? NaN));
   }
   return concatBytes(parts);
 }

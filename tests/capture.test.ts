@@ -224,7 +224,7 @@ describe('.sscap damage recovery', () => {
       expect(parsed.chunkEnds.length, `cut at ${cut}`).toBe(completeChunks);
       expect(chunksOf(parsed)).toEqual(chunksOf(whole).slice(0, completeChunks));
       expect(parsed.events).toEqual(whole.events.slice(0, completeEvents));
-      const tailStart = complete === 0 ? headerLength : (recordEnds[complete - 1] as number);
+      const tailStart = complete === 0 ? headerLength : recordEnds[complete - 1]!;
       if (tailStart === cut) {
         expect(parsed.issues, `cut at ${cut}`).toEqual([]);
       } else {
@@ -247,8 +247,8 @@ describe('.sscap damage recovery', () => {
   it('reports a record with any one damaged byte and recovers every other record', () => {
     const { file, starts } = smallCapture();
     const whole = chunksOf(parseCapture(file));
-    const start = starts[2] as number; // the 5-byte data chunk on port 1 (chunk 1)
-    const end = starts[3] as number;
+    const start = starts[2]!; // the 5-byte data chunk on port 1 (chunk 1)
+    const end = starts[3]!;
     for (let at = start; at < end; at++) {
       const damaged = file.slice();
       damaged[at]! ^= 0x41;
@@ -267,11 +267,9 @@ describe('.sscap damage recovery', () => {
   it('reports a record whose length runs past the end of the file as damaged when intact records follow', () => {
     const { file, starts } = smallCapture();
     const damaged = file.slice();
-    new DataView(damaged.buffer).setUint32((starts[1] as number) + 4, 100_000, true);
+    new DataView(damaged.buffer).setUint32(starts[1]! + 4, 100_000, true);
     const parsed = parseCapture(damaged);
-    expect(parsed.issues.map((i) => [i.kind, i.offset, i.length])).toEqual([
-      ['bad-checksum', starts[1], (starts[2] as number) - (starts[1] as number)],
-    ]);
+    expect(parsed.issues.map((i) => [i.kind, i.offset, i.length])).toEqual([['bad-checksum', starts[1], starts[2]! - starts[1]!]]);
     expect(parsed.chunkEnds).toHaveLength(3);
   });
 
@@ -282,7 +280,7 @@ describe('.sscap damage recovery', () => {
     const before = randomBytes(3, 9).map((b) => b & 0x7f); // no 0xA5: cannot look like a sync byte
     const after = Uint8Array.from([0x00, 0x01, 0x02]);
     expect(randomBytes(37, 7).includes(0xa5), 'test data: no sync byte in the first garbage run').toBe(false);
-    const cut = starts[3] as number;
+    const cut = starts[3]!;
     const mangled = concat(file.subarray(0, headerLength), before, file.subarray(headerLength, cut), middle, file.subarray(cut), after);
     const parsed = parseCapture(mangled);
     expect(chunksOf(parsed)).toEqual(chunksOf(parseCapture(file)));
@@ -302,7 +300,7 @@ describe('.sscap damage recovery', () => {
 
   it('finds a record that starts right after a single stray byte', () => {
     const { file, starts } = smallCapture();
-    const at = starts[2] as number;
+    const at = starts[2]!;
     const mangled = concat(file.subarray(0, at), Uint8Array.from([0x00]), file.subarray(at));
     const parsed = parseCapture(mangled);
     expect(chunksOf(parsed)).toEqual(chunksOf(parseCapture(file)));
@@ -312,11 +310,11 @@ describe('.sscap damage recovery', () => {
   it('reports a damaged record and a cut-off last record as two issues', () => {
     const { file, starts } = smallCapture();
     const damaged = file.slice(0, file.length - 3);
-    damaged[(starts[4] as number) + 18]! ^= 0xff; // inside the "device lost" event's payload
+    damaged[starts[4]! + 18]! ^= 0xff; // inside the "device lost" event's payload
     const parsed = parseCapture(damaged);
     expect(parsed.issues.map((i) => [i.kind, i.offset, i.length])).toEqual([
-      ['bad-checksum', starts[4], (starts[5] as number) - (starts[4] as number)],
-      ['truncated-record', starts[5], damaged.length - (starts[5] as number)],
+      ['bad-checksum', starts[4], starts[5]! - starts[4]!],
+      ['truncated-record', starts[5], damaged.length - starts[5]!],
     ]);
     expect(parsed.events.map((e) => e.text)).toEqual(['port opened']);
     expect(parsed.chunkEnds).toHaveLength(3);
@@ -379,7 +377,7 @@ describe('.sscap damage recovery', () => {
     const { file, starts, headerLength } = smallCapture();
     const damaged = file.slice();
     damaged[13]! ^= 0x10; // the metadata length, off by 4096
-    damaged[(starts[0] as number) + 17]! ^= 0x01; // the first record ("port opened")
+    damaged[starts[0]! + 17]! ^= 0x01; // the first record ("port opened")
     const parsed = parseCapture(damaged);
     expect(parsed.meta).toEqual(parseCapture(file).meta);
     expect(parsed.headerLength).toBe(headerLength);
@@ -387,7 +385,7 @@ describe('.sscap damage recovery', () => {
     expect(parsed.events.map((e) => e.text)).toEqual(['device lost']);
     expect(parsed.issues.map((i) => [i.kind, i.offset, i.length])).toEqual([
       ['bad-header', 0, headerLength],
-      ['bad-checksum', starts[0], (starts[1] as number) - (starts[0] as number)],
+      ['bad-checksum', starts[0], starts[1]! - starts[0]!],
     ]);
   });
 
@@ -426,13 +424,13 @@ describe('.sscap damage recovery', () => {
         const at = headerLength + ((((noise[1 + k] ?? 0) << 8) | (noise[5 + k] ?? 0)) % (file.length - headerLength));
         damaged[at] = noise[9 + k] ?? 0;
       }
-      const touched = (r: number): boolean => damaged.subarray(starts[r], ends[r]).some((b, i) => b !== file[(starts[r] as number) + i]);
+      const touched = (r: number): boolean => damaged.subarray(starts[r], ends[r]).some((b, i) => b !== file[starts[r]! + i]);
       const parsed = parseCapture(damaged);
       let chunk = 0;
       const expected: typeof wholeChunks = [];
       let intactBytes = 0;
       for (let r = 0; r < starts.length; r++) {
-        if (!touched(r)) intactBytes += (ends[r] as number) - (starts[r] as number);
+        if (!touched(r)) intactBytes += ends[r]! - starts[r]!;
         if (isData[r]) {
           if (!touched(r)) expected.push(wholeChunks[chunk] as (typeof wholeChunks)[number]);
           chunk++;

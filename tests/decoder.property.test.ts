@@ -59,7 +59,7 @@ describe('chunk-split invariance', () => {
           const got: string[] = [];
           let at = 0;
           for (let k = 0; at < bytes.length; k++) {
-            const end = Math.min(bytes.length, at + (sizes[k % sizes.length] as number));
+            const end = Math.min(bytes.length, at + sizes[k % sizes.length]!);
             const time = timing === 'per-byte' ? timesUs.subarray(at, end) : timing === 'chunk' ? timesUs[end - 1] : undefined;
             d.push(bytes.subarray(at, end), time);
             for (let f = d.next(); f; f = d.next()) got.push(key(f));

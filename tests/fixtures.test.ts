@@ -6,6 +6,7 @@ import { readdirSync, readFileSync } from 'node:fs';
 import { join } from 'node:path';
 import { describe, expect, it } from 'vitest';
 import { SpektrumDecoder, type DecodedFrame } from '../src/decoder/index.js';
+import { usbChunks } from './feeds.js';
 
 const dir = join(import.meta.dirname, 'fixtures');
 const names = readdirSync(dir)
@@ -72,16 +73,9 @@ const feeds: Record<string, Feed> = {
     }
   },
   'USB batches every 16 ms, chunk times': (d, b, t, out) => {
-    let start = 0;
-    for (let i = 0; i <= b.length; i++) {
-      const deadline = Math.floor((t[start] ?? 0) / 16_000) * 16_000 + 16_000;
-      if (i === b.length || (t[i] as number) >= deadline) {
-        if (i > start) {
-          d.push(b.subarray(start, i), deadline);
-          drain(d, out);
-        }
-        start = i;
-      }
+    for (const chunk of usbChunks(b, t)) {
+      d.push(chunk.bytes, chunk.timeUs);
+      drain(d, out);
     }
   },
   'random splits, chunk times': (d, b, t, out) => {
