@@ -147,6 +147,36 @@ describe('LinkMonitor: missed means missed', () => {
     expect(real.takeRetracted()).toEqual([]);
   });
 
+  it("where the receiver's counter counts, it judges a hold the moment frames resume: a stall beside a real dropout, or in a stream's last moments, is withdrawn", () => {
+    /** Feeds slots (those in `lost` never sent; the counter reports them) delivered with `stallUs`; returns the holds withdrawn on the way. */
+    const run = (link: LinkMonitor, slots: number, lost: Set<number>, stallUs: (k: number) => number): number[] => {
+      const withdrawn: number[] = [];
+      let slot = 0;
+      let fades = 40;
+      for (const t of usbDelivered(slots, 11_000, lost, stallUs)) {
+        let delta = 0;
+        for (; lost.has(slot); slot++) delta++;
+        fades += delta;
+        link.frame(frame(t, delta, 0xb2, fades));
+        link.update(t + 8_000);
+        withdrawn.push(...link.takeRetracted());
+        slot++;
+      }
+      return withdrawn;
+    };
+    // A 100 ms stall at 0.9 s, then a real 154 ms dropout at 1.1 s in the same ledger window.
+    const beside = new LinkMonitor({ jitterUs: 20_000 });
+    const lost = new Set(Array.from({ length: 14 }, (_, i) => 100 + i));
+    expect(run(beside, 300, lost, (k) => (k === 55 ? 100_000 : 0))).toHaveLength(1);
+    expect(beside.stats).toMatchObject({ holds: 1, missedFrames: 14, failsafes: 0 });
+    expect(beside.episodes.map((e) => e.lastFrameUs > 1_000_000)).toEqual([true]);
+    // A 100 ms stall 0.1 s before the stream ends: no ledger window closes after it.
+    const late = new LinkMonitor({ jitterUs: 20_000 });
+    expect(run(late, 200, new Set(), (k) => (k === 131 ? 100_000 : 0))).toHaveLength(1);
+    late.finish(200 * 11_000);
+    expect(late.stats).toMatchObject({ holds: 0, missedFrames: 0 });
+  });
+
   it('a fade-counter jump is a missed frame, at once, with no gap to see', () => {
     const link = new LinkMonitor();
     for (let i = 0; i < 50; i++) link.frame(frame(i * 11_000, 0, 0xb2, 5));

@@ -485,9 +485,17 @@ export class LinkMonitor {
     }
     if (this.#open !== null) {
       this.#open.endUs = Number.isFinite(t) ? t : this.#open.startUs;
-      // What the receiver says it missed in the silence, for confirming the hold.
-      const u = this.#unconfirmed.find((x) => x.episode === this.#open);
-      if (u !== undefined) u.endFades = fades;
+      // What the receiver says it missed in the silence. Where its counter counts, that is the
+      // evidence, and the hold is judged now (a stall's frames arrive late, none missed);
+      // otherwise it waits for the frame count of the ledger window that closes over it.
+      const at = this.#unconfirmed.findIndex((x) => x.episode === this.#open);
+      const u = this.#unconfirmed[at];
+      if (u !== undefined && this.#counting) {
+        this.#unconfirmed.splice(at, 1);
+        this.#judge(u.episode, fades);
+      } else if (u !== undefined) {
+        u.endFades = fades;
+      }
       this.#open = null;
     }
     this.#state = 'live';
@@ -507,23 +515,31 @@ export class LinkMonitor {
     const l = this.#ledger;
     if (l.closes === this.#closesSeen) return;
     this.#closesSeen = l.closes;
-    const p = this.#stats.nominalPeriodUs;
     for (let i = 0; i < this.#unconfirmed.length; ) {
-      const { episode: e, endFades } = this.#unconfirmed[i] as { episode: LinkEpisode; endFades: number };
-      if (!(e.lastFrameUs < l.closedPunctualUs) || e.endUs === null) {
+      const u = this.#unconfirmed[i];
+      if (u === undefined || !(u.episode.lastFrameUs < l.closedPunctualUs) || u.episode.endUs === null) {
         i++;
         continue;
       }
       this.#unconfirmed.splice(i, 1);
-      // Frames the silence would have held had the link lost them; a stall delivers them after it.
-      const due = Number.isFinite(p) ? Math.round((e.endUs - e.lastFrameUs) / p) - 1 : 0;
-      const failsafe = this.#episodes.some((f) => f.kind === 'failsafe' && f.lastFrameUs === e.lastFrameUs);
-      if (failsafe || due < 2 || l.closedMissing >= due / 2 || endFades >= due / 2) continue;
-      const at = this.#episodes.indexOf(e);
-      if (at >= 0) this.#episodes.splice(at, 1);
-      this.#stats.holds--;
-      this.#retracted.push(e.id);
+      this.#judge(u.episode, Math.max(l.closedMissing, u.endFades));
     }
+  }
+
+  /**
+   * Keeps a hold that ended, or withdraws it: `missed` is how many frames the evidence says were
+   * lost in its silence. Frames the silence would have held had the link lost them; a stall
+   * delivers them after it, and a hold that lost under half of them was the adapter's.
+   */
+  #judge(e: LinkEpisode, missed: number): void {
+    const p = this.#stats.nominalPeriodUs;
+    const due = Number.isFinite(p) && e.endUs !== null ? Math.round((e.endUs - e.lastFrameUs) / p) - 1 : 0;
+    const failsafe = this.#episodes.some((f) => f.kind === 'failsafe' && f.lastFrameUs === e.lastFrameUs);
+    if (failsafe || due < 2 || missed >= due / 2) return;
+    const at = this.#episodes.indexOf(e);
+    if (at >= 0) this.#episodes.splice(at, 1);
+    this.#stats.holds--;
+    this.#retracted.push(e.id);
   }
 
   /** Frames the ledger found missing: they count while the receiver has given no counter to go by. */
