@@ -177,6 +177,23 @@ describe('LinkMonitor: missed means missed', () => {
     expect(late.stats).toMatchObject({ holds: 0, missedFrames: 0 });
   });
 
+  it('without a counter, a hold whose frames then come in one burst was a stall: withdrawn when the burst ends, even beside a real dropout', () => {
+    // A 100 ms stall at 0.9 s, then 154 ms of frames never sent at 1.1 s, in the same ledger window.
+    const link = new LinkMonitor({ jitterUs: 20_000 });
+    const lost = new Set(Array.from({ length: 14 }, (_, i) => 100 + i));
+    const withdrawn: number[] = [];
+    for (const t of usbDelivered(300, 11_000, lost, (k) => (k === 55 ? 100_000 : 0))) {
+      link.frame(bare(t));
+      link.update(t + 8_000);
+      withdrawn.push(...link.takeRetracted());
+    }
+    link.finish(300 * 11_000);
+    withdrawn.push(...link.takeRetracted());
+    expect(withdrawn).toHaveLength(1);
+    expect(link.stats).toMatchObject({ holds: 1, failsafes: 0, missedBasis: 'frame-count', missedFrames: 14 });
+    expect(link.episodes.map((e) => e.lastFrameUs > 1_000_000)).toEqual([true]);
+  });
+
   it('a fade-counter jump is a missed frame, at once, with no gap to see', () => {
     const link = new LinkMonitor();
     for (let i = 0; i < 50; i++) link.frame(frame(i * 11_000, 0, 0xb2, 5));

@@ -341,6 +341,12 @@ export class LinkMonitor {
    */
   readonly #unconfirmed: { episode: LinkEpisode; endFades: number }[] = [];
   readonly #retracted: number[] = [];
+  /**
+   * A hold that just ended with no counter to judge it, and the frames that came right after
+   * it closer together than half a period: a stall delivers the frames it held all at once,
+   * while a link that lost them resumes at its pace.
+   */
+  #burst: { episode: LinkEpisode; frames: number } | null = null;
   #closesSeen = 0;
   /** The fade counter has shown that it counts (a value other than 0, or a rise). */
   #counting = false;
@@ -444,6 +450,12 @@ export class LinkMonitor {
       this.#redate(open.lastFrameUs, last);
     }
     const gap = Number.isFinite(t) && Number.isFinite(last) && t >= last ? t - last : NaN;
+    if (this.#burst !== null) {
+      // Within a burst, frames of chunks delivered together may even be dated out of order.
+      const p = s.nominalPeriodUs;
+      if (Number.isFinite(t) && !(t - last >= (Number.isFinite(p) ? p : FRAME_PERIOD_11MS_US) / 2)) this.#burst.frames++;
+      else this.#endBurst();
+    }
     const fades = frame.fadesDelta;
     s.fades += fades;
     this.#lastFades = fades;
@@ -495,6 +507,7 @@ export class LinkMonitor {
         this.#judge(u.episode, fades);
       } else if (u !== undefined) {
         u.endFades = fades;
+        this.#burst = { episode: u.episode, frames: 1 };
       }
       this.#open = null;
     }
@@ -517,13 +530,32 @@ export class LinkMonitor {
     this.#closesSeen = l.closes;
     for (let i = 0; i < this.#unconfirmed.length; ) {
       const u = this.#unconfirmed[i];
-      if (u === undefined || !(u.episode.lastFrameUs < l.closedPunctualUs) || u.episode.endUs === null) {
+      // A hold whose burst is still arriving is judged by the burst first.
+      const waiting = u === undefined || u.episode === this.#burst?.episode;
+      if (waiting || !(u.episode.lastFrameUs < l.closedPunctualUs) || u.episode.endUs === null) {
         i++;
         continue;
       }
       this.#unconfirmed.splice(i, 1);
       this.#judge(u.episode, Math.max(l.closedMissing, u.endFades));
     }
+  }
+
+  /** The burst after a hold is over: a hold whose frames came in it is withdrawn now; any other waits for its ledger window. */
+  #endBurst(): void {
+    const b = this.#burst;
+    this.#burst = null;
+    const e = b?.episode;
+    const p = this.#stats.nominalPeriodUs;
+    if (b === undefined || b === null || e === undefined || e.endUs === null || !Number.isFinite(p)) return;
+    // The silence held `due` frames; the burst brought them (and the frame due when it came).
+    const due = Math.round((e.endUs - e.lastFrameUs) / p) - 1;
+    const missed = Math.max(0, due + 1 - b.frames);
+    if (missed >= due / 2) return;
+    const at = this.#unconfirmed.findIndex((x) => x.episode === e);
+    if (at < 0) return;
+    this.#unconfirmed.splice(at, 1);
+    this.#judge(e, missed);
   }
 
   /**
@@ -590,6 +622,7 @@ export class LinkMonitor {
   finish(endUs: number): LinkState {
     if (this.#finished) return this.#state;
     this.#finished = true;
+    if (this.#burst !== null) this.#endBurst();
     const state = this.update(endUs);
     const s = this.#stats;
     if (!Number.isFinite(endUs) || !Number.isFinite(this.#lastUs) || !Number.isFinite(s.nominalPeriodUs)) return state;
@@ -623,6 +656,7 @@ export class LinkMonitor {
    * for the time in between.
    */
   interrupt(atUs: number): void {
+    this.#burst = null;
     if (this.#open !== null) {
       this.#open.endUs = Number.isFinite(atUs) ? Math.max(atUs, this.#open.startUs) : this.#open.startUs;
       this.#open = null;
