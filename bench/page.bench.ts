@@ -289,18 +289,33 @@ async function armOpenTimer(page: Page): Promise<void> {
   });
 }
 
-async function openTime(page: Page, file: string, timeoutMs: number): Promise<number> {
+/**
+ * Opens `file` and times it: in all, and its parts from the page's marks (open-file.ts,
+ * store.ts): the page reading the file, the worker from the bytes posted to its overview
+ * received (reading the capture and decoding it for the overview), and the page drawing it.
+ */
+async function openTimes(
+  page: Page,
+  file: string,
+  timeoutMs: number,
+): Promise<{ ms: number; pageReadMs: number; workerMs: number; drawMs: number }> {
   await armOpenTimer(page);
   await page.setInputFiles('input[type=file]', file);
   await page.waitForFunction(() => (window as unknown as { __open: { plotted: number } }).__open.plotted > 0, undefined, {
     timeout: timeoutMs,
   });
-  return Math.round(
-    await page.evaluate(() => {
-      const o = (window as unknown as { __open: { start: number; plotted: number } }).__open;
-      return o.plotted - o.start;
-    }),
-  );
+  return page.evaluate(() => {
+    const o = (window as unknown as { __open: { start: number; plotted: number } }).__open;
+    const mark = (name: string) => performance.getEntriesByName(name).at(-1)?.startTime ?? Number.NaN;
+    const read = mark('satscope:capture-read');
+    const received = mark('satscope:overview-received');
+    return {
+      ms: Math.round(o.plotted - o.start),
+      pageReadMs: Math.round(read - o.start),
+      workerMs: Math.round(received - read),
+      drawMs: Math.round(o.plotted - received),
+    };
+  });
 }
 
 /**
@@ -312,7 +327,8 @@ async function seekTime(page: Page, fraction: number): Promise<number> {
   return page.evaluate(async (f) => {
     const input = document.querySelector<HTMLInputElement>('section.replay input.seek');
     const bench = window.__satscopeBench;
-    if (input === null || bench === undefined) return Number.NaN;
+    // A build without the painted hook (BENCH_APP_DIR of an older page) cannot time seeks.
+    if (input === null || bench === undefined || !('painted' in bench)) return Number.NaN;
     const min = Number(input.min);
     const max = Number(input.max);
     const target = Math.round(min + f * (max - min));
@@ -412,7 +428,10 @@ it(
       return;
     }
     const results: Record<string, unknown> = { loadBefore: load() };
-    const server = await startStaticServer(APP_DIR);
+    // BENCH_APP_DIR: another build of the page (e.g. main's), to compare in the same conditions.
+    const appDir = process.env.BENCH_APP_DIR ?? APP_DIR;
+    results.appDir = appDir;
+    const server = await startStaticServer(appDir);
     const tmp = mkdtempSync(join(tmpdir(), 'satscope-bench-'));
     const serialSkip = fakeSerialUnsupportedReason();
     const wantsSerial = ONLY.includes('serial') || ONLY.includes('record');
@@ -611,10 +630,13 @@ it(
         writeCapture(file, usbChunks(hour.bytes, hour.timesUs));
         const size = readFileSync(file).length;
         const times: number[] = [];
+        const parts: { pageReadMs: number; workerMs: number; drawMs: number }[] = [];
         for (let run = 0; run < 3; run++) {
           const page = await newPage();
           await page.goto(server.url('/?demo=0'));
-          times.push(await openTime(page, file, 30_000));
+          const t = await openTimes(page, file, 30_000);
+          times.push(t.ms);
+          parts.push(t);
           await page.close();
         }
         results.openHourCapture = {
@@ -633,7 +655,7 @@ it(
           const page = await newPage();
           await page.goto(server.url('/?bench&demo=0'));
           const idle = threadTimes();
-          const openMs = await openTime(page, DAY_FILE, 300_000);
+          const open = await openTimes(page, DAY_FILE, 300_000);
           const fractions = [0.5, 0.1, 0.9, 0.99, 0.01, 0.5];
           const seeks: number[] = [];
           for (const f of fractions) {
@@ -648,7 +670,8 @@ it(
           const held = pageH.used + pageH.buffers + (workerH?.used ?? Number.NaN) + (workerH?.buffers ?? Number.NaN);
           results.openDayCapture = {
             fileMB: round(fileMB),
-            openToOverviewMs: openMs,
+            openToOverviewMs: open.ms,
+            openPartsMs: { pageRead: open.pageReadMs, worker: open.workerMs, draw: open.drawMs },
             seekFractions: fractions,
             seekMs: seeks,
             seekMsMedian: pct(seeks, 50),
@@ -669,7 +692,7 @@ it(
 
       // What the browser downloads first.
       if (ONLY.includes('bundle')) {
-        const assets = join(APP_DIR, 'assets');
+        const assets = join(appDir, 'assets');
         const files = readdirSync(assets);
         const gz = (f: string) => gzipSync(readFileSync(join(assets, f)), { level: 9 }).length;
         const entry = files.filter((f) => f.startsWith('index-') && f.endsWith('.js'));
@@ -689,7 +712,7 @@ it(
     }
     results.loadAfter = load();
     mkdirSync(join(ROOT, 'bench-results'), { recursive: true });
-    writeFileSync(join(ROOT, 'bench-results/page.json'), `${JSON.stringify(results, null, 2)}\n`);
+    writeFileSync(join(ROOT, 'bench-results', process.env.BENCH_OUT ?? 'page.json'), `${JSON.stringify(results, null, 2)}\n`);
     console.log(JSON.stringify(results, null, 2));
   },
   120 * 60_000,

@@ -179,6 +179,7 @@ function receive(message: FromWorker): void {
       if (message.replay === null) overview.value = null;
       break;
     case 'overview':
+      performance.mark('satscope:overview-received');
       overview.value = message.overview;
       break;
     case 'inspection':
