@@ -13,22 +13,27 @@ function buckets(fromUs: number, n: number, rate: (i: number) => number = (i) =>
 describe('the graph series of a remote', () => {
   it('appends buckets once, in seconds, with a bucket without a value as a gap (null)', () => {
     const s = new SeriesBuffer();
-    s.append(buckets(1_000_000, 3, (i) => (i === 1 ? Number.NaN : i)));
+    const batch = buckets(1_000_000, 3);
+    batch.periodMs[1] = Number.NaN;
+    s.append(batch);
     expect(s.t).toEqual([1, 1.1, 1.2]);
-    expect(s.fadeRate).toEqual([0, null, 2]);
+    expect(s.fadeRate).toEqual([0, 1, 2]);
+    expect(s.periodMs).toEqual([11, null, 11]);
     expect(s.rssi).toEqual([null, null, null]);
     expect(s.appended).toBe(3);
     expect(s.indexAt(1.05)).toBe(1);
   });
 
-  it('keeps the same arrays as it grows, and drops the oldest in one step past twice ten minutes', () => {
+  it('keeps the same arrays as it grows, and drops what is older than ten minutes in one step', () => {
     const s = new SeriesBuffer();
     const column = s.t;
-    for (let k = 0; k < 121; k++) s.append(buckets(k * 10_000_000, 100));
+    for (let k = 0; k < 75; k++) s.append(buckets(k * 10_000_000, 100));
+    expect(s.length).toBe(7500);
+    s.append(buckets(750_000_000, 100));
     expect(s.t).toBe(column);
-    expect(s.appended).toBe(12_100);
+    expect(s.appended).toBe(7600);
     expect(s.length).toBe(6000);
-    expect(s.t[s.length - 1]).toBeCloseTo(1209.9, 6);
+    expect(s.t[s.length - 1]).toBeCloseTo(759.9, 6);
     expect(s.lost.length).toBe(6000);
   });
 });

@@ -10,6 +10,8 @@ import type { Batch } from '../worker/protocol.js';
 const EPISODE_KEEP_US = 600e6;
 /** Ten minutes of 100 ms buckets: the longest graph window. */
 const WINDOW_BUCKETS = 6000;
+/** Buckets kept past the window before the oldest are dropped (in one step every 2.5 minutes). */
+const SLACK_BUCKETS = 1500;
 
 /** A bucket's value as the graphs take it: NaN (no value in that bucket) breaks the line, as null. */
 const gap = (v: number): number | null => (Number.isNaN(v) ? null : v);
@@ -17,16 +19,18 @@ const gap = (v: number): number | null => (Number.isNaN(v) ? null : v);
 /**
  * One remote's graph buckets as columns that grow: each batch's new buckets are appended once,
  * in the form uPlot draws (seconds, gaps as null), and the graphs hand the same arrays to uPlot
- * on every redraw, which draws only what its x scale shows. Nothing is rebuilt per redraw; the
- * oldest window is dropped in one step when twice the longest window has piled up.
+ * on every redraw, which draws only what its x scale shows. Nothing is rebuilt per redraw; what
+ * is older than the longest window is dropped in one step once 2.5 minutes of it piled up.
  */
 export class SeriesBuffer {
   /** Bucket start in seconds of the source clock (uPlot's x), ascending. */
   readonly t: number[] = [];
-  readonly fadeRate: (number | null)[] = [];
+  // Fades and lost frames have a value in every bucket: kept as plain doubles (no null in the
+  // array, so V8 stores them unboxed). RSSI and the period have gaps.
+  readonly fadeRate: number[] = [];
   readonly rssi: (number | null)[] = [];
   readonly periodMs: (number | null)[] = [];
-  readonly lost: (number | null)[] = [];
+  readonly lost: number[] = [];
   /** Buckets appended since the last clear (including those dropped since): what is new to a reader. */
   appended = 0;
   /** Counts clears, so a reader that kept a position knows to start over. */
@@ -39,13 +43,13 @@ export class SeriesBuffer {
   append(s: Batch['series']): void {
     s.t.forEach((t, i) => {
       this.t.push(t / 1e6);
-      this.fadeRate.push(gap(s.fadeRate[i] ?? Number.NaN));
+      this.fadeRate.push(s.fadeRate[i] ?? 0);
       this.rssi.push(gap(s.rssi[i] ?? Number.NaN));
       this.periodMs.push(gap(s.periodMs[i] ?? Number.NaN));
-      this.lost.push(gap(s.lost[i] ?? Number.NaN));
+      this.lost.push(s.lost[i] ?? 0);
     });
     this.appended += s.t.length;
-    if (this.t.length > 2 * WINDOW_BUCKETS) {
+    if (this.t.length > WINDOW_BUCKETS + SLACK_BUCKETS) {
       const drop = this.t.length - WINDOW_BUCKETS;
       for (const col of this.#columns()) col.splice(0, drop);
     }

@@ -9,8 +9,9 @@ import { BUCKET_US } from '../../../worker/protocol.js';
 import type { SeriesBuffer } from '../../live.js';
 
 const BUCKET_S = BUCKET_US / 1e6;
-/** Ten minutes of buckets (the longest window); twice that piled up drops the oldest in one step. */
+/** Ten minutes of buckets (the longest window); 2.5 minutes more piled up are dropped in one step. */
 const KEEP = 6000;
+const SLACK = 1500;
 
 interface Reader {
   series: SeriesBuffer | undefined;
@@ -49,7 +50,7 @@ export class AlignedColumns {
       }
       reader.appended = s.appended;
     });
-    if (this.x.length > 2 * KEEP) {
+    if (this.x.length > KEEP + SLACK) {
       const drop = this.x.length - KEEP;
       this.x.splice(0, drop);
       for (const col of this.columns) col.splice(0, drop);
