@@ -319,28 +319,32 @@ async function openTimes(
 }
 
 /**
- * Seeks to `fraction` of the capture through the seek slider (as a user lets go of it) and
- * returns the ms from the slider's change to the animation frame that drew the remote at its
- * new position (its clock within 2 s after the target: a seek replays a little history first).
+ * Seeks to `fraction` of the capture through the seek slider (as a user lets go of it): ms from
+ * the slider's change to the animation frame that drew the remote at its new position (its clock
+ * within 2 s after the target: a seek replays a little history first), split at the first batch
+ * after the worker's reset into the worker's part and the page's.
  */
-async function seekTime(page: Page, fraction: number): Promise<number> {
+async function seekTime(page: Page, fraction: number): Promise<{ ms: number; workerMs: number; pageMs: number }> {
   return page.evaluate(async (f) => {
+    const none = { ms: Number.NaN, workerMs: Number.NaN, pageMs: Number.NaN };
     const input = document.querySelector<HTMLInputElement>('section.replay input.seek');
     const bench = window.__satscopeBench;
-    // A build without the painted hook (BENCH_APP_DIR of an older page) cannot time seeks.
-    if (input === null || bench === undefined || !('painted' in bench)) return Number.NaN;
+    // A build without these hooks (BENCH_APP_DIR of an older page) cannot time seeks.
+    if (input === null || bench === undefined || !('painted' in bench) || !('firstBatchAtMs' in bench)) return none;
     const min = Number(input.min);
     const max = Number(input.max);
     const target = Math.round(min + f * (max - min));
     input.value = String(target);
     const start = performance.now();
     input.dispatchEvent(new Event('change', { bubbles: true }));
-    return new Promise<number>((resolve) => {
+    return new Promise<typeof none>((resolve) => {
       const deadline = start + 30_000;
       const check = () => {
         const p = bench.painted;
-        if (p.atMs > start && p.clockUs >= target - 1e6 && p.clockUs <= target + 2e6) resolve(p.atMs - start);
-        else if (performance.now() > deadline) resolve(Number.NaN);
+        if (p.atMs > start && p.clockUs >= target - 1e6 && p.clockUs <= target + 2e6) {
+          const batch = bench.firstBatchAtMs > start ? bench.firstBatchAtMs : Number.NaN;
+          resolve({ ms: Math.round(p.atMs - start), workerMs: Math.round(batch - start), pageMs: Math.round(p.atMs - batch) });
+        } else if (performance.now() > deadline) resolve(none);
         else requestAnimationFrame(check);
       };
       requestAnimationFrame(check);
@@ -567,9 +571,12 @@ it(
             const worker = await WorkerTarget.attach(browser);
             const sim = new Simulator({ ...preset('dsmx-11ms-2048-internal'), seed: 7, fades: { lossRate: 0.002 } });
             const origin = sim.scenario.timing.startUs;
-            const hours: { hour: number; pageMB: number; workerMB: number | undefined; wallS: number }[] = [];
+            const hours: { hour: number; pageMB: number; workerMB: number | undefined; wallS: number; buckets: number }[] = [];
+            // The graph buckets the page holds: they grow with wall time (the arrival clock), up to 12.5 minutes' worth.
+            const buckets = () =>
+              page.evaluate(() => [...(window.__satscopeBench?.lives().values() ?? [])].reduce((n, l) => n + l.series.length, 0));
             const first = await pageHeap(page);
-            hours.push({ hour: 0, pageMB: first.used, workerMB: (await worker?.heapMB())?.used, wallS: 0 });
+            hours.push({ hour: 0, pageMB: first.used, workerMB: (await worker?.heapMB())?.used, wallS: 0, buckets: await buckets() });
             const cpu0 = threadTimes();
             const t0 = performance.now();
             const BLOCK_US = 600e6;
@@ -590,6 +597,7 @@ it(
                   pageMB: h.used,
                   workerMB: (await worker?.heapMB())?.used,
                   wallS: round((performance.now() - t0) / 1000, 0),
+                  buckets: await buckets(),
                 });
               }
             }
@@ -612,6 +620,7 @@ it(
               pageHeapSpreadMB: round(Math.max(...pages) - Math.min(...pages), 2),
               workerHeapMBByHour: hours.map((h) => h.workerMB),
               wallSecondsByHour: hours.map((h) => h.wallS),
+              graphBucketsByHour: hours.map((h) => h.buckets),
               load: load(),
             };
             await worker?.detach();
@@ -657,11 +666,12 @@ it(
           const idle = threadTimes();
           const open = await openTimes(page, DAY_FILE, 300_000);
           const fractions = [0.5, 0.1, 0.9, 0.99, 0.01, 0.5];
-          const seeks: number[] = [];
+          const seekParts: { ms: number; workerMs: number; pageMs: number }[] = [];
           for (const f of fractions) {
-            seeks.push(Math.round(await seekTime(page, f)));
+            seekParts.push(await seekTime(page, f));
             await page.waitForTimeout(500);
           }
+          const seeks = seekParts.map((x) => x.ms);
           const worker = await WorkerTarget.attach(browser);
           const pageH = await pageHeap(page);
           const workerH = await worker?.heapMB();
@@ -674,6 +684,8 @@ it(
             openPartsMs: { pageRead: open.pageReadMs, worker: open.workerMs, draw: open.drawMs },
             seekFractions: fractions,
             seekMs: seeks,
+            seekWorkerMs: seekParts.map((x) => x.workerMs),
+            seekPageMs: seekParts.map((x) => x.pageMs),
             seekMsMedian: pct(seeks, 50),
             seekMsMax: Math.max(...seeks),
             pageHeapMB: pageH,
