@@ -380,12 +380,16 @@ function topSelf(profile: { nodes: ProfileNode[]; samples: number[]; timeDeltas:
 
 /**
  * Traces the page for `ms` (BENCH_PROFILE=1): the main thread's time by kind of work (script,
- * style, layout, paint…), in ms per second. Events nest (a task holds its script and layout),
+ * style, layout, paint…), in ms per second, and what the tasks over 50 ms were made of (their
+ * own work by kind, summed over them, ms). Events nest (a task holds its script and layout),
  * so the rows overlap: read each against RunTask, the whole of the thread's tasks.
  */
-async function traceMainThread(page: Page, ms: number): Promise<Record<string, number>> {
+async function traceMainThread(
+  page: Page,
+  ms: number,
+): Promise<{ msPerSecond: Record<string, number>; longTasks: number; inLongTasksMs: Record<string, number> }> {
   const cdp = await page.context().newCDPSession(page);
-  type TraceEvent = { name: string; ph: string; dur?: number; tid: number; args?: { name?: string } };
+  type TraceEvent = { name: string; ph: string; ts: number; dur?: number; tid: number; args?: { name?: string } };
   const events: TraceEvent[] = [];
   // Playwright types trace events as string maps; they are JSON objects with numbers.
   cdp.on('Tracing.dataCollected', (e) => {
@@ -398,17 +402,27 @@ async function traceMainThread(page: Page, ms: number): Promise<Record<string, n
   await done;
   await cdp.detach();
   const main = events.find((e) => e.ph === 'M' && e.name === 'thread_name' && e.args?.name === 'CrRendererMain')?.tid;
+  const complete = events.filter((e) => e.tid === main && e.ph === 'X' && e.dur !== undefined).sort((x, y) => x.ts - y.ts);
   const byName = new Map<string, number>();
-  for (const e of events) {
-    if (e.tid !== main || e.ph !== 'X' || e.dur === undefined) continue;
-    byName.set(e.name, (byName.get(e.name) ?? 0) + e.dur);
+  for (const e of complete) byName.set(e.name, (byName.get(e.name) ?? 0) + (e.dur ?? 0));
+  const long = complete.filter((e) => e.name === 'RunTask' && (e.dur ?? 0) > 50_000);
+  const inLong = new Map<string, number>();
+  for (const task of long) {
+    const end = task.ts + (task.dur ?? 0);
+    for (const e of complete) {
+      if (e.ts < task.ts || e === task) continue;
+      if (e.ts >= end) break;
+      inLong.set(e.name, (inLong.get(e.name) ?? 0) + (e.dur ?? 0));
+    }
   }
-  return Object.fromEntries(
-    [...byName.entries()]
-      .sort((a, b) => b[1] - a[1])
-      .slice(0, 14)
-      .map(([name, us]) => [name, round(us / ms, 1)]),
-  );
+  const top = (m: Map<string, number>, scale: number) =>
+    Object.fromEntries(
+      [...m.entries()]
+        .sort((x, y) => y[1] - x[1])
+        .slice(0, 14)
+        .map(([name, us]) => [name, round(us / scale, 1)]),
+    );
+  return { msPerSecond: top(byName, ms), longTasks: long.length, inLongTasksMs: top(inLong, 1000) };
 }
 
 /** Samples the page's main thread for `ms` (BENCH_PROFILE=1): the functions that took the most time. */
