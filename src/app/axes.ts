@@ -15,6 +15,7 @@ import { chartColors } from './theme.js';
 
 /** Round steps for the time axis, s. */
 const TIME_STEPS = [1, 2, 5, 10, 15, 30, 60, 120, 300, 600];
+const LONGEST_STEP = 600;
 /** Wanted space between two time labels, px. */
 const TIME_LABEL_PX = 64;
 
@@ -29,7 +30,13 @@ export function agoLabel(seconds: number, step = 1): string {
 /** The round step that gives about one label per TIME_LABEL_PX over `spanS` at `widthPx`. */
 export function timeStep(spanS: number, widthPx: number): number {
   const most = Math.max(2, Math.floor(widthPx / TIME_LABEL_PX));
-  return TIME_STEPS.find((s) => spanS / s <= most) ?? (TIME_STEPS.at(-1) as number);
+  return TIME_STEPS.find((s) => spanS / s <= most) ?? LONGEST_STEP;
+}
+
+/** The distance between an axis's first two ticks (1 when there are fewer). */
+function stepOf(splits: readonly number[]): number {
+  const [a, b] = splits;
+  return a === undefined || b === undefined ? 1 : b - a;
 }
 
 /** Tick positions (source clock, s) counted back from `end` in steps of `step`. */
@@ -49,7 +56,7 @@ export function agoAxis(): uPlot.Axis {
     splits: (u, _axis, min, max) => agoSplits(min, max, timeStep(max - min, u.bbox.width / devicePixelRatio)),
     values: (u, splits) => {
       const end = u.scales.x?.max ?? 0;
-      const step = splits.length > 1 ? (splits[1] as number) - (splits[0] as number) : 1;
+      const step = stepOf(splits);
       return splits.map((v) => agoLabel(v - end, step));
     },
   };
@@ -57,7 +64,7 @@ export function agoAxis(): uPlot.Axis {
 
 /** The top of a range from 0 that holds `max` with some room: 1, 2 or 5 × 10ⁿ, at least `floor`. */
 export function niceTop(max: number | null | undefined, floor = 1): number {
-  const want = Number.isFinite(max) && (max as number) > 0 ? (max as number) * 1.1 : 0;
+  const want = max !== null && max !== undefined && Number.isFinite(max) && max > 0 ? max * 1.1 : 0;
   if (want <= floor) return floor;
   const p = 10 ** Math.floor(Math.log10(want));
   for (const m of [1, 2, 5, 10]) if (m * p >= want) return m * p;
@@ -127,8 +134,7 @@ export function valueAxis(label: string, v: ValueScale = {}): uPlot.Axis {
       return niceSplits(max > min ? max : 1, v.integer, labelsFor(u));
     },
     values: (_u, splits) => {
-      const step = splits.length > 1 ? Math.abs((splits[1] as number) - (splits[0] as number)) : 1;
-      const d = decimals(step);
+      const d = decimals(Math.abs(stepOf(splits)));
       return splits.map((y) => y.toFixed(d).replace('-', '−'));
     },
   };
@@ -183,18 +189,22 @@ export function keyboardCursor(u: uPlot, el: HTMLElement): () => void {
   const key = (e: KeyboardEvent) => {
     const xs = u.data[0];
     if (xs === undefined || xs.length === 0) return;
-    const last = xs.length - 1;
+    // The buckets in view (a chart may hold more than its window shows).
+    const first = u.series[0]?.idxs?.[0] ?? 0;
+    const last = u.series[0]?.idxs?.[1] ?? xs.length - 1;
     // From where the cursor is now (the data slides under it), or from the newest bucket.
     const at = (u.cursor.left ?? -1) >= 0 ? u.cursor.idx : null;
-    let i = at === null || at === undefined ? last : Math.min(at, last);
+    let i = at === null || at === undefined ? last : Math.min(Math.max(at, first), last);
     const step = e.shiftKey ? 10 : 1;
-    if (e.key === 'ArrowLeft') i = Math.max(0, i - step);
+    if (e.key === 'ArrowLeft') i = Math.max(first, i - step);
     else if (e.key === 'ArrowRight') i = Math.min(last, i + step);
-    else if (e.key === 'Home') i = 0;
+    else if (e.key === 'Home') i = first;
     else if (e.key === 'End') i = last;
     else return;
+    const x = xs[i];
+    if (x === undefined) return;
     e.preventDefault();
-    setCursor.call(u, { left: u.valToPos(xs[i] as number, 'x'), top: u.bbox.height / devicePixelRatio / 2 }, true, true);
+    setCursor.call(u, { left: u.valToPos(x, 'x'), top: u.bbox.height / devicePixelRatio / 2 }, true, true);
   };
   const blur = () => {
     setCursor.call(u, { left: -10, top: -10 }, true, true);

@@ -108,6 +108,9 @@ export interface FrameDescription {
   emptySlots: number;
 }
 
+/** A frame's bytes for typed reads: bytes and big-endian words (spec §8), checked against its length. */
+const frameView = (bytes: Uint8Array) => new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
+
 const hex2 = (v: number) => `0x${v.toString(16).toUpperCase().padStart(2, '0')}`;
 const hex4 = (v: number) => v.toString(16).toUpperCase().padStart(4, '0');
 
@@ -118,13 +121,13 @@ const hex4 = (v: number) => v.toString(16).toUpperCase().padStart(4, '0');
  * internal frame module, which the app does not import (only the public API), and the rule is
  * three comparisons.
  */
-function isVtx(b: Uint8Array): boolean {
-  return ((b[12] as number) & 0xf0) === 0xe0 && ((b[14] as number) & 0xf0) === 0xe0 && ((b[2] as number) & 0x80) === 0;
+function isVtx(b: DataView): boolean {
+  return (b.getUint8(12) & 0xf0) === 0xe0 && (b.getUint8(14) & 0xf0) === 0xe0 && (b.getUint8(2) & 0x80) === 0;
 }
 
 /** Bytes 12–15 as Spektrum VTX control (the layout PX4 and Betaflight read). */
-function readVtx(b: Uint8Array): VtxControl {
-  const raw = (((b[12] as number) << 24) | ((b[13] as number) << 16) | ((b[14] as number) << 8) | (b[15] as number)) >>> 0;
+function readVtx(b: DataView): VtxControl {
+  const raw = b.getUint32(12);
   return {
     raw,
     band: (raw >>> 21) & 0x07,
@@ -139,9 +142,9 @@ function vtxText(v: VtxControl): string {
   return `VTX band ${v.band} ch ${v.channel} power ${v.power} ${v.region === 1 ? 'EU' : 'US'}${v.pit ? ' pit' : ''}`;
 }
 
-function describeHeader(b: Uint8Array, resolution: Resolution, remote: RemoteKind, headerMode: HeaderMode): HeaderField[] {
-  const b0 = b[0] as number;
-  const b1 = b[1] as number;
+function describeHeader(b: DataView, resolution: Resolution, remote: RemoteKind, headerMode: HeaderMode): HeaderField[] {
+  const b0 = b.getUint8(0);
+  const b1 = b.getUint8(1);
   if (remote === 'external') {
     const fades = (b0 << 8) | b1;
     return [
@@ -215,15 +218,16 @@ function describeHeader(b: Uint8Array, resolution: Resolution, remote: RemoteKin
  */
 export function describeFrame(bytes: Uint8Array, resolution: Resolution, remote: RemoteKind, headerMode: HeaderMode): FrameDescription {
   if (bytes.length < FRAME_SIZE) throw new RangeError(`a frame is ${FRAME_SIZE} bytes, got ${bytes.length}`);
-  const header = describeHeader(bytes, resolution, remote, headerMode);
-  const vtxFrame = isVtx(bytes);
-  const vtx = vtxFrame ? readVtx(bytes) : null;
+  const view = frameView(bytes);
+  const header = describeHeader(view, resolution, remote, headerMode);
+  const vtxFrame = isVtx(view);
+  const vtx = vtxFrame ? readVtx(view) : null;
   const slots: SlotField[] = [];
   /** Slot index (+1) that carried each channel 0–19, to catch a repeated one. */
   const seenIn = new Int8Array(20);
   for (let i = 0; i < 7; i++) {
     const first = 2 + 2 * i;
-    const word = ((bytes[first] as number) << 8) | (bytes[first + 1] as number);
+    const word = view.getUint16(first);
     const s: SlotField = {
       index: i,
       first,
@@ -293,11 +297,11 @@ export function describeFrame(bytes: Uint8Array, resolution: Resolution, remote:
         s.problem = `channel ID ${id} does not exist (1024 mode: 0–11; X-Plus is 2048 only)`;
       }
     }
-    if (s.channel !== null) {
+    if (s.channel !== null && s.position !== null) {
       // X-Plus positions are on the 2047 scale whatever the link's resolution.
-      s.us = servoToMicros(s.position as number, s.kind === 'xplus' ? 2048 : resolution);
+      s.us = servoToMicros(s.position, s.kind === 'xplus' ? 2048 : resolution);
       s.name = channelName(s.channel);
-      const before = seenIn[s.channel] as number;
+      const before = seenIn[s.channel] ?? 0;
       if (before > 0) s.problem = `${s.name} again (slot ${before} has it): a frame carries each channel once`;
       else seenIn[s.channel] = i + 1;
     }
@@ -308,7 +312,7 @@ export function describeFrame(bytes: Uint8Array, resolution: Resolution, remote:
       s.text = `invalid 0x${s.hex} (${s.channel !== null ? `${s.name} again` : `ID ${s.id}`})`;
       s.title = `${where}${phaseNote}: invalid: ${s.problem}${decoded}`;
     } else if (s.kind === 'xplus') {
-      s.label = s.name as string;
+      s.label = s.name ?? '';
       s.text = `${s.name} ${s.position} ${s.us}\u00a0µs`;
       s.title =
         `${where}${phaseNote}, channel ID 12 = X-Plus (§8.6): sub-ID ${s.subId}${s.phase === 1 ? ' + 4 for phase 1' : ''} → channel ${s.channel} (${s.name}), ` +
@@ -331,7 +335,7 @@ export function describeFrame(bytes: Uint8Array, resolution: Resolution, remote:
     header,
     slots,
     vtx,
-    phase: resolution === 2048 ? (((bytes[2] as number) & 0x80) !== 0 ? 1 : 0) : null,
+    phase: resolution === 2048 ? ((view.getUint8(2) & 0x80) !== 0 ? 1 : 0) : null,
     summary: parts.join(' · '),
     parts,
     emptySlots: empty,
@@ -344,10 +348,9 @@ export function describeFrame(bytes: Uint8Array, resolution: Resolution, remote:
  */
 export function countSlots(bytes: Uint8Array): { empty: number; vtx: boolean } {
   if (bytes.length < FRAME_SIZE) return { empty: 0, vtx: false };
-  const vtx = isVtx(bytes);
+  const view = frameView(bytes);
+  const vtx = isVtx(view);
   let empty = 0;
-  for (let i = 0; i < (vtx ? 5 : 7); i++) {
-    if ((((bytes[2 + 2 * i] as number) << 8) | (bytes[3 + 2 * i] as number)) === EMPTY_SLOT) empty++;
-  }
+  for (let i = 0; i < (vtx ? 5 : 7); i++) if (view.getUint16(2 + 2 * i) === EMPTY_SLOT) empty++;
   return { empty, vtx };
 }

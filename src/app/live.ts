@@ -1,58 +1,80 @@
 /**
- * High-rate data on the page: the latest batch's values and the graph series, kept in typed
- * arrays outside the virtual DOM. Renderers read it once per animation frame (frame-loop.ts)
- * and redraw only what changed.
+ * High-rate data on the page: the latest batch's values in typed arrays and the graph series
+ * in growing columns, outside the virtual DOM. Renderers read it once per animation frame
+ * (frame-loop.ts) and redraw only what changed.
  */
 import { CHANNEL_COUNT } from '../decoder/index.js';
 import type { Batch } from '../worker/protocol.js';
 
 /** Episodes are kept as long as the longest graph window (10 min). */
 const EPISODE_KEEP_US = 600e6;
-/** Ten minutes of 100 ms buckets, twice over so that sliding is a rare copy. */
-const SERIES_CAPACITY = 2 * 6000;
+/** Ten minutes of 100 ms buckets: the longest graph window. */
+const WINDOW_BUCKETS = 6000;
+/** Buckets kept past the window before the oldest are dropped (in one step every 2.5 minutes). */
+const SLACK_BUCKETS = 1500;
 
+/** A bucket's value as the graphs take it: NaN (no value in that bucket) breaks the line, as null. */
+const gap = (v: number): number | null => (Number.isNaN(v) ? null : v);
+
+/**
+ * One remote's graph buckets as columns that grow: each batch's new buckets are appended once,
+ * in the form uPlot draws (seconds, gaps as null), and the graphs hand the same arrays to uPlot
+ * on every redraw, which draws only what its x scale shows. Nothing is rebuilt per redraw; what
+ * is older than the longest window is dropped in one step once 2.5 minutes of it piled up.
+ */
 export class SeriesBuffer {
-  /** Bucket start in seconds of the source clock (uPlot's x). */
-  readonly t = new Float64Array(SERIES_CAPACITY);
-  readonly fadeRate = new Float64Array(SERIES_CAPACITY);
-  readonly rssi = new Float64Array(SERIES_CAPACITY);
-  readonly periodMs = new Float64Array(SERIES_CAPACITY);
-  readonly lost = new Float64Array(SERIES_CAPACITY);
-  length = 0;
+  /** Bucket start in seconds of the source clock (uPlot's x), ascending. */
+  readonly t: number[] = [];
+  // Fades and lost frames have a value in every bucket: kept as plain doubles (no null in the
+  // array, so V8 stores them unboxed). RSSI and the period have gaps.
+  readonly fadeRate: number[] = [];
+  readonly rssi: (number | null)[] = [];
+  readonly periodMs: (number | null)[] = [];
+  readonly lost: number[] = [];
+  /** Buckets appended since the last clear (including those dropped since): what is new to a reader. */
+  appended = 0;
+  /** Counts clears, so a reader that kept a position knows to start over. */
+  epoch = 0;
+
+  get length(): number {
+    return this.t.length;
+  }
 
   append(s: Batch['series']): void {
-    const n = s.t.length;
-    if (n === 0) return;
-    if (this.length + n > SERIES_CAPACITY) {
-      // Keep the newest half: graphs show at most half the capacity.
-      const keep = Math.min(this.length, SERIES_CAPACITY / 2 - n);
-      const from = this.length - keep;
-      for (const col of [this.t, this.fadeRate, this.rssi, this.periodMs, this.lost]) col.copyWithin(0, from, this.length);
-      this.length = keep;
+    s.t.forEach((t, i) => {
+      this.t.push(t / 1e6);
+      this.fadeRate.push(s.fadeRate[i] ?? 0);
+      this.rssi.push(gap(s.rssi[i] ?? Number.NaN));
+      this.periodMs.push(gap(s.periodMs[i] ?? Number.NaN));
+      this.lost.push(s.lost[i] ?? 0);
+    });
+    this.appended += s.t.length;
+    if (this.t.length > WINDOW_BUCKETS + SLACK_BUCKETS) {
+      const drop = this.t.length - WINDOW_BUCKETS;
+      for (const col of this.#columns()) col.splice(0, drop);
     }
-    const at = this.length;
-    for (let i = 0; i < n; i++) this.t[at + i] = (s.t[i] as number) / 1e6;
-    this.fadeRate.set(s.fadeRate, at);
-    this.rssi.set(s.rssi, at);
-    this.periodMs.set(s.periodMs, at);
-    this.lost.set(s.lost, at);
-    this.length += n;
   }
 
   clear(): void {
-    this.length = 0;
+    for (const col of this.#columns()) col.length = 0;
+    this.appended = 0;
+    this.epoch++;
   }
 
   /** Index of the first bucket at or after `tSec` (binary search). */
   indexAt(tSec: number): number {
     let lo = 0;
-    let hi = this.length;
+    let hi = this.t.length;
     while (lo < hi) {
       const mid = (lo + hi) >> 1;
-      if ((this.t[mid] as number) < tSec) lo = mid + 1;
+      if ((this.t[mid] ?? Number.POSITIVE_INFINITY) < tSec) lo = mid + 1;
       else hi = mid;
     }
     return lo;
+  }
+
+  #columns(): (number | null)[][] {
+    return [this.t, this.fadeRate, this.rssi, this.periodMs, this.lost];
   }
 }
 

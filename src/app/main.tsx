@@ -11,11 +11,11 @@ import { send, startWorker } from './store.js';
 import { startBenchHooks } from './bench.js';
 
 async function main(): Promise<void> {
-  startWorker();
+  const worker = startWorker();
   const granted = serialUnavailable() === null ? await navigator.serial.getPorts() : [];
   render(<App granted={granted} />, document.getElementById('app') as HTMLElement);
   const params = new URLSearchParams(location.search);
-  if (params.has('bench')) startBenchHooks();
+  if (params.has('bench')) startBenchHooks(worker);
   if (granted.length === 0 && params.get('demo') !== '0') send({ type: 'demo-start' });
   if ('serviceWorker' in navigator && import.meta.env.PROD) {
     navigator.serviceWorker.register('./sw.js').catch(() => undefined);

@@ -14,6 +14,9 @@ export async function openCapture(file: File): Promise<void> {
     return;
   }
   const data = await file.arrayBuffer();
+  // Marks on the performance timeline (DevTools, bench:page) split opening a capture into the
+  // page reading the file, the worker reading it, and the page drawing its overview.
+  performance.mark('satscope:capture-read');
   send({ type: 'replay-open', name: file.name, data }, [data]);
 }
 

@@ -23,6 +23,9 @@ export const selected = signal(0);
 export const recording = signal<RecordingStatus | null>(null);
 export const replay = signal<ReplayStatus | null>(null);
 export const overview = signal<Overview | null>(null);
+/** The replayed capture's name (null: no replay), and its length, µs: they change per capture, not with every status. */
+export const replayName = computed(() => replay.value?.name ?? null);
+export const replaySpanUs = computed(() => (replay.value === null ? 0 : replay.value.endUs - replay.value.startUs));
 export const notices = signal<Notice[]>([]);
 export const resolutionOverride = signal<'auto' | 1024 | 2048>('auto');
 /** The frame inspector's last snapshot of the selected remote (null: none asked for yet). */
@@ -88,24 +91,26 @@ export const linkMismatch = signal<1024 | 2048 | null>(null);
 function refreshSelected(): void {
   const live = current();
   const l = live.link;
-  if (!Object.is(l?.nominalPeriodUs ?? NaN, nominalPeriodUs.value)) nominalPeriodUs.value = l?.nominalPeriodUs ?? NaN;
-  const state = l?.state ?? 'waiting';
-  const ended = live.ended || status.value.state === 'ended';
-  const mismatch = live.mismatch;
-  batch(() => {
-    if (state !== linkState.value) linkState.value = state;
-    if (ended !== linkEnded.value) linkEnded.value = ended;
-    if (mismatch !== linkMismatch.value) linkMismatch.value = mismatch;
-  });
   let x = false;
-  for (let id = 12; id < 20; id++) if (!Number.isNaN(live.seenUs[id])) x = true;
-  if (x !== xplusSeen.value) xplusSeen.value = x;
+  for (let id = 12; id < 20; id++) if (!Number.isNaN(live.seenUs[id] ?? Number.NaN)) x = true;
+  const period = l?.nominalPeriodUs ?? Number.NaN;
+  // One update for the views, however many of these changed (a signal skips a value equal by
+  // ===, which NaN never is).
+  batch(() => {
+    if (!Object.is(period, nominalPeriodUs.value)) nominalPeriodUs.value = period;
+    linkState.value = l?.state ?? 'waiting';
+    linkEnded.value = live.ended || status.value.state === 'ended';
+    linkMismatch.value = live.mismatch;
+    xplusSeen.value = x;
+  });
 }
 
 export function select(id: number): void {
-  if (id !== selected.value) inspection.value = null;
-  selected.value = id;
-  refreshSelected();
+  batch(() => {
+    if (id !== selected.value) inspection.value = null;
+    selected.value = id;
+    refreshSelected();
+  });
 }
 
 let nextNotice = 1;
@@ -144,7 +149,8 @@ function receive(message: FromWorker): void {
       // Keep the selection on a remote that exists, preferring the internal one.
       if (!message.sources.some((s) => s.id === selected.value) && message.sources.length > 0) {
         const internal = message.sources.find((s) => s.format.remote === 'internal');
-        select((internal ?? (message.sources[0] as SourceStatus)).id);
+        const pick = internal ?? message.sources[0];
+        if (pick !== undefined) select(pick.id);
       }
       break;
     }
@@ -173,6 +179,7 @@ function receive(message: FromWorker): void {
       if (message.replay === null) overview.value = null;
       break;
     case 'overview':
+      performance.mark('satscope:overview-received');
       overview.value = message.overview;
       break;
     case 'inspection':
@@ -198,7 +205,8 @@ export function allLives(): ReadonlyMap<number, Live> {
 
 export function startWorker(): Worker {
   worker = new Worker(new URL('../worker/worker.ts', import.meta.url), { type: 'module', name: 'satscope' });
-  worker.addEventListener('message', (event: MessageEvent<FromWorker>) => receive(event.data));
+  // A message's updates (sources and the selection, a replay and its overview…) reach the views as one.
+  worker.addEventListener('message', (event: MessageEvent<FromWorker>) => batch(() => receive(event.data)));
   worker.addEventListener('error', (event) => notify('error', 'The decoder worker failed', event.message || 'Reload the page.'));
   return worker;
 }

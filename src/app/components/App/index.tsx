@@ -3,11 +3,11 @@
  * and system beside the channel bars, X-Plus when it arrives, and the graphs. With nothing to
  * show (no receiver, no demo, no capture), what to wire and how to start instead.
  */
-import { signal } from '@preact/signals';
+import { computed, signal } from '@preact/signals';
 import { useEffect, useState } from 'preact/hooks';
 import { lazy } from '../../lazy.js';
 import { openCapture } from '../../open-file.js';
-import { replay, sources, status, xplusSeen } from '../../store.js';
+import { replayName, replaySpanUs, sources, status, xplusSeen } from '../../store.js';
 import { ChannelBars } from '../ChannelBars/index.js';
 import { Counters } from '../Counters/index.js';
 import { DiagnosisPanel } from '../Diagnosis/index.js';
@@ -28,6 +28,8 @@ const NORMAL = [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11];
 const XPLUS = [12, 13, 14, 15, 16, 17, 18, 19];
 /** The graphs' (and the episode timeline's) window, µs. */
 const windowUs = signal(60e6);
+/** The channel panel's title names the remote shown when there are several (a signal bound to the text). */
+const channelsTitle = computed(() => (sources.value.length > 1 ? `Channels — remote ${status.value.label}` : 'Channels'));
 /** Whether the bind panel is open. */
 export const binding = signal(false);
 
@@ -57,14 +59,14 @@ export function App({ granted }: { granted: SerialPort[] }) {
       window.removeEventListener('drop', drop);
     };
   }, []);
-  const empty = sources.value.length === 0 && replay.value === null;
+  const empty = sources.value.length === 0 && replayName.value === null;
   // A capture shorter than the graphs' window would be a sliver at its right edge: fit it.
-  const replayName = replay.value?.name;
-  const replaySpan = replay.value === null ? 0 : replay.value.endUs - replay.value.startUs;
+  const name = replayName.value;
+  const span = replaySpanUs.value;
   useEffect(() => {
-    if (replayName === undefined || replaySpan <= 0) return;
-    windowUs.value = WINDOWS.find(([us]) => us >= replaySpan)?.[0] ?? windowUs.value;
-  }, [replayName, replaySpan > 0]);
+    if (name === null || span <= 0) return;
+    windowUs.value = WINDOWS.find(([us]) => us >= span)?.[0] ?? windowUs.value;
+  }, [name, span > 0]);
   return (
     <>
       <Toolbar
@@ -117,7 +119,7 @@ export function App({ granted }: { granted: SerialPort[] }) {
               </div>
             ) : null}
             <div class="panel p-channels">
-              <h2>Channels{sources.value.length > 1 ? ` — remote ${status.value.label}` : ''}</h2>
+              <h2>{channelsTitle}</h2>
               <ChannelBars ids={NORMAL} label="Channels 0–11" />
             </div>
             {xplusSeen.value ? (

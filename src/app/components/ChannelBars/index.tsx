@@ -25,6 +25,8 @@ interface Row {
   pct: HTMLElement;
   age: HTMLElement;
   shown: string;
+  /** The row is a meter (its role and range set) rather than a "no data" image. */
+  metered: boolean;
 }
 
 export function ChannelBars({ ids, label }: { ids: number[]; label: string }) {
@@ -32,19 +34,24 @@ export function ChannelBars({ ids, label }: { ids: number[]; label: string }) {
   useEffect(() => {
     const el = list.current;
     if (el === null) return undefined;
-    const rows: Row[] = ids.map((_, i) => {
-      const root = el.children[i] as HTMLElement;
-      const q = (c: string) => root.querySelector(c) as HTMLElement;
-      return { root, fill: q('.fill'), us: q('.us'), raw: q('.raw'), pct: q('.pct'), age: q('.age'), shown: '' };
+    const rows: Row[] = [...el.children].flatMap((root) => {
+      const fill = root.querySelector<HTMLElement>('.fill');
+      const us = root.querySelector<HTMLElement>('.us');
+      const raw = root.querySelector<HTMLElement>('.raw');
+      const pct = root.querySelector<HTMLElement>('.pct');
+      const age = root.querySelector<HTMLElement>('.age');
+      if (!(root instanceof HTMLElement) || fill === null || us === null || raw === null || pct === null || age === null) return [];
+      return [{ root, fill, us, raw, pct, age, shown: '', metered: false }];
     });
     return onFrame(() => {
       const live = current();
       const now = live.nowUs();
       ids.forEach((id, i) => {
-        const row = rows[i] as Row;
-        const seen = live.seenUs[id] as number;
+        const row = rows[i];
+        if (row === undefined) return;
+        const seen = live.seenUs[id] ?? Number.NaN;
         const resolution = channelResolution(id, live.resolution ?? 2048);
-        const pos = live.positions[id] as number;
+        const pos = live.positions[id] ?? 0;
         const never = Number.isNaN(seen);
         // Seen in data without times (+Infinity): shown, never stale.
         const age = seen === Infinity ? 0 : now - seen;
@@ -66,6 +73,7 @@ export function ChannelBars({ ids, label }: { ids: number[]; label: string }) {
           row.root.setAttribute('role', 'img');
           row.root.setAttribute('aria-label', `${channelName(id)}: no data`);
           for (const a of ['aria-valuetext', 'aria-valuenow', 'aria-valuemin', 'aria-valuemax']) row.root.removeAttribute(a);
+          row.metered = false;
           return;
         }
         const us = servoToMicros(pos, resolution);
@@ -77,10 +85,14 @@ export function ChannelBars({ ids, label }: { ids: number[]; label: string }) {
         const b = Math.max(us, 1500);
         row.fill.style.left = left(a);
         row.fill.style.width = `${(((b - a) / SPAN_US) * 100).toFixed(3)}%`;
-        row.root.setAttribute('role', 'meter');
-        row.root.setAttribute('aria-label', channelName(id));
-        row.root.setAttribute('aria-valuemin', String(PULSE_MIN_US));
-        row.root.setAttribute('aria-valuemax', String(PULSE_MAX_US));
+        if (!row.metered) {
+          // What does not change while the channel comes: set once, not on every frame.
+          row.root.setAttribute('role', 'meter');
+          row.root.setAttribute('aria-label', channelName(id));
+          row.root.setAttribute('aria-valuemin', String(PULSE_MIN_US));
+          row.root.setAttribute('aria-valuemax', String(PULSE_MAX_US));
+          row.metered = true;
+        }
         row.root.setAttribute('aria-valuenow', String(us));
         row.root.setAttribute('aria-valuetext', `${us} µs, ${pct.toFixed(0)} %${stale ? ', stale' : ''}`);
       });

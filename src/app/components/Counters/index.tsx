@@ -42,11 +42,19 @@ type Counts = Live['counters'];
 export function Counters() {
   const list = useRef<HTMLDListElement>(null);
   useEffect(() => {
+    const dl = list.current;
+    if (dl === null) return undefined;
+    // Each row's term and value, found once (the rows never change), with whether a non-zero value warns.
+    const cells = ROWS.flatMap(([key, , , warns]) => {
+      const dd = dl.querySelector<HTMLElement>(`:scope > dd[data-key="${key}"]`);
+      const dt = dd?.previousElementSibling;
+      return dd !== null && dt instanceof HTMLElement ? [{ key, warns, dd, dt }] : [];
+    });
     let version = -1;
     let shown: Live | undefined;
     return onFrame(() => {
       const live = current();
-      if ((live === shown && live.version === version) || list.current === null) return;
+      if (live === shown && live.version === version) return;
       version = live.version;
       shown = live;
       const c: Counts = live.counters;
@@ -65,14 +73,12 @@ export function Counters() {
         period: l === null || !Number.isFinite(l.periodUs) ? '—' : `${(l.periodUs / 1000).toFixed(2)} ms`,
         rssi: l === null || !Number.isFinite(l.rssi) ? '—' : `${l.rssi} dBm`,
       };
-      for (const dd of list.current.querySelectorAll<HTMLElement>(':scope > dd[data-key]')) {
-        const key = dd.dataset.key as Key;
+      for (const { key, warns, dd, dt } of cells) {
         const v = values[key];
         const hidden = v === null;
-        const dt = dd.previousElementSibling as HTMLElement;
         if (dd.hidden !== hidden) dd.hidden = dt.hidden = hidden;
         if (v !== null && dd.textContent !== v) dd.textContent = v;
-        const warn = ROWS.find((r) => r[0] === key)?.[3] === true && v !== null && /^[1-9]/.test(v);
+        const warn = warns && v !== null && /^[1-9]/.test(v);
         if (dd.classList.contains('warn') !== warn) dd.classList.toggle('warn', warn);
       }
     });

@@ -8,16 +8,15 @@ import { chooseCapture } from '../../open-file.js';
 import { send } from '../../store.js';
 import './style.css';
 
-/** The three wires of a satellite's lead and where each goes on the adapter. */
+/** The three wires of a satellite's lead, where each goes on the adapter, and its height in the drawing. */
 const WIRES = [
-  { cls: 'orange', wire: 'orange', what: 'power, 3.3 V', pin: '3.3 V' },
-  { cls: 'black', wire: 'black', what: 'ground', pin: 'GND' },
-  { cls: 'grey', wire: 'grey', what: 'DATA (serial out)', pin: 'RX' },
+  { cls: 'orange', wire: 'orange', what: 'power, 3.3 V', pin: '3.3 V', y: 40 },
+  { cls: 'black', wire: 'black', what: 'ground', pin: 'GND', y: 80 },
+  { cls: 'grey', wire: 'grey', what: 'DATA (serial out)', pin: 'RX', y: 120 },
 ] as const;
 
 /** The adapter on the left, the satellite on the right, one line per wire. */
 function Wiring() {
-  const y = [40, 80, 120];
   return (
     <svg class="wiring-svg" viewBox="0 0 340 186" role="img" aria-labelledby="wiring-title">
       <title id="wiring-title">Adapter 3.3 V to the orange wire, GND to the black wire, RX to the grey DATA wire. TX stays free.</title>
@@ -32,21 +31,15 @@ function Wiring() {
       <text class="box-title" x="285" y="32" text-anchor="middle">
         Satellite
       </text>
-      {WIRES.map((w, i) => (
+      {WIRES.map((w) => (
         <g key={w.cls}>
-          <text class="pin" x="100" y={(y[i] as number) + 18} text-anchor="end">
+          <text class="pin" x="100" y={w.y + 18} text-anchor="end">
             {w.pin}
           </text>
-          <circle class="pad" cx="110" cy={(y[i] as number) + 14} r="4" />
-          <path
-            class={`wire-edge`}
-            d={`M110 ${(y[i] as number) + 14} C 170 ${(y[i] as number) + 14}, 180 ${(y[i] as number) + 14}, 236 ${(y[i] as number) + 14}`}
-          />
-          <path
-            class={`wire ${w.cls}`}
-            d={`M110 ${(y[i] as number) + 14} C 170 ${(y[i] as number) + 14}, 180 ${(y[i] as number) + 14}, 236 ${(y[i] as number) + 14}`}
-          />
-          <text class="pin" x="246" y={(y[i] as number) + 18}>
+          <circle class="pad" cx="110" cy={w.y + 14} r="4" />
+          <path class={`wire-edge`} d={`M110 ${w.y + 14} C 170 ${w.y + 14}, 180 ${w.y + 14}, 236 ${w.y + 14}`} />
+          <path class={`wire ${w.cls}`} d={`M110 ${w.y + 14} C 170 ${w.y + 14}, 180 ${w.y + 14}, 236 ${w.y + 14}`} />
+          <text class="pin" x="246" y={w.y + 18}>
             {w.wire}
           </text>
         </g>

@@ -57,19 +57,6 @@ function specs(rssi: boolean): ChartSpec[] {
   ];
 }
 
-/**
- * A column for uPlot with its gaps as null: a bucket without frames has no period (NaN), and
- * uPlot draws a line straight across NaN but breaks it at null.
- */
-function gaps(col: ArrayLike<number>): (number | null)[] {
-  const out = new Array<number | null>(col.length);
-  for (let i = 0; i < col.length; i++) {
-    const v = col[i] as number;
-    out[i] = Number.isNaN(v) ? null : v;
-  }
-  return out;
-}
-
 function makeChart(el: HTMLElement, spec: ChartSpec, width: number, sync: uPlot.SyncPubSub): uPlot {
   const opts: uPlot.Options = {
     width,
@@ -105,33 +92,37 @@ export function Graphs({ windowUs }: { windowUs: Signal<number> }) {
     const sync = uPlot.sync('satscope');
     const list = specs(rssi);
     const width = () => Math.max(200, el.clientWidth - 4);
-    const charts = list.map((spec) => {
+    const panes = list.map((spec) => {
       const box = document.createElement('div');
       box.className = 'chart';
       box.setAttribute('role', 'figure');
       box.setAttribute('aria-label', `${spec.title} over time: hover, or the arrow keys, for the values`);
       box.dataset.chart = spec.key;
       el.append(box);
-      return makeChart(box, spec, width(), sync);
+      return { key: spec.key, box, chart: makeChart(box, spec, width(), sync) };
     });
-    const keys = charts.map((c) => keyboardCursor(c, c.root.parentElement as HTMLElement));
+    const charts = panes.map((p) => p.chart);
+    const cursors = panes.map((p) => keyboardCursor(p.chart, p.box));
     const resize = new ResizeObserver(() =>
       charts.forEach((c) => {
         c.setSize({ width: width(), height: HEIGHT });
       }),
     );
     resize.observe(el);
-    let version = -1;
+    let appended = -1;
+    let epoch = -1;
     let drawnAt = 0;
     let drawn: Live | undefined;
     const stop = onFrame((nowMs) => {
       const live = current();
-      // New buckets come ten times a second; the axis slides with time between them.
-      if (live === drawn && live.version === version && nowMs - drawnAt < 200) return;
-      version = live.version;
-      drawn = live;
-      drawnAt = nowMs;
       const s: SeriesBuffer = live.series;
+      // New buckets come ten times a second; between them the axis slides with time, redrawn
+      // five times a second. Other batches (every few ms) change nothing the graphs show.
+      if (live === drawn && s.epoch === epoch && s.appended === appended && nowMs - drawnAt < 200) return;
+      drawn = live;
+      epoch = s.epoch;
+      appended = s.appended;
+      drawnAt = nowMs;
       const end = live.nowUs() / 1e6;
       if (!Number.isFinite(end)) {
         // A new source with no data yet: show nothing rather than the last source's curves.
@@ -139,21 +130,19 @@ export function Graphs({ windowUs }: { windowUs: Signal<number> }) {
         return;
       }
       const start = end - windowUs.value / 1e6;
-      const from = s.indexAt(start);
-      const x = s.t.subarray(from, s.length);
-      charts.forEach((chart, i) => {
-        const key = (list[i] as ChartSpec).key;
+      // The remote's own growing columns, whole: uPlot draws the part its x scale shows.
+      for (const { chart, key } of panes) {
         chart.batch(() => {
-          chart.setData([x as unknown as number[], gaps(s[key].subarray(from, s.length))], false);
+          chart.setData([s.t, s[key]], false);
           chart.setScale('x', { min: start, max: end });
         });
-        showNewest(chart, x.length);
-      });
+        showNewest(chart, s.length);
+      }
     });
     return () => {
       stop();
       resize.disconnect();
-      keys.forEach((off) => {
+      cursors.forEach((off) => {
         off();
       });
       charts.forEach((c) => {

@@ -28,9 +28,7 @@ const AWAY_PX = 32;
 const time = (us: number) => (Number.isFinite(us) ? (us / 1e6).toFixed(3) : '—');
 
 function hex(bytes: Uint8Array, from = 0, to = bytes.length): string {
-  let s = '';
-  for (let i = from; i < to; i++) s += (i > from ? ' ' : '') + (bytes[i] as number).toString(16).toUpperCase().padStart(2, '0');
-  return s;
+  return Array.from(bytes.subarray(from, to), (b) => b.toString(16).toUpperCase().padStart(2, '0')).join(' ');
 }
 
 function FrameCells({ e }: { e: InspectEntry }) {

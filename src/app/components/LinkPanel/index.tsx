@@ -3,7 +3,7 @@
  * Failsafe (a second without a frame), the time since the last frame, hold and failsafe counts,
  * and a timeline of the episodes over the graphs' window.
  */
-import type { Signal } from '@preact/signals';
+import { computed, type Signal } from '@preact/signals';
 import { useEffect, useRef } from 'preact/hooks';
 import { onFrame } from '../../frame-loop.js';
 import type { Live } from '../../live.js';
@@ -26,13 +26,26 @@ function ago(us: number): string {
   return `${(us / 1e6).toFixed(1)} s`;
 }
 
+// The state, its hint and the panel's colour as signals bound to the DOM: a Live/Hold flip
+// changes two texts and a class, and re-renders nothing.
+const sectionClass = computed(() => `link ${linkState.value}`);
+const label = computed(() => LABEL[linkState.value]);
+// A replay at its end keeps its last state, frozen, and says it ended; a forced resolution
+// that matches no frame is not link loss.
+const hint = computed(() =>
+  linkEnded.value
+    ? 'Replay ended: the state at the end of the capture'
+    : linkMismatch.value !== null
+      ? `Forced ${resolutionOverride.value}: no frame matches; the stream looks like ${linkMismatch.value}`
+      : HINT[linkState.value],
+);
+
 export function LinkPanel({ windowUs }: { windowUs: Signal<number> }) {
   const since = useRef<HTMLSpanElement>(null);
   const counts = useRef<HTMLSpanElement>(null);
   const strip = useRef<HTMLDivElement>(null);
   useEffect(() => {
     let shown = '';
-    let stripVersion = -1;
     let stripAt = 0;
     let stripLive: Live | undefined;
     return onFrame((nowMs) => {
@@ -44,9 +57,9 @@ export function LinkPanel({ windowUs }: { windowUs: Signal<number> }) {
         since.current.textContent = text;
         shown = text;
       }
-      // The timeline moves with time: redraw it on new data or four times a second.
-      if (strip.current === null || (live === stripLive && live.version === stripVersion && nowMs - stripAt < 250)) return;
-      stripVersion = live.version;
+      // The timeline moves with time: redrawn four times a second (and at once for another
+      // remote), not for every batch.
+      if (strip.current === null || (live === stripLive && nowMs - stripAt < 250)) return;
       stripLive = live;
       stripAt = nowMs;
       if (counts.current !== null) counts.current.textContent = l === null ? 'none' : `${l.holds} holds · ${l.failsafes} failsafes`;
@@ -61,18 +74,8 @@ export function LinkPanel({ windowUs }: { windowUs: Signal<number> }) {
     });
   }, [windowUs]);
 
-  const state = linkState.value;
-  const mismatch = linkMismatch.value;
-  // A replay at its end keeps its last state, frozen, and says it ended; a forced resolution
-  // that matches no frame is not link loss.
-  const label = LABEL[state];
-  const hint = linkEnded.value
-    ? `Replay ended: the state at the end of the capture`
-    : mismatch !== null
-      ? `Forced ${resolutionOverride.value}: no frame matches; the stream looks like ${mismatch}`
-      : HINT[state];
   return (
-    <section class={`link ${state}`} aria-label="Link state">
+    <section class={sectionClass} aria-label="Link state">
       <div class="state" role="status" aria-live="polite" data-testid="link-state">
         {label}
       </div>

@@ -5,25 +5,100 @@
  * a row, or its remote's button from the keyboard, shows that remote in the views below. The
  * table scrolls inside the panel on a narrow screen.
  */
-import type { Signal } from '@preact/signals';
+import { type Signal, useComputed } from '@preact/signals';
 import { useEffect, useRef } from 'preact/hooks';
 import uPlot from 'uplot';
-import { BUCKET_US, REMOTE_LABELS } from '../../../worker/protocol.js';
+import { REMOTE_LABELS, type SourceStatus } from '../../../worker/protocol.js';
 import { onFrame } from '../../frame-loop.js';
 import type { Live } from '../../live.js';
 import { allLives, select, selected, send, sources } from '../../store.js';
 import { drawEpisodes } from '../../timeline.js';
+import { AlignedColumns } from './columns.js';
 import { agoAxis, hoverCursor, keyboardCursor, legendTime, legendValue, showNewest, valueAxis, valueScale } from '../../axes.js';
 import { chartColors, theme } from '../../theme.js';
 import './style.css';
 
-/** The worker's graph buckets, in seconds of the source's clock (uPlot's x). */
-const BUCKET_S = BUCKET_US / 1e6;
 /** Fade rate in the chart: at least 0–1 /s, so an all-zero window still has labelled ticks. */
 const FADE_SCALE = { floor: 1 };
 
 function stateOf(live: Live | undefined): string {
   return live?.link?.state ?? 'waiting';
+}
+
+/**
+ * One remote's row. Whether it is the one shown below is a signal bound to the row's class and
+ * its button's aria-pressed, so choosing another remote touches two attributes per row and
+ * re-renders nothing.
+ */
+function RemoteRow({ source: s, color }: { source: SourceStatus; color: string }) {
+  const shown = useComputed(() => selected.value === s.id);
+  const rowClass = useComputed(() => (shown.value ? 'on' : ''));
+  return (
+    <tr class={rowClass} onClick={() => select(s.id)} data-testid={`remote-${s.label}`}>
+      <td class="remote-cell">
+        <span class="swatch" aria-hidden="true" style={{ background: color }} />
+        <select
+          aria-label={`Label of ${s.name}`}
+          value={s.label}
+          onClick={(e) => e.stopPropagation()}
+          onChange={(e) => send({ type: 'set-label', source: s.id, label: e.currentTarget.value })}
+        >
+          {[...new Set([...REMOTE_LABELS, s.label])].map((l) => (
+            <option key={l} value={l}>
+              {l}
+            </option>
+          ))}
+        </select>
+        <span class="kind">{s.format.remote === 'internal' ? 'internal' : s.format.remote === 'external' ? 'external' : ''}</span>
+      </td>
+      <td>
+        <span data-cell="state" class="state-chip waiting">
+          waiting
+        </span>
+      </td>
+      <td data-cell="fades" class="num">
+        0
+      </td>
+      <td data-cell="rate" class="num">
+        —
+      </td>
+      <td data-cell="episodes" class="num">
+        0 / 0
+      </td>
+      <td data-cell="frames" class="num">
+        0
+      </td>
+      <td class="name">
+        {/* The row's keyboard way in: a real button, so Tab reaches it and Enter or Space shows the remote. */}
+        <button
+          type="button"
+          class="show"
+          aria-pressed={shown}
+          title={`Show remote ${s.label} in the views below`}
+          onClick={(e) => {
+            e.stopPropagation();
+            select(s.id);
+          }}
+        >
+          {s.name}
+        </button>
+      </td>
+      <td>
+        {s.kind === 'serial' ? (
+          <button
+            type="button"
+            class="link"
+            onClick={(e) => {
+              e.stopPropagation();
+              send({ type: 'serial-close', source: s.id });
+            }}
+          >
+            Disconnect
+          </button>
+        ) : null}
+      </td>
+    </tr>
+  );
 }
 
 export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
@@ -64,41 +139,24 @@ export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
     const keys = keyboardCursor(plot, box);
     const resize = new ResizeObserver(() => plot.setSize({ width: Math.max(200, box.clientWidth), height: 120 }));
     resize.observe(box);
-    const x: number[] = [];
-    const columns: (number | null)[][] = order.map(() => []);
+    const aligned = new AlignedColumns(order.length);
     let drawnAt = 0;
     const stop = onFrame((nowMs) => {
       if (nowMs - drawnAt < 200) return;
       drawnAt = nowMs;
       const lives = allLives();
-      // One x axis: the union of the remotes' bucket times (they share the clock and the grid).
-      const first = lives.get(order[0] as number);
+      const first = order[0] === undefined ? undefined : lives.get(order[0]);
       if (first === undefined) return;
       const end = first.nowUs() / 1e6;
       if (!Number.isFinite(end)) return;
       const start = end - windowUs.value / 1e6;
-      // The remotes' buckets share one 100 ms grid on one clock: the x axis is that grid, and
-      // each column is filled in place (no union, no sort, no new arrays per redraw).
-      const k0 = Math.ceil(start / BUCKET_S - 1e-6);
-      const n = Math.max(0, Math.floor(end / BUCKET_S + 1e-6) - k0 + 1);
-      x.length = n;
-      for (let i = 0; i < n; i++) x[i] = (k0 + i) * BUCKET_S;
-      order.forEach((id, r) => {
-        const col = columns[r] as (number | null)[];
-        col.length = n;
-        col.fill(null);
-        const s = lives.get(id)?.series;
-        if (s === undefined) return;
-        for (let i = s.indexAt(start); i < s.length; i++) {
-          const k = Math.round((s.t[i] as number) / BUCKET_S) - k0;
-          if (k >= 0 && k < n) col[k] = s.fadeRate[i] as number;
-        }
-      });
+      aligned.update(order.map((id) => lives.get(id)?.series));
+      // The whole grid: uPlot draws the part its x scale shows.
       plot.batch(() => {
-        plot.setData([x, ...columns] as uPlot.AlignedData, false);
+        plot.setData([aligned.x, ...aligned.columns], false);
         plot.setScale('x', { min: start, max: end });
       });
-      showNewest(plot, x.length);
+      showNewest(plot, aligned.x.length);
       // Episode lanes, one per remote, on the same window.
       const el = lanes.current;
       if (el === null) return;
@@ -118,32 +176,21 @@ export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
   }, [ids, windowUs, palette]);
 
   useEffect(() => {
-    let shown = '';
+    // What each row shows, by the remote's data it was written from: a row is rewritten only
+    // when its remote has a new batch (or is a new source on that id).
+    const shown = list.map(() => ({ live: undefined as Live | undefined, version: -1 }));
     return onFrame(() => {
       const body = table.current;
       if (body === null) return;
       const lives = allLives();
-      const text = list
-        .map((s) => {
-          const live = lives.get(s.id);
-          const l = live?.link;
-          return [
-            stateOf(live),
-            live?.counters.frames ?? 0,
-            l?.fades ?? 0,
-            l === null || l === undefined ? '—' : (l.fadeRate * 60).toFixed(0),
-            l?.holds ?? 0,
-            l?.failsafes ?? 0,
-          ].join('|');
-        })
-        .join(';');
-      if (text === shown) return;
-      shown = text;
       list.forEach((s, i) => {
-        const row = body.children[i];
         const live = lives.get(s.id);
-        if (!(row instanceof HTMLElement)) return;
-        const cells = row.querySelectorAll<HTMLElement>('[data-cell]');
+        const last = shown[i];
+        const row = body.children[i];
+        if (last === undefined || !(row instanceof HTMLElement)) return;
+        if (last.live === live && last.version === (live?.version ?? -1)) return;
+        last.live = live;
+        last.version = live?.version ?? -1;
         const l = live?.link;
         const values: Record<string, string> = {
           state: stateOf(live),
@@ -152,10 +199,10 @@ export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
           rate: l === null || l === undefined ? '—' : `${(l.fadeRate * 60).toFixed(0)}/min`,
           episodes: `${l?.holds ?? 0} / ${l?.failsafes ?? 0}`,
         };
-        for (const c of cells) {
-          const v = values[c.dataset.cell as string] ?? '';
+        for (const c of row.querySelectorAll<HTMLElement>('[data-cell]')) {
+          const v = values[c.dataset.cell ?? ''] ?? '';
           if (c.textContent !== v) c.textContent = v;
-          if (c.dataset.cell === 'state') c.className = `state-chip ${v}`;
+          if (c.dataset.cell === 'state' && c.className !== `state-chip ${v}`) c.className = `state-chip ${v}`;
         }
       });
     });
@@ -183,70 +230,7 @@ export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
           </thead>
           <tbody ref={table}>
             {list.map((s, i) => (
-              <tr key={s.id} class={selected.value === s.id ? 'on' : ''} onClick={() => select(s.id)} data-testid={`remote-${s.label}`}>
-                <td class="remote-cell">
-                  <span class="swatch" aria-hidden="true" style={{ background: colors[i % colors.length] }} />
-                  <select
-                    aria-label={`Label of ${s.name}`}
-                    value={s.label}
-                    onClick={(e) => e.stopPropagation()}
-                    onChange={(e) => send({ type: 'set-label', source: s.id, label: (e.currentTarget as HTMLSelectElement).value })}
-                  >
-                    {[...new Set([...REMOTE_LABELS, s.label])].map((l) => (
-                      <option key={l} value={l}>
-                        {l}
-                      </option>
-                    ))}
-                  </select>
-                  <span class="kind">{s.format.remote === 'internal' ? 'internal' : s.format.remote === 'external' ? 'external' : ''}</span>
-                </td>
-                <td>
-                  <span data-cell="state" class="state-chip waiting">
-                    waiting
-                  </span>
-                </td>
-                <td data-cell="fades" class="num">
-                  0
-                </td>
-                <td data-cell="rate" class="num">
-                  —
-                </td>
-                <td data-cell="episodes" class="num">
-                  0 / 0
-                </td>
-                <td data-cell="frames" class="num">
-                  0
-                </td>
-                <td class="name">
-                  {/* The row's keyboard way in: a real button, so Tab reaches it and Enter or Space shows the remote. */}
-                  <button
-                    type="button"
-                    class="show"
-                    aria-pressed={selected.value === s.id}
-                    title={`Show remote ${s.label} in the views below`}
-                    onClick={(e) => {
-                      e.stopPropagation();
-                      select(s.id);
-                    }}
-                  >
-                    {s.name}
-                  </button>
-                </td>
-                <td>
-                  {s.kind === 'serial' ? (
-                    <button
-                      type="button"
-                      class="link"
-                      onClick={(e) => {
-                        e.stopPropagation();
-                        send({ type: 'serial-close', source: s.id });
-                      }}
-                    >
-                      Disconnect
-                    </button>
-                  ) : null}
-                </td>
-              </tr>
+              <RemoteRow key={s.id} source={s} color={colors[i % colors.length] ?? ''} />
             ))}
           </tbody>
         </table>

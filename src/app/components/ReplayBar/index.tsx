@@ -2,9 +2,10 @@
  * Replay controls: play/pause, speed (1×, 4×, as fast as possible) and a timeline of the whole
  * capture (fades and lost frames per second, failsafe episodes) to seek on.
  */
-import { useEffect, useRef, useState } from 'preact/hooks';
+import { computed, useComputed, useSignal } from '@preact/signals';
+import { useEffect, useRef } from 'preact/hooks';
 import uPlot from 'uplot';
-import { overview, replay, send } from '../../store.js';
+import { overview, replay, replayName, replaySpanUs, send } from '../../store.js';
 import { chartColors, theme } from '../../theme.js';
 import './style.css';
 
@@ -19,10 +20,25 @@ function clock(us: number): string {
   return `${Math.floor(s / 60)}:${(s % 60).toFixed(1).padStart(4, '0')}`;
 }
 
-export function ReplayBar() {
+// The replay status comes five times a second and mostly only its position moves: the bar
+// renders from the parts that change rarely, and the clock text and the slider's position are
+// signals bound straight to the DOM.
+const playing = computed(() => replay.value?.playing ?? false);
+const speed = computed(() => replay.value?.speed ?? 1);
+const startUs = computed(() => replay.value?.startUs ?? 0);
+const endUs = computed(() => replay.value?.endUs ?? 0);
+const described = computed(() => (replay.value === null ? '' : `${replay.value.kind}, timing ${replay.value.timing}`));
+const clockText = computed(() => {
   const r = replay.value;
+  return r === null ? '' : `${clock(r.positionUs - r.startUs)} / ${clock(Math.max(1, r.endUs - r.startUs))}`;
+});
+
+export function ReplayBar() {
+  const name = replayName.value;
   const chart = useRef<HTMLDivElement>(null);
-  const [dragging, setDragging] = useState<number | null>(null);
+  /** While the thumb is held: where it is (the position updates must not pull it back). */
+  const dragging = useSignal<number | null>(null);
+  const position = useComputed(() => dragging.value ?? replay.value?.positionUs ?? 0);
   const o = overview.value;
   const palette = theme.value;
   useEffect(() => {
@@ -66,19 +82,17 @@ export function ReplayBar() {
     );
     return () => plot.destroy();
     // The overview can arrive before the replay status that makes this bar (and its box) appear.
-  }, [o, r !== null, palette]);
-  if (r === null) return null;
-  const span = Math.max(1, r.endUs - r.startUs);
+  }, [o, name !== null, palette]);
+  if (name === null) return null;
+  const span = Math.max(1, replaySpanUs.value);
   return (
     <section class="replay" aria-label="Replay">
       <div class="replay-row">
-        <strong class="name" title={r.name}>
-          {r.name}
+        <strong class="name" title={name}>
+          {name}
         </strong>
-        <span class="muted">
-          {r.kind}, timing {r.timing}
-        </span>
-        {r.playing ? (
+        <span class="muted">{described}</span>
+        {playing.value ? (
           <button type="button" class="primary" onClick={() => send({ type: 'replay-pause' })}>
             Pause
           </button>
@@ -88,7 +102,8 @@ export function ReplayBar() {
             class="primary"
             onClick={() => {
               // At the end, play starts over.
-              if (r.positionUs >= r.endUs) send({ type: 'replay-seek', timeUs: r.startUs });
+              const r = replay.peek();
+              if (r !== null && r.positionUs >= r.endUs) send({ type: 'replay-seek', timeUs: r.startUs });
               send({ type: 'replay-play' });
             }}
           >
@@ -101,8 +116,8 @@ export function ReplayBar() {
               key={label}
               type="button"
               role="radio"
-              aria-checked={r.speed === v}
-              class={r.speed === v ? 'on' : ''}
+              aria-checked={speed.value === v}
+              class={speed.value === v ? 'on' : ''}
               onClick={() => send({ type: 'replay-speed', speed: v })}
             >
               {label}
@@ -110,7 +125,7 @@ export function ReplayBar() {
           ))}
         </div>
         <span class="time" data-testid="replay-time">
-          {clock(r.positionUs - r.startUs)} / {clock(span)}
+          {clockText}
         </span>
       </div>
       <div class="overview" ref={chart} />
@@ -118,15 +133,16 @@ export function ReplayBar() {
         type="range"
         class="seek"
         aria-label="Seek"
-        min={r.startUs}
-        max={r.endUs}
+        min={startUs.value}
+        max={endUs.value}
         step={Math.max(1, Math.round(span / 2000))}
-        value={dragging ?? r.positionUs}
-        // While the thumb is held, the position updates must not pull it back.
-        onInput={(e) => setDragging(Number((e.currentTarget as HTMLInputElement).value))}
+        value={position}
+        onInput={(e) => {
+          dragging.value = Number(e.currentTarget.value);
+        }}
         onChange={(e) => {
-          setDragging(null);
-          send({ type: 'replay-seek', timeUs: Number((e.currentTarget as HTMLInputElement).value) });
+          dragging.value = null;
+          send({ type: 'replay-seek', timeUs: Number(e.currentTarget.value) });
         }}
       />
     </section>

@@ -2,6 +2,7 @@
  * What the link is: DSM2 or DSMX, 11 or 22 ms, 1024 or 2048, internal or external remote,
  * RSSI-capable, and whether the resolution was read from the system byte or inferred.
  */
+import { computed } from '@preact/signals';
 import { systemInfo } from '../../../decoder/index.js';
 import { nominalPeriodUs, status } from '../../store.js';
 import './style.css';
@@ -14,6 +15,12 @@ function protocol(system: number | null, resolution: number | null, periodUs: nu
   if (resolution === 1024) return 'DSM2 22 ms';
   return ms ? `DSM2/DSMX ${ms}` : 'DSM2/DSMX';
 }
+
+/** The protocol's name, a signal bound to its text: the measured period can name it before a system byte does. */
+const protocolText = computed(() => {
+  const { format } = status.value;
+  return protocol(format.system, format.resolution, nominalPeriodUs.value);
+});
 
 export function SystemBadge() {
   const { format } = status.value;
@@ -29,7 +36,7 @@ export function SystemBadge() {
   return (
     <section class="badge" aria-label="System" title={format.explanation}>
       <span class="chip strong" data-testid="protocol">
-        {protocol(format.system, format.resolution, nominalPeriodUs.value)}
+        {protocolText}
       </span>
       <span class="chip" data-testid="resolution">
         {format.resolution ?? '?'}

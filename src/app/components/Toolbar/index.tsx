@@ -3,10 +3,11 @@
  * granted before, the demo, open a capture, bind), recording, the report, and settings
  * (resolution, theme) behind a menu. On a phone the groups wrap onto rows of their own.
  */
+import { computed } from '@preact/signals';
 import { useEffect, useState } from 'preact/hooks';
 import { chooseAndConnect, connect, portLabel } from '../../serial.js';
 import type { SourceStatus } from '../../../worker/protocol.js';
-import { recording, replay, resolutionOverride, send, sources } from '../../store.js';
+import { recording, replayName, resolutionOverride, send, sources } from '../../store.js';
 import { chooseCapture, openCapture, setCaptureInput } from '../../open-file.js';
 import { setTheme, theme, themeChoice } from '../../theme.js';
 import { Menu } from '../Menu/index.js';
@@ -27,9 +28,8 @@ function summary(list: SourceStatus[]): { text: string; tone: string } {
   if (first === undefined) return { text: 'No receiver', tone: 'idle' };
   if (first.kind === 'demo') return { text: `Demo receiver: ${list.length} simulated remotes (DSMX 11 ms)`, tone: 'demo' };
   if (first.kind === 'replay') {
-    const r = replay.value;
     const state = first.state === 'ended' ? ' (end)' : first.state === 'paused' ? ' (paused)' : '';
-    return { text: `${r?.name ?? 'Replay'}${state}`, tone: 'replay' };
+    return { text: `${replayName.value ?? 'Replay'}${state}`, tone: 'replay' };
   }
   const lost = list.some((s) => s.state === 'lost');
   const opening = list.some((s) => s.state === 'opening');
@@ -74,19 +74,43 @@ function Moon() {
   );
 }
 
+// The recorder reports about once a second while it records, and only the running length and
+// size change then: the toolbar renders from what changes rarely, and that text is a signal
+// bound to the DOM.
+const recActive = computed(() => recording.value?.active === true);
+const recProgress = computed(() => {
+  const r = recording.value;
+  return r?.active ? `${duration(r.durationUs)} · ${size(r.bytes)}` : '';
+});
+/** Bytes recorded (so far, or in the finished recording). */
+const recHasBytes = computed(() => (recording.value?.bytes ?? 0) > 0);
+/** The size of the finished recording that can be exported, or null. */
+const recSaved = computed(() => {
+  const r = recording.value;
+  return r !== null && !r.active && r.bytes > 0 ? size(r.bytes) : null;
+});
+const recRecovered = computed(() => {
+  const x = recording.value?.recovered;
+  return x ? `An unfinished recording from ${new Date(x.createdAt).toLocaleString()} (${size(x.bytes)}) was kept.` : null;
+});
+const recError = computed(() => recording.value?.error ?? null);
+
 export function Toolbar({ granted, onBind }: { granted: SerialPort[]; onBind(): void }) {
   const [exported, setExported] = useState(false);
   const list = sources.value;
   const kind = list[0]?.kind;
-  const rec = recording.value;
+  const active = recActive.value;
+  const saved = recSaved.value;
+  const recovered = recRecovered.value;
+  const error = recError.value;
   const live = kind === 'serial' || kind === 'demo';
   const pill = summary(list);
   const dark = theme.value === 'dark';
   // A report covers a replayed capture or what was recorded.
-  const canReport = kind === 'replay' || (rec !== null && rec.bytes > 0);
+  const canReport = kind === 'replay' || recHasBytes.value;
   useEffect(() => {
-    if (rec?.active) setExported(false);
-  }, [rec?.active]);
+    if (active) setExported(false);
+  }, [active]);
   return (
     <header class="toolbar">
       <h1 class="brand">
@@ -170,19 +194,16 @@ export function Toolbar({ granted, onBind }: { granted: SerialPort[]; onBind(): 
           hidden
           aria-label="Capture file"
           onChange={(e) => {
-            const f = (e.currentTarget as HTMLInputElement).files?.[0];
+            const f = e.currentTarget.files?.[0];
             if (f) void openCapture(f);
-            (e.currentTarget as HTMLInputElement).value = '';
+            e.currentTarget.value = '';
           }}
         />
       </div>
       <div class="tb-group recorder" role="group" aria-label="Recording">
-        {rec?.active ? (
+        {active ? (
           <button type="button" class="rec on" onClick={() => send({ type: 'record-stop' })} aria-label="Stop recording">
-            ■ Stop{' '}
-            <span class="rec-info">
-              {duration(rec.durationUs)} · {size(rec.bytes)}
-            </span>
+            ■ Stop <span class="rec-info">{recProgress}</span>
           </button>
         ) : (
           <button
@@ -195,7 +216,7 @@ export function Toolbar({ granted, onBind }: { granted: SerialPort[]; onBind(): 
             ● Record
           </button>
         )}
-        {rec !== null && !rec.active && rec.bytes > 0 ? (
+        {saved !== null ? (
           <div class="split">
             <button
               type="button"
@@ -203,7 +224,7 @@ export function Toolbar({ granted, onBind }: { granted: SerialPort[]; onBind(): 
                 send({ type: 'export', what: 'sscap', recording: 'last' });
                 setExported(true);
               }}
-              title={`Save the recording (${size(rec.bytes)}) as .sscap: bytes with their arrival times`}
+              title={`Save the recording (${saved}) as .sscap: bytes with their arrival times`}
             >
               Export .sscap
             </button>
@@ -312,9 +333,9 @@ export function Toolbar({ granted, onBind }: { granted: SerialPort[]; onBind(): 
           )}
         </Menu>
       </div>
-      {rec?.recovered ? (
+      {recovered !== null ? (
         <div class="recovered" role="alert">
-          An unfinished recording from {new Date(rec.recovered.createdAt).toLocaleString()} ({size(rec.recovered.bytes)}) was kept.
+          {recovered}
           <button type="button" onClick={() => send({ type: 'export', what: 'sscap', recording: 'recovered' })}>
             Export .sscap
           </button>
@@ -326,9 +347,9 @@ export function Toolbar({ granted, onBind }: { granted: SerialPort[]; onBind(): 
           </button>
         </div>
       ) : null}
-      {rec?.error ? (
+      {error ? (
         <div class="recovered error" role="alert">
-          {rec.error}
+          {error}
         </div>
       ) : null}
     </header>
