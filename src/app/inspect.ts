@@ -1,38 +1,25 @@
 /**
- * What each byte of a 16-byte frame means, field by field, for the frame inspector: the header
- * (§8.3, §8.3.1, §8.4), then the seven slots read as the spec says (§8.1, §8.2, §8.6), with
- * empty slots (0xFFFF) and Spektrum VTX control as real receivers send them. A pure function
- * of the bytes and the format the decoder settled on, so it shows the frame the way a firmware
- * decoder should read it, slot by slot, including what is wrong with a slot.
+ * What each byte of a 16-byte frame means, in words, for the frame inspector: the header
+ * (§8.3, §8.3.1, §8.4) and the seven slots (§8.1, §8.2, §8.6), with empty slots (0xFFFF) and
+ * Spektrum VTX control as real receivers send them. The reading itself is the library's
+ * `readFrameFields`, made with the decoder's own tables, so the inspector shows a frame
+ * exactly as the decoder read it; this file only says it.
  */
 import {
-  EMPTY_SLOT,
   FRAME_SIZE,
-  XPLUS_FIRST,
   channelName,
-  servoToMicros,
+  readFrameFields,
   systemInfo,
+  type FrameFields,
   type HeaderMode,
   type RemoteKind,
   type Resolution,
+  type SlotFields,
+  type SlotKind,
   type VtxControl,
 } from '../decoder/index.js';
 
-// §8.1 and §8.2's masks. The library keeps them internal, so they are restated here.
-/** §8.1: 1024 mode, bits 15–10 channel ID, bits 9–0 position. */
-const SHIFT_1024_CHANID = 10;
-const MASK_1024_SXPOS = 0x03ff;
-/** §8.2: 2048 mode, bit 15 phase, bits 14–11 channel ID, bits 10–0 position. */
-const MASK_2048_PHASE = 0x8000;
-const SHIFT_2048_CHANID = 11;
-const MASK_2048_SXPOS = 0x07ff;
-/** §8.5: IDs 0–11 are ordinary channels. */
-const MAX_NORMAL_CHANNEL = 11;
-/** §8.6: channel ID 12 in 2048 mode is X-Plus; bits 10–9 add 0–3, the phase bit adds 4. */
-const XPLUS_CHANNEL_ID = 12;
-const MASK_XPLUS_VALUE = 0x01ff;
-
-export type SlotKind = 'channel' | 'xplus' | 'empty' | 'vtx' | 'invalid';
+export type { SlotKind };
 
 /** One header field. */
 export interface HeaderField {
@@ -54,34 +41,14 @@ export interface HeaderField {
   title: string;
 }
 
-/** One of the seven 16-bit slots. */
-export interface SlotField {
-  /** 0–6. */
-  index: number;
+/** One of the seven 16-bit slots, as the library reads it, with words to show. */
+export interface SlotField extends SlotFields {
   /** Byte range in the frame, inclusive (2–3 … 14–15). */
-  first: number;
   last: number;
-  word: number;
   /** The word as four hex digits. */
   hex: string;
-  kind: SlotKind;
-  /** §8.2's phase bit (bit 15) in 2048 mode; null in 1024 mode, where bit 15 is part of the ID. */
-  phase: 0 | 1 | null;
-  /** The channel ID field as sent (bits 14–11 or 15–10); null for empty and VTX slots. */
-  id: number | null;
-  /** X-Plus: bits 10–9, the offset 0–3 added to channel 12 (§8.6). */
-  subId: number | null;
-  /** X-Plus: the 9-bit value (bits 8–0) before scaling. */
-  value9: number | null;
-  /** The channel 0–19 the slot carries (X-Plus resolved), or null. */
-  channel: number | null;
-  /** Servo position: 0–1023 or 0–2047; X-Plus scaled to 11 bits (value9 << 2). */
-  position: number | null;
-  /** Pulse width (§9), X-Plus on the 2048 scale. */
-  us: number | null;
+  /** The channel's name, or null. */
   name: string | null;
-  /** What is wrong with an invalid slot. */
-  problem: string | null;
   /** A short tag to print under the bytes: "1p", "X+2", "empty", "VTX", "!". */
   label: string;
   /** The slot in the one-line summary (empty for the second VTX slot). */
@@ -108,45 +75,16 @@ export interface FrameDescription {
   emptySlots: number;
 }
 
-/** A frame's bytes for typed reads: bytes and big-endian words (spec §8), checked against its length. */
-const frameView = (bytes: Uint8Array) => new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
-
 const hex2 = (v: number) => `0x${v.toString(16).toUpperCase().padStart(2, '0')}`;
 const hex4 = (v: number) => v.toString(16).toUpperCase().padStart(4, '0');
-
-/**
- * Whether bytes 12–15 carry VTX control: both words' top nibble 0xE, in a frame whose first
- * slot has phase 0 (two X-Plus words X+5…X+8 also start with 0xE, but only in phase-1 frames).
- * This is the decoder's `isVtxFrame` rule restated: that function lives in the library's
- * internal frame module, which the app does not import (only the public API), and the rule is
- * three comparisons.
- */
-function isVtx(b: DataView): boolean {
-  return (b.getUint8(12) & 0xf0) === 0xe0 && (b.getUint8(14) & 0xf0) === 0xe0 && (b.getUint8(2) & 0x80) === 0;
-}
-
-/** Bytes 12–15 as Spektrum VTX control (the layout PX4 and Betaflight read). */
-function readVtx(b: DataView): VtxControl {
-  const raw = b.getUint32(12);
-  return {
-    raw,
-    band: (raw >>> 21) & 0x07,
-    channel: (raw >>> 16) & 0x0f,
-    pit: ((raw >>> 4) & 1) === 1,
-    region: (raw >>> 3) & 1,
-    power: raw & 0x07,
-  };
-}
 
 function vtxText(v: VtxControl): string {
   return `VTX band ${v.band} ch ${v.channel} power ${v.power} ${v.region === 1 ? 'EU' : 'US'}${v.pit ? ' pit' : ''}`;
 }
 
-function describeHeader(b: DataView, resolution: Resolution, remote: RemoteKind, headerMode: HeaderMode): HeaderField[] {
-  const b0 = b.getUint8(0);
-  const b1 = b.getUint8(1);
-  if (remote === 'external') {
-    const fades = (b0 << 8) | b1;
+function describeHeader(f: FrameFields): HeaderField[] {
+  if (f.remote === 'external') {
+    const fades = f.fades ?? 0;
     return [
       {
         field: 'fades',
@@ -161,16 +99,17 @@ function describeHeader(b: DataView, resolution: Resolution, remote: RemoteKind,
       },
     ];
   }
+  const b1 = f.system ?? 0;
   const first: HeaderField =
-    headerMode === 'rssi'
+    f.rssi !== null
       ? (() => {
-          const dBm = b0 >= 0x80 ? b0 - 0x100 : b0;
+          const dBm = f.rssi;
           const loss = dBm === -128;
           return {
             field: 'rssi' as const,
             first: 0,
             last: 0,
-            raw: b0,
+            raw: dBm & 0xff,
             value: dBm,
             valid: true,
             label: 'RSSI',
@@ -182,12 +121,12 @@ function describeHeader(b: DataView, resolution: Resolution, remote: RemoteKind,
           field: 'fades',
           first: 0,
           last: 0,
-          raw: b0,
-          value: b0,
+          raw: f.fades ?? 0,
+          value: f.fades ?? 0,
           valid: true,
           label: 'fades',
-          text: `fades ${b0}`,
-          title: `byte 0: fade count, UINT8 (internal remote, §8.3) = ${b0}`,
+          text: `fades ${f.fades ?? 0}`,
+          title: `byte 0: fade count, UINT8 (internal remote, §8.3) = ${f.fades ?? 0}`,
         };
   const info = systemInfo(b1);
   let title = `byte 1: system ${hex2(b1)}`;
@@ -195,7 +134,7 @@ function describeHeader(b: DataView, resolution: Resolution, remote: RemoteKind,
     title += ': not a valid system byte (§8.3 allows 0x01, 0x12, 0xA2, 0xB2; a receiver sending another value is not bound)';
   } else {
     title += ` = ${info.name} (§8.3)`;
-    if (info.resolution !== resolution) title += `; but the channel IDs read at ${resolution}, not ${info.resolution}`;
+    if (info.resolution !== f.resolution) title += `; but the channel IDs read at ${f.resolution}, not ${info.resolution}`;
   }
   const system: HeaderField = {
     field: 'system',
@@ -203,7 +142,7 @@ function describeHeader(b: DataView, resolution: Resolution, remote: RemoteKind,
     last: 1,
     raw: b1,
     value: b1,
-    valid: info !== undefined,
+    valid: f.systemValid,
     label: 'sys',
     text: info === undefined ? `${hex2(b1)} not a valid system byte` : `${hex2(b1)} ${info.protocol} ${info.periodMs} ms`,
     title,
@@ -217,97 +156,34 @@ function describeHeader(b: DataView, resolution: Resolution, remote: RemoteKind,
  * @throws {RangeError} when fewer than 16 bytes are given.
  */
 export function describeFrame(bytes: Uint8Array, resolution: Resolution, remote: RemoteKind, headerMode: HeaderMode): FrameDescription {
-  if (bytes.length < FRAME_SIZE) throw new RangeError(`a frame is ${FRAME_SIZE} bytes, got ${bytes.length}`);
-  const view = frameView(bytes);
-  const header = describeHeader(view, resolution, remote, headerMode);
-  const vtxFrame = isVtx(view);
-  const vtx = vtxFrame ? readVtx(view) : null;
-  const slots: SlotField[] = [];
-  /** Slot index (+1) that carried each channel 0–19, to catch a repeated one. */
-  const seenIn = new Int8Array(20);
-  for (let i = 0; i < 7; i++) {
-    const first = 2 + 2 * i;
-    const word = view.getUint16(first);
+  const f = readFrameFields(bytes, resolution, remote, headerMode);
+  const header = describeHeader(f);
+  const vtx = f.vtx;
+  const slots = f.slots.map((read): SlotField => {
     const s: SlotField = {
-      index: i,
-      first,
-      last: first + 1,
-      word,
-      hex: hex4(word),
-      kind: 'invalid',
-      phase: resolution === 2048 ? ((word & MASK_2048_PHASE) !== 0 ? 1 : 0) : null,
-      id: null,
-      subId: null,
-      value9: null,
-      channel: null,
-      position: null,
-      us: null,
-      name: null,
-      problem: null,
+      ...read,
+      last: read.first + 1,
+      hex: hex4(read.word),
+      name: read.channel === null ? null : channelName(read.channel),
       label: '',
       text: '',
       title: '',
     };
-    const where = `bytes ${first}–${first + 1}, slot ${i + 1}, word 0x${s.hex}`;
+    const where = `bytes ${s.first}–${s.last}, slot ${s.index + 1}, word 0x${s.hex}`;
     const phaseNote = s.phase === null ? '' : `, phase ${s.phase}`;
-    if (vtx !== null && i >= 5) {
+    if (s.kind === 'vtx' && vtx !== null) {
       // Slots 6 and 7 together carry one 32-bit VTX value: both get the whole decode.
-      s.kind = 'vtx';
       s.label = 'VTX';
-      s.text = i === 5 ? vtxText(vtx) : '';
+      s.text = s.index === 5 ? vtxText(vtx) : '';
       s.title =
         `${where}: Spektrum VTX control (bytes 12–15 = 0x${hex4(vtx.raw >>> 16)}${hex4(vtx.raw & 0xffff)}, both words' top nibble 0xE in a phase-0 frame): ` +
         `band ${vtx.band}, channel ${vtx.channel}, power ${vtx.power}, region ${vtx.region === 1 ? 'EU' : 'US'}, pit mode ${vtx.pit ? 'on' : 'off'}`;
-      slots.push(s);
-      continue;
-    }
-    if (word === EMPTY_SLOT) {
-      s.kind = 'empty';
+    } else if (s.kind === 'empty') {
       s.label = 'empty';
       s.text = 'empty';
       s.title = `${where}: empty slot (0xFFFF: unused, not a channel)`;
-      slots.push(s);
-      continue;
-    }
-    if (resolution === 2048) {
-      const id = (word >> SHIFT_2048_CHANID) & 0x0f;
-      s.id = id;
-      if (id <= MAX_NORMAL_CHANNEL) {
-        s.kind = 'channel';
-        s.channel = id;
-        s.position = word & MASK_2048_SXPOS;
-      } else if (id === XPLUS_CHANNEL_ID) {
-        // §8.6: bits 10–9 add 0–3 to 12, the phase bit adds 4, and 9 bits scale to 11.
-        s.kind = 'xplus';
-        s.subId = (word >> 9) & 0x03;
-        s.value9 = word & MASK_XPLUS_VALUE;
-        s.channel = XPLUS_FIRST + s.subId + (s.phase === 1 ? 4 : 0);
-        s.position = s.value9 << 2;
-      } else {
-        s.problem = `channel ID ${id} does not exist (2048 mode: 0–11, or 12 for X-Plus)`;
-      }
-    } else {
-      const id = word >> SHIFT_1024_CHANID;
-      s.id = id;
-      if (id <= MAX_NORMAL_CHANNEL) {
-        s.kind = 'channel';
-        s.channel = id;
-        s.position = word & MASK_1024_SXPOS;
-      } else {
-        s.problem = `channel ID ${id} does not exist (1024 mode: 0–11; X-Plus is 2048 only)`;
-      }
-    }
-    if (s.channel !== null && s.position !== null) {
-      // X-Plus positions are on the 2047 scale whatever the link's resolution.
-      s.us = servoToMicros(s.position, s.kind === 'xplus' ? 2048 : resolution);
-      s.name = channelName(s.channel);
-      const before = seenIn[s.channel] ?? 0;
-      if (before > 0) s.problem = `${s.name} again (slot ${before} has it): a frame carries each channel once`;
-      else seenIn[s.channel] = i + 1;
-    }
-    if (s.problem !== null) {
+    } else if (s.kind === 'invalid') {
       const decoded = s.channel !== null ? `; reads as ${s.name} ${s.position}` : '';
-      s.kind = 'invalid';
       s.label = '!';
       s.text = `invalid 0x${s.hex} (${s.channel !== null ? `${s.name} again` : `ID ${s.id}`})`;
       s.title = `${where}${phaseNote}: invalid: ${s.problem}${decoded}`;
@@ -323,11 +199,10 @@ export function describeFrame(bytes: Uint8Array, resolution: Resolution, remote:
       s.text = `${s.channel}${p} ${s.name} ${s.position} ${s.us}\u00a0µs`;
       s.title = `${where}${phaseNote}, channel ID ${s.channel} (${s.name}), position ${s.position} of ${resolution - 1} = ${s.us}\u00a0µs`;
     }
-    slots.push(s);
-  }
-  const empty = slots.filter((s) => s.kind === 'empty').length;
+    return s;
+  });
   const parts = [...header.map((h) => h.text), ...slots.filter((s) => s.kind !== 'empty' && s.text !== '').map((s) => s.text)];
-  if (empty > 0) parts.push(`${empty} empty`);
+  if (f.emptySlots > 0) parts.push(`${f.emptySlots} empty`);
   return {
     resolution,
     remote,
@@ -335,10 +210,10 @@ export function describeFrame(bytes: Uint8Array, resolution: Resolution, remote:
     header,
     slots,
     vtx,
-    phase: resolution === 2048 ? ((view.getUint8(2) & 0x80) !== 0 ? 1 : 0) : null,
+    phase: f.phase,
     summary: parts.join(' · '),
     parts,
-    emptySlots: empty,
+    emptySlots: f.emptySlots,
   };
 }
 
@@ -348,9 +223,6 @@ export function describeFrame(bytes: Uint8Array, resolution: Resolution, remote:
  */
 export function countSlots(bytes: Uint8Array): { empty: number; vtx: boolean } {
   if (bytes.length < FRAME_SIZE) return { empty: 0, vtx: false };
-  const view = frameView(bytes);
-  const vtx = isVtx(view);
-  let empty = 0;
-  for (let i = 0; i < (vtx ? 5 : 7); i++) if (view.getUint16(2 + 2 * i) === EMPTY_SLOT) empty++;
-  return { empty, vtx };
+  const f = readFrameFields(bytes, 2048, 'internal', 'fades');
+  return { empty: f.emptySlots, vtx: f.vtx !== null };
 }
