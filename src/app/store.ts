@@ -7,6 +7,7 @@
 import { batch, computed, signal } from '@preact/signals';
 import type { InspectEntry } from '../worker/inspector.js';
 import type { BindProgress, FromWorker, Overview, RecordingStatus, ReplayStatus, SourceStatus, ToWorker } from '../worker/protocol.js';
+import { onFrame } from './frame-loop.js';
 import { Live } from './live.js';
 import type { DiagnosisStatus } from '../worker/protocol.js';
 
@@ -105,6 +106,21 @@ function refreshSelected(): void {
   });
 }
 
+/**
+ * The worker's news reaches the link state at the next animation frame, with the counters,
+ * bars and graphs that draw from the same batch there: the page never says "Replay ended" (or
+ * Hold, or Live) beside figures one batch old.
+ */
+let refreshDue = false;
+function refreshOnFrame(): void {
+  refreshDue = true;
+}
+onFrame(() => {
+  if (!refreshDue) return;
+  refreshDue = false;
+  refreshSelected();
+});
+
 export function select(id: number): void {
   batch(() => {
     if (id !== selected.value) inspection.value = null;
@@ -143,7 +159,7 @@ function receive(message: FromWorker): void {
   switch (message.type) {
     case 'sources': {
       sources.value = message.sources;
-      refreshSelected();
+      refreshOnFrame();
       for (const s of message.sources) liveOf(s.id).clockRate = s.clockRate;
       for (const id of lives.keys()) if (!message.sources.some((s) => s.id === id)) lives.delete(id);
       // Keep the selection on a remote that exists, preferring the internal one.
@@ -156,7 +172,7 @@ function receive(message: FromWorker): void {
     }
     case 'batch':
       liveOf(message.source).apply(message.batch);
-      if (message.source === selected.value) refreshSelected();
+      if (message.source === selected.value) refreshOnFrame();
       break;
     case 'reset':
       if (message.source === undefined) lives.clear();

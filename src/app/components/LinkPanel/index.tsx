@@ -46,6 +46,7 @@ export function LinkPanel({ windowUs }: { windowUs: Signal<number> }) {
   const strip = useRef<HTMLDivElement>(null);
   useEffect(() => {
     let shown = '';
+    let shownEpisodes = '';
     let stripAt = 0;
     let stripLive: Live | undefined;
     return onFrame((nowMs) => {
@@ -57,12 +58,17 @@ export function LinkPanel({ windowUs }: { windowUs: Signal<number> }) {
         since.current.textContent = text;
         shown = text;
       }
+      // The counts change with the batch that changed them, as the counters beside them do.
+      const episodes = l === null ? 'none' : `${l.holds} holds · ${l.failsafes} failsafes`;
+      if (episodes !== shownEpisodes && counts.current !== null) {
+        counts.current.textContent = episodes;
+        shownEpisodes = episodes;
+      }
       // The timeline moves with time: redrawn four times a second (and at once for another
       // remote), not for every batch.
       if (strip.current === null || (live === stripLive && nowMs - stripAt < 250)) return;
       stripLive = live;
       stripAt = nowMs;
-      if (counts.current !== null) counts.current.textContent = l === null ? 'none' : `${l.holds} holds · ${l.failsafes} failsafes`;
       const parts = drawEpisodes(strip.current, live.episodes.values(), now, windowUs.value);
       const el = strip.current;
       el.setAttribute(
