@@ -18,8 +18,9 @@ import { encodeCapture, importRaw, readCapture, type Capture, type CaptureRecord
 import { captureSpan, healthReport, summarizeCapture, timingJitterUs } from '../src/analysis/index.js';
 import { preset, simulate } from '../src/simulator/index.js';
 import { Engine } from '../src/worker/engine.js';
-import { ReplaySource, type ReplayClock } from '../src/worker/sources/replay.js';
+import { ReplaySource } from '../src/worker/sources/replay.js';
 import { usbChunks, perByteCapture } from './feeds.js';
+import { SimulatedClock } from './worker-fakes.js';
 
 const CAPTURES = resolve(import.meta.dirname, '../../shared/captures');
 const present = existsSync(CAPTURES);
@@ -97,32 +98,6 @@ function fromReport(capture: Capture): Story {
     resolution: r.resolution.value,
     reason: r.resolution.reason,
   };
-}
-
-/** Wall time for replay: each tick moves it 10 ms; every reading moves it a µs, so slices end. */
-class SimulatedClock implements ReplayClock {
-  ms = 0;
-  readonly #timers = new Map<number, () => void>();
-  #next = 1;
-  now(): number {
-    this.ms += 0.001;
-    return this.ms;
-  }
-  every(_ms: number, fn: () => void): unknown {
-    const id = this.#next++;
-    this.#timers.set(id, fn);
-    return id;
-  }
-  cancel(handle: unknown): void {
-    this.#timers.delete(handle as number);
-  }
-  /** Runs the timers, 10 ms apart, until `done()` or none is left. */
-  run(done: () => boolean): void {
-    for (let guard = 0; !done() && this.#timers.size > 0 && guard < 1e6; guard++) {
-      this.ms += 10;
-      for (const fn of [...this.#timers.values()]) fn();
-    }
-  }
 }
 
 /**

@@ -1,6 +1,7 @@
 /** A fake clock and host for driving the worker's parts in Node: time moves only when a test says. */
 import type { Clock, Host } from '../src/worker/host.js';
 import type { FromWorker } from '../src/worker/protocol.js';
+import type { ReplayClock } from '../src/worker/sources/replay.js';
 
 interface Timer {
   at: number;
@@ -68,4 +69,34 @@ export function fakeHost(clock = new FakeClock()) {
   const of = <T extends FromWorker['type']>(type: T): Extract<FromWorker, { type: T }>[] =>
     posts.filter((p): p is Extract<FromWorker, { type: T }> => p.type === type);
   return { host, clock, posts, of };
+}
+
+/** Wall time for replay: each tick moves it 10 ms; every reading moves it a µs, so slices end. */
+export class SimulatedClock implements ReplayClock {
+  ms = 0;
+  readonly #timers = new Map<number, () => void>();
+  #next = 1;
+  now(): number {
+    this.ms += 0.001;
+    return this.ms;
+  }
+  every(_ms: number, fn: () => void): unknown {
+    const id = this.#next++;
+    this.#timers.set(id, fn);
+    return id;
+  }
+  cancel(handle: unknown): void {
+    if (typeof handle === 'number') this.#timers.delete(handle);
+  }
+  /** Runs the timers `n` times, 10 ms apart (fewer if none is left). */
+  tick(n = 1): void {
+    for (let i = 0; i < n && this.#timers.size > 0; i++) {
+      this.ms += 10;
+      for (const fn of [...this.#timers.values()]) fn();
+    }
+  }
+  /** Runs the timers, 10 ms apart, until `done()` or none is left. */
+  run(done: () => boolean): void {
+    for (let guard = 0; !done() && this.#timers.size > 0 && guard < 1e6; guard++) this.tick();
+  }
 }

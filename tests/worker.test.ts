@@ -9,9 +9,10 @@ import { captureSpan } from '../src/analysis/index.js';
 import type { Batch } from '../src/worker/protocol.js';
 import { preset, simulate } from '../src/simulator/index.js';
 import { Engine, SETTLE_US } from '../src/worker/engine.js';
-import { ReplaySource, type ReplayClock } from '../src/worker/sources/replay.js';
+import { ReplaySource } from '../src/worker/sources/replay.js';
 import { openProblem } from '../src/worker/sources/serial.js';
 import { usbChunks, perByteCapture } from './feeds.js';
+import { SimulatedClock } from './worker-fakes.js';
 
 interface Collected {
   series: { t: number[]; fadeRate: number[]; lost: number[]; periodMs: number[] };
@@ -170,31 +171,6 @@ describe('a forced resolution is not link loss', () => {
     expect(c.episodes).toEqual([]);
   });
 });
-
-/** Wall time for replay: each tick moves it 10 ms; every reading a µs, so slices end. */
-class SimulatedClock implements ReplayClock {
-  ms = 0;
-  readonly timers = new Map<number, () => void>();
-  #next = 1;
-  now(): number {
-    this.ms += 0.001;
-    return this.ms;
-  }
-  every(_ms: number, fn: () => void): unknown {
-    const id = this.#next++;
-    this.timers.set(id, fn);
-    return id;
-  }
-  cancel(handle: unknown): void {
-    this.timers.delete(handle as number);
-  }
-  tick(n = 1): void {
-    for (let i = 0; i < n && this.timers.size > 0; i++) {
-      this.ms += 10;
-      for (const fn of [...this.timers.values()]) fn();
-    }
-  }
-}
 
 function replayOf(capture: Capture, options: { untimedPeriodUs?: number } = {}) {
   const clock = new SimulatedClock();
