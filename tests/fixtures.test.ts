@@ -13,20 +13,6 @@ const names = readdirSync(dir)
   .filter((f) => f.endsWith('.expected.json'))
   .map((f) => f.replace('.expected.json', ''));
 
-interface ExpectedFrame {
-  offset: number;
-  timeUs: number;
-  remote: string;
-  system: number | null;
-  resolution: number;
-  fades: number | null;
-  rssi: number | null;
-  ids: number[];
-  positions: number[];
-  vtx: Record<string, unknown> | null;
-  damage: { kind: string } | null;
-}
-
 interface Seen {
   offset: number;
   timeUs: number;
@@ -38,6 +24,11 @@ interface Seen {
   ids: number[];
   positions: number[];
   vtx: Record<string, unknown> | null;
+}
+
+/** A frame as the fixture's expected file lists it: what the decoder must see, and the damage the simulator did there. */
+interface ExpectedFrame extends Seen {
+  damage: { kind: string } | null;
 }
 
 function see(f: DecodedFrame): Seen {
