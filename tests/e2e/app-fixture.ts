@@ -7,7 +7,9 @@ import { join, resolve } from 'node:path';
 import type { Browser, Page } from 'playwright-core';
 import { CaptureWriter } from '../../src/capture/index.js';
 import { concatBytes } from '../bytes.js';
-import { chromiumAvailable, launchChromium, startStaticServer, type StaticServer } from './harness/browser.js';
+import { chromiumAvailable, launchChromium, startStaticServer, type LaunchChromiumOptions, type StaticServer } from './harness/browser.js';
+import { installSerialPolicy } from './harness/policy.js';
+import { openFakeSerialPort, type FakeSerialPort } from './harness/pty-serial.js';
 
 export const ROOT = resolve(import.meta.dirname, '../..');
 export const APP_DIR = join(ROOT, 'dist-app');
@@ -39,6 +41,38 @@ export async function startApp(): Promise<AppSession> {
       await server.close();
     },
   };
+}
+
+export interface SerialAppSession extends AppSession {
+  /** The pty standing in for /dev/ttyS0, which the managed policy grants the page. */
+  fake: FakeSerialPort;
+}
+
+/**
+ * The built page served, a managed policy granting its origin the serial ports, a pty in place
+ * of /dev/ttyS0, and Chromium: what every real-WebSerial test needs. `close()` undoes it all,
+ * and so does a failure half-way.
+ */
+export async function startSerialApp(launch: LaunchChromiumOptions = {}): Promise<SerialAppSession> {
+  mkdirSync(SHOTS, { recursive: true });
+  const undo: (() => Promise<void>)[] = [];
+  const close = async () => {
+    for (const step of undo.reverse()) await step();
+  };
+  try {
+    const server = await startStaticServer(APP_DIR);
+    undo.push(() => server.close());
+    const policy = await installSerialPolicy(server.origin);
+    undo.push(() => policy.remove());
+    const fake = await openFakeSerialPort();
+    undo.push(() => fake.close());
+    const browser = await launchChromium(launch);
+    undo.push(() => browser.close());
+    return { browser, server, fake, close };
+  } catch (error) {
+    await close();
+    throw error;
+  }
 }
 
 export async function shot(page: Page, name: string): Promise<string> {

@@ -8,16 +8,15 @@ import type { Browser } from 'playwright-core';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { planPulses } from '../../src/bind/index.js';
 import { preset, simulate } from '../../src/simulator/index.js';
-import { APP_DIR, browserUnavailable, shot } from './app-fixture.js';
-import { launchChromium, startStaticServer, type StaticServer } from './harness/browser.js';
-import { installSerialPolicy, type SerialPolicy } from './harness/policy.js';
-import { buildSignalShim, fakeSerialUnsupportedReason, openFakeSerialPort, type FakeSerialPort } from './harness/pty-serial.js';
+import { browserUnavailable, shot, startSerialApp, type SerialAppSession } from './app-fixture.js';
+import type { StaticServer } from './harness/browser.js';
+import { buildSignalShim, fakeSerialUnsupportedReason, type FakeSerialPort } from './harness/pty-serial.js';
 
 const skip = browserUnavailable() ?? fakeSerialUnsupportedReason();
 if (skip !== null) console.warn(`skipping the bind tests: ${skip}`);
 
+let rig: SerialAppSession | undefined;
 let server: StaticServer;
-let policy: SerialPolicy;
 let fake: FakeSerialPort;
 let browser: Browser;
 let shim: string | null = null;
@@ -26,18 +25,13 @@ beforeAll(async () => {
   if (skip !== null) return;
   shim = await buildSignalShim();
   if (shim === null) return;
-  server = await startStaticServer(APP_DIR);
-  policy = await installSerialPolicy(server.origin);
-  fake = await openFakeSerialPort();
-  browser = await launchChromium({ preload: [shim] });
+  rig = await startSerialApp({ preload: [shim] });
+  ({ server, fake, browser } = rig);
 });
 
 afterAll(async () => {
   if (skip !== null || shim === null) return;
-  await browser?.close();
-  await fake?.close();
-  await policy?.remove();
-  await server?.close();
+  await rig?.close();
 });
 
 describe.skipIf(skip !== null)('binding a satellite', () => {

@@ -13,10 +13,9 @@ import { join } from 'node:path';
 import type { Browser, BrowserContext, Page } from 'playwright-core';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { ibusStream, preset, receiveAs, simulate } from '../../src/simulator/index.js';
-import { APP_DIR, SHOTS, browserUnavailable, usbChunks, writeCapture } from './app-fixture.js';
-import { launchChromium, startStaticServer, type StaticServer } from './harness/browser.js';
-import { installSerialPolicy, type SerialPolicy } from './harness/policy.js';
-import { fakeSerialUnsupportedReason, openFakeSerialPort, type FakeSerialPort } from './harness/pty-serial.js';
+import { SHOTS, browserUnavailable, usbChunks, writeCapture, startSerialApp, type SerialAppSession } from './app-fixture.js';
+import type { StaticServer } from './harness/browser.js';
+import { fakeSerialUnsupportedReason, type FakeSerialPort } from './harness/pty-serial.js';
 
 const skip = browserUnavailable() ?? fakeSerialUnsupportedReason();
 if (skip !== null) console.warn(`skipping the Diagnosis tests: ${skip}`);
@@ -40,8 +39,8 @@ async function axe(page: Page): Promise<string[]> {
 /** The issue's bar: the right finding on the panel within this long. */
 const WITHIN_MS = 2000;
 
+let rig: SerialAppSession | undefined;
 let server: StaticServer;
-let policy: SerialPolicy;
 let fake: FakeSerialPort;
 let browser: Browser;
 let dir = '';
@@ -57,18 +56,13 @@ beforeAll(async () => {
   if (skip !== null) return;
   dir = mkdtempSync(join(tmpdir(), 'satscope-diagnosis-'));
   mkdirSync(SHOTS, { recursive: true });
-  server = await startStaticServer(APP_DIR);
-  policy = await installSerialPolicy(server.origin);
-  fake = await openFakeSerialPort();
-  browser = await launchChromium();
+  rig = await startSerialApp();
+  ({ server, fake, browser } = rig);
 });
 
 afterAll(async () => {
   if (skip !== null) return;
-  await browser?.close();
-  await fake?.close();
-  await policy?.remove();
-  await server?.close();
+  await rig?.close();
   rmSync(dir, { recursive: true, force: true });
 });
 

@@ -15,17 +15,16 @@ import { importRaw, importSaleaeCsv, parseCapture } from '../../src/capture/inde
 import { summarizeCapture } from '../../src/analysis/index.js';
 import { LinkMonitor, SpektrumDecoder, type LinkEpisode } from '../../src/decoder/index.js';
 import { preset, simulate } from '../../src/simulator/index.js';
-import { APP_DIR, SHARED_CAPTURES, barValues, browserUnavailable, shot } from './app-fixture.js';
-import { launchChromium, startStaticServer, type StaticServer } from './harness/browser.js';
+import { SHARED_CAPTURES, barValues, browserUnavailable, shot, startSerialApp, type SerialAppSession } from './app-fixture.js';
+import type { StaticServer } from './harness/browser.js';
 import { loadCpus } from './harness/load.js';
-import { installSerialPolicy, type SerialPolicy } from './harness/policy.js';
-import { fakeSerialUnsupportedReason, monotonicUs, openFakeSerialPort, type FakeSerialPort } from './harness/pty-serial.js';
+import { fakeSerialUnsupportedReason, monotonicUs, type FakeSerialPort } from './harness/pty-serial.js';
 
 const skip = browserUnavailable() ?? fakeSerialUnsupportedReason();
 if (skip !== null) console.warn(`skipping the WebSerial tests: ${skip}`);
 
+let rig: SerialAppSession | undefined;
 let server: StaticServer;
-let policy: SerialPolicy;
 let fake: FakeSerialPort;
 let browser: Browser;
 let dir = '';
@@ -44,18 +43,13 @@ function receiverStream(): { bytes: Uint8Array; timesUs: Float64Array; source: s
 beforeAll(async () => {
   if (skip !== null) return;
   dir = mkdtempSync(join(tmpdir(), 'satscope-serial-'));
-  server = await startStaticServer(APP_DIR);
-  policy = await installSerialPolicy(server.origin);
-  fake = await openFakeSerialPort();
-  browser = await launchChromium();
+  rig = await startSerialApp();
+  ({ server, fake, browser } = rig);
 });
 
 afterAll(async () => {
   if (skip !== null) return;
-  await browser?.close();
-  await fake?.close();
-  await policy?.remove();
-  await server?.close();
+  await rig?.close();
   rmSync(dir, { recursive: true, force: true });
 });
 
