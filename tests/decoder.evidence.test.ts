@@ -7,8 +7,9 @@ import { describe, expect, it } from 'vitest';
 import { SpektrumDecoder, copyFrame, type DecoderEvent, type DecoderOptions, type FrameSnapshot } from '../src/decoder/index.js';
 import { importRaw, importSaleaeCsv } from '../src/capture/index.js';
 import { healthReport, summarizeCapture } from '../src/analysis/index.js';
-import { encodeExternalFrame, encodeInternalFrame, encodeServo2048 } from '../src/simulator/index.js';
+import { encodeExternalFrame, encodeInternalFrame } from '../src/simulator/index.js';
 import { concatBytes as join } from './bytes.js';
+import { dsmxSlots } from './frames.js';
 import { runBounded } from './bounded.js';
 
 const hex = (s: string) =>
@@ -32,31 +33,8 @@ function decodeAll(
   return { frames, decoder, events };
 }
 
-/** A DSMX frame pair's slots (10 channels), positions drifting with `t`. */
-function slots(i: number, t: number): number[] {
-  const p = (x: number) => 1024 + Math.round(300 * Math.sin(t + x));
-  return i % 2 === 0
-    ? [
-        encodeServo2048(1, p(1), 1),
-        encodeServo2048(5, p(5)),
-        encodeServo2048(2, p(2)),
-        encodeServo2048(3, p(3)),
-        encodeServo2048(0, p(0)),
-        encodeServo2048(7, p(7)),
-        encodeServo2048(6, p(6)),
-      ]
-    : [
-        encodeServo2048(1, p(1)),
-        encodeServo2048(5, p(5)),
-        encodeServo2048(2, p(2)),
-        encodeServo2048(3, p(3)),
-        encodeServo2048(4, p(4)),
-        encodeServo2048(8, p(8)),
-        encodeServo2048(9, p(9)),
-      ];
-}
-const internal = (i: number, fades: number, system = 0xb2) => encodeInternalFrame({ fades, system }, slots(i, i / 10));
-const external = (i: number, fades: number) => encodeExternalFrame(fades, slots(i, i / 10));
+const internal = (i: number, fades: number, system = 0xb2) => encodeInternalFrame({ fades, system }, dsmxSlots(i, i / 10));
+const external = (i: number, fades: number) => encodeExternalFrame(fades, dsmxSlots(i, i / 10));
 
 describe('progress', () => {
   it('finishes the 48-byte stream that locked, failed and re-locked at the same offset forever, in every option', async () => {

@@ -18,6 +18,7 @@ import {
   vtxWords,
 } from '../src/simulator/index.js';
 import { concatBytes as join } from './bytes.js';
+import { dsmxPair } from './frames.js';
 
 /** Decodes bytes fed in one piece, then end(): owned snapshots. */
 function decodeAll(bytes: Uint8Array, decoder = new SpektrumDecoder(), time?: number | Float64Array): FrameSnapshot[] {
@@ -31,30 +32,6 @@ function decodeAll(bytes: Uint8Array, decoder = new SpektrumDecoder(), time?: nu
 const chans = (f: FrameSnapshot) => f.channels.map((c) => [c.id, c.pos]);
 
 /** DSMX 11 ms, 10 channels over a frame pair, as the PX4 capture lays them out. */
-function dsmxPair(fades: number, system: number, t: number): Uint8Array[] {
-  const p = (x: number) => 1024 + Math.round(300 * Math.sin(t + x));
-  return [
-    encodeInternalFrame({ fades, system }, [
-      encodeServo2048(1, p(1), 1),
-      encodeServo2048(5, p(5)),
-      encodeServo2048(2, p(2)),
-      encodeServo2048(3, p(3)),
-      encodeServo2048(0, p(0)),
-      encodeServo2048(7, p(7)),
-      encodeServo2048(6, p(6)),
-    ]),
-    encodeInternalFrame({ fades, system }, [
-      encodeServo2048(1, p(1)),
-      encodeServo2048(5, p(5)),
-      encodeServo2048(2, p(2)),
-      encodeServo2048(3, p(3)),
-      encodeServo2048(4, p(4)),
-      encodeServo2048(8, p(8)),
-      encodeServo2048(9, p(9)),
-    ]),
-  ];
-}
-
 function dsmxStream(pairs: number, system = 0xb2, fades = 7): Uint8Array {
   const frames: Uint8Array[] = [];
   for (let i = 0; i < pairs; i++) frames.push(...dsmxPair(fades, system, i / 10));

@@ -11,35 +11,12 @@ import {
 } from '../src/simulator/index.js';
 import { DISCARD_BYTES_CAP, InspectorLog, type InspectEntry } from '../src/worker/inspector.js';
 import { concatBytes as join } from './bytes.js';
+import { dsmxPair } from './frames.js';
 
 /** A DSMX 11 ms frame pair: phase bit on the first slot of the first frame. */
-function pair(t: number, fades = 3): Uint8Array[] {
-  const p = (x: number) => 1024 + Math.round(300 * Math.sin(t + x));
-  return [
-    encodeInternalFrame({ fades, system: 0xb2 }, [
-      encodeServo2048(1, p(1), 1),
-      encodeServo2048(5, p(5)),
-      encodeServo2048(2, p(2)),
-      encodeServo2048(3, p(3)),
-      encodeServo2048(0, p(0)),
-      encodeServo2048(7, p(7)),
-      encodeServo2048(6, p(6)),
-    ]),
-    encodeInternalFrame({ fades, system: 0xb2 }, [
-      encodeServo2048(1, p(1)),
-      encodeServo2048(5, p(5)),
-      encodeServo2048(2, p(2)),
-      encodeServo2048(3, p(3)),
-      encodeServo2048(4, p(4)),
-      encodeServo2048(8, p(8)),
-      encodeServo2048(9, p(9)),
-    ]),
-  ];
-}
-
 function frames(pairs: number, from = 0): Uint8Array[] {
   const out: Uint8Array[] = [];
-  for (let i = 0; i < pairs; i++) out.push(...pair((from + i) / 10));
+  for (let i = 0; i < pairs; i++) out.push(...dsmxPair(3, 0xb2, (from + i) / 10));
   return out;
 }
 
