@@ -545,33 +545,33 @@ export class LinkMonitor {
   #endBurst(): void {
     const b = this.#burst;
     this.#burst = null;
-    const e = b?.episode;
+    if (b === null) return;
+    // The burst brought the silence's frames, and the frame due when it came.
+    const missed = Math.max(0, this.#dueIn(b.episode) + 1 - b.frames);
+    const at = this.#unconfirmed.findIndex((x) => x.episode === b.episode);
+    if (at >= 0 && this.#judge(b.episode, missed)) this.#unconfirmed.splice(at, 1);
+  }
+
+  /** Frames a hold's silence would have held had the link lost them (0 while it is open or no period is known). */
+  #dueIn(e: LinkEpisode): number {
     const p = this.#stats.nominalPeriodUs;
-    if (b === undefined || b === null || e === undefined || e.endUs === null || !Number.isFinite(p)) return;
-    // The silence held `due` frames; the burst brought them (and the frame due when it came).
-    const due = Math.round((e.endUs - e.lastFrameUs) / p) - 1;
-    const missed = Math.max(0, due + 1 - b.frames);
-    if (missed >= due / 2) return;
-    const at = this.#unconfirmed.findIndex((x) => x.episode === e);
-    if (at < 0) return;
-    this.#unconfirmed.splice(at, 1);
-    this.#judge(e, missed);
+    return Number.isFinite(p) && e.endUs !== null ? Math.round((e.endUs - e.lastFrameUs) / p) - 1 : 0;
   }
 
   /**
-   * Keeps a hold that ended, or withdraws it: `missed` is how many frames the evidence says were
-   * lost in its silence. Frames the silence would have held had the link lost them; a stall
-   * delivers them after it, and a hold that lost under half of them was the adapter's.
+   * Keeps a hold that ended, or withdraws it (and says so): `missed` is how many frames the
+   * evidence says were lost in its silence. A stall delivers the frames it held after it, so a
+   * hold that lost under half of them was the adapter's.
    */
-  #judge(e: LinkEpisode, missed: number): void {
-    const p = this.#stats.nominalPeriodUs;
-    const due = Number.isFinite(p) && e.endUs !== null ? Math.round((e.endUs - e.lastFrameUs) / p) - 1 : 0;
+  #judge(e: LinkEpisode, missed: number): boolean {
+    const due = this.#dueIn(e);
     const failsafe = this.#episodes.some((f) => f.kind === 'failsafe' && f.lastFrameUs === e.lastFrameUs);
-    if (failsafe || due < 2 || missed >= due / 2) return;
+    if (failsafe || due < 2 || missed >= due / 2) return false;
     const at = this.#episodes.indexOf(e);
     if (at >= 0) this.#episodes.splice(at, 1);
     this.#stats.holds--;
     this.#retracted.push(e.id);
+    return true;
   }
 
   /** Frames the ledger found missing: they count while the receiver has given no counter to go by. */
