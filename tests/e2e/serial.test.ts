@@ -13,8 +13,8 @@ import type { Browser, Page } from 'playwright-core';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { importRaw, importSaleaeCsv, parseCapture } from '../../src/capture/index.js';
 import { summarizeCapture } from '../../src/analysis/index.js';
-import { LinkMonitor, SpektrumDecoder, type LinkEpisode } from '../../src/decoder/index.js';
 import { preset, simulate } from '../../src/simulator/index.js';
+import { perByteCapture } from '../feeds.js';
 import { SHARED_CAPTURES, barValues, browserUnavailable, shot, startSerialApp, type SerialAppSession } from './app-fixture.js';
 import type { StaticServer } from './harness/browser.js';
 import { loadCpus } from './harness/load.js';
@@ -126,7 +126,9 @@ describe.skipIf(skip !== null)('a receiver on a serial port', () => {
   it('shows the holds and failsafe of real dropouts within 1 s of when they happened, with both cores busy', async () => {
     // A DSMX 11 ms link that drops out for 0.2 s (a hold) and for 1.3 s (a failsafe), then recovers.
     const sim = simulate(preset('dropouts-failsafe'));
-    const truth = linkTruth(sim.bytes, sim.timesUs);
+    // The truth as `satscope info` tells it from the same bytes with their times.
+    const summary = summarizeCapture(perByteCapture(sim));
+    const truth = { episodes: summary.episodes, missedFrames: summary.link.missedFrames };
     expect(truth.episodes.map((e) => e.kind)).toEqual(['hold', 'hold', 'failsafe']);
 
     const context = await browser.newContext({ viewport: { width: 1400, height: 1000 } });
@@ -187,13 +189,3 @@ describe.skipIf(skip !== null)('a receiver on a serial port', () => {
     await context.close();
   });
 });
-
-/** The hold and failsafe episodes and missed frames the library finds in a stream with per-byte times. */
-function linkTruth(bytes: Uint8Array, timesUs: Float64Array): { episodes: LinkEpisode[]; missedFrames: number } {
-  const decoder = new SpektrumDecoder();
-  const link = new LinkMonitor();
-  decoder.push(bytes, timesUs);
-  decoder.end();
-  for (let f = decoder.next(); f !== undefined; f = decoder.next()) link.frame(f);
-  return { episodes: link.episodes.map((e) => ({ ...e })), missedFrames: link.stats.missedFrames };
-}
