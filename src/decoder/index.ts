@@ -7,7 +7,6 @@
 export { SpektrumDecoder, type DecoderOptions } from './decoder.js';
 export {
   HOLD_MIN_US,
-  LEDGER_WINDOW_US,
   LinkMonitor,
   PERIOD_SNAP_US,
   holdThresholdUs,
@@ -19,6 +18,7 @@ export {
   type LinkStats,
   type MissedBasis,
 } from './link.js';
+export { LEDGER_WINDOW_US } from './ledger.js';
 export { readFrameFields, type FrameFields, type SlotFields, type SlotKind } from './fields.js';
 export { copyFrame, type ChannelValue, type FrameSnapshot } from './snapshot.js';
 export { decodeStream, type TimedChunk } from './stream.js';

@@ -27,6 +27,7 @@
  */
 import { FAILSAFE_TIMEOUT_US, FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US, systemInfo } from './spec.js';
 import type { DecodedFrame } from './types.js';
+import { FrameLedger } from './ledger.js';
 
 export type LinkState = 'waiting' | 'live' | 'hold' | 'failsafe';
 
@@ -114,13 +115,6 @@ export interface LinkStats {
 export const HOLD_MIN_US = 40_000;
 /** Mean intervals below this are an 11 ms system, above a 22 ms one. */
 export const PERIOD_SNAP_US = 16_500;
-/** The shortest window over which frames received are counted against frames expected, µs. */
-export const LEDGER_WINDOW_US = 500_000;
-/** At the end of a stream, the least late of this many last frames tells what is missing after the last window's most punctual frame. */
-const TAIL_FRAMES = 4;
-/** Delivery jitter is the largest spread of the last this many windows. */
-const JITTER_WINDOWS = 8;
-
 /** 11 or 22 ms: the system period a mean frame interval belongs to. */
 export function nominalPeriodOf(meanIntervalUs: number): number {
   return meanIntervalUs < PERIOD_SNAP_US ? FRAME_PERIOD_11MS_US : FRAME_PERIOD_22MS_US;
@@ -142,172 +136,6 @@ export function holdThresholdUs(nominalPeriodUs: number, jitterUs: number): numb
 
 const PERIOD_WINDOW = 33;
 const RATE_WINDOW = 512;
-
-/**
- * Frames received against frames expected. Each frame is given the next slot of the receiver's
- * schedule; its lateness is how far after that slot it came, against a reference frame. Frames
- * can only come late (an adapter holds bytes back; it never delivers them before they were
- * sent), so the most punctual frame of a window tells the schedule: when even it is a whole
- * period or more late, frames are missing, and the window's largest gap is where.
- */
-class FrameLedger {
-  #period = NaN;
-  #refUs = NaN;
-  #refSlot = 0;
-  #slot = 0;
-  #lastUs = NaN;
-  // The open window.
-  #winStartUs = NaN;
-  #winFrames = 0;
-  #winMinL = Infinity;
-  #winMinSlot = 0;
-  #winMinUs = NaN;
-  #winMaxL = -Infinity;
-  /** The last frames' times and slots (a ring), for the end of the stream. */
-  readonly #tailUs = new Float64Array(TAIL_FRAMES);
-  readonly #tailSlot = new Float64Array(TAIL_FRAMES);
-  #tailCount = 0;
-  #winSumL = 0;
-  #winGapUs = 0;
-  #winGapFromUs = NaN;
-  #winGapToUs = NaN;
-  readonly #spreads: number[] = [];
-  #pendingSpread = NaN;
-  #pendingDelay = NaN;
-  delayUs = NaN;
-  jitterUs = NaN;
-  /** Windows closed so far, and of the last: the frames it found missing and its most punctual frame's time. */
-  closes = 0;
-  closedMissing = 0;
-  closedPunctualUs = NaN;
-
-  /** @param priorJitterUs the delivery jitter to assume until measured */
-  constructor(readonly priorJitterUs: number) {}
-
-  reset(): void {
-    this.#period = NaN;
-    this.#refUs = NaN;
-    this.#lastUs = NaN;
-    this.#openWindow(NaN);
-  }
-
-  #openWindow(t: number): void {
-    this.#winStartUs = t;
-    this.#winFrames = 0;
-    this.#winMinL = Infinity;
-    this.#winMaxL = -Infinity;
-    this.#winSumL = 0;
-    this.#winGapUs = 0;
-    this.#winGapFromUs = this.#winGapToUs = NaN;
-  }
-
-  /** Feeds a frame at `t`; returns frames confirmed missing (and reports where through `missed`). */
-  frame(t: number, period: number, missed: (fromUs: number, toUs: number, count: number) => void): number {
-    if (!Number.isFinite(period)) return 0;
-    // Chunk-time estimates of two chunks delivered together can overlap a little: not a clock step.
-    if (t < this.#lastUs && t > this.#lastUs - period) t = this.#lastUs;
-    if (period !== this.#period || !Number.isFinite(this.#refUs) || !(t >= this.#lastUs || Number.isNaN(this.#lastUs))) {
-      // A new period (or the first frame, or time going back): start the schedule here.
-      this.#period = period;
-      this.#refUs = t;
-      this.#refSlot = this.#slot = 0;
-      this.#lastUs = t;
-      this.#tailCount = 0;
-      this.#openWindow(t);
-      this.#take(t, 0, 0);
-      return 0;
-    }
-    const gap = t - this.#lastUs;
-    this.#slot++;
-    let late = t - this.#refUs - (this.#slot - this.#refSlot) * period;
-    if (late < 0) {
-      // More punctual than the reference: it becomes the reference, and the window's lateness shifts.
-      this.#winMinL -= late;
-      this.#winMaxL -= late;
-      this.#winSumL -= late * this.#winFrames;
-      this.#refUs = t;
-      this.#refSlot = this.#slot;
-      late = 0;
-    }
-    if (gap > this.#winGapUs) {
-      this.#winGapUs = gap;
-      this.#winGapFromUs = this.#lastUs;
-      this.#winGapToUs = t;
-    }
-    this.#lastUs = t;
-    this.#take(t, late, this.#slot);
-    if (t - this.#winStartUs < LEDGER_WINDOW_US || this.#winFrames < 8) return 0;
-    return this.#close(missed);
-  }
-
-  #take(t: number, late: number, slot: number): void {
-    this.#winFrames++;
-    this.#winSumL += late;
-    if (late > this.#winMaxL) this.#winMaxL = late;
-    if (late < this.#winMinL) {
-      this.#winMinL = late;
-      this.#winMinSlot = slot;
-      this.#winMinUs = t;
-    }
-    this.#tailUs[this.#tailCount % TAIL_FRAMES] = t;
-    this.#tailSlot[this.#tailCount % TAIL_FRAMES] = slot;
-    this.#tailCount++;
-  }
-
-  /** Closes the window: confirms what even its most punctual frame says is missing. */
-  #close(missed: (fromUs: number, toUs: number, count: number) => void): number {
-    const p = this.#period;
-    const k = Math.max(0, Math.round(this.#winMinL / p));
-    if (k > 0 && Number.isFinite(this.#winGapFromUs)) missed(this.#winGapFromUs + p, this.#winGapToUs, k);
-    else if (k > 0) missed(this.#winMinUs - k * p, this.#winMinUs, k);
-    // The most punctual frame is the schedule from now on (this also follows clock drift).
-    // Jitter from windows with nothing missing in them. A frame missed after a window's most
-    // punctual frame is only confirmed by the next window, and would pass a period off as
-    // lateness: a window's spread counts once the next one has found nothing missing.
-    if (k === 0 && Number.isFinite(this.#pendingSpread)) {
-      this.#spreads.push(this.#pendingSpread);
-      if (this.#spreads.length > JITTER_WINDOWS) this.#spreads.shift();
-      this.jitterUs = Math.max(...this.#spreads);
-      this.delayUs = this.#pendingDelay;
-    }
-    this.#pendingSpread = k === 0 && this.#winFrames > 1 ? this.#winMaxL - this.#winMinL : NaN;
-    this.#pendingDelay = this.#winSumL / this.#winFrames - this.#winMinL;
-    this.closes++;
-    this.closedMissing = k;
-    this.closedPunctualUs = this.#winMinUs;
-    this.#refUs = this.#winMinUs;
-    this.#refSlot = this.#winMinSlot + k;
-    this.#slot += k;
-    this.#openWindow(this.#lastUs);
-    return k;
-  }
-
-  /** End of the stream: closes the open window, then counts the frames due in the silence before `endUs` beyond `graceUs`. */
-  finish(endUs: number, graceUs: number, missed: (fromUs: number, toUs: number, count: number) => void): number {
-    if (!Number.isFinite(this.#refUs)) return 0;
-    const p = this.#period;
-    // No later window will look at the frames after the last window's most punctual one: even
-    // the least late of them is the evidence there will be.
-    let tailMin = Infinity;
-    for (let i = 0; i < Math.min(TAIL_FRAMES, this.#tailCount); i++) {
-      const late = (this.#tailUs[i] ?? NaN) - this.#refUs - ((this.#tailSlot[i] ?? NaN) - this.#refSlot) * p;
-      if (late < tailMin) tailMin = late;
-    }
-    const after = Number.isFinite(tailMin) ? Math.max(0, Math.round((tailMin - this.#winMinL) / p)) : 0;
-    const gapFrom = this.#winGapFromUs;
-    const gapTo = this.#winGapToUs;
-    let n = this.#winFrames > 1 ? this.#close(missed) : 0;
-    if (after > 0) missed(Number.isFinite(gapFrom) ? gapFrom + p : this.#lastUs, Number.isFinite(gapTo) ? gapTo : this.#lastUs, after);
-    n += after;
-    const silence = endUs - this.#lastUs;
-    if (silence > graceUs) {
-      const k = Math.max(0, Math.floor((silence - graceUs) / p));
-      if (k > 0) missed(this.#lastUs + p, endUs, k);
-      n += k;
-    }
-    return n;
-  }
-}
 
 export class LinkMonitor {
   readonly #holdOption: number | undefined;
