@@ -64,20 +64,16 @@ export type {
 
 export { preset, presets, PRESET_NAMES, demoScenario, CLONE_BYTE_TIME_US } from './presets.js';
 
+export { UART_115200_8N1, characterTimeUs, lineSignal, uartReceive, receiveAs, noiseSignal } from './line.js';
+export type { Parity, SerialFormat, Transmission, LineSignal, UartErrorKind, UartError, UartResult } from './line.js';
 export {
-  UART_115200_8N1,
   SBUS_FORMAT,
   CRSF_FORMAT,
-  characterTimeUs,
-  lineSignal,
-  uartReceive,
-  receiveAs,
   spektrumTransmission,
   srxlV1Stream,
   srxl2Stream,
   ibusStream,
   sbusStream,
   crsfStream,
-  noiseSignal,
-} from './line.js';
-export type { Parity, SerialFormat, Transmission, LineSignal, UartErrorKind, UartError, UartResult, StreamOptions } from './line.js';
+  type StreamOptions,
+} from './protocols.js';
