@@ -6,7 +6,7 @@
  */
 import { FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US, FRAME_SIZE, systemInfo, type FormatInfo } from '../decoder/index.js';
 import type { Capture } from '../capture/index.js';
-import { type LinkSeries, decodeCapture } from '../analysis/index.js';
+import { type LinkSeries, captureSpan, decodeCapture } from '../analysis/index.js';
 import type { Overview } from './protocol.js';
 
 const BIN_US = 1_000_000;
@@ -34,9 +34,11 @@ export function overviewOf(
   let periodUs = Number.NaN;
   // Untimed: each frame's stream offset, fades and missed frames, as columns.
   const marks: { offset: number[]; fades: number[]; missed: number[] } = { offset: [], fades: [], missed: [] };
+  // One walk of the chunks for where the capture starts and ends, not one per port.
+  const { startUs: originUs, endUs } = captureSpan(capture);
   for (const port of ports) {
     let missed = 0;
-    const { link, series, decoder } = decodeCapture(capture, { resolution, port, binUs: BIN_US }, (f, l) => {
+    const { link, series, decoder } = decodeCapture(capture, { resolution, port, binUs: BIN_US, originUs, endUs }, (f, l) => {
       if (untimed) {
         marks.offset.push(f.offset);
         marks.fades.push(l.lastFades);
