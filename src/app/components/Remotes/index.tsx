@@ -51,21 +51,21 @@ function RemoteRow({ source: s, color }: { source: SourceStatus; color: string }
         </select>
         <span class="kind">{s.format.remote === 'internal' ? 'internal' : s.format.remote === 'external' ? 'external' : ''}</span>
       </td>
-      <td>
+      <td class="state-cell">
         <span data-cell="state" class="state-chip waiting">
           waiting
         </span>
       </td>
-      <td data-cell="fades" class="num">
+      <td data-cell="fades" data-label="Fades" class="num">
         0
       </td>
-      <td data-cell="rate" class="num">
+      <td data-cell="rate" data-label="Fade rate" class="num">
         —
       </td>
-      <td data-cell="episodes" class="num">
+      <td data-cell="episodes" data-label="Holds / failsafes" class="num">
         0 / 0
       </td>
-      <td data-cell="frames" class="num">
+      <td data-cell="frames" data-label="Frames" class="num">
         0
       </td>
       <td class="name">
@@ -83,7 +83,7 @@ function RemoteRow({ source: s, color }: { source: SourceStatus; color: string }
           {s.name}
         </button>
       </td>
-      <td>
+      <td class="action-cell">
         {s.kind === 'serial' ? (
           <button
             type="button"
