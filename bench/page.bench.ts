@@ -425,6 +425,43 @@ async function traceMainThread(
   return { msPerSecond: top(byName, ms), longTasks: long.length, inLongTasksMs: top(inLong, 1000) };
 }
 
+/**
+ * Records the main thread's tasks until the returned function is called, from a trace (only the
+ * tasks are kept): each task's wall time, as the `longtask` observer sees it, and the thread's
+ * own CPU time in it. A task over 50 ms of wall time but under 50 ms of CPU is the thread
+ * waiting for a core (descheduled on a loaded machine), not the page's work.
+ */
+async function traceTasks(
+  page: Page,
+): Promise<() => Promise<{ overWallMs50: number; overCpuMs50: number; maxCpuMs: number; maxWallMs: number }>> {
+  const cdp = await page.context().newCDPSession(page);
+  type TraceEvent = { name: string; ph: string; dur?: number; tdur?: number; tid: number; args?: { name?: string } };
+  let main: number | undefined;
+  const tasks: TraceEvent[] = [];
+  // Playwright types trace events as string maps; they are JSON objects with numbers.
+  cdp.on('Tracing.dataCollected', (e) => {
+    for (const x of e.value as unknown as TraceEvent[]) {
+      if (x.ph === 'M' && x.name === 'thread_name' && x.args?.name === 'CrRendererMain') main = x.tid;
+      else if (x.ph === 'X' && x.name === 'RunTask' && (x.dur ?? 0) > 20_000) tasks.push(x);
+    }
+  });
+  const done = new Promise<void>((resolve) => cdp.once('Tracing.tracingComplete', () => resolve()));
+  await cdp.send('Tracing.start', { categories: 'disabled-by-default-devtools.timeline', transferMode: 'ReportEvents' });
+  return async () => {
+    await cdp.send('Tracing.end');
+    await done;
+    await cdp.detach();
+    const mine = tasks.filter((t) => t.tid === main);
+    const ms = (us: number | undefined) => (us ?? 0) / 1000;
+    return {
+      overWallMs50: mine.filter((t) => ms(t.dur) > 50).length,
+      overCpuMs50: mine.filter((t) => ms(t.tdur) > 50).length,
+      maxCpuMs: round(Math.max(0, ...mine.map((t) => ms(t.tdur)))),
+      maxWallMs: round(Math.max(0, ...mine.map((t) => ms(t.dur)))),
+    };
+  };
+}
+
 /** Samples the page's main thread for `ms` (BENCH_PROFILE=1): the functions that took the most time. */
 async function profilePage(page: Page, ms: number): Promise<string[]> {
   const cdp = await page.context().newCDPSession(page);
@@ -540,6 +577,7 @@ it(
         const heapBefore = await pageHeap(page);
         const workerBefore = await worker?.heapMB();
         await collect(page);
+        const stopTasks = await traceTasks(page);
         const cpu0 = threadTimes();
         const samples: { s: number; pageMB: number }[] = [];
         const t0 = performance.now();
@@ -551,12 +589,14 @@ it(
         const seconds = (performance.now() - t0) / 1000;
         const cpu = cpuShare(cpu0, threadTimes(), seconds);
         const m = summarize('four remotes at 11 ms (four-port capture at 1×)', round(seconds, 0), await collect(page));
+        const tasks = await stopTasks();
         const heapAfter = await pageHeap(page);
         // After the measured window: sampling slows the page.
         const profile = process.env.BENCH_PROFILE ? await profilePage(page, 20_000) : undefined;
         const trace = process.env.BENCH_PROFILE ? await traceMainThread(page, 10_000) : undefined;
         results.fourRemotes = {
           ...m,
+          longTasksByTrace: tasks,
           ...cpu,
           fileMB: round(size / (1 << 20), 2),
           pageHeapMBBefore: heapBefore.used,
