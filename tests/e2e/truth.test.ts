@@ -12,8 +12,9 @@ import { join } from 'node:path';
 import type { Page } from 'playwright-core';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { importSaleaeCsv, readCapture } from '../../src/capture/index.js';
-import { summarizeCapture, type CaptureSummary } from '../../src/analysis/index.js';
+import { summarizeCapture } from '../../src/analysis/index.js';
 import { preset, simulate } from '../../src/simulator/index.js';
+import { resolutionSource } from '../../src/app/components/SystemBadge/words.js';
 import { SHARED_CAPTURES, browserUnavailable, shot, startApp, usbChunks, writeCapture, type AppSession } from './app-fixture.js';
 
 const skip = browserUnavailable();
@@ -184,23 +185,10 @@ describe.skipIf(skip !== null)('honest states', () => {
         frames: String(summary.decoder.frames),
         missed: String(summary.link.missedFrames),
         episodes: `${summary.link.holds} holds · ${summary.link.failsafes} failsafes`,
-        resolution: resolutionChip(summary.format),
+        resolution: `${summary.format.resolution ?? '?'}${resolutionSource(summary.format.resolutionReason)}`,
       });
       expect(errors).toEqual([]);
       await page.context().close();
     });
   }
 });
-
-/** The resolution chip's words for what the library decided (the page's SystemBadge). */
-function resolutionChip(format: CaptureSummary['format']): string {
-  const why =
-    format.resolutionReason === 'channel-ids' || format.resolutionReason === 'system-byte-contradicted'
-      ? ' inferred'
-      : format.resolutionReason === 'internal-remote'
-        ? ' from the internal remote'
-        : format.resolutionReason === 'override'
-          ? ' set by you'
-          : '';
-  return `${format.resolution ?? '?'}${why}`;
-}

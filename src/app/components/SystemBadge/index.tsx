@@ -5,6 +5,7 @@
 import { computed } from '@preact/signals';
 import { systemInfo } from '../../../decoder/index.js';
 import { nominalPeriodUs, status } from '../../store.js';
+import { resolutionSource } from './words.js';
 import './style.css';
 
 function protocol(system: number | null, resolution: number | null, periodUs: number): string {
@@ -31,7 +32,7 @@ export function SystemBadge() {
       </section>
     );
   }
-  const inferred = format.resolutionReason === 'channel-ids' || format.resolutionReason === 'system-byte-contradicted';
+  const source = resolutionSource(format.resolutionReason);
   const hex = format.system === null ? null : `0x${format.system.toString(16).toUpperCase().padStart(2, '0')}`;
   return (
     <section class="badge" aria-label="System" title={format.explanation}>
@@ -40,9 +41,7 @@ export function SystemBadge() {
       </span>
       <span class="chip" data-testid="resolution">
         {format.resolution ?? '?'}
-        {inferred ? <em> inferred</em> : null}
-        {format.resolutionReason === 'override' ? <em> set by you</em> : null}
-        {format.resolutionReason === 'internal-remote' ? <em> from the internal remote</em> : null}
+        {source === '' ? null : <em>{source}</em>}
       </span>
       <span class="chip" data-testid="remote">
         {format.remote === 'internal' ? 'Internal remote' : 'External remote'}
