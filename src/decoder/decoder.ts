@@ -26,6 +26,7 @@
  */
 import { BYTE_TIME_US, FRAME_SIZE, systemInfo, type Resolution } from './spec.js';
 import { byteAt, countZeroWords, createFrame, FrameSlots, INVALID, layoutChannels, readFrame, showSlots, slotLayout } from './frame.js';
+import { copySlots, type DecoderCheckpoint } from './checkpoint.js';
 import type {
   DecodedFrame,
   DecoderEvent,
@@ -1285,5 +1286,123 @@ export class SpektrumDecoder {
     while (i < last && timeAt(ends, i) <= x) i++;
     this.#chunkHead = i;
     return i;
+  }
+
+  // ---- checkpoints -------------------------------------------------------------------------
+
+  /**
+   * The decoder's whole state now, as data no later call changes (checkpoint.ts): the bytes it
+   * still holds and their chunk records, the lock, the format, the layouts, the staged frame
+   * and the counters. Between calls only (not while a borrowed frame is in use).
+   */
+  checkpoint(): DecoderCheckpoint {
+    const h = this.#chunkHead;
+    const t = this.#chunkTail;
+    return {
+      resolutionOption: this.#options.resolution,
+      remoteOption: this.#options.remote,
+      headerModeOption: this.#options.headerMode,
+      fixedBy: this.#fixedBy,
+      bytes: this.#buf.slice(this.#head, this.#tail),
+      byteTimes: this.#byteTimes === null ? null : this.#byteTimes.slice(this.#head, this.#tail),
+      base: this.#base + this.#head,
+      chunkEnds: this.#chunkEnds.slice(h, t),
+      chunkTimes: this.#chunkTimes.slice(h, t),
+      chunkPerByte: this.#chunkPerByte.slice(h, t),
+      ended: this.#ended,
+      locked: this.#locked,
+      everLocked: this.#everLocked,
+      confirmedUntil: this.#confirmedUntil,
+      resolution: this.#resolution,
+      reason: this.#reason,
+      remote: this.#remote,
+      system: this.#system,
+      b0Mode: this.#b0Mode,
+      forcedMismatch: this.#forcedMismatch,
+      last0: this.#last0,
+      last1: this.#last1,
+      haveLast: this.#haveLast,
+      jumpTrusted: this.#jumpTrusted,
+      nextAt: this.#nextAt,
+      nextLayout: this.#nextLayout,
+      layouts: this.#layouts.slice(),
+      layoutCount: this.#layoutCount,
+      layoutNext: this.#layoutNext,
+      shown: copySlots(this.#shown),
+      staged: copySlots(this.#staged),
+      stagedAt: this.#stagedAt,
+      frameIndex: this.#frame.index,
+      stats: { ...this.#stats },
+      candInternal: this.#candInternal,
+      candSystem: this.#candSystem,
+      candB0: this.#candB0,
+      candFrames: this.#candFrames,
+      candSkipped: this.#candSkipped,
+    };
+  }
+
+  /**
+   * Puts the decoder back where `checkpoint()` was taken (from this decoder or another): fed
+   * the same bytes from there, it gives the same frames, events, counters and format. Its own
+   * `onEvent` and `fastPath` stay; `cp` is left as it was and can be restored again.
+   */
+  restore(cp: DecoderCheckpoint): void {
+    const n = cp.bytes.length;
+    let capacity = INITIAL_CAPACITY;
+    while (capacity < n) capacity *= 2;
+    this.#buf = new Uint8Array(capacity);
+    this.#buf.set(cp.bytes);
+    this.#buf32 = new Uint32Array(this.#buf.buffer);
+    this.#byteTimes = null;
+    if (cp.byteTimes !== null) {
+      this.#byteTimes = new Float64Array(capacity);
+      this.#byteTimes.set(cp.byteTimes);
+    }
+    this.#head = 0;
+    this.#tail = n;
+    this.#base = cp.base;
+    const chunks = cp.chunkEnds.length;
+    let records = 64;
+    while (records < chunks) records *= 2;
+    this.#chunkEnds = new Float64Array(records);
+    this.#chunkEnds.set(cp.chunkEnds);
+    this.#chunkTimes = new Float64Array(records);
+    this.#chunkTimes.set(cp.chunkTimes);
+    this.#chunkPerByte = new Uint8Array(records);
+    this.#chunkPerByte.set(cp.chunkPerByte);
+    this.#chunkHead = 0;
+    this.#chunkTail = chunks;
+    this.#options = { resolution: cp.resolutionOption, remote: cp.remoteOption, headerMode: cp.headerModeOption };
+    this.#fixedBy = cp.fixedBy;
+    this.#ended = cp.ended;
+    this.#locked = cp.locked;
+    this.#everLocked = cp.everLocked;
+    this.#confirmedUntil = cp.confirmedUntil;
+    this.#resolution = cp.resolution;
+    this.#reason = cp.reason;
+    this.#remote = cp.remote;
+    this.#system = cp.system;
+    this.#b0Mode = cp.b0Mode;
+    this.#forcedMismatch = cp.forcedMismatch;
+    this.#last0 = cp.last0;
+    this.#last1 = cp.last1;
+    this.#haveLast = cp.haveLast;
+    this.#jumpTrusted = cp.jumpTrusted;
+    this.#nextAt = cp.nextAt;
+    this.#nextLayout = cp.nextLayout;
+    this.#layouts.set(cp.layouts);
+    this.#layoutCount = cp.layoutCount;
+    this.#layoutNext = cp.layoutNext;
+    copySlots(cp.shown, this.#shown);
+    copySlots(cp.staged, this.#staged);
+    this.#stagedAt = cp.stagedAt;
+    this.#frame.index = cp.frameIndex;
+    showSlots(this.#frame, this.#shown);
+    Object.assign(this.#stats, cp.stats);
+    this.#candInternal = cp.candInternal;
+    this.#candSystem = cp.candSystem;
+    this.#candB0 = cp.candB0;
+    this.#candFrames = cp.candFrames;
+    this.#candSkipped = cp.candSkipped;
   }
 }

@@ -19,6 +19,7 @@ export {
   type MissedBasis,
 } from './link.js';
 export { LEDGER_WINDOW_US } from './ledger.js';
+export type { DecoderCheckpoint, LinkCheckpoint } from './checkpoint.js';
 export { readFrameFields, type FrameFields, type SlotFields, type SlotKind } from './fields.js';
 export { copyFrame, type ChannelValue, type FrameSnapshot } from './snapshot.js';
 export { decodeStream, type TimedChunk } from './stream.js';

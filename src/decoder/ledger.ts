@@ -4,6 +4,8 @@
  * the adapter's delivery delay and jitter that the same lateness measures. The link monitor
  * (link.ts) owns one.
  */
+import type { LedgerCheckpoint } from './checkpoint.js';
+
 /** The shortest window over which frames received are counted against frames expected, µs. */
 export const LEDGER_WINDOW_US = 500_000;
 /** At the end of a stream, the least late of this many last frames tells what is missing after the last window's most punctual frame. */
@@ -148,6 +150,68 @@ export class FrameLedger {
     this.#slot += k;
     this.#openWindow(this.#lastUs);
     return k;
+  }
+
+  /** The ledger's whole state now (checkpoint.ts). */
+  checkpoint(): LedgerCheckpoint {
+    return {
+      period: this.#period,
+      refUs: this.#refUs,
+      refSlot: this.#refSlot,
+      slot: this.#slot,
+      lastUs: this.#lastUs,
+      winStartUs: this.#winStartUs,
+      winFrames: this.#winFrames,
+      winMinL: this.#winMinL,
+      winMinSlot: this.#winMinSlot,
+      winMinUs: this.#winMinUs,
+      winMaxL: this.#winMaxL,
+      tailUs: this.#tailUs.slice(),
+      tailSlot: this.#tailSlot.slice(),
+      tailCount: this.#tailCount,
+      winSumL: this.#winSumL,
+      winGapUs: this.#winGapUs,
+      winGapFromUs: this.#winGapFromUs,
+      winGapToUs: this.#winGapToUs,
+      spreads: this.#spreads.slice(),
+      pendingSpread: this.#pendingSpread,
+      pendingDelay: this.#pendingDelay,
+      delayUs: this.delayUs,
+      jitterUs: this.jitterUs,
+      closes: this.closes,
+      closedMissing: this.closedMissing,
+      closedPunctualUs: this.closedPunctualUs,
+    };
+  }
+
+  /** Puts the ledger back where `checkpoint()` was taken; `cp` can be restored again. */
+  restore(cp: LedgerCheckpoint): void {
+    this.#period = cp.period;
+    this.#refUs = cp.refUs;
+    this.#refSlot = cp.refSlot;
+    this.#slot = cp.slot;
+    this.#lastUs = cp.lastUs;
+    this.#winStartUs = cp.winStartUs;
+    this.#winFrames = cp.winFrames;
+    this.#winMinL = cp.winMinL;
+    this.#winMinSlot = cp.winMinSlot;
+    this.#winMinUs = cp.winMinUs;
+    this.#winMaxL = cp.winMaxL;
+    this.#tailUs.set(cp.tailUs);
+    this.#tailSlot.set(cp.tailSlot);
+    this.#tailCount = cp.tailCount;
+    this.#winSumL = cp.winSumL;
+    this.#winGapUs = cp.winGapUs;
+    this.#winGapFromUs = cp.winGapFromUs;
+    this.#winGapToUs = cp.winGapToUs;
+    this.#spreads.splice(0, this.#spreads.length, ...cp.spreads);
+    this.#pendingSpread = cp.pendingSpread;
+    this.#pendingDelay = cp.pendingDelay;
+    this.delayUs = cp.delayUs;
+    this.jitterUs = cp.jitterUs;
+    this.closes = cp.closes;
+    this.closedMissing = cp.closedMissing;
+    this.closedPunctualUs = cp.closedPunctualUs;
   }
 
   /** End of the stream: closes the open window, then counts the frames due in the silence before `endUs` beyond `graceUs`. */

@@ -28,6 +28,7 @@
 import { FAILSAFE_TIMEOUT_US, FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US, systemInfo } from './spec.js';
 import type { DecodedFrame } from './types.js';
 import { FrameLedger } from './ledger.js';
+import { copyEpisodes, type LinkCheckpoint } from './checkpoint.js';
 
 export type LinkState = 'waiting' | 'live' | 'hold' | 'failsafe';
 
@@ -493,6 +494,71 @@ export class LinkMonitor {
     this.#periodCount = 0;
     this.#ledger.reset();
     this.#state = 'waiting';
+  }
+
+  /**
+   * The monitor's whole state now (checkpoint.ts): state, episodes (copies), the period and
+   * fade-rate windows, the ledger, the holds not yet judged and the counters.
+   */
+  checkpoint(): LinkCheckpoint {
+    return {
+      state: this.#state,
+      lastUs: this.#lastUs,
+      systemPeriod: this.#systemPeriod,
+      periodTimes: this.#periodTimes.slice(),
+      periodCount: this.#periodCount,
+      periodOldest: this.#periodOldest,
+      systemByte: this.#systemByte,
+      rateTimes: this.#rateTimes.slice(),
+      rateFades: this.#rateFades.slice(),
+      rateCount: this.#rateCount,
+      rateNext: this.#rateNext,
+      graph: copyEpisodes({ episodes: this.#episodes, open: this.#open, unconfirmed: this.#unconfirmed, burst: this.#burst }),
+      nextEpisode: this.#nextEpisode,
+      retracted: this.#retracted.slice(),
+      ledger: this.#ledger.checkpoint(),
+      closesSeen: this.#closesSeen,
+      counting: this.#counting,
+      lastFades: this.#lastFades,
+      lastInterval: this.#lastInterval,
+      finished: this.#finished,
+      stats: { ...this.#stats },
+    };
+  }
+
+  /**
+   * Puts the monitor back where `checkpoint()` was taken (on this monitor or another): fed the
+   * same frames and times from there, it gives the same states, episodes, counters and missed
+   * frames. Its own options and `onMissed` stay; `cp` can be restored again.
+   */
+  restore(cp: LinkCheckpoint): void {
+    this.#state = cp.state;
+    this.#lastUs = cp.lastUs;
+    this.#systemPeriod = cp.systemPeriod;
+    this.#periodTimes.set(cp.periodTimes);
+    this.#periodCount = cp.periodCount;
+    this.#periodOldest = cp.periodOldest;
+    this.#systemByte = cp.systemByte;
+    this.#rateTimes.set(cp.rateTimes);
+    this.#rateFades.set(cp.rateFades);
+    this.#rateCount = cp.rateCount;
+    this.#rateNext = cp.rateNext;
+    const g = copyEpisodes(cp.graph);
+    // Pushed one by one: a long session's thousands of episodes are too many for spread arguments.
+    this.#episodes.length = 0;
+    for (const e of g.episodes) this.#episodes.push(e);
+    this.#open = g.open;
+    this.#unconfirmed.splice(0, this.#unconfirmed.length, ...g.unconfirmed); // at most 64
+    this.#burst = g.burst;
+    this.#nextEpisode = cp.nextEpisode;
+    this.#retracted.splice(0, this.#retracted.length, ...cp.retracted);
+    this.#ledger.restore(cp.ledger);
+    this.#closesSeen = cp.closesSeen;
+    this.#counting = cp.counting;
+    this.#lastFades = cp.lastFades;
+    this.#lastInterval = cp.lastInterval;
+    this.#finished = cp.finished;
+    Object.assign(this.#stats, cp.stats);
   }
 
   /** Re-dates the episodes counted from `fromUs` to count from the frame at `lastUs`. */

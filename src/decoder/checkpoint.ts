@@ -1,0 +1,160 @@
+/**
+ * Checkpoints: the whole state of a decoder, a link monitor or its frame ledger at a point
+ * between calls, as plain data no later call changes. `restore()` puts an instance of the same
+ * options back exactly there, as many times as asked, so that a replay seeks by restoring the
+ * nearest checkpoint and feeding only the bytes after it: the same frames, counters, events
+ * and episodes as feeding everything from the start. A checkpoint holds what was still
+ * undecided (the bytes the decoder holds, the open ledger window, the episodes), never the
+ * stream before it: a few kilobytes.
+ *
+ * What an instance was constructed with (options, callbacks) is not state: the instance that
+ * restores keeps its own.
+ */
+import { FrameSlots } from './frame.js';
+import type { Resolution } from './spec.js';
+import type { DecoderStats, RemoteKind, ResolutionReason } from './types.js';
+import type { LinkEpisode, LinkState, LinkStats } from './link.js';
+
+/** A copy of `from`'s slot arrays and counts in `into` (a fresh set when none is given). */
+export function copySlots(from: FrameSlots, into: FrameSlots = new FrameSlots()): FrameSlots {
+  into.ids.set(from.ids);
+  into.positions.set(from.positions);
+  into.words.set(from.words);
+  into.bytes.set(from.bytes);
+  Object.assign(into.vtx, from.vtx);
+  into.count = from.count;
+  into.empty = from.empty;
+  into.hasVtx = from.hasVtx;
+  return into;
+}
+
+/** `SpektrumDecoder.checkpoint()`. */
+export interface DecoderCheckpoint {
+  readonly resolutionOption: 'auto' | Resolution;
+  readonly remoteOption: 'auto' | RemoteKind;
+  readonly headerModeOption: 'auto' | 'fades' | 'rssi';
+  readonly fixedBy: 'user' | 'internal-remote';
+  /** The bytes not yet decided, from stream offset `base`, and their per-byte times (null when none came). */
+  readonly bytes: Uint8Array;
+  readonly byteTimes: Float64Array | null;
+  readonly base: number;
+  /** The records of the chunks those bytes came in (their ends are stream offsets). */
+  readonly chunkEnds: Float64Array;
+  readonly chunkTimes: Float64Array;
+  readonly chunkPerByte: Uint8Array;
+  readonly ended: boolean;
+  readonly locked: boolean;
+  readonly everLocked: boolean;
+  readonly confirmedUntil: number;
+  readonly resolution: Resolution;
+  readonly reason: ResolutionReason;
+  readonly remote: RemoteKind;
+  readonly system: number | null;
+  readonly b0Mode: number;
+  readonly forcedMismatch: Resolution | null;
+  readonly last0: number;
+  readonly last1: number;
+  readonly haveLast: boolean;
+  readonly jumpTrusted: boolean;
+  readonly nextAt: number;
+  readonly nextLayout: number;
+  readonly layouts: Int32Array;
+  readonly layoutCount: number;
+  readonly layoutNext: number;
+  readonly shown: FrameSlots;
+  readonly staged: FrameSlots;
+  readonly stagedAt: number;
+  readonly frameIndex: number;
+  readonly stats: Readonly<DecoderStats>;
+  readonly candInternal: boolean;
+  readonly candSystem: number;
+  readonly candB0: number;
+  readonly candFrames: number;
+  readonly candSkipped: number;
+}
+
+/** `FrameLedger.checkpoint()`. */
+export interface LedgerCheckpoint {
+  readonly period: number;
+  readonly refUs: number;
+  readonly refSlot: number;
+  readonly slot: number;
+  readonly lastUs: number;
+  readonly winStartUs: number;
+  readonly winFrames: number;
+  readonly winMinL: number;
+  readonly winMinSlot: number;
+  readonly winMinUs: number;
+  readonly winMaxL: number;
+  readonly tailUs: Float64Array;
+  readonly tailSlot: Float64Array;
+  readonly tailCount: number;
+  readonly winSumL: number;
+  readonly winGapUs: number;
+  readonly winGapFromUs: number;
+  readonly winGapToUs: number;
+  readonly spreads: readonly number[];
+  readonly pendingSpread: number;
+  readonly pendingDelay: number;
+  readonly delayUs: number;
+  readonly jitterUs: number;
+  readonly closes: number;
+  readonly closedMissing: number;
+  readonly closedPunctualUs: number;
+}
+
+/** The link monitor's episodes and what refers to them: the open one, the holds not yet judged, the burst after one. */
+export interface EpisodeGraph {
+  episodes: LinkEpisode[];
+  open: LinkEpisode | null;
+  unconfirmed: { episode: LinkEpisode; endFades: number }[];
+  burst: { episode: LinkEpisode; frames: number } | null;
+}
+
+/**
+ * A copy of `g` in which every episode is a new object and each one, wherever it is referred
+ * to (the monitor compares them by identity), is the same copy; a hold judged later may be one
+ * the episode list no longer keeps.
+ */
+export function copyEpisodes(g: Readonly<EpisodeGraph>): EpisodeGraph {
+  const copies = new Map<LinkEpisode, LinkEpisode>();
+  const copy = (e: LinkEpisode): LinkEpisode => {
+    let c = copies.get(e);
+    if (c === undefined) {
+      c = { ...e };
+      copies.set(e, c);
+    }
+    return c;
+  };
+  return {
+    episodes: g.episodes.map(copy),
+    open: g.open === null ? null : copy(g.open),
+    unconfirmed: g.unconfirmed.map((u) => ({ episode: copy(u.episode), endFades: u.endFades })),
+    burst: g.burst === null ? null : { episode: copy(g.burst.episode), frames: g.burst.frames },
+  };
+}
+
+/** `LinkMonitor.checkpoint()`. */
+export interface LinkCheckpoint {
+  readonly state: LinkState;
+  readonly lastUs: number;
+  readonly systemPeriod: number;
+  readonly periodTimes: Float64Array;
+  readonly periodCount: number;
+  readonly periodOldest: number;
+  readonly systemByte: number;
+  readonly rateTimes: Float64Array;
+  readonly rateFades: Float64Array;
+  readonly rateCount: number;
+  readonly rateNext: number;
+  readonly graph: Readonly<EpisodeGraph>;
+  readonly nextEpisode: number;
+  readonly retracted: readonly number[];
+  readonly ledger: LedgerCheckpoint;
+  readonly closesSeen: number;
+  readonly counting: boolean;
+  readonly lastFades: number;
+  readonly lastInterval: number;
+  readonly finished: boolean;
+  readonly stats: Readonly<LinkStats>;
+}
