@@ -24,7 +24,11 @@ const STATUS_MS = 200;
 const SEEK_HISTORY_US = 60e6;
 /** The capture is decoded for this long at a time, then messages and playback go through. */
 const PASS_SLICE_MS = 40;
-/** The growing overview is sent at most this often (the page draws it each time). */
+/**
+ * The growing overview is sent at most this often, and no more often than a quarter of the time
+ * the reading has taken so far: the page draws the whole of it each time, so a long capture's
+ * few dozen seconds of reading cost it a handful of draws, not one a second.
+ */
 const OVERVIEW_EVERY_MS = 1000;
 
 export interface ReplayParts {
@@ -43,6 +47,7 @@ export class ReplaySession implements Driver {
   readonly #pass: ReplayPass | null;
   #passTimer: unknown;
   #lastOverviewMs = Number.NEGATIVE_INFINITY;
+  #passStartMs = Number.NaN;
   #stopped = false;
 
   /**
@@ -151,12 +156,14 @@ export class ReplaySession implements Driver {
     const pass = this.#pass;
     if (pass === null || pass.done || this.#stopped) return;
     const { host } = this.#p;
+    if (Number.isNaN(this.#passStartMs)) this.#passStartMs = host.clock.now();
     const slice = (): void => {
       this.#passTimer = undefined;
       if (this.#stopped) return;
       const done = pass.step(PASS_SLICE_MS, () => host.clock.now());
-      if (done || host.clock.now() - this.#lastOverviewMs >= OVERVIEW_EVERY_MS) {
-        this.#lastOverviewMs = host.clock.now();
+      const nowMs = host.clock.now();
+      if (done || nowMs - this.#lastOverviewMs >= Math.max(OVERVIEW_EVERY_MS, (nowMs - this.#passStartMs) / 4)) {
+        this.#lastOverviewMs = nowMs;
         postOverview(host, pass.overview());
       }
       if (!done) this.#passTimer = host.clock.after(0, slice);
