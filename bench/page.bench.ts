@@ -266,13 +266,13 @@ function multiPortCapture(path: string, scenarios: Scenario[], seconds: number):
 
 /**
  * Arms a timer in the page from the file input's change (the test's own upload of the file
- * through CDP is not counted) to the first overview drawn (maybe of the part read so far) and
- * the first frames counted, and to the overview drawn complete.
+ * through CDP is not counted) to the first overview drawn (of a long capture, the part read so
+ * far), to the first frames counted, and to the overview drawn complete.
  */
 async function armOpenTimer(page: Page): Promise<void> {
   await page.evaluate(() => {
-    const w = window as unknown as { __open: { start: number; plotted: number; complete: number } };
-    w.__open = { start: 0, plotted: 0, complete: 0 };
+    const w = window as unknown as { __open: { start: number; plotted: number; counted: number; complete: number } };
+    w.__open = { start: 0, plotted: 0, counted: 0, complete: 0 };
     document.querySelector('input[type=file]')?.addEventListener(
       'change',
       () => {
@@ -282,11 +282,12 @@ async function armOpenTimer(page: Page): Promise<void> {
     );
     new MutationObserver((_, obs) => {
       const counted = document.querySelector('[data-testid="count-frames"]')?.textContent !== '—';
-      if (w.__open.plotted === 0 && document.querySelector('section.replay .overview canvas') !== null && counted)
+      if (w.__open.counted === 0 && counted) w.__open.counted = performance.now();
+      if (w.__open.plotted === 0 && document.querySelector('section.replay .overview canvas') !== null)
         w.__open.plotted = performance.now();
       // A page without a growing overview (BENCH_APP_DIR of an older build) is complete at once.
       const o = document.querySelector('section.replay .overview');
-      if (w.__open.plotted > 0 && o?.querySelector('canvas') && o.getAttribute('data-complete') !== 'false') {
+      if (w.__open.counted > 0 && o?.querySelector('canvas') && o.getAttribute('data-complete') !== 'false') {
         w.__open.complete = performance.now();
         obs.disconnect();
       }
@@ -309,19 +310,20 @@ async function openTimes(
   page: Page,
   file: string,
   timeoutMs: number,
-): Promise<{ ms: number; completeMs: number; pageReadMs: number; workerMs: number; drawMs: number }> {
+): Promise<{ ms: number; countedMs: number; completeMs: number; pageReadMs: number; workerMs: number; drawMs: number }> {
   await armOpenTimer(page);
   await page.setInputFiles('input[type=file]', file);
   await page.waitForFunction(() => (window as unknown as { __open: { complete: number } }).__open.complete > 0, undefined, {
     timeout: timeoutMs,
   });
   return page.evaluate(() => {
-    const o = (window as unknown as { __open: { start: number; plotted: number; complete: number } }).__open;
+    const o = (window as unknown as { __open: { start: number; plotted: number; counted: number; complete: number } }).__open;
     const mark = (name: string) => performance.getEntriesByName(name).at(-1)?.startTime ?? Number.NaN;
     const read = mark('satscope:capture-read');
     const received = mark('satscope:overview-received');
     return {
       ms: Math.round(o.plotted - o.start),
+      countedMs: Math.round(o.counted - o.start),
       completeMs: Math.round(o.complete - o.start),
       pageReadMs: Math.round(read - o.start),
       workerMs: Math.round(received - read),
@@ -751,6 +753,7 @@ it(
           results.openDayCapture = {
             fileMB: round(fileMB),
             openToOverviewMs: open.ms,
+            openToFramesCountedMs: open.countedMs,
             openToCompleteOverviewMs: open.completeMs,
             openPartsMs: { pageRead: open.pageReadMs, worker: open.workerMs, draw: open.drawMs },
             seekFractions: fractions,

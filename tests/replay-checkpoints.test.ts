@@ -10,6 +10,9 @@ import { LinkMonitor, SpektrumDecoder, USB_CHUNK_JITTER_US } from '../src/decode
 import { preset, simulate } from '../src/simulator/index.js';
 import { Dispatcher } from '../src/worker/dispatcher.js';
 import { overviewOf } from '../src/worker/overview.js';
+import { ReplayPass } from '../src/worker/replay-pass.js';
+import { type PreviewSizes, previewOf } from '../src/worker/replay-preview.js';
+import { captureSpan } from '../src/analysis/index.js';
 import type { Overview } from '../src/worker/protocol.js';
 import { usbChunks } from './feeds.js';
 import { FakeClock, fakeHost } from './worker-fakes.js';
@@ -18,10 +21,14 @@ const MINUTE = 60e6;
 
 /** Two remotes for 12 minutes (longer than a fresh decode's 10-minute history), the internal one with dropouts and a failsafe. */
 function longCapture(): Uint8Array {
+  return longCaptureWithSeed(3);
+}
+
+function longCaptureWithSeed(seed: number): Uint8Array {
   const a = simulate(
     {
       ...preset('dsmx-11ms-2048-internal'),
-      seed: 3,
+      seed,
       dropouts: [
         { atUs: 2 * MINUTE, durationUs: 300_000 },
         { atUs: 5 * MINUTE, durationUs: 1_500_000 },
@@ -49,9 +56,9 @@ class ReadingClock extends FakeClock {
   }
 }
 
-function open(clock: FakeClock) {
+function open(clock: FakeClock, previewSizes?: PreviewSizes) {
   const fake = fakeHost(clock);
-  const worker = new Dispatcher(fake.host);
+  const worker = new Dispatcher(fake.host, { previewSizes });
   const send = async (...messages: Parameters<Dispatcher['receive']>[0][]): Promise<void> => {
     for (const m of messages) worker.receive(m);
     await worker.queue.idle();
@@ -144,5 +151,80 @@ describe('a long capture in the worker', () => {
     expect(worker.registry.get(0)?.engine.link.stats.failsafes).toBe(0);
     await send({ type: 'replay-seek', timeUs: start + 8 * MINUTE });
     expect(worker.registry.get(0)?.engine.link.stats.failsafes).toBe(1);
+  });
+
+  it('previews a long file from its first records and its end, and the decode begun on them goes on with the whole capture to the same overview and checkpoints', () => {
+    const capture = readCapture(FILE, 'long.sscap');
+    const ports = capturePorts(capture);
+    const span = captureSpan(capture);
+    const preview = previewOf(FILE, 'long.sscap', { minBytes: 0, headBytes: 400_000, tailBytes: 20_000 });
+    expect(preview).not.toBeNull();
+    if (preview === null) return;
+    expect([preview.startUs, preview.endUs]).toEqual([span.startUs, span.endUs]);
+    expect(preview.ports).toEqual(ports);
+    // The head is the file's first records: a prefix of the whole capture's chunks.
+    const n = preview.head.chunkEnds.length;
+    expect(n).toBeGreaterThan(1000);
+    expect(n).toBeLessThan(capture.chunkEnds.length / 4);
+    expect(Array.from(preview.head.chunkTimesUs)).toEqual(Array.from(capture.chunkTimesUs.subarray(0, n)));
+    const now = (() => {
+      let t = 0;
+      return () => (t += 1);
+    })();
+    const early = new ReplayPass(preview.head, preview.ports, 'auto', preview.startUs, preview.endUs, true);
+    // Decoded to the head's end, it is not done: the capture goes on.
+    for (let k = 0; k < 100; k++) expect(early.step(40, now)).toBe(false);
+    expect(early.overview().complete).toBe(false);
+    const other = readCapture(longCaptureWithSeed(5), 'other.sscap');
+    expect(early.continueWith(other, ports, span.startUs, span.endUs)).toBe(false);
+    expect(early.continueWith(capture, ports, span.startUs, span.endUs)).toBe(true);
+    while (!early.step(40, now));
+    const whole = new ReplayPass(capture, ports, 'auto', span.startUs, span.endUs);
+    while (!whole.step(40, now));
+    const a = early.overview();
+    const b = whole.overview();
+    expect([Array.from(a.t), Array.from(a.fadeRate), Array.from(a.lost), a.failsafe]).toEqual([
+      Array.from(b.t),
+      Array.from(b.fadeRate),
+      Array.from(b.lost),
+      b.failsafe,
+    ]);
+    expect(early.checkpoints.map((c) => c.chunk)).toEqual(whole.checkpoints.map((c) => c.chunk));
+    expect(JSON.stringify(early.checkpoints.at(-1)?.ports.get(1)?.link)).toBe(JSON.stringify(whole.checkpoints.at(-1)?.ports.get(1)?.link));
+  });
+
+  it('reads a file too short for a preview, or not a capture with chunk times, whole', () => {
+    expect(previewOf(FILE, 'long.sscap')).toBeNull();
+    expect(previewOf(new Uint8Array(1000), 'zeros.bin', { minBytes: 0, headBytes: 400, tailBytes: 100 })).toBeNull();
+  });
+
+  it("shows a long file's span and its first records' overview before reading it whole, then plays and seeks as one read whole", async () => {
+    const clock = new FakeClock();
+    const { send, posts, worker } = open(clock, { minBytes: 0, headBytes: 400_000, tailBytes: 20_000 });
+    await send({ type: 'replay-open', name: 'long.sscap', data: FILE.slice().buffer });
+    const capture = readCapture(FILE, 'long.sscap');
+    const span = captureSpan(capture);
+    // First: the span and a partial overview, nothing played; then the replay of the whole file.
+    const first = posts.findIndex((m) => m.type === 'replay' && m.replay !== null);
+    const firstReplay = posts[first];
+    expect(firstReplay?.type === 'replay' && firstReplay.replay).toMatchObject({
+      startUs: span.startUs,
+      endUs: span.endUs,
+      playing: false,
+      frames: 0,
+    });
+    const overviews = posts.flatMap((m, k) => (m.type === 'overview' ? [{ k, o: m.overview }] : []));
+    expect(overviews[0]?.k).toBeGreaterThan(first);
+    expect(overviews[0]?.o.complete).toBe(false);
+    expect(overviews[0]?.o.readUntilUs).toBeLessThan(span.startUs + 2 * MINUTE);
+    const playing = posts.findIndex((m) => m.type === 'replay' && m.replay?.playing === true);
+    expect(playing).toBeGreaterThan(overviews[0]?.k ?? Infinity);
+    const last = overviews.at(-1)?.o;
+    const once = overviewOf(capture, capturePorts(capture), 'auto').overview;
+    expect(last?.complete).toBe(true);
+    expect(Array.from(last?.lost ?? [])).toEqual(Array.from(once.lost));
+    expect(last?.failsafe).toEqual(once.failsafe);
+    await send({ type: 'replay-pause' }, { type: 'replay-seek', timeUs: span.startUs + 11 * MINUTE });
+    expect({ ...worker.registry.get(0)?.engine.decoder.stats }).toEqual(libraryUpTo(capture, 0, span.startUs + 11 * MINUTE).decoder);
   });
 });

@@ -38,6 +38,9 @@ export interface Checkpoint {
 
 export class ReplayPass {
   readonly checkpoints: Checkpoint[] = [];
+  /** The capture decoded; while `#prefix`, only the first records of the file (replay-preview.ts). */
+  #capture: Capture;
+  #prefix: boolean;
   readonly #ports: PortPass[];
   readonly #byPort = new Map<number, PortPass>();
   /** The next chunk of the capture to feed. */
@@ -48,14 +51,19 @@ export class ReplayPass {
 
   /**
    * @param originUs, endUs the capture's span (`captureSpan`): bin 0 starts at the first, the links are judged at the last
+   * @param prefix `capture` is the file's first records only: decoding stops at its end, and
+   *   goes on once `continueWith` is given the whole capture
    */
   constructor(
-    readonly capture: Capture,
-    ports: readonly number[],
+    capture: Capture,
+    readonly ports: readonly number[],
     readonly resolution: 'auto' | 1024 | 2048,
     readonly originUs: number,
     readonly endUs: number,
+    prefix = false,
   ) {
+    this.#capture = capture;
+    this.#prefix = prefix;
     this.#ports = ports.map((port) => {
       const series = new LinkSeries(BIN_US, originUs);
       return {
@@ -73,10 +81,31 @@ export class ReplayPass {
     return this.#done;
   }
 
-  /** How much of the capture has been decoded, 0…1 (by chunks). */
-  get progress(): number {
-    const n = this.capture.chunkEnds.length;
-    return n === 0 ? 1 : this.#chunk / n;
+  get capture(): Capture {
+    return this.#capture;
+  }
+
+  /**
+   * A pass begun on the file's first records goes on with the whole capture, when that starts
+   * with every chunk decoded so far (the same ends, times and ports), on the same ports and span;
+   * false (and nothing changed) otherwise.
+   */
+  continueWith(capture: Capture, ports: readonly number[], originUs: number, endUs: number): boolean {
+    const head = this.#capture;
+    const n = this.#chunk;
+    if (!this.#prefix || originUs !== this.originUs || endUs !== this.endUs || capture.chunkEnds.length < n) return false;
+    if (ports.length !== this.ports.length || ports.some((p, k) => p !== this.ports[k])) return false;
+    for (let i = 0; i < n; i++) {
+      if (
+        capture.chunkEnds[i] !== head.chunkEnds[i] ||
+        capture.chunkTimesUs[i] !== head.chunkTimesUs[i] ||
+        capture.chunkPorts[i] !== head.chunkPorts[i]
+      )
+        return false;
+    }
+    this.#capture = capture;
+    this.#prefix = false;
+    return true;
   }
 
   /**
@@ -86,7 +115,7 @@ export class ReplayPass {
   step(budgetMs: number, now: () => number): boolean {
     if (this.#done) return true;
     const started = now();
-    const { bytes, chunkEnds, chunkTimesUs, chunkPorts } = this.capture;
+    const { bytes, chunkEnds, chunkTimesUs, chunkPorts } = this.#capture;
     const n = chunkEnds.length;
     let i = this.#chunk;
     while (i < n) {
@@ -103,7 +132,8 @@ export class ReplayPass {
       if ((i & 0xff) === 0 && now() - started >= budgetMs) break;
     }
     this.#chunk = i;
-    if (i < n) return false;
+    // A prefix's end is not the capture's: the rest comes with continueWith.
+    if (i < n || this.#prefix) return false;
     for (const p of this.#ports) {
       p.decoder.end();
       drain(p);

@@ -13,9 +13,10 @@ import type { Batcher } from './batcher.js';
 import type { Diagnosis } from './diagnosis.js';
 import { type Host, notice } from './host.js';
 import { overviewOf } from './overview.js';
-import type { Overview } from './protocol.js';
+import type { Overview, ReplayStatus } from './protocol.js';
 import type { Driver, SourceRegistry } from './registry.js';
 import { type Checkpoint, ReplayPass } from './replay-pass.js';
+import { type PreviewSizes, previewOf } from './replay-preview.js';
 import { ReplaySource } from './sources/replay.js';
 
 /** The position moves every tick; the page needs it a few times a second. */
@@ -36,6 +37,8 @@ export interface ReplayParts {
   registry: SourceRegistry;
   diagnosis: Diagnosis;
   batcher: Batcher;
+  /** How much of a long capture is read first (default: replay-preview.ts's). */
+  previewSizes?: PreviewSizes | undefined;
 }
 
 export class ReplaySession implements Driver {
@@ -56,16 +59,28 @@ export class ReplaySession implements Driver {
    */
   static async open(name: string, data: ArrayBuffer, parts: ReplayParts): Promise<ReplaySession | null> {
     const { host, registry, diagnosis } = parts;
+    const bytes = new Uint8Array(data);
+    // A long capture: its start decoded and shown on its whole span before all of it is read.
+    const preview = previewOf(bytes, name, parts.previewSizes);
+    let early: ReplayPass | null = null;
+    if (preview !== null) {
+      await registry.closeAll();
+      early = new ReplayPass(preview.head, preview.ports, registry.resolution, preview.startUs, preview.endUs, true);
+      early.step(PASS_SLICE_MS, () => host.clock.now());
+      host.post({ type: 'replay', replay: readingStatus(name, preview.startUs, preview.endUs) });
+      postOverview(host, early.overview());
+    }
     let capture: Capture;
     try {
       // The file itself is not kept: the capture holds what replay and a report need.
-      capture = readCapture(new Uint8Array(data), name);
+      capture = readCapture(bytes, name);
     } catch (error) {
       const why = error instanceof CaptureFormatError ? error.message : String(error);
       notice(host, 'error', `Cannot open ${name}`, why);
+      if (preview !== null) host.post({ type: 'replay', replay: null });
       return null;
     }
-    await registry.closeAll();
+    if (preview === null) await registry.closeAll();
     if (capture.issues.length > 0) {
       notice(
         host,
@@ -80,7 +95,11 @@ export class ReplaySession implements Driver {
     let periodUs = FRAME_PERIOD_11MS_US;
     const span = capture.timing === 'per-chunk' ? captureSpan(capture) : undefined;
     if (span !== undefined && Number.isFinite(span.startUs)) {
-      pass = new ReplayPass(capture, ports, registry.resolution, span.startUs, span.endUs);
+      // The preview's decode goes on where the whole capture starts as its first records did.
+      pass =
+        early?.continueWith(capture, ports, span.startUs, span.endUs) === true
+          ? early
+          : new ReplayPass(capture, ports, registry.resolution, span.startUs, span.endUs);
     } else {
       ({ overview, periodUs } = overviewOf(capture, ports, registry.resolution));
     }
@@ -284,4 +303,22 @@ export class ReplaySession implements Driver {
 
 function postOverview(host: Host, overview: Overview): void {
   host.post({ type: 'overview', overview }, [overview.t.buffer, overview.fadeRate.buffer, overview.lost.buffer]);
+}
+
+/** The replay's status while a long capture's file is still being read: its span, nothing played. */
+function readingStatus(name: string, startUs: number, endUs: number): ReplayStatus {
+  return {
+    name,
+    kind: 'sscap',
+    timing: 'per-chunk',
+    startUs,
+    endUs,
+    positionUs: startUs,
+    playing: false,
+    speed: 1,
+    frames: 0,
+    issues: [],
+    recordedTiming: true,
+    ended: false,
+  };
 }
