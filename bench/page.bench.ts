@@ -266,12 +266,13 @@ function multiPortCapture(path: string, scenarios: Scenario[], seconds: number):
 
 /**
  * Arms a timer in the page from the file input's change (the test's own upload of the file
- * through CDP is not counted) to the overview drawn and the first frames counted.
+ * through CDP is not counted) to the first overview drawn (of a long capture, the part read so
+ * far), to the first frames counted, and to the overview drawn complete.
  */
 async function armOpenTimer(page: Page): Promise<void> {
   await page.evaluate(() => {
-    const w = window as unknown as { __open: { start: number; plotted: number } };
-    w.__open = { start: 0, plotted: 0 };
+    const w = window as unknown as { __open: { start: number; plotted: number; counted: number; complete: number } };
+    w.__open = { start: 0, plotted: 0, counted: 0, complete: 0 };
     document.querySelector('input[type=file]')?.addEventListener(
       'change',
       () => {
@@ -281,11 +282,22 @@ async function armOpenTimer(page: Page): Promise<void> {
     );
     new MutationObserver((_, obs) => {
       const counted = document.querySelector('[data-testid="count-frames"]')?.textContent !== '—';
-      if (document.querySelector('section.replay .overview canvas') !== null && counted) {
+      if (w.__open.counted === 0 && counted) w.__open.counted = performance.now();
+      if (w.__open.plotted === 0 && document.querySelector('section.replay .overview canvas') !== null)
         w.__open.plotted = performance.now();
+      // A page without a growing overview (BENCH_APP_DIR of an older build) is complete at once.
+      const o = document.querySelector('section.replay .overview');
+      if (w.__open.counted > 0 && o?.querySelector('canvas') && o.getAttribute('data-complete') !== 'false') {
+        w.__open.complete = performance.now();
         obs.disconnect();
       }
-    }).observe(document.body, { subtree: true, childList: true, characterData: true });
+    }).observe(document.body, {
+      subtree: true,
+      childList: true,
+      characterData: true,
+      attributes: true,
+      attributeFilter: ['data-complete'],
+    });
   });
 }
 
@@ -298,19 +310,21 @@ async function openTimes(
   page: Page,
   file: string,
   timeoutMs: number,
-): Promise<{ ms: number; pageReadMs: number; workerMs: number; drawMs: number }> {
+): Promise<{ ms: number; countedMs: number; completeMs: number; pageReadMs: number; workerMs: number; drawMs: number }> {
   await armOpenTimer(page);
   await page.setInputFiles('input[type=file]', file);
-  await page.waitForFunction(() => (window as unknown as { __open: { plotted: number } }).__open.plotted > 0, undefined, {
+  await page.waitForFunction(() => (window as unknown as { __open: { complete: number } }).__open.complete > 0, undefined, {
     timeout: timeoutMs,
   });
   return page.evaluate(() => {
-    const o = (window as unknown as { __open: { start: number; plotted: number } }).__open;
+    const o = (window as unknown as { __open: { start: number; plotted: number; counted: number; complete: number } }).__open;
     const mark = (name: string) => performance.getEntriesByName(name).at(-1)?.startTime ?? Number.NaN;
     const read = mark('satscope:capture-read');
     const received = mark('satscope:overview-received');
     return {
       ms: Math.round(o.plotted - o.start),
+      countedMs: Math.round(o.counted - o.start),
+      completeMs: Math.round(o.complete - o.start),
       pageReadMs: Math.round(read - o.start),
       workerMs: Math.round(received - read),
       drawMs: Math.round(o.plotted - received),
@@ -693,12 +707,14 @@ it(
         writeCapture(file, usbChunks(hour.bytes, hour.timesUs));
         const size = readFileSync(file).length;
         const times: number[] = [];
+        const complete: number[] = [];
         const parts: { pageReadMs: number; workerMs: number; drawMs: number }[] = [];
         for (let run = 0; run < 3; run++) {
           const page = await newPage();
           await page.goto(server.url('/?demo=0'));
           const t = await openTimes(page, file, 30_000);
           times.push(t.ms);
+          complete.push(t.completeMs);
           parts.push(t);
           await page.close();
         }
@@ -707,6 +723,8 @@ it(
           frames: sim.framesGenerated,
           msRuns: times,
           msMedian: pct(times, 50),
+          completeMsRuns: complete,
+          completeMsMedian: pct(complete, 50),
           load: load(),
         };
       }
@@ -735,6 +753,8 @@ it(
           results.openDayCapture = {
             fileMB: round(fileMB),
             openToOverviewMs: open.ms,
+            openToFramesCountedMs: open.countedMs,
+            openToCompleteOverviewMs: open.completeMs,
             openPartsMs: { pageRead: open.pageReadMs, worker: open.workerMs, draw: open.drawMs },
             seekFractions: fractions,
             seekMs: seeks,

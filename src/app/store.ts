@@ -195,7 +195,9 @@ function receive(message: FromWorker): void {
       if (message.replay === null) overview.value = null;
       break;
     case 'overview':
-      performance.mark('satscope:overview-received');
+      // The first (maybe partial) overview, and the complete one.
+      if (overview.peek() === null) performance.mark('satscope:overview-received');
+      if (message.overview.complete) performance.mark('satscope:overview-complete');
       overview.value = message.overview;
       break;
     case 'inspection':

@@ -16,6 +16,7 @@ import { TaskQueue } from './queue.js';
 import { Recorder } from './recorder.js';
 import { SourceRegistry } from './registry.js';
 import { ReplaySession } from './replay-session.js';
+import type { PreviewSizes } from './replay-preview.js';
 import { type ReportMaker, WORKER_REPORT_MAKER, report } from './report.js';
 import { setResolution, shareResolution, tellMismatch } from './resolution.js';
 import { DemoSource } from './sources/demo.js';
@@ -25,6 +26,8 @@ import { SerialPorts } from './sources/serial-ports.js';
 export interface DispatcherOptions {
   findPort?: (identity: PortIdentity) => Promise<SerialPort | undefined>;
   makeReport?: ReportMaker;
+  /** How much of a long capture is read first (tests, on small files); replay-preview.ts has the defaults. */
+  previewSizes?: PreviewSizes;
 }
 
 export class Dispatcher {
@@ -36,6 +39,7 @@ export class Dispatcher {
   readonly serial: SerialPorts;
   readonly sink: LiveSink;
   readonly #makeReport: ReportMaker;
+  readonly #previewSizes: PreviewSizes | undefined;
 
   constructor(
     readonly host: Host,
@@ -75,6 +79,7 @@ export class Dispatcher {
       findPort: options.findPort,
     });
     this.#makeReport = options.makeReport ?? WORKER_REPORT_MAKER;
+    this.#previewSizes = options.previewSizes;
   }
 
   /** A message from the page: queued behind those before it. */
@@ -151,7 +156,13 @@ export class Dispatcher {
         await recorder.discardRecovered();
         break;
       case 'replay-open':
-        await ReplaySession.open(message.name, message.data, { host, registry, diagnosis: this.diagnosis, batcher: this.batcher });
+        await ReplaySession.open(message.name, message.data, {
+          host,
+          registry,
+          diagnosis: this.diagnosis,
+          batcher: this.batcher,
+          previewSizes: this.#previewSizes,
+        });
         break;
       case 'replay-play':
         this.replay?.play();

@@ -10,6 +10,8 @@ import {
   LinkMonitor,
   SpektrumDecoder,
   type DecodedFrame,
+  type DecoderCheckpoint,
+  type LinkCheckpoint,
   type LinkEpisode,
   type Resolution,
 } from '../decoder/index.js';
@@ -103,6 +105,20 @@ export class Engine {
     this.#pushTimes[k] = typeof time === 'number' ? undefined : time;
     this.#arrivedMs = arrivedMs;
     this.#drain();
+  }
+
+  /**
+   * A fresh engine starts where a checkpoint of this source's decode was taken (a replay's
+   * seek): the counters, lock, format, episodes and link state are the stream's up to there;
+   * the graph buckets, channels and inspector fill from the bytes fed after it.
+   */
+  restore(decoder: DecoderCheckpoint, link: LinkCheckpoint): void {
+    this.decoder.restore(decoder);
+    this.link.restore(link);
+    this.#forced = decoder.resolutionOption !== 'auto';
+    // Frames found missing from here on are placed from the checkpoint's last frame.
+    this.#currentUs = this.link.lastFrameUs;
+    this.#changed = true;
   }
 
   /**

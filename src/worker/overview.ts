@@ -9,7 +9,8 @@ import type { Capture } from '../capture/index.js';
 import { type LinkSeries, captureSpan, decodeCapture } from '../analysis/index.js';
 import type { Overview } from './protocol.js';
 
-const BIN_US = 1_000_000;
+/** The overview's bins: one second. */
+export const BIN_US = 1_000_000;
 
 /** The frame period a decoder's format implies (its system byte, or 1024 resolution: 22 ms), NaN when it implies none. */
 function periodOf(format: FormatInfo): number {
@@ -64,11 +65,25 @@ export function overviewOf(
       fades[b] = (fades[b] ?? 0) + (marks.fades[k] ?? 0);
       lost[b] = (lost[b] ?? 0) + (marks.missed[k] ?? 0);
     });
-    return { overview: { t, fadeRate: fades, lost, failsafe: [] }, periodUs };
+    return { overview: { t, fadeRate: fades, lost, failsafe: [], readUntilUs: Number.NaN, complete: true }, periodUs };
   }
-  const bins = Math.max(0, ...all.map((x) => x.bins));
+  return { overview: sumOverview(all, failsafe, undefined, endUs, true), periodUs };
+}
+
+/**
+ * The ports' series summed bin by bin (fades and lost frames), `bins` of them (default: as many
+ * as the longest series has), read up to `readUntilUs`.
+ */
+export function sumOverview(
+  all: readonly LinkSeries[],
+  failsafe: Overview['failsafe'],
+  bins: number | undefined,
+  readUntilUs: number,
+  complete: boolean,
+): Overview {
+  const n = bins ?? Math.max(0, ...all.map((x) => x.bins));
   const origin = all[0]?.originUs ?? Number.NaN;
-  const t = new Float64Array(Number.isNaN(origin) ? 0 : bins);
+  const t = new Float64Array(Number.isNaN(origin) ? 0 : n);
   const fades = new Float32Array(t.length);
   const lost = new Float32Array(t.length);
   for (let b = 0; b < t.length; b++) {
@@ -82,5 +97,5 @@ export function overviewOf(
     fades[b] = f;
     lost[b] = l;
   }
-  return { overview: { t, fadeRate: fades, lost, failsafe }, periodUs };
+  return { t, fadeRate: fades, lost, failsafe, readUntilUs, complete };
 }

@@ -152,12 +152,19 @@ export interface ReplayStatus {
   ended: boolean;
 }
 
-/** Whole-capture series for the replay timeline, made once when a capture opens. */
+/**
+ * Whole-capture series for the replay timeline, made when a capture opens: sent as it grows
+ * (each message the whole of it so far) while the capture is decoded, then once complete.
+ */
 export interface Overview {
   t: Float64Array;
   fadeRate: Float32Array;
   lost: Float32Array;
   failsafe: { startUs: number; endUs: number }[];
+  /** Every port is decoded up to here (µs, the capture's clock; NaN without timing): what lies after is not read yet. */
+  readUntilUs: number;
+  /** The whole capture is read. */
+  complete: boolean;
 }
 
 /** One step of a bind as it happened. */

@@ -1,25 +1,44 @@
 /**
- * A capture opened for replay: read once, its overview made (overview.ts), then played through
- * the live path by a ReplaySource (sources/replay.ts) feeding one source per port, with play,
- * pause, speed and seek, and its status sent to the page a few times a second.
+ * A capture opened for replay: read once, played through the live path by a ReplaySource
+ * (sources/replay.ts) feeding one source per port, with play, pause, speed and seek, and its
+ * status sent to the page a few times a second. A capture with recorded chunk times is decoded
+ * once more, a slice at a time while it plays (replay-pass.ts): its overview is sent as it
+ * grows, and a seek starts from that decode's nearest checkpoint. Others get their overview at
+ * once (overview.ts) and seek with fresh decodes.
  */
 import { CaptureFormatError, capturePorts, readCapture, type Capture } from '../capture/index.js';
-import { timingJitterUs } from '../analysis/index.js';
+import { FRAME_PERIOD_11MS_US } from '../decoder/index.js';
+import { captureSpan, timingJitterUs } from '../analysis/index.js';
 import type { Batcher } from './batcher.js';
 import type { Diagnosis } from './diagnosis.js';
 import { type Host, notice } from './host.js';
 import { overviewOf } from './overview.js';
+import type { Overview, ReplayStatus } from './protocol.js';
 import type { Driver, SourceRegistry } from './registry.js';
+import { type Checkpoint, ReplayPass } from './replay-pass.js';
+import { type PreviewSizes, previewOf } from './replay-preview.js';
 import { ReplaySource } from './sources/replay.js';
 
 /** The position moves every tick; the page needs it a few times a second. */
 const STATUS_MS = 200;
+/** A seek from a checkpoint feeds at least this much before the target: the graphs' history (their default window). */
+const SEEK_HISTORY_US = 60e6;
+/** The capture is decoded for this long at a time, then messages and playback go through. */
+const PASS_SLICE_MS = 40;
+/**
+ * The growing overview is sent at most this often, and no more often than a quarter of the time
+ * the reading has taken so far: the page draws the whole of it each time, so a long capture's
+ * few dozen seconds of reading cost it a handful of draws, not one a second.
+ */
+const OVERVIEW_EVERY_MS = 1000;
 
 export interface ReplayParts {
   host: Host;
   registry: SourceRegistry;
   diagnosis: Diagnosis;
   batcher: Batcher;
+  /** How much of a long capture is read first (default: replay-preview.ts's). */
+  previewSizes?: PreviewSizes | undefined;
 }
 
 export class ReplaySession implements Driver {
@@ -27,6 +46,12 @@ export class ReplaySession implements Driver {
   readonly source: ReplaySource;
   readonly #p: ReplayParts;
   #lastStatusMs = Number.NEGATIVE_INFINITY;
+  /** The capture's decode for the overview and the checkpoints (null: the overview came at once, seeks decode afresh). */
+  readonly #pass: ReplayPass | null;
+  #passTimer: unknown;
+  #lastOverviewMs = Number.NEGATIVE_INFINITY;
+  #passStartMs = Number.NaN;
+  #stopped = false;
 
   /**
    * Reads `data` and starts playing it, every source before it closed; null (the user told why)
@@ -34,16 +59,28 @@ export class ReplaySession implements Driver {
    */
   static async open(name: string, data: ArrayBuffer, parts: ReplayParts): Promise<ReplaySession | null> {
     const { host, registry, diagnosis } = parts;
+    const bytes = new Uint8Array(data);
+    // A long capture: its start decoded and shown on its whole span before all of it is read.
+    const preview = previewOf(bytes, name, parts.previewSizes);
+    let early: ReplayPass | null = null;
+    if (preview !== null) {
+      await registry.closeAll();
+      early = new ReplayPass(preview.head, preview.ports, registry.resolution, preview.startUs, preview.endUs, true);
+      early.step(PASS_SLICE_MS, () => host.clock.now());
+      host.post({ type: 'replay', replay: readingStatus(name, preview.startUs, preview.endUs) });
+      postOverview(host, early.overview());
+    }
     let capture: Capture;
     try {
       // The file itself is not kept: the capture holds what replay and a report need.
-      capture = readCapture(new Uint8Array(data), name);
+      capture = readCapture(bytes, name);
     } catch (error) {
       const why = error instanceof CaptureFormatError ? error.message : String(error);
       notice(host, 'error', `Cannot open ${name}`, why);
+      if (preview !== null) host.post({ type: 'replay', replay: null });
       return null;
     }
-    await registry.closeAll();
+    if (preview === null) await registry.closeAll();
     if (capture.issues.length > 0) {
       notice(
         host,
@@ -52,12 +89,26 @@ export class ReplaySession implements Driver {
         `${capture.issues[0]?.message ?? ''} Every intact record is kept.`,
       );
     }
-    const { overview, periodUs } = overviewOf(capture, capturePorts(capture), registry.resolution);
-    const session = new ReplaySession(name, capture, periodUs, parts);
+    const ports = capturePorts(capture);
+    let pass: ReplayPass | null = null;
+    let overview: Overview | null = null;
+    let periodUs = FRAME_PERIOD_11MS_US;
+    const span = capture.timing === 'per-chunk' ? captureSpan(capture) : undefined;
+    if (span !== undefined && Number.isFinite(span.startUs)) {
+      // The preview's decode goes on where the whole capture starts as its first records did.
+      pass =
+        early?.continueWith(capture, ports, span.startUs, span.endUs) === true
+          ? early
+          : new ReplayPass(capture, ports, registry.resolution, span.startUs, span.endUs);
+    } else {
+      ({ overview, periodUs } = overviewOf(capture, ports, registry.resolution));
+    }
+    const session = new ReplaySession(name, capture, periodUs, parts, pass);
     const r = session.source;
     await registry.use(session);
     diagnosis.replay(capture, r.startUs);
-    host.post({ type: 'overview', overview }, [overview.t.buffer, overview.fadeRate.buffer, overview.lost.buffer]);
+    if (overview !== null) postOverview(host, overview);
+    else session.#readOn(true);
     if (!r.recordedTiming) {
       notice(
         host,
@@ -78,8 +129,10 @@ export class ReplaySession implements Driver {
     capture: Capture,
     periodUs: number,
     parts: ReplayParts,
+    pass: ReplayPass | null,
   ) {
     this.#p = parts;
+    this.#pass = pass;
     const { host, registry } = parts;
     this.source = new ReplaySource(
       capture,
@@ -114,7 +167,34 @@ export class ReplaySession implements Driver {
     return this.source.linkNowUs(id);
   }
 
+  /**
+   * Decodes the next slice of the capture for the overview and the checkpoints (the first one
+   * now, the others after the messages and ticks waiting), and sends the overview as it grows.
+   */
+  #readOn(now = false): void {
+    const pass = this.#pass;
+    if (pass === null || pass.done || this.#stopped) return;
+    const { host } = this.#p;
+    if (Number.isNaN(this.#passStartMs)) this.#passStartMs = host.clock.now();
+    const slice = (): void => {
+      this.#passTimer = undefined;
+      if (this.#stopped) return;
+      const done = pass.step(PASS_SLICE_MS, () => host.clock.now());
+      const nowMs = host.clock.now();
+      if (done || nowMs - this.#lastOverviewMs >= Math.max(OVERVIEW_EVERY_MS, (nowMs - this.#passStartMs) / 4)) {
+        this.#lastOverviewMs = nowMs;
+        postOverview(host, pass.overview());
+      }
+      if (!done) this.#passTimer = host.clock.after(0, slice);
+    };
+    if (now) slice();
+    else this.#passTimer = host.clock.after(0, slice);
+  }
+
   async stop(): Promise<void> {
+    this.#stopped = true;
+    this.#p.host.clock.cancel(this.#passTimer);
+    this.#passTimer = undefined;
     this.source.stop();
     this.#p.host.post({ type: 'replay', replay: null });
   }
@@ -163,13 +243,34 @@ export class ReplaySession implements Driver {
     this.status();
   }
 
-  /** Starts over at `timeUs`: fresh decodes, fed the history before it (ReplaySource.seek). */
+  /**
+   * Starts over at `timeUs`: from the capture's decode's nearest checkpoint at least a graph
+   * history before it, with the whole capture's counters, episodes and link state up to there;
+   * without one (no such decode, or another resolution chosen since), fresh decodes fed the
+   * history before it (ReplaySource.seek).
+   */
   seek(timeUs: number): void {
     const state = this.source.playing ? 'playing' : 'paused';
     this.#resetSources();
-    this.source.seek(timeUs);
+    const from = this.#checkpointFor(timeUs);
+    if (from !== undefined && from !== null) {
+      for (const [port, cp] of from.ports) this.#p.registry.get(port)?.engine.restore(cp.decoder, cp.link);
+    }
+    this.source.seek(timeUs, from === undefined ? undefined : (from?.chunk ?? 0));
     this.#p.registry.setAllStates(state);
     this.status();
+  }
+
+  /**
+   * The checkpoint a seek to `timeUs` starts from; null to start from the capture's first chunk
+   * (the target is that near the start); undefined when the decodes must start afresh.
+   */
+  #checkpointFor(timeUs: number): Checkpoint | null | undefined {
+    const pass = this.#pass;
+    if (pass === null || this.#p.registry.resolution !== pass.resolution) return undefined;
+    const r = this.source;
+    const target = Math.min(Math.max(timeUs, r.startUs), r.endUs);
+    return pass.checkpointFor(target, SEEK_HISTORY_US) ?? null;
   }
 
   /** Tells the page where the replay is. */
@@ -198,4 +299,26 @@ export class ReplaySession implements Driver {
       },
     });
   }
+}
+
+function postOverview(host: Host, overview: Overview): void {
+  host.post({ type: 'overview', overview }, [overview.t.buffer, overview.fadeRate.buffer, overview.lost.buffer]);
+}
+
+/** The replay's status while a long capture's file is still being read: its span, nothing played. */
+function readingStatus(name: string, startUs: number, endUs: number): ReplayStatus {
+  return {
+    name,
+    kind: 'sscap',
+    timing: 'per-chunk',
+    startUs,
+    endUs,
+    positionUs: startUs,
+    playing: false,
+    speed: 1,
+    frames: 0,
+    issues: [],
+    recordedTiming: true,
+    ended: false,
+  };
 }

@@ -11,7 +11,8 @@ import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import type { Page } from 'playwright-core';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
-import { importSaleaeCsv, readCapture } from '../../src/capture/index.js';
+import { importSaleaeCsv, readCapture, type Capture } from '../../src/capture/index.js';
+import { LinkMonitor, SpektrumDecoder, USB_CHUNK_JITTER_US } from '../../src/decoder/index.js';
 import { summarizeCapture } from '../../src/analysis/index.js';
 import { preset, simulate } from '../../src/simulator/index.js';
 import { resolutionSource } from '../../src/app/components/SystemBadge/words.js';
@@ -192,3 +193,65 @@ describe.skipIf(skip !== null)('honest states', () => {
     });
   }
 });
+
+describe.skipIf(skip !== null)('seeking in a long capture', () => {
+  it('shows after a seek the counters and episodes of the whole capture up to there, as the library decodes them', async () => {
+    // 12 minutes: longer than a decode started afresh ten minutes before the target would see.
+    const sim = simulate(
+      {
+        ...preset('dsmx-11ms-2048-internal'),
+        seed: 9,
+        dropouts: [
+          { atUs: 60e6, durationUs: 300_000 },
+          { atUs: 150e6, durationUs: 1_500_000 },
+        ],
+      },
+      12 * 60e6,
+    );
+    const path = join(dir, 'twelve-minutes.sscap');
+    writeCapture(path, usbChunks(sim.bytes, sim.timesUs));
+    const capture = readCapture(new Uint8Array(readFileSync(path)), path);
+    const { page, errors } = await open('?demo=0');
+    await page.setInputFiles('input[type=file]', path);
+    await page.locator('section.replay .overview[data-complete="true"]').waitFor({ timeout: 30_000 });
+    await page.getByRole('button', { name: 'Pause' }).click();
+    const seek = page.locator('input.seek');
+    const start = Number(await seek.getAttribute('min'));
+    // The slider snaps the value to its step: the target is what it took.
+    const target = await seek.evaluate(
+      (el, v) => {
+        const input = el as HTMLInputElement;
+        input.value = String(v);
+        input.dispatchEvent(new Event('change', { bubbles: true }));
+        return Number(input.value);
+      },
+      start + 11.2 * 60e6,
+    );
+    const shownAt = `${Math.floor((target - start) / 60e6)}:${(((target - start) / 1e6) % 60).toFixed(1).padStart(4, '0')} /`;
+    await page.getByTestId('replay-time').filter({ hasText: shownAt }).waitFor();
+    const want = libraryUpTo(capture, target);
+    expect(want.holds).toBe(2);
+    await page
+      .getByTestId('count-frames')
+      .filter({ hasText: new RegExp(`^${want.frames}$`) })
+      .waitFor({ timeout: 5000 });
+    await expect(page.getByTestId('count-missed').textContent()).resolves.toBe(String(want.missed));
+    await expect(page.getByTestId('count-bytes').textContent()).resolves.toBe(String(want.bytes));
+    await expect(page.locator('.link dd').nth(1).textContent()).resolves.toBe(`${want.holds} holds · ${want.failsafes} failsafes`);
+    expect(errors).toEqual([]);
+    await page.context().close();
+  });
+});
+
+/** What the library's decoder and link monitor say fed every chunk of port 0 that arrived by `untilUs`. */
+function libraryUpTo(capture: Capture, untilUs: number) {
+  const decoder = new SpektrumDecoder();
+  const link = new LinkMonitor({ jitterUs: USB_CHUNK_JITTER_US });
+  for (let i = 0; i < capture.chunkEnds.length; i++) {
+    if (capture.chunkPorts[i] !== 0 || (capture.chunkTimesUs[i] ?? Infinity) > untilUs) continue;
+    decoder.push(capture.bytes.subarray(i === 0 ? 0 : capture.chunkEnds[i - 1], capture.chunkEnds[i]), capture.chunkTimesUs[i]);
+    for (let f = decoder.next(); f !== undefined; f = decoder.next()) link.frame(f);
+  }
+  const l = link.stats;
+  return { frames: decoder.stats.frames, bytes: decoder.stats.bytes, missed: l.missedFrames, holds: l.holds, failsafes: l.failsafes };
+}

@@ -158,6 +158,20 @@ class PortChunks {
     this.nextByte = lo - start;
   }
 
+  /** Puts the cursor on this port's first chunk at or after the capture's chunk `i` (a checkpoint's). */
+  seekToChunk(i: number): void {
+    const index = this.#index;
+    let lo = 0;
+    let hi = this.length;
+    while (lo < hi) {
+      const mid = (lo + hi) >>> 1;
+      if ((index[mid] ?? 0) < i) lo = mid + 1;
+      else hi = mid;
+    }
+    this.next = lo;
+    this.nextByte = 0;
+  }
+
   get(k: number): Chunk {
     const i = this.#chunk(k);
     const c = this.capture;
@@ -203,7 +217,10 @@ const TICK_MS = 10;
 const SLICE_MS = 12;
 /** The most wall time one tick may move the replay clock by. */
 const MAX_STEP_MS = 100;
-/** A seek replays this much before the target so the graphs and failsafe state have history. */
+/**
+ * A seek without a checkpoint (fresh decodes) replays this much before the target so the graphs
+ * and failsafe state have history.
+ */
 const SEEK_HISTORY_US = 10 * 60e6;
 
 export class ReplaySource {
@@ -305,15 +322,20 @@ export class ReplaySource {
   }
 
   /**
-   * Moves to `timeUs`: the caller resets its decode state first; the chunks from a while before
-   * the target are fed at once so history is there, then playback goes on from the target.
+   * Moves to `timeUs`: the caller resets its decode state first, or restores it to a checkpoint
+   * taken before the capture's chunk `fromChunk`; the chunks from there (or, without one, from
+   * a while before the target) are fed at once so history is there, then playback goes on from
+   * the target.
    */
-  seek(timeUs: number): void {
+  seek(timeUs: number, fromChunk?: number): void {
     const target = Math.min(Math.max(timeUs, this.startUs), this.endUs);
     this.#lastFedUs = NaN;
     this.#ended = false;
     const from = target - SEEK_HISTORY_US;
-    for (const c of this.#chunks) c.seekTo(from);
+    for (const c of this.#chunks) {
+      if (fromChunk === undefined) c.seekTo(from);
+      else c.seekToChunk(fromChunk);
+    }
     const done = this.#feedUntil(target, Infinity);
     this.#clockUs = target;
     this.#wallMs = this.#clock.now();

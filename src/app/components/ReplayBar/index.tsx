@@ -1,6 +1,8 @@
 /**
  * Replay controls: play/pause, speed (1×, 4×, as fast as possible) and a timeline of the whole
- * capture (fades and lost frames per second, failsafe episodes) to seek on.
+ * capture (fades and lost frames per second, failsafe episodes) to seek on. While the worker is
+ * still reading a long capture the timeline grows: the part not read yet is drawn as such (never
+ * as a clean link), and a seek goes no further than what has been read.
  */
 import { computed, useComputed, useSignal } from '@preact/signals';
 import { useEffect, useRef } from 'preact/hooks';
@@ -28,6 +30,17 @@ const speed = computed(() => replay.value?.speed ?? 1);
 const startUs = computed(() => replay.value?.startUs ?? 0);
 const endUs = computed(() => replay.value?.endUs ?? 0);
 const described = computed(() => (replay.value === null ? '' : `${replay.value.kind}, timing ${replay.value.timing}`));
+/** While the capture is still being read: how far (µs, the capture's clock), else null. */
+const readUntil = computed(() => {
+  const o = overview.value;
+  return o === null || o.complete || !Number.isFinite(o.readUntilUs) ? null : o.readUntilUs;
+});
+const readingText = computed(() => {
+  const r = replay.value;
+  const until = readUntil.value;
+  if (r === null || until === null) return '';
+  return `Reading the capture: ${Math.floor((100 * (until - r.startUs)) / Math.max(1, r.endUs - r.startUs))} %`;
+});
 const clockText = computed(() => {
   const r = replay.value;
   return r === null ? '' : `${clock(r.positionUs - r.startUs)} / ${clock(Math.max(1, r.endUs - r.startUs))}`;
@@ -41,12 +54,17 @@ export function ReplayBar() {
   const position = useComputed(() => dragging.value ?? replay.value?.positionUs ?? 0);
   const o = overview.value;
   const palette = theme.value;
+  // The whole capture's span, so that a timeline still growing sits where it belongs.
+  const fromS = startUs.value / 1e6;
+  const toS = endUs.value / 1e6;
   useEffect(() => {
     const el = chart.current;
-    if (el === null || o === null || o.t.length === 0) return undefined;
+    if (el === null || o === null) return undefined;
     const x = Array.from(o.t, (t) => t / 1e6);
     const bands = o.failsafe;
+    const unread = o.complete || !Number.isFinite(o.readUntilUs) ? null : o.readUntilUs / 1e6;
     const c = chartColors(palette);
+    const spanned = toS > fromS;
     const plot = new uPlot(
       {
         width: Math.max(300, el.clientWidth),
@@ -54,7 +72,7 @@ export function ReplayBar() {
         legend: { show: false },
         cursor: { show: false },
         axes: [{ show: false }, { show: false }],
-        scales: { x: { time: false } },
+        scales: { x: spanned ? { time: false, range: () => [fromS, toS] } : { time: false } },
         series: [
           {},
           { stroke: c.lost, fill: `${c.lost}66`, paths: uPlot.paths.bars?.({ size: [1, Infinity] }), points: { show: false } },
@@ -72,6 +90,21 @@ export function ReplayBar() {
                 const z = u.valToPos(b.endUs / 1e6, 'x', true);
                 ctx.fillRect(a, u.bbox.top, Math.max(2, z - a), u.bbox.height);
               }
+              if (unread !== null) {
+                // Not read yet: hatched, so that it never reads as a clean stretch of link.
+                const a = u.valToPos(unread, 'x', true);
+                const z = u.bbox.left + u.bbox.width;
+                ctx.beginPath();
+                ctx.rect(a, u.bbox.top, z - a, u.bbox.height);
+                ctx.clip();
+                ctx.strokeStyle = c.axis;
+                ctx.globalAlpha = 0.35;
+                for (let h = a - u.bbox.height; h < z; h += 8) {
+                  ctx.moveTo(h, u.bbox.top + u.bbox.height);
+                  ctx.lineTo(h + u.bbox.height, u.bbox.top);
+                }
+                ctx.stroke();
+              }
               ctx.restore();
             },
           ],
@@ -82,7 +115,7 @@ export function ReplayBar() {
     );
     return () => plot.destroy();
     // The overview can arrive before the replay status that makes this bar (and its box) appear.
-  }, [o, name !== null, palette]);
+  }, [o, name !== null, palette, fromS, toS]);
   if (name === null) return null;
   const span = Math.max(1, replaySpanUs.value);
   return (
@@ -124,11 +157,19 @@ export function ReplayBar() {
             </button>
           ))}
         </div>
+        <span class="muted" data-testid="replay-reading">
+          {readingText}
+        </span>
         <span class="time" data-testid="replay-time">
           {clockText}
         </span>
       </div>
-      <div class="overview" ref={chart} />
+      <div
+        class="overview"
+        ref={chart}
+        data-complete={o === null ? undefined : String(o.complete)}
+        title={readUntil.value === null ? undefined : 'Hatched: not read yet. Seeking goes as far as the capture has been read.'}
+      />
       <input
         type="range"
         class="seek"
@@ -142,7 +183,10 @@ export function ReplayBar() {
         }}
         onChange={(e) => {
           dragging.value = null;
-          send({ type: 'replay-seek', timeUs: Number(e.currentTarget.value) });
+          // No further than the capture has been read: its counters and link state are known up to there.
+          const until = readUntil.peek();
+          const to = Number(e.currentTarget.value);
+          send({ type: 'replay-seek', timeUs: until === null ? to : Math.min(to, until) });
         }}
       />
     </section>

@@ -1,0 +1,209 @@
+/**
+ * The one decode of a whole capture a replay makes when it opens (captures with recorded chunk
+ * times): every port's decoder, link monitor and 1 s link series (the report's), fed the chunks
+ * in the capture's order a slice at a time, so that the page draws the overview as it grows and
+ * stays responsive. On the way it keeps a checkpoint of every port's decoder and link monitor
+ * each CHECKPOINT_US of capture time: a seek restores the nearest one and feeds only from there,
+ * with the counters, episodes and link state of the whole capture up to the target.
+ */
+import { type DecoderCheckpoint, type LinkCheckpoint, type LinkMonitor, SpektrumDecoder } from '../decoder/index.js';
+import type { Capture } from '../capture/index.js';
+import { LinkSeries, monitorWithSeries, timingJitterUs } from '../analysis/index.js';
+import { BIN_US, sumOverview } from './overview.js';
+import type { Overview } from './protocol.js';
+
+/** Capture time between two checkpoints: 1440 of them a day, each a few kilobytes a port. */
+export const CHECKPOINT_US = 60e6;
+
+/**
+ * How far behind the slowest port's last frame the overview is drawn while the pass runs: frames
+ * found missing are confirmed over ledger windows (0.5 s) and placed where they were due.
+ */
+const SETTLE_BINS = 2;
+
+interface PortPass {
+  port: number;
+  decoder: SpektrumDecoder;
+  link: LinkMonitor;
+  series: LinkSeries;
+}
+
+/** Every port's decode state before the capture's chunk `chunk` (all chunks before it fed). */
+export interface Checkpoint {
+  chunk: number;
+  /** The latest arrival among the chunks fed, µs: a seek to a target at or after it may start here. */
+  fedUntilUs: number;
+  ports: Map<number, { decoder: DecoderCheckpoint; link: LinkCheckpoint }>;
+}
+
+export class ReplayPass {
+  readonly checkpoints: Checkpoint[] = [];
+  /** The capture decoded; while `#prefix`, only the first records of the file (replay-preview.ts). */
+  #capture: Capture;
+  #prefix: boolean;
+  readonly #ports: PortPass[];
+  readonly #byPort = new Map<number, PortPass>();
+  /** The next chunk of the capture to feed. */
+  #chunk = 0;
+  #fedUntilUs = Number.NEGATIVE_INFINITY;
+  #nextCheckpointUs: number;
+  #done = false;
+
+  /**
+   * @param originUs, endUs the capture's span (`captureSpan`): bin 0 starts at the first, the links are judged at the last
+   * @param prefix `capture` is the file's first records only: decoding stops at its end, and
+   *   goes on once `continueWith` is given the whole capture
+   */
+  constructor(
+    capture: Capture,
+    readonly ports: readonly number[],
+    readonly resolution: 'auto' | 1024 | 2048,
+    readonly originUs: number,
+    readonly endUs: number,
+    prefix = false,
+  ) {
+    this.#capture = capture;
+    this.#prefix = prefix;
+    this.#ports = ports.map((port) => {
+      const series = new LinkSeries(BIN_US, originUs);
+      return {
+        port,
+        decoder: new SpektrumDecoder({ resolution }),
+        link: monitorWithSeries({ jitterUs: timingJitterUs(capture.timing) }, series),
+        series,
+      };
+    });
+    for (const p of this.#ports) this.#byPort.set(p.port, p);
+    this.#nextCheckpointUs = originUs + CHECKPOINT_US;
+  }
+
+  get done(): boolean {
+    return this.#done;
+  }
+
+  get capture(): Capture {
+    return this.#capture;
+  }
+
+  /**
+   * A pass begun on the file's first records goes on with the whole capture, when that starts
+   * with every chunk decoded so far (the same ends, times and ports), on the same ports and span;
+   * false (and nothing changed) otherwise.
+   */
+  continueWith(capture: Capture, ports: readonly number[], originUs: number, endUs: number): boolean {
+    const head = this.#capture;
+    const n = this.#chunk;
+    if (!this.#prefix || originUs !== this.originUs || endUs !== this.endUs || capture.chunkEnds.length < n) return false;
+    if (ports.length !== this.ports.length || ports.some((p, k) => p !== this.ports[k])) return false;
+    for (let i = 0; i < n; i++) {
+      if (
+        capture.chunkEnds[i] !== head.chunkEnds[i] ||
+        capture.chunkTimesUs[i] !== head.chunkTimesUs[i] ||
+        capture.chunkPorts[i] !== head.chunkPorts[i]
+      )
+        return false;
+    }
+    this.#capture = capture;
+    this.#prefix = false;
+    return true;
+  }
+
+  /**
+   * Feeds chunks for about `budgetMs` of `now()`'s time (at least one), the end of the stream
+   * once they are all in. Returns whether the pass is done.
+   */
+  step(budgetMs: number, now: () => number): boolean {
+    if (this.#done) return true;
+    const started = now();
+    const { bytes, chunkEnds, chunkTimesUs, chunkPorts } = this.#capture;
+    const n = chunkEnds.length;
+    let i = this.#chunk;
+    while (i < n) {
+      const atUs = chunkTimesUs[i] ?? Number.NaN;
+      if (atUs >= this.#nextCheckpointUs) this.#checkpoint(i, atUs);
+      const p = this.#byPort.get(chunkPorts[i] ?? -1);
+      if (p !== undefined) {
+        p.decoder.push(bytes.subarray(i === 0 ? 0 : (chunkEnds[i - 1] ?? 0), chunkEnds[i] ?? 0), Number.isNaN(atUs) ? undefined : atUs);
+        drain(p);
+      }
+      if (atUs > this.#fedUntilUs) this.#fedUntilUs = atUs;
+      i++;
+      // The clock is read every 256 chunks: reading it costs more than a chunk.
+      if ((i & 0xff) === 0 && now() - started >= budgetMs) break;
+    }
+    this.#chunk = i;
+    // A prefix's end is not the capture's: the rest comes with continueWith.
+    if (i < n || this.#prefix) return false;
+    for (const p of this.#ports) {
+      p.decoder.end();
+      drain(p);
+      p.link.finish(this.endUs);
+      p.series.extendTo(this.endUs);
+    }
+    this.#done = true;
+    return true;
+  }
+
+  #checkpoint(chunk: number, atUs: number): void {
+    const ports = new Map<number, { decoder: DecoderCheckpoint; link: LinkCheckpoint }>();
+    for (const p of this.#ports) ports.set(p.port, { decoder: p.decoder.checkpoint(), link: p.link.checkpoint() });
+    this.checkpoints.push({ chunk, fedUntilUs: this.#fedUntilUs, ports });
+    // The next one a whole interval on, however long the silence before this chunk.
+    while (this.#nextCheckpointUs <= atUs) this.#nextCheckpointUs += CHECKPOINT_US;
+  }
+
+  /**
+   * The latest checkpoint a replay at `targetUs` may start from, `historyUs` before it at least
+   * (the graphs' history), or undefined when the capture's start is as near.
+   */
+  checkpointFor(targetUs: number, historyUs: number): Checkpoint | undefined {
+    const before = targetUs - historyUs;
+    let lo = 0;
+    let hi = this.checkpoints.length;
+    while (lo < hi) {
+      const mid = (lo + hi) >>> 1;
+      if ((this.checkpoints[mid]?.fedUntilUs ?? Number.POSITIVE_INFINITY) <= before) lo = mid + 1;
+      else hi = mid;
+    }
+    return this.checkpoints[lo - 1];
+  }
+
+  /**
+   * The overview as far as it is known: every port decoded up to `readUntilUs` (all of it once
+   * done); what lies after is not read yet, and nothing there is drawn.
+   */
+  overview(): Overview {
+    let readUntilUs = this.endUs;
+    if (!this.#done) {
+      // Bins still open to frames and to missing frames not yet confirmed are not drawn.
+      readUntilUs = this.#fedUntilUs;
+      for (const p of this.#ports) {
+        const last = p.link.lastFrameUs;
+        if (Number.isFinite(last) && last < readUntilUs) readUntilUs = last;
+      }
+      readUntilUs = Math.max(this.originUs, Math.floor((readUntilUs - this.originUs) / BIN_US - SETTLE_BINS) * BIN_US + this.originUs);
+    }
+    const bins = this.#done ? undefined : Math.max(0, Math.round((readUntilUs - this.originUs) / BIN_US));
+    const failsafe: Overview['failsafe'] = [];
+    for (const p of this.#ports)
+      for (const e of p.link.episodes)
+        if (e.kind === 'failsafe' && e.startUs < readUntilUs)
+          // One still open where the reading has got to lasts at least that far, not past it.
+          failsafe.push({ startUs: e.startUs, endUs: this.#done ? (e.endUs ?? e.startUs) : Math.min(e.endUs ?? readUntilUs, readUntilUs) });
+    return sumOverview(
+      this.#ports.map((p) => p.series),
+      failsafe,
+      bins,
+      readUntilUs,
+      this.#done,
+    );
+  }
+}
+
+function drain(p: PortPass): void {
+  const { decoder, link, series } = p;
+  for (let f = decoder.next(); f !== undefined; f = decoder.next()) {
+    link.frame(f);
+    series.frame(f, link);
+  }
+}

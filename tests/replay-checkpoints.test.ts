@@ -1,0 +1,230 @@
+/**
+ * A long capture in the worker (replay-pass.ts, replay-session.ts): its overview grows as it is
+ * read, never showing what has not been read, and ends equal to the overview made in one go; a
+ * seek starts from the nearest checkpoint, with the counters and link figures of the whole
+ * capture up to the target, as a decode fed every chunk up to there has them.
+ */
+import { describe, expect, it } from 'vitest';
+import { type Capture, capturePorts, encodeCapture, readCapture } from '../src/capture/index.js';
+import { LinkMonitor, SpektrumDecoder, USB_CHUNK_JITTER_US } from '../src/decoder/index.js';
+import { preset, simulate } from '../src/simulator/index.js';
+import { Dispatcher } from '../src/worker/dispatcher.js';
+import { overviewOf } from '../src/worker/overview.js';
+import { ReplayPass } from '../src/worker/replay-pass.js';
+import { type PreviewSizes, previewOf } from '../src/worker/replay-preview.js';
+import { captureSpan } from '../src/analysis/index.js';
+import type { Overview } from '../src/worker/protocol.js';
+import { usbChunks } from './feeds.js';
+import { FakeClock, fakeHost } from './worker-fakes.js';
+
+const MINUTE = 60e6;
+
+/** Two remotes for 12 minutes (longer than a fresh decode's 10-minute history), the internal one with dropouts and a failsafe. */
+function longCapture(): Uint8Array {
+  return longCaptureWithSeed(3);
+}
+
+function longCaptureWithSeed(seed: number): Uint8Array {
+  const a = simulate(
+    {
+      ...preset('dsmx-11ms-2048-internal'),
+      seed,
+      dropouts: [
+        { atUs: 2 * MINUTE, durationUs: 300_000 },
+        { atUs: 5 * MINUTE, durationUs: 1_500_000 },
+        { atUs: 9.5 * MINUTE, durationUs: 200_000 },
+      ],
+    },
+    12 * MINUTE,
+  );
+  const b = simulate({ ...preset('dsmx-11ms-2048-external'), seed: 4 }, 12 * MINUTE);
+  const records = [
+    ...usbChunks(a.bytes, a.timesUs).map((c) => ({ type: 'data' as const, bytes: c.bytes, timeUs: c.timeUs, port: 0 })),
+    ...usbChunks(b.bytes, b.timesUs).map((c) => ({ type: 'data' as const, bytes: c.bytes, timeUs: c.timeUs + 3, port: 1 })),
+  ].sort((x, y) => x.timeUs - y.timeUs);
+  return encodeCapture({ baudRate: 115200 }, records);
+}
+
+const FILE = longCapture();
+
+/** A clock that moves 10 ms each time it is read, so the capture's decode goes in slices. */
+class ReadingClock extends FakeClock {
+  #extra = 0;
+  override now(): number {
+    this.#extra += 10;
+    return super.now() + this.#extra;
+  }
+}
+
+function open(clock: FakeClock, previewSizes?: PreviewSizes) {
+  const fake = fakeHost(clock);
+  const worker = new Dispatcher(fake.host, { previewSizes });
+  const send = async (...messages: Parameters<Dispatcher['receive']>[0][]): Promise<void> => {
+    for (const m of messages) worker.receive(m);
+    await worker.queue.idle();
+  };
+  return { ...fake, worker, send };
+}
+
+/** What a library decoder and link monitor say about `port` fed every chunk of it that arrived by `untilUs`. */
+function libraryUpTo(capture: Capture, port: number, untilUs: number) {
+  const decoder = new SpektrumDecoder();
+  const link = new LinkMonitor({ jitterUs: USB_CHUNK_JITTER_US });
+  for (let i = 0; i < capture.chunkEnds.length; i++) {
+    if (capture.chunkPorts[i] !== port || (capture.chunkTimesUs[i] ?? Infinity) > untilUs) continue;
+    decoder.push(capture.bytes.subarray(i === 0 ? 0 : capture.chunkEnds[i - 1], capture.chunkEnds[i]), capture.chunkTimesUs[i]);
+    for (let f = decoder.next(); f !== undefined; f = decoder.next()) link.frame(f);
+  }
+  return { decoder: { ...decoder.stats }, link: { ...link.stats } };
+}
+
+describe('a long capture in the worker', () => {
+  it('draws its overview as it is read: nothing after the part read, each part as the complete one has it, and complete at the end as made in one go', async () => {
+    const clock = new ReadingClock();
+    const { send, of } = open(clock);
+    await send({ type: 'replay-open', name: 'long.sscap', data: FILE.slice().buffer });
+    const first = of('overview')[0];
+    expect(first?.overview.complete).toBe(false);
+    for (let guard = 0; guard < 1000 && !of('overview').at(-1)?.overview.complete; guard++) clock.advance(10);
+    const all = of('overview').map((m) => m.overview);
+    expect(all.length).toBeGreaterThan(3);
+    const last = all.at(-1) as Overview;
+    expect(last.complete).toBe(true);
+    const capture = readCapture(FILE, 'long.sscap');
+    const once = overviewOf(capture, capturePorts(capture), 'auto').overview;
+    expect(Array.from(last.t)).toEqual(Array.from(once.t));
+    expect(Array.from(last.fadeRate)).toEqual(Array.from(once.fadeRate));
+    expect(Array.from(last.lost)).toEqual(Array.from(once.lost));
+    expect(last.failsafe).toEqual(once.failsafe);
+    expect(once.failsafe.length).toBe(1);
+    let before = Number.NEGATIVE_INFINITY;
+    for (const o of all.slice(0, -1)) {
+      // It grows, and only up to where every port has been read.
+      expect(o.readUntilUs).toBeGreaterThanOrEqual(before);
+      before = o.readUntilUs;
+      expect(o.t.length).toBeLessThanOrEqual(Math.round((o.readUntilUs - (once.t[0] ?? 0)) / 1e6));
+      for (let b = 0; b < o.t.length; b++) {
+        expect(o.t[b]).toBe(once.t[b]);
+        expect([b, o.fadeRate[b], o.lost[b]]).toEqual([b, once.fadeRate[b], once.lost[b]]);
+      }
+      for (const f of o.failsafe) expect(f.endUs).toBeLessThanOrEqual(o.readUntilUs);
+    }
+  });
+
+  it("seeks anywhere from a checkpoint: the counters and link figures are the whole capture's up to the target", async () => {
+    const clock = new FakeClock();
+    const { send, worker } = open(clock);
+    await send({ type: 'replay-open', name: 'long.sscap', data: FILE.slice().buffer }, { type: 'replay-pause' });
+    const capture = readCapture(FILE, 'long.sscap');
+    const start = worker.replay?.source.startUs ?? Number.NaN;
+    // Past the fresh decode's 10 minutes, before and after the failsafe, backwards and forwards.
+    for (const at of [11.2, 3.5, 0.5, 7.25, 10.9, 1.4]) {
+      const target = start + at * MINUTE;
+      await send({ type: 'replay-seek', timeUs: target });
+      for (const port of [0, 1]) {
+        const engine = worker.registry.get(port)?.engine;
+        const want = libraryUpTo(capture, port, target);
+        expect({ at, port, decoder: { ...engine?.decoder.stats } }).toEqual({ at, port, decoder: want.decoder });
+        const l = engine?.link.stats;
+        const got = {
+          frames: l?.frames,
+          fades: l?.fades,
+          missed: l?.missedFrames,
+          lost: l?.lostFrames,
+          holds: l?.holds,
+          failsafes: l?.failsafes,
+        };
+        const w = want.link;
+        expect({ at, port, ...got }).toEqual({
+          at,
+          port,
+          frames: w.frames,
+          fades: w.fades,
+          missed: w.missedFrames,
+          lost: w.lostFrames,
+          holds: w.holds,
+          failsafes: w.failsafes,
+        });
+      }
+    }
+    // After the failsafe at 5 minutes, it is counted.
+    expect(worker.registry.get(0)?.engine.link.stats.failsafes).toBe(0);
+    await send({ type: 'replay-seek', timeUs: start + 8 * MINUTE });
+    expect(worker.registry.get(0)?.engine.link.stats.failsafes).toBe(1);
+  });
+
+  it('previews a long file from its first records and its end, and the decode begun on them goes on with the whole capture to the same overview and checkpoints', () => {
+    const capture = readCapture(FILE, 'long.sscap');
+    const ports = capturePorts(capture);
+    const span = captureSpan(capture);
+    const preview = previewOf(FILE, 'long.sscap', { minBytes: 0, headBytes: 400_000, tailBytes: 20_000 });
+    expect(preview).not.toBeNull();
+    if (preview === null) return;
+    expect([preview.startUs, preview.endUs]).toEqual([span.startUs, span.endUs]);
+    expect(preview.ports).toEqual(ports);
+    // The head is the file's first records: a prefix of the whole capture's chunks.
+    const n = preview.head.chunkEnds.length;
+    expect(n).toBeGreaterThan(1000);
+    expect(n).toBeLessThan(capture.chunkEnds.length / 4);
+    expect(Array.from(preview.head.chunkTimesUs)).toEqual(Array.from(capture.chunkTimesUs.subarray(0, n)));
+    const now = (() => {
+      let t = 0;
+      return () => (t += 1);
+    })();
+    const early = new ReplayPass(preview.head, preview.ports, 'auto', preview.startUs, preview.endUs, true);
+    // Decoded to the head's end, it is not done: the capture goes on.
+    for (let k = 0; k < 100; k++) expect(early.step(40, now)).toBe(false);
+    expect(early.overview().complete).toBe(false);
+    const other = readCapture(longCaptureWithSeed(5), 'other.sscap');
+    expect(early.continueWith(other, ports, span.startUs, span.endUs)).toBe(false);
+    expect(early.continueWith(capture, ports, span.startUs, span.endUs)).toBe(true);
+    while (!early.step(40, now));
+    const whole = new ReplayPass(capture, ports, 'auto', span.startUs, span.endUs);
+    while (!whole.step(40, now));
+    const a = early.overview();
+    const b = whole.overview();
+    expect([Array.from(a.t), Array.from(a.fadeRate), Array.from(a.lost), a.failsafe]).toEqual([
+      Array.from(b.t),
+      Array.from(b.fadeRate),
+      Array.from(b.lost),
+      b.failsafe,
+    ]);
+    expect(early.checkpoints.map((c) => c.chunk)).toEqual(whole.checkpoints.map((c) => c.chunk));
+    expect(JSON.stringify(early.checkpoints.at(-1)?.ports.get(1)?.link)).toBe(JSON.stringify(whole.checkpoints.at(-1)?.ports.get(1)?.link));
+  });
+
+  it('reads a file too short for a preview, or not a capture with chunk times, whole', () => {
+    expect(previewOf(FILE, 'long.sscap')).toBeNull();
+    expect(previewOf(new Uint8Array(1000), 'zeros.bin', { minBytes: 0, headBytes: 400, tailBytes: 100 })).toBeNull();
+  });
+
+  it("shows a long file's span and its first records' overview before reading it whole, then plays and seeks as one read whole", async () => {
+    const clock = new FakeClock();
+    const { send, posts, worker } = open(clock, { minBytes: 0, headBytes: 400_000, tailBytes: 20_000 });
+    await send({ type: 'replay-open', name: 'long.sscap', data: FILE.slice().buffer });
+    const capture = readCapture(FILE, 'long.sscap');
+    const span = captureSpan(capture);
+    // First: the span and a partial overview, nothing played; then the replay of the whole file.
+    const first = posts.findIndex((m) => m.type === 'replay' && m.replay !== null);
+    const firstReplay = posts[first];
+    expect(firstReplay?.type === 'replay' && firstReplay.replay).toMatchObject({
+      startUs: span.startUs,
+      endUs: span.endUs,
+      playing: false,
+      frames: 0,
+    });
+    const overviews = posts.flatMap((m, k) => (m.type === 'overview' ? [{ k, o: m.overview }] : []));
+    expect(overviews[0]?.k).toBeGreaterThan(first);
+    expect(overviews[0]?.o.complete).toBe(false);
+    expect(overviews[0]?.o.readUntilUs).toBeLessThan(span.startUs + 2 * MINUTE);
+    const playing = posts.findIndex((m) => m.type === 'replay' && m.replay?.playing === true);
+    expect(playing).toBeGreaterThan(overviews[0]?.k ?? Infinity);
+    const last = overviews.at(-1)?.o;
+    const once = overviewOf(capture, capturePorts(capture), 'auto').overview;
+    expect(last?.complete).toBe(true);
+    expect(Array.from(last?.lost ?? [])).toEqual(Array.from(once.lost));
+    expect(last?.failsafe).toEqual(once.failsafe);
+    await send({ type: 'replay-pause' }, { type: 'replay-seek', timeUs: span.startUs + 11 * MINUTE });
+    expect({ ...worker.registry.get(0)?.engine.decoder.stats }).toEqual(libraryUpTo(capture, 0, span.startUs + 11 * MINUTE).decoder);
+  });
+});
