@@ -157,7 +157,7 @@ describe('a long capture in the worker', () => {
     const capture = readCapture(FILE, 'long.sscap');
     const ports = capturePorts(capture);
     const span = captureSpan(capture);
-    const preview = previewOf(FILE, 'long.sscap', { minBytes: 0, headBytes: 400_000, tailBytes: 20_000 });
+    const preview = previewOf(FILE, { minBytes: 0, headBytes: 400_000, tailBytes: 20_000 });
     expect(preview).not.toBeNull();
     if (preview === null) return;
     expect([preview.startUs, preview.endUs]).toEqual([span.startUs, span.endUs]);
@@ -194,8 +194,8 @@ describe('a long capture in the worker', () => {
   });
 
   it('reads a file too short for a preview, or not a capture with chunk times, whole', () => {
-    expect(previewOf(FILE, 'long.sscap')).toBeNull();
-    expect(previewOf(new Uint8Array(1000), 'zeros.bin', { minBytes: 0, headBytes: 400, tailBytes: 100 })).toBeNull();
+    expect(previewOf(FILE)).toBeNull();
+    expect(previewOf(new Uint8Array(1000), { minBytes: 0, headBytes: 400, tailBytes: 100 })).toBeNull();
   });
 
   it("shows a long file's span and its first records' overview before reading it whole, then plays and seeks as one read whole", async () => {

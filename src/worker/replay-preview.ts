@@ -5,8 +5,7 @@
  * a record a cut leaves). The start gives the records to decode first; the end gives where the
  * capture ends, so that the page can place the part read on the whole span at once.
  */
-import { type Capture, capturePorts, hasCaptureMagic, readCapture } from '../capture/index.js';
-import { CRC_SIZE, HEADER_FIXED_SIZE, OFF_META_LENGTH } from '../capture/layout.js';
+import { type Capture, capturePorts, hasCaptureMagic, parseCapture } from '../capture/index.js';
 import { captureSpan } from '../analysis/index.js';
 
 /** A file this large gets a preview: under it, reading it whole is as quick. */
@@ -35,21 +34,20 @@ export interface PreviewSizes {
 const SIZES: PreviewSizes = { minBytes: PREVIEW_MIN_BYTES, headBytes: PREVIEW_BYTES, tailBytes: TAIL_BYTES };
 
 /** The preview of `bytes`, or null when it is not a long .sscap with chunk times whose start and end read. */
-export function previewOf(bytes: Uint8Array, name: string, sizes: PreviewSizes = SIZES): Preview | null {
+export function previewOf(bytes: Uint8Array, sizes: PreviewSizes = SIZES): Preview | null {
   const { minBytes, headBytes, tailBytes } = sizes;
   if (bytes.length < Math.max(minBytes, headBytes + tailBytes) || !hasCaptureMagic(bytes)) return null;
-  const headerLength =
-    HEADER_FIXED_SIZE + new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength).getUint32(OFF_META_LENGTH, true) + CRC_SIZE;
-  if (headerLength > headBytes) return null;
   let head: Capture;
   let tail: Capture;
   try {
-    head = readCapture(bytes.subarray(0, headBytes), name);
-    // The header, then the file's last bytes: a capture whose first record is cut.
+    const start = parseCapture(bytes.subarray(0, headBytes));
+    // The header as the reader found it, then the file's last bytes: a capture whose first record is cut.
+    const { headerLength } = start;
     const end = new Uint8Array(headerLength + tailBytes);
     end.set(bytes.subarray(0, headerLength));
     end.set(bytes.subarray(bytes.length - tailBytes), headerLength);
-    tail = readCapture(end, name);
+    head = start;
+    tail = parseCapture(end);
   } catch {
     // Whatever is wrong, reading the whole file says it.
     return null;

@@ -61,7 +61,7 @@ export class ReplaySession implements Driver {
     const { host, registry, diagnosis } = parts;
     const bytes = new Uint8Array(data);
     // A long capture: its start decoded and shown on its whole span before all of it is read.
-    const preview = previewOf(bytes, name, parts.previewSizes);
+    const preview = previewOf(bytes, parts.previewSizes);
     let early: ReplayPass | null = null;
     if (preview !== null) {
       await registry.closeAll();
