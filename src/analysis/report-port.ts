@@ -67,8 +67,13 @@ class IntervalTally {
   #distinct = 0;
   #column: Column | null = null;
 
-  /** A finite interval. */
-  add(value: number): void {
+  /**
+   * The link monitor's last ordinary interval, if it has one. (Read here rather than passed in:
+   * a double passed to a call V8 does not inline is boxed, an allocation a frame.)
+   */
+  add(link: LinkMonitor): void {
+    const value = link.lastIntervalUs;
+    if (!Number.isFinite(value)) return;
     const keys = this.#keys;
     if (keys === null) {
       this.#column?.push(value);
@@ -89,8 +94,11 @@ class IntervalTally {
       keys[slot] = v;
       this.#counts[slot] = 1;
       this.#distinct++;
-      return;
-    }
+    } else this.#keepEvery(keys, v);
+  }
+
+  /** Past `MAX_DISTINCT_INTERVALS`: every value kept from now on, those counted so far first. */
+  #keepEvery(keys: Float64Array, v: number): void {
     const column = new Column();
     for (let i = 0; i < INTERVAL_SLOTS; i++) for (let c = this.#counts[i] ?? 0; c > 0; c--) column.push(keys[i] ?? NaN);
     column.push(v);
@@ -243,6 +251,8 @@ class PortTally {
   /** Sums of whole µs (servoToMicros rounds), so exact in any order. */
   readonly channelSum = new Float64Array(CHANNEL_COUNT);
   readonly #ch = PortTally.#channels();
+  /** The frame being read: its time and index, for `#changed` (a double passed as an argument to a call V8 does not inline is boxed). */
+  readonly #frame = new Float64Array(2);
   readonly glitchesRaw: RawGlitch[] = [];
   glitchCount = 0;
   glitchFrames = 0;
@@ -259,8 +269,7 @@ class PortTally {
     if (this.frames === 0) this.firstUs = t;
     this.lastUs = t;
     this.frames++;
-    const interval = link.lastIntervalUs;
-    if (Number.isFinite(interval)) this.intervals.add(interval);
+    this.intervals.add(link);
     const rs = f.rssi;
     if (rs !== null && !Number.isNaN(rs)) {
       if (rs === -128) this.rssiLoss++;
@@ -273,6 +282,8 @@ class PortTally {
     }
     if (f.fades !== null && f.fades !== 0) this.fadeCounterMoved = true;
     const { ids, positions, count, resolution, index } = f;
+    this.#frame[0] = t;
+    this.#frame[1] = index;
     const ch = this.#ch;
     const frames = this.channelFrames;
     for (let i = 0; i < count; i++) {
@@ -288,12 +299,14 @@ class PortTally {
         ch[o + CH_AT_B] = t;
         ch[o + CH_IDX_B] = index;
         ch[o + CH_REPEAT] = 1;
-      } else this.#changed(id, pos, res, t, index);
+      } else this.#changed(id, pos, res);
     }
   }
 
   /** Channel `id` took a new value (or its first): range, sum, and a spike ending here. */
-  #changed(id: number, pos: number, res: Resolution, t: number, index: number): void {
+  #changed(id: number, pos: number, res: Resolution): void {
+    const t = this.#frame[0] as number;
+    const index = this.#frame[1] as number;
     const ch = this.#ch;
     const o = id * CH_STRIDE;
     const n = this.channelFrames[id] as number;
