@@ -70,6 +70,19 @@ function crc8DvbS2(ring: Uint8Array, start: number, length: number): number {
 }
 
 /**
+ * How far back a scanner looks: what it finds at a byte depends on the `SCAN_MEMORY` bytes
+ * before it (the longest packet it can still be pending on, and its ring) and on nothing earlier.
+ * After a stretch of `SCAN_MEMORY` bytes none of which starts a candidate (`startsCandidate`), it
+ * holds no candidate, so its state there is those bytes alone.
+ */
+export const SCAN_MEMORY = HISTORY - 1;
+
+/** Whether a byte starts a candidate the scanner keeps pending (SRXL v1 0xA5, SRXL2 0xA6, CRSF's sync bytes). */
+export function startsCandidate(byte: number): boolean {
+  return ((startKinds ??= buildStartKinds())[byte] ?? -1) >= 0;
+}
+
+/**
  * Finds IBUS, SRXL v1, SRXL2, CRSF and SBUS packets in a byte stream, fed in any chunking.
  * Each packet is checked by its checksum (SBUS, which has none, by its header and footer and
  * the next header 25 bytes on). `onPacket` is called once per packet with its kind and the
@@ -87,6 +100,19 @@ export class PacketScanner {
   lastSrxl2Type = -1;
 
   constructor(readonly onPacket: (kind: PacketKind, endIndex: number) => void) {}
+
+  /**
+   * `count` bytes of the stream went by unscanned: the stream index moves on and what comes next
+   * is scanned as if the stream began there (no candidate pending, nothing remembered). Packets
+   * ending within `SCAN_MEMORY` bytes after may be missed or be chance ones; after that, when the
+   * bytes fed since hold no `startsCandidate` byte in their first `SCAN_MEMORY`, the scanner is in
+   * the very state it would be in had it scanned everything.
+   */
+  pass(count: number): void {
+    this.#n += count;
+    this.#pending = 0;
+    this.#ring.fill(0);
+  }
 
   push(bytes: Uint8Array): void {
     // The state in locals for the loop (written back at the end): this runs on every byte, so

@@ -13,6 +13,12 @@ export const NOTHING_AFTER_US = 1_000_000;
 export const NOTHING_CERTAIN_US = 3_000_000;
 /** Line findings look at the last 3 one-second bins. */
 export const LINE_WINDOW_BINS = 3;
+
+/** The seconds (from `fromS` to `toS`, inclusive) the line findings at `nowUs` look at. */
+export function lineWindow(nowUs: number): { fromS: number; toS: number } {
+  const toS = Math.floor(nowUs / 1e6);
+  return { fromS: toS - LINE_WINDOW_BINS + 1, toS };
+}
 /** A fade-counter drop after a gap this long is a restart, not a wrap. */
 export const RESTART_MIN_GAP_US = 100_000;
 /** Seconds with fades on two remotes or more, out of the seconds with fades on any, above which they fade together. */

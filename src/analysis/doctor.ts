@@ -177,9 +177,11 @@ export class Doctor {
 
   /**
    * Bytes as they arrived: `time` is the chunk's arrival time (its last byte), per-byte times,
-   * or nothing (then the last time seen on this port).
+   * or nothing (then the last time seen on this port). The first `unscanned` of them are counted
+   * but not scanned for foreign packets (`PacketScanner.pass`): for a caller that takes findings
+   * only at one time and knows those bytes cannot change them (see `decodeCapture`).
    */
-  bytes(port: number, bytes: Uint8Array, time?: number | Float64Array): void {
+  bytes(port: number, bytes: Uint8Array, time?: number | Float64Array, unscanned = 0): void {
     if (bytes.length === 0) return;
     const p = this.#port(port);
     let t: number;
@@ -196,7 +198,11 @@ export class Doctor {
     }
     this.#activity(p, t, bytes.length);
     p.scanTimeUs = t;
-    p.scanner.push(bytes);
+    if (unscanned <= 0) p.scanner.push(bytes);
+    else {
+      p.scanner.pass(Math.min(unscanned, bytes.length));
+      if (unscanned < bytes.length) p.scanner.push(bytes.subarray(unscanned));
+    }
   }
 
   /**

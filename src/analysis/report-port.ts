@@ -207,6 +207,7 @@ export interface PortData {
 export interface PortPass {
   originUs: number;
   endUs: number;
+  /** The report's doctor: its findings are taken once, at `endUs` (`diagnosedHealthReport`). */
   doctor: Doctor | undefined;
 }
 
@@ -387,7 +388,7 @@ export function decodePort(
       binUs: REPORT_BIN_US,
       originUs: pass.originUs,
       endUs: pass.endUs,
-      ...(pass.doctor !== undefined ? { doctor: pass.doctor } : {}),
+      ...(pass.doctor !== undefined ? { doctor: pass.doctor, doctorJudgedAtEnd: true } : {}),
       onEvent: (e) => {
         if (e.type === 'format-changed') formatChanges++;
       },
