@@ -231,6 +231,24 @@ describe('healthReport: timing', () => {
     expect(r.findings.find((f) => f.code === 'jitter')).toMatchObject({ level: 'ok' });
   });
 
+  it('gives the same period statistics past 4096 distinct intervals, when every interval is kept', () => {
+    // 70 s of per-byte times: over 6000 intervals, most of them distinct.
+    const sim = run(preset('dsmx-11ms-2048-internal'), 70_000_000);
+    const fp = healthReport(perByteCapture(sim)).remotes[0]!.framePeriod!;
+    const times = intactOf(sim).map((f) => f.timeUs);
+    const sorted = times
+      .slice(1)
+      .map((t, i) => t - times[i]!)
+      .filter((d) => d < 16_500)
+      .sort((a, b) => a - b);
+    expect(new Set(sorted).size).toBeGreaterThan(4096);
+    const r1 = (x: number): number => Math.round(x * 10) / 10;
+    const rank = (p: number): number => sorted[Math.ceil((p / 100) * sorted.length) - 1]!;
+    expect(fp.intervals).toBe(sorted.length);
+    expect([fp.minUs, fp.p50Us, fp.p95Us, fp.p99Us, fp.maxUs]).toEqual([sorted[0]!, rank(50), rank(95), rank(99), sorted.at(-1)!].map(r1));
+    expect(fp.meanUs).toBeCloseTo(sorted.reduce((a, b) => a + b, 0) / sorted.length, 0);
+  });
+
   it('calls an irregular frame period out', () => {
     // Every other frame 3 ms late: intervals of 19 and 25 ms on a 22 ms system, a 3 ms deviation.
     const sim = run(preset('dsmx-22ms-2048-internal'), 4_000_000);

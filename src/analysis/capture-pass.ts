@@ -14,6 +14,8 @@ import { BYTE_TIME_US, SpektrumDecoder, USB_CHUNK_JITTER_US, type DecodedFrame, 
 import type { LinkMonitor } from '../decoder/index.js';
 import type { Doctor } from './doctor.js';
 import { doctorEvent } from './doctor-events.js';
+import { SCAN_MEMORY, startsCandidate } from './doctor-line.js';
+import { lineWindow } from './doctor-state.js';
 import { LinkSeries, monitorWithSeries } from './series.js';
 
 export interface DecodeCaptureOptions extends DecoderOptions {
@@ -31,6 +33,13 @@ export interface DecodeCaptureOptions extends DecoderOptions {
    * capture only: without timing the doctor needs a clock of its own (`doctorCapture`).
    */
   doctor?: Doctor;
+  /**
+   * The doctor's findings will be taken only at `endUs` (a whole capture's diagnosis). Then the
+   * foreign packets it could find before its line window at that time (`lineWindow`) cannot
+   * count, and the bytes that could only show those are not scanned (`firstScanned`): the same
+   * findings for less work.
+   */
+  doctorJudgedAtEnd?: boolean;
 }
 
 /** The delivery jitter to assume for a capture's timing until it is measured: USB batching for chunk times, none for a logic analyser's. */
@@ -80,6 +89,37 @@ export function captureSpan(capture: Capture): { startUs: number; endUs: number 
   return start <= end ? { startUs: start, endUs: end } : { startUs: NaN, endUs: NaN };
 }
 
+/**
+ * Where the doctor's packet scan of `port` must start (a chunk and a byte in it) for the packets
+ * it books from `fromUs` on to be exactly those a scan of every byte books, when nothing else of
+ * the scan is read. Packets are booked at the time of the chunk their last byte came in, so
+ * chunks before the first one timed `fromUs` or later (or untimed: booked at an earlier chunk's
+ * time) book only before `fromUs`. The scanner's state at that chunk depends only on the bytes
+ * before it back to the last `SCAN_MEMORY` of them without a `startsCandidate` byte, so the scan
+ * starts there (or at the port's first byte when there is no such stretch).
+ */
+export function firstScanned(capture: Capture, port: number, fromUs: number): { chunk: number; offset: number } {
+  const { bytes, chunkEnds, chunkTimesUs, chunkPorts } = capture;
+  let first = chunkEnds.length;
+  for (let i = 0; i < chunkEnds.length; i++) {
+    if (chunkPorts[i] === port && !((chunkTimesUs[i] ?? NaN) < fromUs)) {
+      first = i;
+      break;
+    }
+  }
+  // Back from there through the port's earlier bytes, for SCAN_MEMORY in a row that start nothing.
+  let clean = 0;
+  for (let i = first - 1; i >= 0; i--) {
+    if (chunkPorts[i] !== port) continue;
+    const from = i > 0 ? (chunkEnds[i - 1] ?? 0) : 0;
+    for (let b = (chunkEnds[i] ?? 0) - 1; b >= from; b--) {
+      if (startsCandidate(bytes[b] ?? 0)) clean = 0;
+      else if (++clean === SCAN_MEMORY) return { chunk: i, offset: b - from };
+    }
+  }
+  return { chunk: 0, offset: 0 };
+}
+
 /** The capture's events on `port`, in the order they were recorded among the chunks. */
 function portEvents(capture: Capture, port: number): CaptureEvent[] {
   return capture.events.filter((e) => e.port === port).sort((a, b) => a.chunkIndex - b.chunkIndex);
@@ -97,7 +137,7 @@ export function decodeCapture(
   options: DecodeCaptureOptions,
   onFrame: (frame: DecodedFrame, link: LinkMonitor) => void,
 ): { decoder: SpektrumDecoder; link: LinkMonitor; series: LinkSeries } {
-  const { port = 0, binUs = 1_000_000, originUs, endUs, doctor, ...decoderOptions } = options;
+  const { port = 0, binUs = 1_000_000, originUs, endUs, doctor, doctorJudgedAtEnd = false, ...decoderOptions } = options;
   const span = originUs === undefined || endUs === undefined ? captureSpan(capture) : { startUs: originUs, endUs };
   const end = endUs ?? span.endUs;
   const decoder = new SpektrumDecoder(decoderOptions);
@@ -125,11 +165,21 @@ export function decodeCapture(
       onFrame(f, link);
     }
   };
-  const push = (bytes: Uint8Array, time: number | Float64Array | undefined): void => {
-    doctor?.bytes(port, bytes, time);
+  const push = (bytes: Uint8Array, time: number | Float64Array | undefined, unscanned: number): void => {
+    doctor?.bytes(port, bytes, time, unscanned);
     decoder.push(bytes, time);
     drain();
   };
+  // The doctor's packet scan starts at chunk `scan.chunk`, byte `scan.offset` in it, when its
+  // findings are taken only at the end and nothing else reads the scan: a port opened at another
+  // speed counts packets for the probe (events naming a baud rate), so such a port is scanned whole.
+  const judged =
+    doctor !== undefined &&
+    doctorJudgedAtEnd &&
+    capture.timing === 'per-chunk' &&
+    Number.isFinite(end) &&
+    !events.some((e) => /baud/i.test(e.text));
+  const scan = judged ? firstScanned(capture, port, lineWindow(end).fromS * 1e6) : { chunk: 0, offset: 0 };
   const { bytes, chunkEnds, chunkTimesUs, chunkPorts, byteTimesUs } = capture;
   let from = 0;
   for (let i = 0; i < chunkEnds.length; i++) {
@@ -139,11 +189,11 @@ export function decodeCapture(
       if (byteTimesUs !== undefined) {
         for (let s = from; s < to; s += SLICE_BYTES) {
           const e = Math.min(s + SLICE_BYTES, to);
-          push(bytes.subarray(s, e), byteTimesUs.subarray(s, e));
+          push(bytes.subarray(s, e), byteTimesUs.subarray(s, e), 0);
         }
       } else {
         const t = chunkTimesUs[i] ?? NaN;
-        push(bytes.subarray(from, to), Number.isNaN(t) ? undefined : t);
+        push(bytes.subarray(from, to), Number.isNaN(t) ? undefined : t, i < scan.chunk ? to - from : i === scan.chunk ? scan.offset : 0);
       }
     }
     from = to;

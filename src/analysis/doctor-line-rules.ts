@@ -7,6 +7,7 @@ import { foreignSettings, PROTOCOL_SETTINGS, type ForeignProtocol } from './doct
 import {
   dur,
   LINE_WINDOW_BINS,
+  lineWindow,
   M_BREAKS,
   M_BYTES,
   M_CHAR_ERRORS,
@@ -53,8 +54,7 @@ export function nothingFindings(p: PortState, now: number, add: AddFinding): voi
 }
 
 export function lineVerdict(p: PortState, now: number, ctx: RuleContext): LineVerdict {
-  const toS = Math.floor(now / 1e6);
-  const fromS = toS - LINE_WINDOW_BINS + 1;
+  const { fromS, toS } = lineWindow(now);
   const windowStart = Math.max(fromS * 1e6, Number.isFinite(p.firstActivityUs) ? p.firstActivityUs : fromS * 1e6);
   const seconds = Math.max(
     0,
@@ -76,8 +76,7 @@ export function lineVerdict(p: PortState, now: number, ctx: RuleContext): LineVe
 }
 
 export function lineFindings(p: PortState, v: LineVerdict, now: number, add: AddFinding): void {
-  const toS = Math.floor(now / 1e6);
-  const fromS = toS - LINE_WINDOW_BINS + 1;
+  const { fromS, toS } = lineWindow(now);
   const overruns = p.bins.sum(M_OVERRUNS, fromS, toS);
   if (overruns > 0) {
     add({

@@ -23,6 +23,16 @@ const CRSF_MAX_LENGTH = 62;
 const SBUS_LENGTH = 25;
 const HISTORY = 128;
 const MAX_PENDING = 16;
+/** The candidate a byte starts, by byte value: 0 SRXL v1 (0xA5), 1 SRXL2 (0xA6), 2 CRSF (its sync bytes), −1 none. Built on first use. */
+let startKinds: Int8Array | undefined;
+
+function buildStartKinds(): Int8Array {
+  const t = new Int8Array(256).fill(-1);
+  t[0xa5] = 0;
+  t[0xa6] = 1;
+  for (const sync of [0xc8, 0xee, 0xea]) t[sync] = 2;
+  return t;
+}
 
 /** CRC-16/XMODEM (poly 0x1021) and CRC-8/DVB-S2 (poly 0xD5), MSB first: one table lookup a byte. */
 let crcTables: { c16: Uint16Array; c8: Uint8Array } | undefined;
@@ -60,6 +70,19 @@ function crc8DvbS2(ring: Uint8Array, start: number, length: number): number {
 }
 
 /**
+ * How far back a scanner looks: what it finds at a byte depends on the `SCAN_MEMORY` bytes
+ * before it (the longest packet it can still be pending on, and its ring) and on nothing earlier.
+ * After a stretch of `SCAN_MEMORY` bytes none of which starts a candidate (`startsCandidate`), it
+ * holds no candidate, so its state there is those bytes alone.
+ */
+export const SCAN_MEMORY = HISTORY - 1;
+
+/** Whether a byte starts a candidate the scanner keeps pending (SRXL v1 0xA5, SRXL2 0xA6, CRSF's sync bytes). */
+export function startsCandidate(byte: number): boolean {
+  return ((startKinds ??= buildStartKinds())[byte] ?? -1) >= 0;
+}
+
+/**
  * Finds IBUS, SRXL v1, SRXL2, CRSF and SBUS packets in a byte stream, fed in any chunking.
  * Each packet is checked by its checksum (SBUS, which has none, by its header and footer and
  * the next header 25 bytes on). `onPacket` is called once per packet with its kind and the
@@ -78,74 +101,43 @@ export class PacketScanner {
 
   constructor(readonly onPacket: (kind: PacketKind, endIndex: number) => void) {}
 
+  /**
+   * `count` bytes of the stream went by unscanned: the stream index moves on and what comes next
+   * is scanned as if the stream began there (no candidate pending, nothing remembered). Packets
+   * ending within `SCAN_MEMORY` bytes after may be missed or be chance ones; after that, when the
+   * bytes fed since hold no `startsCandidate` byte in their first `SCAN_MEMORY`, the scanner is in
+   * the very state it would be in had it scanned everything.
+   */
+  pass(count: number): void {
+    this.#n += count;
+    this.#pending = 0;
+    this.#ring.fill(0);
+  }
+
   push(bytes: Uint8Array): void {
-    // The state in locals for the loop (written back at the end): this runs on every byte.
+    // The state in locals for the loop (written back at the end): this runs on every byte, so
+    // the usual byte (no packet ends here, none is pending, it starts none) costs a store, two
+    // compares and one table lookup.
     const ring = this.#ring;
     const mask = HISTORY - 1;
     const pendingAt = this.#pendingAt;
     const pendingKind = this.#pendingKind;
+    const starts = (startKinds ??= buildStartKinds());
     let pending = this.#pending;
     let k = this.#n;
     for (let i = 0; i < bytes.length; i++, k++) {
-      const b = bytes[i] ?? 0;
+      const b = bytes[i] as number;
       ring[k & mask] = b;
-      // IBUS ends here?
-      if (k >= IBUS_LENGTH - 1) {
-        const s = k - (IBUS_LENGTH - 1);
-        if (ring[s & mask] === 0x20 && ring[(s + 1) & mask] === 0x40) {
-          let sum = 0;
-          for (let j = 0; j < IBUS_LENGTH - 2; j++) sum += ring[(s + j) & mask] ?? 0;
-          const check = (ring[(k - 1) & mask] ?? 0) | ((ring[k & mask] ?? 0) << 8);
-          if (((0xffff - sum) & 0xffff) === check) this.onPacket('ibus', k);
-        }
-      }
+      // IBUS ends here? (0x20 0x40 31 bytes back.)
+      if (ring[(k - (IBUS_LENGTH - 1)) & mask] === 0x20 && k >= IBUS_LENGTH - 1) this.#ibus(k);
       // SBUS: a 0x0F 25 bytes back, a footer just before this byte, and this byte the next 0x0F.
       if (b === 0x0f && k >= SBUS_LENGTH) {
-        const s = k - SBUS_LENGTH;
-        const footer = ring[(k - 1) & mask] ?? 0;
-        if (ring[s & mask] === 0x0f && (footer === 0x00 || (footer & 0xcf) === 0x04)) this.onPacket('sbus', k - 1);
+        const footer = ring[(k - 1) & mask] as number;
+        if (ring[(k - SBUS_LENGTH) & mask] === 0x0f && (footer === 0x00 || (footer & 0xcf) === 0x04)) this.onPacket('sbus', k - 1);
       }
       // Packets announced by a length byte: check the ones that end here.
-      let w = 0;
-      for (let p = 0; p < pending; p++) {
-        const at = pendingAt[p] ?? 0;
-        const kind = pendingKind[p] ?? 0;
-        const lengthAt = at + (kind === 2 ? 1 : 2);
-        let keep = true;
-        if (kind === 0) {
-          // SRXL v1 has no length byte: a fixed 18 bytes.
-          if (k === at + SRXL_V1_LENGTH - 1) {
-            keep = false;
-            const crc = ((ring[(k - 1) & mask] ?? 0) << 8) | (ring[k & mask] ?? 0);
-            if (crc16Xmodem(ring, at, SRXL_V1_LENGTH - 2) === crc) this.onPacket('srxl-v1', k);
-          }
-        } else if (k === lengthAt) {
-          const length = ring[k & mask] ?? 0;
-          keep = kind === 2 ? length >= 2 && length <= CRSF_MAX_LENGTH : length >= SRXL_MIN_LENGTH && length <= SRXL_MAX_LENGTH;
-        } else if (k > lengthAt) {
-          const length = ring[lengthAt & mask] ?? 0;
-          const total = kind === 2 ? length + 2 : length;
-          if (k === at + total - 1) {
-            keep = false;
-            if (kind === 2) {
-              if (crc8DvbS2(ring, at + 2, total - 3) === ring[k & mask]) this.onPacket('crsf', k);
-            } else {
-              const crc = ((ring[(k - 1) & mask] ?? 0) << 8) | (ring[k & mask] ?? 0);
-              if (crc16Xmodem(ring, at, total - 2) === crc) {
-                this.lastSrxl2Type = ring[(at + 1) & mask] ?? 0;
-                this.onPacket('srxl2', k);
-              }
-            }
-          }
-        }
-        if (keep && k - at < HISTORY - 1) {
-          pendingAt[w] = at;
-          pendingKind[w] = kind;
-          w++;
-        }
-      }
-      pending = w;
-      const start = b === 0xa5 ? 0 : b === 0xa6 ? 1 : b === 0xc8 || b === 0xee || b === 0xea ? 2 : -1;
+      if (pending > 0) pending = this.#checkPending(k, pending);
+      const start = starts[b] as number;
       if (start >= 0) {
         if (pending === MAX_PENDING) {
           pendingAt.copyWithin(0, 1);
@@ -159,6 +151,69 @@ export class PacketScanner {
     }
     this.#pending = pending;
     this.#n = k;
+  }
+
+  /** An IBUS packet that may end at stream index `k` (its first byte is 0x20): checked and reported. */
+  #ibus(k: number): void {
+    const ring = this.#ring;
+    const mask = HISTORY - 1;
+    const s = k - (IBUS_LENGTH - 1);
+    if (ring[(s + 1) & mask] !== 0x40) return;
+    let sum = 0;
+    for (let j = 0; j < IBUS_LENGTH - 2; j++) sum += ring[(s + j) & mask] ?? 0;
+    const check = (ring[(k - 1) & mask] ?? 0) | ((ring[k & mask] ?? 0) << 8);
+    if (((0xffff - sum) & 0xffff) === check) this.onPacket('ibus', k);
+  }
+
+  /**
+   * The pending candidates at stream index `k` (its byte already in the ring): those that end
+   * here are checked and reported, those that can no longer be a packet dropped. Returns how
+   * many remain (kept in order at the start of the lists).
+   */
+  #checkPending(k: number, pending: number): number {
+    const ring = this.#ring;
+    const mask = HISTORY - 1;
+    const pendingAt = this.#pendingAt;
+    const pendingKind = this.#pendingKind;
+    let w = 0;
+    for (let p = 0; p < pending; p++) {
+      const at = pendingAt[p] ?? 0;
+      const kind = pendingKind[p] ?? 0;
+      const lengthAt = at + (kind === 2 ? 1 : 2);
+      let keep = true;
+      if (kind === 0) {
+        // SRXL v1 has no length byte: a fixed 18 bytes.
+        if (k === at + SRXL_V1_LENGTH - 1) {
+          keep = false;
+          const crc = ((ring[(k - 1) & mask] ?? 0) << 8) | (ring[k & mask] ?? 0);
+          if (crc16Xmodem(ring, at, SRXL_V1_LENGTH - 2) === crc) this.onPacket('srxl-v1', k);
+        }
+      } else if (k === lengthAt) {
+        const length = ring[k & mask] ?? 0;
+        keep = kind === 2 ? length >= 2 && length <= CRSF_MAX_LENGTH : length >= SRXL_MIN_LENGTH && length <= SRXL_MAX_LENGTH;
+      } else if (k > lengthAt) {
+        const length = ring[lengthAt & mask] ?? 0;
+        const total = kind === 2 ? length + 2 : length;
+        if (k === at + total - 1) {
+          keep = false;
+          if (kind === 2) {
+            if (crc8DvbS2(ring, at + 2, total - 3) === ring[k & mask]) this.onPacket('crsf', k);
+          } else {
+            const crc = ((ring[(k - 1) & mask] ?? 0) << 8) | (ring[k & mask] ?? 0);
+            if (crc16Xmodem(ring, at, total - 2) === crc) {
+              this.lastSrxl2Type = ring[(at + 1) & mask] ?? 0;
+              this.onPacket('srxl2', k);
+            }
+          }
+        }
+      }
+      if (keep && k - at < HISTORY - 1) {
+        pendingAt[w] = at;
+        pendingKind[w] = kind;
+        w++;
+      }
+    }
+    return w;
   }
 }
 

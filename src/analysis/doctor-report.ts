@@ -31,7 +31,7 @@ export function diagnosedHealthReport(capture: Capture, options: HealthReportOpt
       memoryUs: Infinity,
       originUs: Number.isFinite(span.startUs) ? span.startUs : 0,
     });
-    report = healthReportFeeding(capture, options, doctor);
+    report = healthReportFeeding(capture, options, doctor, span);
     // Ports with events but no data (opened, and nothing came): the doctor hears their events.
     const data = new Set(capturePorts(capture));
     const quiet = [...new Set(capture.events.map((e) => e.port))].filter((p) => !data.has(p)).sort((a, b) => a - b);

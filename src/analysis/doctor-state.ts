@@ -13,6 +13,12 @@ export const NOTHING_AFTER_US = 1_000_000;
 export const NOTHING_CERTAIN_US = 3_000_000;
 /** Line findings look at the last 3 one-second bins. */
 export const LINE_WINDOW_BINS = 3;
+
+/** The seconds (from `fromS` to `toS`, inclusive) the line findings at `nowUs` look at. */
+export function lineWindow(nowUs: number): { fromS: number; toS: number } {
+  const toS = Math.floor(nowUs / 1e6);
+  return { fromS: toS - LINE_WINDOW_BINS + 1, toS };
+}
 /** A fade-counter drop after a gap this long is a restart, not a wrap. */
 export const RESTART_MIN_GAP_US = 100_000;
 /** Seconds with fades on two remotes or more, out of the seconds with fades on any, above which they fade together. */
@@ -42,17 +48,41 @@ export const METRICS = M_PACKETS + PACKET_KINDS.length;
 export class Bins {
   readonly #data = new Float64Array(BIN_COUNT * METRICS);
   readonly #second = new Float64Array(BIN_COUNT).fill(NaN);
+  readonly #time = new Float64Array(1);
 
   add(metric: number, timeUs: number, n: number): void {
-    if (!Number.isFinite(timeUs)) return;
+    this.#time[0] = timeUs;
+    this.addTo(this.#slot(), metric, n);
+  }
+
+  /**
+   * The slot for the counters of frame `f` (its time's second, cleared if it held an older
+   * second), or −1 when they go nowhere (no time, or older than the window): found once a frame,
+   * then `addTo` for each counter. (It takes the frame, not its time: a double passed to a call
+   * V8 does not inline is boxed, an allocation a frame.)
+   */
+  slotOf(f: { readonly timeUs: number }): number {
+    this.#time[0] = f.timeUs;
+    return this.#slot();
+  }
+
+  /** Adds `n` to `metric` in `slot` (from `slotOf`; −1: nowhere). */
+  addTo(slot: number, metric: number, n: number): void {
+    if (slot >= 0) this.#data[slot * METRICS + metric] = (this.#data[slot * METRICS + metric] ?? 0) + n;
+  }
+
+  /** The slot for the time in `#time[0]` (handed over there, not as an argument: see `slotOf`). */
+  #slot(): number {
+    const timeUs = this.#time[0] as number;
+    if (!Number.isFinite(timeUs)) return -1;
     const s = Math.floor(timeUs / 1e6);
     const slot = ((s % BIN_COUNT) + BIN_COUNT) % BIN_COUNT;
     if (this.#second[slot] !== s) {
-      if (s < (this.#second[slot] ?? NaN)) return; // older than the window
+      if (s < (this.#second[slot] ?? NaN)) return -1; // older than the window
       this.#second[slot] = s;
       this.#data.fill(0, slot * METRICS, slot * METRICS + METRICS);
     }
-    this.#data[slot * METRICS + metric] = (this.#data[slot * METRICS + metric] ?? 0) + n;
+    return slot;
   }
 
   /** Sum over the seconds fromS…toS (inclusive). */

@@ -50,6 +50,8 @@ export class Doctor {
   readonly #memoryUs: number;
   readonly #since = new Map<string, number>();
   readonly #originUs: number;
+  /** The port state `#port` gave last (forgotten with its port by `detach`). */
+  #last: PortState | null = null;
 
   /** @throws {TypeError} on an option out of range. */
   constructor(options: DoctorOptions = {}) {
@@ -71,6 +73,9 @@ export class Doctor {
   }
 
   #port(port: number): PortState {
+    // Bytes and frames come a port at a time: the last one asked for is usually asked for again.
+    const last = this.#last;
+    if (last !== null && last.port === port) return last;
     let p = this.#ports.get(port);
     if (p === undefined) {
       const state: PortState = {
@@ -108,6 +113,7 @@ export class Doctor {
       p = state;
       this.#ports.set(port, p);
     }
+    this.#last = p;
     return p;
   }
 
@@ -151,6 +157,7 @@ export class Doctor {
    */
   detach(port: number): void {
     this.#ports.delete(port);
+    if (this.#last?.port === port) this.#last = null;
     for (const key of [...this.#since.keys()]) if (key.split(':')[1]?.split(',').includes(String(port))) this.#since.delete(key);
   }
 
@@ -170,9 +177,11 @@ export class Doctor {
 
   /**
    * Bytes as they arrived: `time` is the chunk's arrival time (its last byte), per-byte times,
-   * or nothing (then the last time seen on this port).
+   * or nothing (then the last time seen on this port). The first `unscanned` of them are counted
+   * but not scanned for foreign packets (`PacketScanner.pass`): for a caller that takes findings
+   * only at one time and knows those bytes cannot change them (see `decodeCapture`).
    */
-  bytes(port: number, bytes: Uint8Array, time?: number | Float64Array): void {
+  bytes(port: number, bytes: Uint8Array, time?: number | Float64Array, unscanned = 0): void {
     if (bytes.length === 0) return;
     const p = this.#port(port);
     let t: number;
@@ -189,7 +198,11 @@ export class Doctor {
     }
     this.#activity(p, t, bytes.length);
     p.scanTimeUs = t;
-    p.scanner.push(bytes);
+    if (unscanned <= 0) p.scanner.push(bytes);
+    else {
+      p.scanner.pass(Math.min(unscanned, bytes.length));
+      if (unscanned < bytes.length) p.scanner.push(bytes.subarray(unscanned));
+    }
   }
 
   /**
@@ -211,8 +224,10 @@ export class Doctor {
   frame(port: number, f: DecodedFrame): void {
     const p = this.#port(port);
     const t = f.timeUs;
+    // The bin every counter of this frame goes in, found once.
+    const slot = p.bins.slotOf(f);
     p.frames++;
-    p.bins.add(M_FRAME_BYTES, t, FRAME_SIZE);
+    p.bins.addTo(slot, M_FRAME_BYTES, FRAME_SIZE);
     p.guess.frame(f.bytes);
     for (let i = 0; i < f.count; i++) {
       const id = f.ids[i] ?? 0;
@@ -238,7 +253,7 @@ export class Doctor {
     p.prevDiscarded = discarded;
     if (link !== undefined) {
       const missed = link.stats.lostFrames;
-      p.bins.add(M_MISSED, t, missed - p.prevMissed);
+      p.bins.addTo(slot, M_MISSED, missed - p.prevMissed);
       p.prevMissed = missed;
     }
     // A counter that went back down after a gap is a receiver that restarted (power), not a
@@ -251,7 +266,7 @@ export class Doctor {
       const wrapped = (f.fades - p.prevFades + modulus) % modulus;
       const restarted = f.fades < p.prevFades && gap >= RESTART_MIN_GAP_US && Math.abs(wrapped - expected) > Math.max(8, 0.5 * expected);
       if (restarted) p.restarts.push({ timeUs: t, from: p.prevFades, to: f.fades, gapUs: gap });
-      else p.bins.add(M_FADES, t, f.fadesDelta);
+      else p.bins.addTo(slot, M_FADES, f.fadesDelta);
     }
     if (f.fades !== null) p.prevFades = f.fades;
     p.prevFrameUs = t;

@@ -50,41 +50,79 @@ class Column {
 
 /** Distinct intervals counted by value before the tally keeps every value instead. */
 const MAX_DISTINCT_INTERVALS = 4096;
+/** Slots of the tally's hash table: a power of two, twice the distinct values it holds at most. */
+const INTERVAL_SLOT_BITS = 13;
+const INTERVAL_SLOTS = 1 << INTERVAL_SLOT_BITS;
 
 /**
  * The ordinary frame intervals. Chunk-timed frames take few distinct intervals (a day of
- * DSMX 11 ms through a USB adapter: about 120), so they are counted by value and a day costs a
- * small map; past `MAX_DISTINCT_INTERVALS` values (a logic analyser's times) every value is kept.
+ * DSMX 11 ms through a USB adapter: about 120), so they are counted by value, in an
+ * open-addressing table of typed arrays (a frame costs a hash and a probe or two, and allocates
+ * nothing); past `MAX_DISTINCT_INTERVALS` values (a logic analyser's times) every value is kept.
  */
 class IntervalTally {
-  #counts: Map<number, number> | null = new Map();
+  /** The values (NaN: an empty slot) and how often each came; null once every value is kept. */
+  #keys: Float64Array | null = new Float64Array(INTERVAL_SLOTS).fill(NaN);
+  #counts = new Float64Array(INTERVAL_SLOTS);
+  #distinct = 0;
   #column: Column | null = null;
 
-  add(v: number): void {
-    const counts = this.#counts;
-    if (counts === null) {
-      this.#column?.push(v);
+  /**
+   * The link monitor's last ordinary interval, if it has one. (Read here rather than passed in:
+   * a double passed to a call V8 does not inline is boxed, an allocation a frame.)
+   */
+  add(link: LinkMonitor): void {
+    const value = link.lastIntervalUs;
+    if (!Number.isFinite(value)) return;
+    const keys = this.#keys;
+    if (keys === null) {
+      this.#column?.push(value);
       return;
     }
-    const c = counts.get(v);
-    if (c !== undefined) counts.set(v, c + 1);
-    else if (counts.size < MAX_DISTINCT_INTERVALS) counts.set(v, 1);
-    else {
-      const column = new Column();
-      for (const [value, count] of counts) for (let k = 0; k < count; k++) column.push(value);
-      column.push(v);
-      this.#column = column;
-      this.#counts = null;
+    const v = value + 0; // −0 counts as 0
+    let slot = intervalHash(v);
+    for (;;) {
+      const k = keys[slot] as number;
+      if (k === v) {
+        (this.#counts[slot] as number)++;
+        return;
+      }
+      if (Number.isNaN(k)) break; // an empty slot, so v is new
+      slot = (slot + 1) & (INTERVAL_SLOTS - 1);
     }
+    if (this.#distinct < MAX_DISTINCT_INTERVALS) {
+      keys[slot] = v;
+      this.#counts[slot] = 1;
+      this.#distinct++;
+    } else this.#keepEvery(keys, v);
+  }
+
+  /** Past `MAX_DISTINCT_INTERVALS`: every value kept from now on, those counted so far first. */
+  #keepEvery(keys: Float64Array, v: number): void {
+    const column = new Column();
+    for (let i = 0; i < INTERVAL_SLOTS; i++) for (let c = this.#counts[i] ?? 0; c > 0; c--) column.push(keys[i] ?? NaN);
+    column.push(v);
+    this.#column = column;
+    this.#keys = null;
   }
 
   /** The statistics, as over the values sorted. Null without any. */
   stats(basis: ReportPeriodStats['basis']): ReportPeriodStats | null {
-    if (this.#counts === null) return periodStats(this.#column?.view().sort() ?? new Float64Array(0), null, basis);
-    const values = Float64Array.from(this.#counts.keys()).sort();
-    const counts = Float64Array.from(values, (v) => this.#counts?.get(v) ?? 0);
+    const keys = this.#keys;
+    if (keys === null) return periodStats(this.#column?.view().sort() ?? new Float64Array(0), null, basis);
+    const order: number[] = [];
+    for (let i = 0; i < INTERVAL_SLOTS; i++) if (!Number.isNaN(keys[i])) order.push(i);
+    order.sort((x, y) => (keys[x] ?? 0) - (keys[y] ?? 0));
+    const values = Float64Array.from(order, (i) => keys[i] ?? NaN);
+    const counts = Float64Array.from(order, (i) => this.#counts[i] ?? 0);
     return periodStats(values, counts, basis);
   }
+}
+
+/** A slot for a finite interval: its integer part and its fraction mixed, as a table index. */
+function intervalHash(v: number): number {
+  const whole = Math.floor(v);
+  return (Math.imul(whole | 0, 0x9e3779b1) ^ Math.imul(((v - whole) * 0x10000) | 0, 0x85ebca6b)) >>> (32 - INTERVAL_SLOT_BITS);
 }
 
 /**
@@ -169,12 +207,32 @@ export interface PortData {
 export interface PortPass {
   originUs: number;
   endUs: number;
+  /** The report's doctor: its findings are taken once, at `endUs` (`diagnosedHealthReport`). */
   doctor: Doctor | undefined;
 }
 
+// What `PortTally` keeps of each channel, at `id × CH_STRIDE` in one Float64Array: its last
+// position and the resolution it was read at, and its last two appearances (% travel, µs, time,
+// frame index): B the newer, A the older; the frame being read is C. After a repeat (C had B's
+// value) A's value is B's and its time no longer matters (no spike can end on a repeat), so a
+// repeat only moves B's time (`CH_REPEAT` says A is B's value).
+const CH_POS = 0;
+const CH_RES = 1;
+const CH_PCT_B = 2;
+const CH_US_B = 3;
+const CH_AT_B = 4;
+const CH_IDX_B = 5;
+const CH_PCT_A = 6;
+const CH_US_A = 7;
+const CH_AT_A = 8;
+const CH_IDX_A = 9;
+const CH_REPEAT = 10;
+const CH_STRIDE = 16;
+
 /**
  * One port's sums, frame by frame: what `decodePort` keeps. A class with fields rather than a
- * closure over local variables, so that its per-frame work stays in registers and plain loads.
+ * closure over local variables, so that its per-frame work stays in registers and plain loads;
+ * each channel's state in one typed array, and nothing allocated per frame.
  */
 class PortTally {
   frames = 0;
@@ -187,32 +245,32 @@ class PortTally {
   rssiTotal = 0;
   fadeCounterMoved = false;
   readonly intervals = new IntervalTally();
+  /** Appearances of each channel (also: how many of A and B it has). */
   readonly channelFrames = new Uint32Array(CHANNEL_COUNT);
   readonly channelMin = new Float64Array(CHANNEL_COUNT).fill(Infinity);
   readonly channelMax = new Float64Array(CHANNEL_COUNT).fill(-Infinity);
+  /** Sums of whole µs (servoToMicros rounds), so exact in any order. */
   readonly channelSum = new Float64Array(CHANNEL_COUNT);
-  // The last two appearances of each channel: % travel, µs, time, frame index. [2·id] is the
-  // older (A), [2·id + 1] the newer (B); the frame being read is C.
-  readonly #pct = new Float64Array(CHANNEL_COUNT * 2);
-  readonly #us = new Float64Array(CHANNEL_COUNT * 2);
-  readonly #at = new Float64Array(CHANNEL_COUNT * 2);
-  readonly #idx = new Float64Array(CHANNEL_COUNT * 2);
-  readonly #seen = new Uint32Array(CHANNEL_COUNT);
-  /** Each channel's last position and the resolution it was read at. */
-  readonly #lastPos = new Float64Array(CHANNEL_COUNT).fill(-1);
-  readonly #lastRes = new Uint16Array(CHANNEL_COUNT);
+  readonly #ch = PortTally.#channels();
+  /** The frame being read: its time and index, for `#changed` (a double passed as an argument to a call V8 does not inline is boxed). */
+  readonly #frame = new Float64Array(2);
   readonly glitchesRaw: RawGlitch[] = [];
   glitchCount = 0;
   glitchFrames = 0;
   #lastGlitchFrame = -1;
+
+  static #channels(): Float64Array {
+    const ch = new Float64Array(CHANNEL_COUNT * CH_STRIDE);
+    for (let id = 0; id < CHANNEL_COUNT; id++) ch[id * CH_STRIDE + CH_POS] = -1;
+    return ch;
+  }
 
   frame(f: DecodedFrame, link: LinkMonitor): void {
     const t = f.timeUs;
     if (this.frames === 0) this.firstUs = t;
     this.lastUs = t;
     this.frames++;
-    const interval = link.lastIntervalUs;
-    if (Number.isFinite(interval)) this.intervals.add(interval);
+    this.intervals.add(link);
     const rs = f.rssi;
     if (rs !== null && !Number.isNaN(rs)) {
       if (rs === -128) this.rssiLoss++;
@@ -224,49 +282,53 @@ class PortTally {
       }
     }
     if (f.fades !== null && f.fades !== 0) this.fadeCounterMoved = true;
-    const timed = Number.isFinite(t);
-    const { ids, positions } = f;
-    for (let i = 0; i < f.count; i++) this.#channel(ids[i] ?? 0, positions[i] ?? 0, f.resolution, t, timed, f.index);
+    const { ids, positions, count, resolution, index } = f;
+    this.#frame[0] = t;
+    this.#frame[1] = index;
+    const ch = this.#ch;
+    const frames = this.channelFrames;
+    for (let i = 0; i < count; i++) {
+      const id = ids[i] as number;
+      const pos = positions[i] as number;
+      const res = channelResolution(id, resolution);
+      const o = id * CH_STRIDE;
+      if (pos === ch[o + CH_POS] && res === ch[o + CH_RES]) {
+        // The value B had (about half of all appearances in a flight): the same µs and % travel,
+        // already within the channel's range, and no spike, since C returns exactly to B.
+        frames[id] = (frames[id] as number) + 1;
+        this.channelSum[id] = (this.channelSum[id] as number) + (ch[o + CH_US_B] as number);
+        ch[o + CH_AT_B] = t;
+        ch[o + CH_IDX_B] = index;
+        ch[o + CH_REPEAT] = 1;
+      } else this.#changed(id, pos, res);
+    }
   }
 
-  #channel(id: number, pos: number, linkResolution: Resolution, t: number, timed: boolean, index: number): void {
-    const res = channelResolution(id, linkResolution);
-    const a = 2 * id;
-    const n = this.#seen[id] ?? 0;
-    if (n >= 1 && pos === this.#lastPos[id] && res === this.#lastRes[id]) {
-      // The value B had (about half of all appearances in a flight): the same µs and % travel,
-      // already within the channel's range, and no spike, since C returns exactly to B.
-      const u = this.#us[a + 1] ?? NaN;
-      this.channelFrames[id] = (this.channelFrames[id] ?? 0) + 1;
-      this.channelSum[id] = (this.channelSum[id] ?? 0) + u;
-      this.#pct[a] = this.#pct[a + 1] ?? NaN;
-      this.#us[a] = u;
-      this.#at[a] = this.#at[a + 1] ?? NaN;
-      this.#idx[a] = this.#idx[a + 1] ?? NaN;
-      this.#at[a + 1] = t;
-      this.#idx[a + 1] = index;
-      this.#seen[id] = n + 1;
-      return;
-    }
-    this.#lastPos[id] = pos;
-    this.#lastRes[id] = res;
+  /** Channel `id` took a new value (or its first): range, sum, and a spike ending here. */
+  #changed(id: number, pos: number, res: Resolution): void {
+    const t = this.#frame[0] as number;
+    const index = this.#frame[1] as number;
+    const ch = this.#ch;
+    const o = id * CH_STRIDE;
+    const n = this.channelFrames[id] as number;
+    ch[o + CH_POS] = pos;
+    ch[o + CH_RES] = res;
     const u = servoToMicros(pos, res);
     const p = servoToPercent(pos, res);
-    this.channelFrames[id] = (this.channelFrames[id] ?? 0) + 1;
-    if (u < (this.channelMin[id] ?? Infinity)) this.channelMin[id] = u;
-    if (u > (this.channelMax[id] ?? -Infinity)) this.channelMax[id] = u;
-    this.channelSum[id] = (this.channelSum[id] ?? 0) + u;
-    const pct = this.#pct;
-    const us = this.#us;
-    const at = this.#at;
-    const idx = this.#idx;
-    if (n >= 2) {
-      const pA = pct[a] ?? NaN;
-      const pB = pct[a + 1] ?? NaN;
-      const atA = at[a] ?? NaN;
+    this.channelFrames[id] = n + 1;
+    if (u < (this.channelMin[id] as number)) this.channelMin[id] = u;
+    if (u > (this.channelMax[id] as number)) this.channelMax[id] = u;
+    this.channelSum[id] = (this.channelSum[id] as number) + u;
+    if (n >= 2 && ch[o + CH_REPEAT] === 0) {
+      const pA = ch[o + CH_PCT_A] as number;
+      const pB = ch[o + CH_PCT_B] as number;
+      const atA = ch[o + CH_AT_A] as number;
       const up = pB - pA;
       const down = pB - p;
-      const span = timed && Number.isFinite(atA) ? t - atA <= SPIKE_WINDOW_US : index - (idx[a] ?? NaN) <= SPIKE_WINDOW_FRAMES;
+      const span =
+        Number.isFinite(t) && Number.isFinite(atA)
+          ? t - atA <= SPIKE_WINDOW_US
+          : index - (ch[o + CH_IDX_A] as number) <= SPIKE_WINDOW_FRAMES;
       if (
         span &&
         Math.abs(up) >= SPIKE_MIN_JUMP_PERCENT &&
@@ -275,18 +337,18 @@ class PortTally {
         Math.abs(p - pA) <= SPIKE_RETURN_PERCENT
       ) {
         this.glitchCount++;
-        const frameIndex = idx[a + 1] ?? NaN;
+        const frameIndex = ch[o + CH_IDX_B] as number;
         if (frameIndex !== this.#lastGlitchFrame) this.glitchFrames++;
         this.#lastGlitchFrame = frameIndex;
         if (this.glitchesRaw.length < MAX_LISTED_GLITCHES) {
           this.glitchesRaw.push({
             kind: 'spike',
-            absUs: at[a + 1] ?? NaN,
+            absUs: ch[o + CH_AT_B] as number,
             frameIndex,
             channel: id,
             name: channelName(id),
-            beforeUs: us[a] ?? NaN,
-            spikeUs: us[a + 1] ?? NaN,
+            beforeUs: ch[o + CH_US_A] as number,
+            spikeUs: ch[o + CH_US_B] as number,
             afterUs: u,
             jumpPercent: r1(up),
           });
@@ -294,16 +356,16 @@ class PortTally {
       }
     }
     if (n >= 1) {
-      pct[a] = pct[a + 1] ?? NaN;
-      us[a] = us[a + 1] ?? NaN;
-      at[a] = at[a + 1] ?? NaN;
-      idx[a] = idx[a + 1] ?? NaN;
+      ch[o + CH_PCT_A] = ch[o + CH_PCT_B] as number;
+      ch[o + CH_US_A] = ch[o + CH_US_B] as number;
+      ch[o + CH_AT_A] = ch[o + CH_AT_B] as number;
+      ch[o + CH_IDX_A] = ch[o + CH_IDX_B] as number;
     }
-    pct[a + 1] = p;
-    us[a + 1] = u;
-    at[a + 1] = t;
-    idx[a + 1] = index;
-    this.#seen[id] = n + 1;
+    ch[o + CH_PCT_B] = p;
+    ch[o + CH_US_B] = u;
+    ch[o + CH_AT_B] = t;
+    ch[o + CH_IDX_B] = index;
+    ch[o + CH_REPEAT] = 0;
   }
 }
 
@@ -326,7 +388,7 @@ export function decodePort(
       binUs: REPORT_BIN_US,
       originUs: pass.originUs,
       endUs: pass.endUs,
-      ...(pass.doctor !== undefined ? { doctor: pass.doctor } : {}),
+      ...(pass.doctor !== undefined ? { doctor: pass.doctor, doctorJudgedAtEnd: true } : {}),
       onEvent: (e) => {
         if (e.type === 'format-changed') formatChanges++;
       },

@@ -50,13 +50,18 @@ export function healthReport(capture: Capture, options: HealthReportOptions = {}
 /**
  * `healthReport`, with `doctor` (when given, for a timed capture) fed every port's bytes, events
  * and frames from the same decode: `diagnosedHealthReport` asks it for its findings after.
+ * `span` is the capture's `captureSpan`, when the caller has it already.
  */
-export function healthReportFeeding(capture: Capture, options: HealthReportOptions, doctor: Doctor | undefined): HealthReport {
+export function healthReportFeeding(
+  capture: Capture,
+  options: HealthReportOptions,
+  doctor: Doctor | undefined,
+  span: { startUs: number; endUs: number } = captureSpan(capture),
+): HealthReport {
   const ports = capturePorts(capture);
   const timed = capture.timing !== 'none';
-  // The shared clock: from the earliest to the latest time recorded on any port (each port's
-  // series bins from the same origin and its link ends there).
-  const span = captureSpan(capture);
+  // The shared clock (span): from the earliest to the latest time recorded on any port (each
+  // port's series bins from the same origin and its link ends there).
   const pass: PortPass = { originUs: span.startUs, endUs: span.endUs, doctor };
   // §8: the internal remote holds the key for every remote; external ports take its resolution.
   const read = readPorts(
