@@ -263,7 +263,8 @@ export class SpektrumDecoder {
    * @throws {TypeError} after `end()`, or when per-byte times do not match the bytes in length.
    */
   push(bytes: Uint8Array, time?: number | Float64Array): void {
-    if (this.#ended) throw new TypeError('push() after end(): call reset() to decode a new stream');
+    // `=== true` on the hot paths: optimised code tests a boolean field for every kind of falsy value otherwise.
+    if (this.#ended === true) throw new TypeError('push() after end(): call reset() to decode a new stream');
     // push() is kept small so that it is inlined into the caller's loop, and the time is stored
     // here rather than passed on: a double handed from there to a call that is not inlined, or
     // to `instanceof`, is boxed (a 16-byte heap number every push). See #append.
@@ -302,8 +303,10 @@ export class SpektrumDecoder {
       this.#head = 0;
     }
     if (this.#tail + n > this.#buf.length) {
-      let capacity = this.#buf.length * 2;
-      while (capacity < this.#tail + n) capacity *= 2;
+      // Doubled, or as much as this push needs (in whole 4 kB) when that is more: a stream pushed
+      // whole takes its own size, not the next power of two (a quarter to a half more memory to
+      // zero, fault in and collect).
+      const capacity = Math.max(this.#buf.length * 2, Math.ceil((this.#tail + n) / 4096) * 4096);
       const buf = new Uint8Array(capacity);
       buf.set(this.#buf.subarray(0, this.#tail));
       this.#buf = buf;
@@ -567,8 +570,8 @@ export class SpektrumDecoder {
     const at = this.#base + o;
     // The whole next frame is not in: the general path would wait too, unless the stream has
     // ended or the frame is one acquisition confirmed (emitted as it stands).
-    if (n + 16 > this.#tail) return this.#ended || at < this.#confirmedUntil ? null : undefined;
-    if (at !== this.#nextAt || at < this.#confirmedUntil || !this.#haveLast) return null;
+    if (n + 16 > this.#tail) return this.#ended === true || at < this.#confirmedUntil ? null : undefined;
+    if (at !== this.#nextAt || at < this.#confirmedUntil || this.#haveLast !== true) return null; // `=== true`: see push()
     const layout = this.#nextLayout;
     if (layout === -1 || !this.#knownLayout(layout)) return null; // INVALID
     const buf = this.#buf;
@@ -846,7 +849,7 @@ export class SpektrumDecoder {
     s.frameBytes += 16; // FRAME_SIZE, written out as in #nextFast
     s.pendingBytes -= 16;
     s.emptySlots += slots.empty;
-    if (slots.hasVtx) s.vtxFrames++;
+    if (slots.hasVtx === true) s.vtxFrames++; // `=== true`: see push()
     this.#head = o + 16;
     return frame;
   }

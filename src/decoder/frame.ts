@@ -186,7 +186,7 @@ export function showSlots(frame: DecodedFrame, slots: FrameSlots): void {
   frame.words = slots.words;
   frame.bytes = slots.bytes;
   frame.count = slots.count;
-  frame.vtx = slots.hasVtx ? slots.vtx : null;
+  frame.vtx = slots.hasVtx === true ? slots.vtx : null; // a strict test: optimised code otherwise tests for every falsy kind
 }
 
 /**
