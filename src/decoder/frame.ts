@@ -192,10 +192,15 @@ export function showSlots(frame: DecodedFrame, slots: FrameSlots): void {
 /**
  * `slotLayout` and decoding in one pass: the frame's layout under `resolution` (or INVALID),
  * with its 16 raw bytes, slot words, channel IDs and positions, empty slots and VTX control
- * written to `into`. `b32`, when given, is `b` as 32-bit words (`b.byteOffset` 0): a frame at
- * a multiple of 4 is copied in four moves. On INVALID `into` is left part written. This is the
- * decoder's hottest function: plain byte arithmetic on the Uint8Array and one table lookup per
- * slot (VTX control, rare, is read in a function of its own).
+ * written to `into`. `b32` is `b` as 32-bit words (`b.byteOffset` 0). On INVALID `into` is
+ * left part written. This is the decoder's hottest function: one table lookup per slot (VTX
+ * control, rare, is read in a function of its own).
+ *
+ * The frame is read as four 32-bit words in little-endian order (four loads where the frame
+ * lies at a multiple of 4 on a little-endian platform, as a compacted buffer puts it; else
+ * assembled from its bytes) and each slot's big-endian word taken from them: a quarter less
+ * time than sixteen byte loads, each checked against the array's length (measured, node 20).
+ * The same words, stored, copy the frame's bytes.
  *
  * The seven slots are written out one after the other, not looped over: optimised code checks
  * every typed array it touches (its map, length and data pointer) again on each pass of a loop,
@@ -212,7 +217,29 @@ export function showSlots(frame: DecodedFrame, slots: FrameSlots): void {
  */
 export function readFrame(b: Uint8Array, b32: Uint32Array, o: number, resolution: Resolution, into: FrameSlots): number {
   const table = resolution === 2048 ? SLOT_2048 : SLOT_1024;
-  const { ids, positions, words } = into;
+  const { ids, positions, words, bytes32 } = into;
+  let x0: number;
+  let x1: number;
+  let x2: number;
+  let x3: number;
+  if ((o & 3) === 0 && LITTLE_ENDIAN) {
+    const k = o >> 2;
+    x0 = b32[k]!;
+    x1 = b32[k + 1]!;
+    x2 = b32[k + 2]!;
+    x3 = b32[k + 3]!;
+    bytes32[0] = x0;
+    bytes32[1] = x1;
+    bytes32[2] = x2;
+    bytes32[3] = x3;
+  } else {
+    x0 = littleEndianAt(b, o);
+    x1 = littleEndianAt(b, o + 4);
+    x2 = littleEndianAt(b, o + 8);
+    x3 = littleEndianAt(b, o + 12);
+    const bytes = into.bytes;
+    for (let i = 0; i < 16; i++) bytes[i] = b[o + i]!; // FRAME_SIZE
+  }
   const vtx = isVtxFrame(b, o);
   let seen = 0;
   let layout = 0;
@@ -220,7 +247,7 @@ export function readFrame(b: Uint8Array, b32: Uint32Array, o: number, resolution
   let word = 0;
   let entry = 0;
   let bit = 0;
-  word = (b[o + 2]! << 8) | b[o + 3]!;
+  word = ((x0 >>> 8) & 0xff00) | (x0 >>> 24);
   words[0] = word;
   if (word === 0xffff) {
     layout |= 13 << 0; // EMPTY_SLOT: code 13
@@ -233,7 +260,7 @@ export function readFrame(b: Uint8Array, b32: Uint32Array, o: number, resolution
     ids[count] = (entry >> 4) & 0x1f;
     positions[count++] = (word & (entry >> 11)) << ((entry >> 9) & 0x03);
   }
-  word = (b[o + 4]! << 8) | b[o + 5]!;
+  word = ((x1 & 0xff) << 8) | ((x1 >>> 8) & 0xff);
   words[1] = word;
   if (word === 0xffff) {
     layout |= 13 << 4; // EMPTY_SLOT: code 13
@@ -246,7 +273,7 @@ export function readFrame(b: Uint8Array, b32: Uint32Array, o: number, resolution
     ids[count] = (entry >> 4) & 0x1f;
     positions[count++] = (word & (entry >> 11)) << ((entry >> 9) & 0x03);
   }
-  word = (b[o + 6]! << 8) | b[o + 7]!;
+  word = ((x1 >>> 8) & 0xff00) | (x1 >>> 24);
   words[2] = word;
   if (word === 0xffff) {
     layout |= 13 << 8; // EMPTY_SLOT: code 13
@@ -259,7 +286,7 @@ export function readFrame(b: Uint8Array, b32: Uint32Array, o: number, resolution
     ids[count] = (entry >> 4) & 0x1f;
     positions[count++] = (word & (entry >> 11)) << ((entry >> 9) & 0x03);
   }
-  word = (b[o + 8]! << 8) | b[o + 9]!;
+  word = ((x2 & 0xff) << 8) | ((x2 >>> 8) & 0xff);
   words[3] = word;
   if (word === 0xffff) {
     layout |= 13 << 12; // EMPTY_SLOT: code 13
@@ -272,7 +299,7 @@ export function readFrame(b: Uint8Array, b32: Uint32Array, o: number, resolution
     ids[count] = (entry >> 4) & 0x1f;
     positions[count++] = (word & (entry >> 11)) << ((entry >> 9) & 0x03);
   }
-  word = (b[o + 10]! << 8) | b[o + 11]!;
+  word = ((x2 >>> 8) & 0xff00) | (x2 >>> 24);
   words[4] = word;
   if (word === 0xffff) {
     layout |= 13 << 16; // EMPTY_SLOT: code 13
@@ -289,7 +316,7 @@ export function readFrame(b: Uint8Array, b32: Uint32Array, o: number, resolution
     layout |= VTX_CODES;
     readVtx(b, o, into);
   } else {
-    word = (b[o + 12]! << 8) | b[o + 13]!;
+    word = ((x3 & 0xff) << 8) | ((x3 >>> 8) & 0xff);
     words[5] = word;
     if (word === 0xffff) {
       layout |= 13 << 20; // EMPTY_SLOT: code 13
@@ -302,7 +329,7 @@ export function readFrame(b: Uint8Array, b32: Uint32Array, o: number, resolution
       ids[count] = (entry >> 4) & 0x1f;
       positions[count++] = (word & (entry >> 11)) << ((entry >> 9) & 0x03);
     }
-    word = (b[o + 14]! << 8) | b[o + 15]!;
+    word = ((x3 >>> 8) & 0xff00) | (x3 >>> 24);
     words[6] = word;
     if (word === 0xffff) {
       layout |= 13 << 24; // EMPTY_SLOT: code 13
@@ -319,22 +346,15 @@ export function readFrame(b: Uint8Array, b32: Uint32Array, o: number, resolution
   into.count = count;
   into.empty = (vtx ? 5 : 7) - count; // SLOTS_PER_FRAME less the two VTX slots
   into.hasVtx = vtx;
-  copyBytes(b, b32, o, into.bytes, into.bytes32);
-  return (b[o + 2]! & 0x80) !== 0 ? layout | (1 << 28) : layout; // LAYOUT_PHASE_BIT
+  return (x0 & 0x800000) !== 0 ? layout | (1 << 28) : layout; // byte 2's top bit: LAYOUT_PHASE_BIT
 }
 
-/** Copies the frame at `o` to `bytes` (`bytes32` its 32-bit view): four 32-bit moves when `o` is a multiple of 4. */
-function copyBytes(b: Uint8Array, b32: Uint32Array, o: number, bytes: Uint8Array, bytes32: Uint32Array): void {
-  if ((o & 3) === 0) {
-    // In the platform's byte order both ways: the same 16 bytes.
-    const k = o >> 2;
-    bytes32[0] = b32[k]!;
-    bytes32[1] = b32[k + 1]!;
-    bytes32[2] = b32[k + 2]!;
-    bytes32[3] = b32[k + 3]!;
-  } else {
-    for (let i = 0; i < 16; i++) bytes[i] = b[o + i]!; // FRAME_SIZE
-  }
+/** Whether this platform stores a 32-bit word's low byte first (then a Uint32Array reads four bytes in the order `littleEndianAt` assembles them). */
+const LITTLE_ENDIAN = new Uint8Array(new Uint32Array([1]).buffer)[0] === 1;
+
+/** The four bytes at `p` as a little-endian 32-bit word, on any platform. */
+function littleEndianAt(b: Uint8Array, p: number): number {
+  return b[p]! | (b[p + 1]! << 8) | (b[p + 2]! << 16) | (b[p + 3]! << 24);
 }
 
 /** The VTX words (slots 5 and 6) and record of the VTX frame at `o`. */
