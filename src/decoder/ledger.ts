@@ -26,7 +26,10 @@ export class FrameLedger {
   #refSlot = 0;
   #slot = 0;
   #lastUs = NaN;
-  /** The time of the frame `frame()` hands to #frameAt (see `frame()`). */
+  /**
+   * The time of the frame `frame()` hands to #frameAt (see `frame()`): read at once, never
+   * between calls, so it is no part of the ledger's state (`checkpoint()` leaves it out).
+   */
   #nowUs = NaN;
   // The open window.
   #winStartUs = NaN;
