@@ -247,98 +247,105 @@ export function readFrame(b: Uint8Array, b32: Uint32Array, o: number, resolution
   let word = 0;
   let entry = 0;
   let bit = 0;
+  let shift = 0; // 4i: slot i's place in the layout
   word = ((x0 >>> 8) & 0xff00) | (x0 >>> 24);
-  words[0] = word;
+  words[shift >> 2] = word;
   if (word === 0xffff) {
-    layout |= 13 << 0; // EMPTY_SLOT: code 13
+    layout |= 13 << shift; // EMPTY_SLOT: code 13
   } else {
     entry = table[word >> 8]!;
     bit = 1 << ((entry >> 4) & 0x1f);
     if (entry === -1 || (seen & bit) !== 0) return -1; // NO_SLOT, or an ID twice: INVALID
     seen |= bit;
-    layout |= (entry & 0x0f) << 0;
+    layout |= (entry & 0x0f) << shift;
     ids[count] = (entry >> 4) & 0x1f;
     positions[count++] = (word & (entry >> 11)) << ((entry >> 9) & 0x03);
   }
+  shift += 4;
   word = ((x1 & 0xff) << 8) | ((x1 >>> 8) & 0xff);
-  words[1] = word;
+  words[shift >> 2] = word;
   if (word === 0xffff) {
-    layout |= 13 << 4; // EMPTY_SLOT: code 13
+    layout |= 13 << shift; // EMPTY_SLOT: code 13
   } else {
     entry = table[word >> 8]!;
     bit = 1 << ((entry >> 4) & 0x1f);
     if (entry === -1 || (seen & bit) !== 0) return -1; // NO_SLOT, or an ID twice: INVALID
     seen |= bit;
-    layout |= (entry & 0x0f) << 4;
+    layout |= (entry & 0x0f) << shift;
     ids[count] = (entry >> 4) & 0x1f;
     positions[count++] = (word & (entry >> 11)) << ((entry >> 9) & 0x03);
   }
+  shift += 4;
   word = ((x1 >>> 8) & 0xff00) | (x1 >>> 24);
-  words[2] = word;
+  words[shift >> 2] = word;
   if (word === 0xffff) {
-    layout |= 13 << 8; // EMPTY_SLOT: code 13
+    layout |= 13 << shift; // EMPTY_SLOT: code 13
   } else {
     entry = table[word >> 8]!;
     bit = 1 << ((entry >> 4) & 0x1f);
     if (entry === -1 || (seen & bit) !== 0) return -1; // NO_SLOT, or an ID twice: INVALID
     seen |= bit;
-    layout |= (entry & 0x0f) << 8;
+    layout |= (entry & 0x0f) << shift;
     ids[count] = (entry >> 4) & 0x1f;
     positions[count++] = (word & (entry >> 11)) << ((entry >> 9) & 0x03);
   }
+  shift += 4;
   word = ((x2 & 0xff) << 8) | ((x2 >>> 8) & 0xff);
-  words[3] = word;
+  words[shift >> 2] = word;
   if (word === 0xffff) {
-    layout |= 13 << 12; // EMPTY_SLOT: code 13
+    layout |= 13 << shift; // EMPTY_SLOT: code 13
   } else {
     entry = table[word >> 8]!;
     bit = 1 << ((entry >> 4) & 0x1f);
     if (entry === -1 || (seen & bit) !== 0) return -1; // NO_SLOT, or an ID twice: INVALID
     seen |= bit;
-    layout |= (entry & 0x0f) << 12;
+    layout |= (entry & 0x0f) << shift;
     ids[count] = (entry >> 4) & 0x1f;
     positions[count++] = (word & (entry >> 11)) << ((entry >> 9) & 0x03);
   }
+  shift += 4;
   word = ((x2 >>> 8) & 0xff00) | (x2 >>> 24);
-  words[4] = word;
+  words[shift >> 2] = word;
   if (word === 0xffff) {
-    layout |= 13 << 16; // EMPTY_SLOT: code 13
+    layout |= 13 << shift; // EMPTY_SLOT: code 13
   } else {
     entry = table[word >> 8]!;
     bit = 1 << ((entry >> 4) & 0x1f);
     if (entry === -1 || (seen & bit) !== 0) return -1; // NO_SLOT, or an ID twice: INVALID
     seen |= bit;
-    layout |= (entry & 0x0f) << 16;
+    layout |= (entry & 0x0f) << shift;
     ids[count] = (entry >> 4) & 0x1f;
     positions[count++] = (word & (entry >> 11)) << ((entry >> 9) & 0x03);
   }
+  shift += 4;
   if (vtx) {
     layout |= VTX_CODES;
     readVtx(b, o, into);
   } else {
     word = ((x3 & 0xff) << 8) | ((x3 >>> 8) & 0xff);
-    words[5] = word;
+    words[shift >> 2] = word;
     if (word === 0xffff) {
-      layout |= 13 << 20; // EMPTY_SLOT: code 13
+      layout |= 13 << shift; // EMPTY_SLOT: code 13
     } else {
       entry = table[word >> 8]!;
       bit = 1 << ((entry >> 4) & 0x1f);
       if (entry === -1 || (seen & bit) !== 0) return -1; // NO_SLOT, or an ID twice: INVALID
       seen |= bit;
-      layout |= (entry & 0x0f) << 20;
+      layout |= (entry & 0x0f) << shift;
       ids[count] = (entry >> 4) & 0x1f;
       positions[count++] = (word & (entry >> 11)) << ((entry >> 9) & 0x03);
     }
+    shift += 4;
     word = ((x3 >>> 8) & 0xff00) | (x3 >>> 24);
-    words[6] = word;
+    words[shift >> 2] = word;
     if (word === 0xffff) {
-      layout |= 13 << 24; // EMPTY_SLOT: code 13
+      layout |= 13 << shift; // EMPTY_SLOT: code 13
     } else {
       entry = table[word >> 8]!;
       bit = 1 << ((entry >> 4) & 0x1f);
       if (entry === -1 || (seen & bit) !== 0) return -1; // NO_SLOT, or an ID twice: INVALID
       seen |= bit;
-      layout |= (entry & 0x0f) << 24;
+      layout |= (entry & 0x0f) << shift;
       ids[count] = (entry >> 4) & 0x1f;
       positions[count++] = (word & (entry >> 11)) << ((entry >> 9) & 0x03);
     }
