@@ -17,6 +17,8 @@ import {
   encodeXPlus,
   vtxWords,
 } from '../src/simulator/index.js';
+import { readFileSync } from 'node:fs';
+import { join as joinPath } from 'node:path';
 import { concatBytes as join } from './bytes.js';
 import { dsmxPair } from './frames.js';
 
@@ -354,6 +356,25 @@ describe('finding frames without a sync byte', () => {
     decoder.push(dsmxStream(3));
     expect(decoder.stats.bytes).toBe(96);
   });
+});
+
+describe('where a frame lies in memory', () => {
+  // Frames at a multiple of 4 in the decoder's buffer are read as 32-bit words, others byte by
+  // byte: 0–3 stray bytes before a stream (pushed whole, so never moved) put its frames at every
+  // alignment, and every one must decode alike.
+  it.each(['dsmx-11ms-2048-internal', 'dsm2-22ms-1024-external', 'rssi-spm4649t', 'xplus-dx9', 'vtx', 'dropouts-and-damage'])(
+    'decodes fixture %s to the same frames after 0, 1, 2 or 3 stray bytes',
+    (name) => {
+      const stream = new Uint8Array(readFileSync(joinPath(import.meta.dirname, 'fixtures', `${name}.bin`)));
+      const at = (shift: number) => {
+        const frames = decodeAll(join([new Uint8Array(shift).fill(0x5a), stream]));
+        return frames.map((f) => ({ ...f, offset: f.offset - shift, bytes: Array.from(f.bytes) }));
+      };
+      const aligned = at(0);
+      expect(aligned.length).toBeGreaterThan(50);
+      for (const shift of [1, 2, 3]) expect(at(shift), `${shift} stray bytes`).toEqual(aligned);
+    },
+  );
 });
 
 describe('time', () => {

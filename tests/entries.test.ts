@@ -12,7 +12,8 @@ describe('package entries in a bundle', () => {
     expect(core).toContain('push() after end()');
     expect(core).not.toMatch(/Saleae|Link health report|serialrx_provider|\.sscap/);
     expect(sizes['satscope/report'].text).toContain('Link health report');
-    // The figure the README quotes, with room for small changes.
-    expect(sizes.satscope.gzip).toBeLessThan(14 * 1024);
+    // The figure the README quotes, with room for small changes (14.1 kB since the decoder's
+    // slots are read written out, not looped: 1.4x the decoding speed for 0.3 kB).
+    expect(sizes.satscope.gzip).toBeLessThan(14.5 * 1024);
   }, 60_000);
 });

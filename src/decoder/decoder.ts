@@ -24,7 +24,7 @@
  * an unlock into an acquisition, which itself consumes or locks with frames it has confirmed
  * (emitted unconditionally): so `next()` always returns after bounded work.
  */
-import { BYTE_TIME_US, FRAME_SIZE, systemInfo, type Resolution } from './spec.js';
+import { FRAME_SIZE, systemInfo, type Resolution } from './spec.js';
 import { byteAt, countZeroWords, createFrame, FrameSlots, INVALID, layoutChannels, readFrame, showSlots, slotLayout } from './frame.js';
 import { copySlots, type DecoderCheckpoint } from './checkpoint.js';
 import type {
@@ -263,7 +263,8 @@ export class SpektrumDecoder {
    * @throws {TypeError} after `end()`, or when per-byte times do not match the bytes in length.
    */
   push(bytes: Uint8Array, time?: number | Float64Array): void {
-    if (this.#ended) throw new TypeError('push() after end(): call reset() to decode a new stream');
+    // `=== true` on the hot paths: optimised code tests a boolean field for every kind of falsy value otherwise.
+    if (this.#ended === true) throw new TypeError('push() after end(): call reset() to decode a new stream');
     // push() is kept small so that it is inlined into the caller's loop, and the time is stored
     // here rather than passed on: a double handed from there to a call that is not inlined, or
     // to `instanceof`, is boxed (a 16-byte heap number every push). See #append.
@@ -302,8 +303,10 @@ export class SpektrumDecoder {
       this.#head = 0;
     }
     if (this.#tail + n > this.#buf.length) {
-      let capacity = this.#buf.length * 2;
-      while (capacity < this.#tail + n) capacity *= 2;
+      // Doubled, or as much as this push needs (in whole 4 kB) when that is more: a stream pushed
+      // whole takes its own size, not the next power of two (a quarter to a half more memory to
+      // zero, fault in and collect).
+      const capacity = Math.max(this.#buf.length * 2, Math.ceil((this.#tail + n) / 4096) * 4096);
       const buf = new Uint8Array(capacity);
       buf.set(this.#buf.subarray(0, this.#tail));
       this.#buf = buf;
@@ -558,51 +561,57 @@ export class SpektrumDecoder {
    * Each byte is read once: validating the next frame decodes it into the spare slot arrays
    * (#staged), which the frame shows when that one is emitted in turn.
    */
-  #nextFast(): DecodedFrame | null {
+  #nextFast(): DecodedFrame | null | undefined {
+    // Numbers are written out, each beside the constant it is (FRAME_SIZE, FADE_STEP, B0_*,
+    // INVALID): optimised code reads a module's constants and imports from its context with a
+    // hole check each time (see readFrame).
     const o = this.#head;
-    const n = o + FRAME_SIZE;
-    if (n + FRAME_SIZE > this.#tail) return null;
+    const n = o + 16; // FRAME_SIZE
     const at = this.#base + o;
-    if (at !== this.#nextAt || at < this.#confirmedUntil || !this.#haveLast) return null;
+    // The whole next frame is not in: the general path would wait too, unless the stream has
+    // ended or the frame is one acquisition confirmed (emitted as it stands).
+    if (n + 16 > this.#tail) return this.#ended === true || at < this.#confirmedUntil ? null : undefined;
+    if (at !== this.#nextAt || at < this.#confirmedUntil || this.#haveLast !== true) return null; // `=== true`: see push()
     const layout = this.#nextLayout;
-    if (layout === INVALID || !this.#knownLayout(layout)) return null;
-    const resolution = this.#resolution;
+    if (layout === -1 || !this.#knownLayout(layout)) return null; // INVALID
     const buf = this.#buf;
-    const b0 = byteAt(buf, o);
-    const b1 = byteAt(buf, o + 1);
+    const b0 = buf[o]!;
+    const b1 = buf[o + 1]!;
     const internal = this.#remote === 'internal';
     let delta = 0;
     if (internal) {
       const mode = this.#b0Mode;
-      const system = this.#system;
-      if (b1 !== system || buf[n + 1] !== system) return null;
-      if (mode === B0_FADES) {
-        // #fitsLast and #follows with FADE_STEP, and #fadeDelta's rise without an event.
+      if (b1 !== this.#system || buf[n + 1] !== b1) return null;
+      if (mode === 0) {
+        // B0_FADES: #fitsLast and #follows with FADE_STEP, and #fadeDelta's rise without an event.
         delta = (b0 - this.#last0) & 0xff;
-        if (delta >= FADE_STEP || ((byteAt(buf, n) - b0) & 0xff) >= FADE_STEP) return null;
-      } else if (mode === B0_RSSI) {
-        if (!plausibleRssi(b0) || !plausibleRssi(byteAt(buf, n))) return null;
-      } else if (mode !== B0_RSSI_FORCED) {
-        return null; // B0_UNKNOWN: emitting may decide byte 0 (an event), the general path's job.
+        if (delta >= 8 || ((buf[n]! - b0) & 0xff) >= 8) return null;
+      } else if (mode === 1) {
+        // B0_RSSI
+        if (!plausibleRssi(b0) || !plausibleRssi(buf[n]!)) return null;
+      } else if (mode !== 3) {
+        return null; // B0_UNKNOWN (not B0_RSSI_FORCED): emitting may decide byte 0 (an event), the general path's job.
       }
     } else {
       const count = (b0 << 8) | b1;
       delta = (count - ((this.#last0 << 8) | this.#last1)) & 0xffff;
-      if (delta >= FADE_STEP || ((((byteAt(buf, n) << 8) | byteAt(buf, n + 1)) - count) & 0xffff) >= FADE_STEP) return null;
+      if (delta >= 8 || ((((buf[n]! << 8) | buf[n + 1]!) - count) & 0xffff) >= 8) return null;
     }
     // This frame's slots: staged while the one before was confirmed, else decoded now.
+    const resolution = this.#resolution;
     const slots = this.#staged;
     if (this.#stagedAt !== at) readFrame(buf, this.#buf32, o, resolution, slots);
     const spare = this.#shown;
     const next = readFrame(buf, this.#buf32, n, resolution, spare);
-    if (next === INVALID) {
+    if (next === -1) {
+      // INVALID
       this.#stagedAt = at;
       return null;
     }
     this.#shown = slots;
     this.#staged = spare;
-    this.#stagedAt = at + FRAME_SIZE;
-    this.#nextAt = at + FRAME_SIZE;
+    this.#stagedAt = at + 16;
+    this.#nextAt = at + 16;
     this.#nextLayout = next;
     const frame = this.#frame;
     frame.index++;
@@ -612,7 +621,7 @@ export class SpektrumDecoder {
     if (internal) {
       frame.remote = 'internal';
       frame.system = b1;
-      if (this.#b0Mode === B0_FADES) {
+      if (this.#b0Mode === 0) {
         frame.rssi = null;
         frame.fades = b0;
       } else {
@@ -837,11 +846,11 @@ export class SpektrumDecoder {
   #counted(frame: DecodedFrame, o: number, slots: FrameSlots): DecodedFrame {
     const s = this.#stats;
     s.frames++;
-    s.frameBytes += FRAME_SIZE;
-    s.pendingBytes -= FRAME_SIZE;
+    s.frameBytes += 16; // FRAME_SIZE, written out as in #nextFast
+    s.pendingBytes -= 16;
     s.emptySlots += slots.empty;
-    if (slots.hasVtx) s.vtxFrames++;
-    this.#head = o + FRAME_SIZE;
+    if (slots.hasVtx === true) s.vtxFrames++; // `=== true`: see push()
+    this.#head = o + 16;
     return frame;
   }
 
@@ -1262,7 +1271,7 @@ export class SpektrumDecoder {
   #stampTime(frame: DecodedFrame, o: number): void {
     const x = this.#base + o;
     this.#dateByte(x, this.#dropChunksBefore(x));
-    frame.timeUs = timeAt(this.#when, 0);
+    frame.timeUs = this.#when[0]!;
   }
 
   /**
@@ -1272,10 +1281,11 @@ export class SpektrumDecoder {
    */
   #dateByte(x: number, i: number): void {
     const byteTimes = this.#byteTimes;
+    // 86.80555555555556: BYTE_TIME_US written out, as in #nextFast.
     this.#when[0] =
       this.#chunkPerByte[i] === 1 && byteTimes !== null
-        ? timeAt(byteTimes, x - this.#base)
-        : timeAt(this.#chunkTimes, i) - (timeAt(this.#chunkEnds, i) - 1 - x) * BYTE_TIME_US;
+        ? byteTimes[x - this.#base]!
+        : this.#chunkTimes[i]! - (this.#chunkEnds[i]! - 1 - x) * 86.80555555555556;
   }
 
   /** Forgets the records of chunks that end at or before stream offset `x` (keeps the last one); returns the first kept. */
@@ -1283,7 +1293,7 @@ export class SpektrumDecoder {
     const ends = this.#chunkEnds;
     const last = this.#chunkTail - 1;
     let i = this.#chunkHead;
-    while (i < last && timeAt(ends, i) <= x) i++;
+    while (i < last && ends[i]! <= x) i++;
     this.#chunkHead = i;
     return i;
   }

@@ -26,6 +26,11 @@ export class FrameLedger {
   #refSlot = 0;
   #slot = 0;
   #lastUs = NaN;
+  /**
+   * The time of the frame `frame()` hands to #frameAt (see `frame()`): read at once, never
+   * between calls, so it is no part of the ledger's state (`checkpoint()` leaves it out).
+   */
+  #nowUs = NaN;
   // The open window.
   #winStartUs = NaN;
   #winFrames = 0;
@@ -71,9 +76,22 @@ export class FrameLedger {
     this.#winGapFromUs = this.#winGapToUs = NaN;
   }
 
-  /** Feeds a frame at `t`; returns frames confirmed missing (and reports where through `missed`). */
+  /**
+   * Feeds a frame at `t`; returns frames confirmed missing (and reports where through `missed`).
+   *
+   * Kept small, so that it is inlined into the monitor's `frame()`: a double handed to a call
+   * that is not inlined is boxed (a 16-byte heap number every frame), so the time goes to
+   * #frameAt through #nowUs (a field holding a double is written in place).
+   */
   frame(t: number, period: number, missed: (fromUs: number, toUs: number, count: number) => void): number {
     if (!Number.isFinite(period)) return 0;
+    this.#nowUs = t;
+    return this.#frameAt(period, missed);
+  }
+
+  /** `frame()` at #nowUs, with a known period. */
+  #frameAt(period: number, missed: (fromUs: number, toUs: number, count: number) => void): number {
+    let t = this.#nowUs;
     // Chunk-time estimates of two chunks delivered together can overlap a little: not a clock step.
     if (t < this.#lastUs && t > this.#lastUs - period) t = this.#lastUs;
     if (period !== this.#period || !Number.isFinite(this.#refUs) || !(t >= this.#lastUs || Number.isNaN(this.#lastUs))) {

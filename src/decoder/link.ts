@@ -141,7 +141,12 @@ const RATE_WINDOW = 512;
 export class LinkMonitor {
   readonly #holdOption: number | undefined;
   readonly #failsafeAfterUs: number;
-  readonly #jitterPrior: number;
+  /**
+   * Starts as NaN so that V8 keeps it as a double even when the option is a whole number: the
+   * jitter in force is this or the measured one, and a whole-number field beside a double made
+   * optimised code box the double every frame (16 bytes a frame).
+   */
+  readonly #jitterPrior: number = NaN;
   readonly #onMissed: LinkOptions['onMissed'];
   #state: LinkState = 'waiting';
   #lastUs = NaN;
@@ -300,7 +305,7 @@ export class LinkMonitor {
         if (gap > 3 * (Number.isFinite(p) ? p : FRAME_PERIOD_22MS_US)) this.#periodCount = 0;
       }
       this.#lastUs = t;
-      this.#measure(t, fades);
+      this.#measure(fades); // at #lastUs: a double handed to a call that is not inlined is boxed, 16 bytes a frame
       this.#ledger.frame(t, s.nominalPeriodUs, this.#missed);
       this.#confirmHolds();
       s.deliveryDelayUs = this.#ledger.delayUs;
@@ -585,7 +590,9 @@ export class LinkMonitor {
     this.#open = episode;
   }
 
-  #measure(t: number, fadesDelta: number): void {
+  /** Period and fade rate with the frame at #lastUs. */
+  #measure(fadesDelta: number): void {
+    const t = this.#lastUs;
     const s = this.#stats;
     // Period: the span of the last 32 gap-free intervals, which averages out chunk jitter.
     const times = this.#periodTimes;
