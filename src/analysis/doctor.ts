@@ -130,6 +130,17 @@ export class Doctor {
   }
 
   /**
+   * The port's decoder and link monitor were restored (a replay seeking to a checkpoint): their
+   * counters already hold what came before, none of it in this doctor's time, so the per-second
+   * missed frames and damage count from where the counters stand now.
+   */
+  restored(port: number): void {
+    const p = this.#port(port);
+    p.prevMissed = p.source?.link?.stats.lostFrames ?? 0;
+    p.prevDiscarded = p.source?.decoder.stats.discardedBytes ?? 0;
+  }
+
+  /**
    * The port was opened (or reopened) at `timeUs`, at `baudRate` (default 115200). Opening at
    * another rate starts a probe: what is recognised there confirms a line finding.
    */

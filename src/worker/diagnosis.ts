@@ -111,6 +111,11 @@ export class Diagnosis {
     };
   }
 
+  /** A source's decoder and link monitor were restored from a checkpoint: the doctor counts from there. */
+  restored(id: number): void {
+    this.#doctor.restored(id);
+  }
+
   /** A source's label changed: the findings name it. */
   relabel(id: number, engine: Engine, label: string): void {
     this.#labels.set(id, label);

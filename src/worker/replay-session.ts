@@ -254,7 +254,12 @@ export class ReplaySession implements Driver {
     this.#resetSources();
     const from = this.#checkpointFor(timeUs);
     if (from !== undefined && from !== null) {
-      for (const [port, cp] of from.ports) this.#p.registry.get(port)?.engine.restore(cp.decoder, cp.link);
+      for (const [port, cp] of from.ports) {
+        const engine = this.#p.registry.get(port)?.engine;
+        if (engine === undefined) continue;
+        engine.restore(cp.decoder, cp.link);
+        this.#p.diagnosis.restored(port);
+      }
     }
     this.source.seek(timeUs, from === undefined ? undefined : (from?.chunk ?? 0));
     this.#p.registry.setAllStates(state);
