@@ -17,9 +17,10 @@ const SPEEDS = [
   [0, 'max'],
 ] as const;
 
+/** m:ss.s, rounded to a tenth before it is split, so 59.96 s reads 1:00.0, never 0:60.0. */
 function clock(us: number): string {
-  const s = Math.max(0, us / 1e6);
-  return `${Math.floor(s / 60)}:${(s % 60).toFixed(1).padStart(4, '0')}`;
+  const tenths = Math.round(Math.max(0, us / 1e5));
+  return `${Math.floor(tenths / 600)}:${((tenths % 600) / 10).toFixed(1).padStart(4, '0')}`;
 }
 
 // The replay status comes five times a second and mostly only its position moves: the bar
