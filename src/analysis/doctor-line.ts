@@ -88,6 +88,16 @@ export function startsCandidate(byte: number): boolean {
  * the next header 25 bytes on). `onPacket` is called once per packet with its kind and the
  * stream index of its last byte.
  */
+/** `PacketScanner.checkpoint()`. */
+export interface PacketScannerCheckpoint {
+  readonly ring: Uint8Array;
+  readonly n: number;
+  readonly pendingAt: Float64Array;
+  readonly pendingKind: Uint8Array;
+  readonly pending: number;
+  readonly lastSrxl2Type: number;
+}
+
 export class PacketScanner {
   readonly #ring = new Uint8Array(HISTORY);
   /** Stream index of the next byte. */
@@ -108,6 +118,28 @@ export class PacketScanner {
    * bytes fed since hold no `startsCandidate` byte in their first `SCAN_MEMORY`, the scanner is in
    * the very state it would be in had it scanned everything.
    */
+  /** The scanner's whole state (the last bytes, the candidates pending, the stream index), as copies. */
+  checkpoint(): PacketScannerCheckpoint {
+    return {
+      ring: this.#ring.slice(),
+      n: this.#n,
+      pendingAt: this.#pendingAt.slice(),
+      pendingKind: this.#pendingKind.slice(),
+      pending: this.#pending,
+      lastSrxl2Type: this.lastSrxl2Type,
+    };
+  }
+
+  /** Back to where `checkpoint()` was taken (on this scanner or another); `onPacket` stays its own. */
+  restore(cp: PacketScannerCheckpoint): void {
+    this.#ring.set(cp.ring);
+    this.#n = cp.n;
+    this.#pendingAt.set(cp.pendingAt);
+    this.#pendingKind.set(cp.pendingKind);
+    this.#pending = cp.pending;
+    this.lastSrxl2Type = cp.lastSrxl2Type;
+  }
+
   pass(count: number): void {
     this.#n += count;
     this.#pending = 0;
@@ -325,6 +357,14 @@ export function classifyLine(c: LineCounts): LineVerdict {
  * `gapUs`; the period is the median interval between burst starts when at least 70 % of the
  * intervals lie within 10 % of it. Keeps the last 64 burst starts.
  */
+/** `BurstClock.checkpoint()`. */
+export interface BurstClockCheckpoint {
+  readonly starts: Float64Array;
+  readonly count: number;
+  readonly next: number;
+  readonly last: number;
+}
+
 export class BurstClock {
   readonly #starts = new Float64Array(64);
   #count = 0;
@@ -340,6 +380,19 @@ export class BurstClock {
       if (this.#count < 64) this.#count++;
     }
     if (t > this.#last) this.#last = t;
+  }
+
+  /** The burst starts kept and the last event, as copies. */
+  checkpoint(): BurstClockCheckpoint {
+    return { starts: this.#starts.slice(), count: this.#count, next: this.#next, last: this.#last };
+  }
+
+  /** Back to where `checkpoint()` was taken; `gapUs` stays this clock's own. */
+  restore(cp: BurstClockCheckpoint): void {
+    this.#starts.set(cp.starts);
+    this.#count = cp.count;
+    this.#next = cp.next;
+    this.#last = cp.last;
   }
 
   /** Forget everything (e.g. when the port reopens). */

@@ -10,28 +10,51 @@
  */
 import type { Capture } from '../capture/index.js';
 import { capturePorts } from '../capture/index.js';
-import { healthReportFeeding } from './report.js';
+import { healthReportFeeding, type ReadingsElsewhere } from './report.js';
+import type { PortReadingJob } from './report-port-message.js';
+import { likelyReadings } from './resolution-key.js';
 import type { HealthReport, HealthReportOptions } from './report-types.js';
 import { captureSpan, decodeCapture } from './capture-pass.js';
 import { doctorCapture } from './doctor-capture.js';
 import { Doctor } from './doctor.js';
-import type { DoctorFinding } from './doctor-types.js';
+import type { DoctorFinding, DoctorOptions } from './doctor-types.js';
+
+/** The report's doctor for a timed capture: the whole capture remembered, times from its start. */
+function reportDoctorOptions(capture: Capture, span: { startUs: number }): DoctorOptions {
+  return {
+    timing: capture.timing === 'per-byte' ? 'per-byte' : 'per-chunk',
+    memoryUs: Infinity,
+    originUs: Number.isFinite(span.startUs) ? span.startUs : 0,
+  };
+}
+
+/**
+ * The port readings `diagnosedHealthReport(capture, options)` will most likely ask for besides
+ * its first (`likelyReadings`), with its clock and its doctor's options: jobs for other threads
+ * (`readPortMessage`), handed back through its `elsewhere`.
+ */
+export function diagnosedReportJobs(capture: Capture, options: HealthReportOptions = {}): PortReadingJob[] {
+  const span = captureSpan(capture);
+  const doctor = capture.timing === 'none' ? null : reportDoctorOptions(capture, span);
+  return likelyReadings(capture, capturePorts(capture), options.resolution ?? 'auto').map((r) => ({
+    ...r,
+    originUs: span.startUs,
+    endUs: span.endUs,
+    doctor,
+  }));
+}
 
 /** `healthReport(capture, options)` with `diagnosis` filled in. Pure, like both. */
-export function diagnosedHealthReport(capture: Capture, options: HealthReportOptions = {}): HealthReport {
+export function diagnosedHealthReport(capture: Capture, options: HealthReportOptions = {}, elsewhere?: ReadingsElsewhere): HealthReport {
   let report: HealthReport;
   let findings: DoctorFinding[];
   if (capture.timing === 'none') {
-    report = healthReportFeeding(capture, options, undefined);
+    report = healthReportFeeding(capture, options, undefined, undefined, elsewhere);
     findings = doctorCapture(capture, options.resolution !== undefined ? { resolution: options.resolution } : {}).findings;
   } else {
     const span = captureSpan(capture);
-    const doctor = new Doctor({
-      timing: capture.timing === 'per-byte' ? 'per-byte' : 'per-chunk',
-      memoryUs: Infinity,
-      originUs: Number.isFinite(span.startUs) ? span.startUs : 0,
-    });
-    report = healthReportFeeding(capture, options, doctor, span);
+    const doctor = new Doctor(reportDoctorOptions(capture, span));
+    report = healthReportFeeding(capture, options, doctor, span, elsewhere);
     // Ports with events but no data (opened, and nothing came): the doctor hears their events.
     const data = new Set(capturePorts(capture));
     const quiet = [...new Set(capture.events.map((e) => e.port))].filter((p) => !data.has(p)).sort((a, b) => a - b);

@@ -168,6 +168,16 @@ function contiguous(mask: number, min: number, max: number): number {
   return mask >>> n === 0 ? n : 0;
 }
 
+/** `ArduPilotGuess.checkpoint()`. */
+export interface ArduPilotGuessCheckpoint {
+  readonly outcomes: GuessTally;
+  readonly last10: number;
+  readonly last11: number;
+  readonly cs10: number;
+  readonly cs11: number;
+  readonly samples: number;
+}
+
 /** Replays ArduPilot's guess over a remote's frames, window after window, and counts the outcomes. */
 export class ArduPilotGuess {
   readonly outcomes: GuessTally = { 10: 0, 11: 0, none: 0 };
@@ -177,6 +187,28 @@ export class ArduPilotGuess {
   #cs10 = 0;
   #cs11 = 0;
   #samples = 0;
+
+  /** The outcomes and the window in progress, as a copy. */
+  checkpoint(): ArduPilotGuessCheckpoint {
+    return {
+      outcomes: { ...this.outcomes },
+      last10: this.last10,
+      last11: this.last11,
+      cs10: this.#cs10,
+      cs11: this.#cs11,
+      samples: this.#samples,
+    };
+  }
+
+  /** Back to where `checkpoint()` was taken. */
+  restore(cp: ArduPilotGuessCheckpoint): void {
+    Object.assign(this.outcomes, cp.outcomes);
+    this.last10 = cp.last10;
+    this.last11 = cp.last11;
+    this.#cs10 = cp.cs10;
+    this.#cs11 = cp.cs11;
+    this.#samples = cp.samples;
+  }
 
   /** One frame's 16 bytes. */
   frame(b: ArrayLike<number>): void {

@@ -3,8 +3,15 @@
  * 64 seconds, and the state its rules read (activity, packets, frames, formats, restarts).
  */
 import type { Resolution } from '../decoder/index.js';
-import { type BurstClock, PACKET_KINDS, type PacketKind, type PacketScanner } from './doctor-line.js';
-import type { ArduPilotGuess, ForeignProtocol } from './doctor-stacks.js';
+import {
+  type BurstClock,
+  type BurstClockCheckpoint,
+  PACKET_KINDS,
+  type PacketKind,
+  type PacketScanner,
+  type PacketScannerCheckpoint,
+} from './doctor-line.js';
+import type { ArduPilotGuess, ArduPilotGuessCheckpoint, ForeignProtocol } from './doctor-stacks.js';
 import type { DoctorPortSource } from './doctor-types.js';
 
 /** Silence after the port opened before "nothing arrives": a linked satellite sends every 11 or 22 ms, so 1 s is 45 missed frames. */
@@ -104,6 +111,23 @@ export class Bins {
   clear(): void {
     this.#second.fill(NaN);
   }
+
+  /** The counters and the second each slot holds, as copies (`Doctor.portCheckpoint`). */
+  checkpoint(): BinsCheckpoint {
+    return { data: this.#data.slice(), second: this.#second.slice() };
+  }
+
+  /** Back to where `checkpoint()` was taken; `cp` is copied, so it can be restored again. */
+  restore(cp: BinsCheckpoint): void {
+    this.#data.set(cp.data);
+    this.#second.set(cp.second);
+  }
+}
+
+/** `Bins.checkpoint()`. */
+export interface BinsCheckpoint {
+  readonly data: Float64Array;
+  readonly second: Float64Array;
 }
 
 export interface FormatSnapshot {
@@ -152,6 +176,17 @@ export interface PortState {
   restarts: { timeUs: number; from: number; to: number; gapUs: number }[];
   rssiFrames: number;
 }
+
+/**
+ * `Doctor.portCheckpoint()`: a port's whole state as plain data (structured-clonable), without
+ * the decoder and link monitor it reads (`source`, attached again by whoever restores).
+ */
+export type PortCheckpoint = Omit<PortState, 'source' | 'bins' | 'scanner' | 'burst' | 'guess'> & {
+  readonly bins: BinsCheckpoint;
+  readonly scanner: PacketScannerCheckpoint;
+  readonly burst: BurstClockCheckpoint;
+  readonly guess: ArduPilotGuessCheckpoint;
+};
 
 /** "2.4 s" */
 export const dur = (us: number): string => `${(us / 1e6).toFixed(1)} s`;

@@ -32,6 +32,7 @@ import {
   RESTART_MIN_GAP_US,
   SETUP_MIN_FRAMES,
   type FormatSnapshot,
+  type PortCheckpoint,
   type PortState,
 } from './doctor-state.js';
 import type { AddFinding, Confidence, DoctorFinding, DoctorOptions, DoctorPortSource, RuleContext, Severity } from './doctor-types.js';
@@ -138,6 +139,53 @@ export class Doctor {
     const p = this.#port(port);
     p.prevMissed = p.source?.link?.stats.lostFrames ?? 0;
     p.prevDiscarded = p.source?.decoder.stats.discardedBytes ?? 0;
+  }
+
+  /**
+   * Everything this doctor holds of `port` (undefined when it holds nothing), as plain data no
+   * later call changes: `restorePort` puts it into another doctor (a port decoded on another
+   * thread), where it answers exactly as if that doctor had been fed the port itself. What the
+   * doctor holds across ports (when each finding first held) is not in it.
+   */
+  portCheckpoint(port: number): PortCheckpoint | undefined {
+    const p = this.#ports.get(port);
+    if (p === undefined) return undefined;
+    // The snapshots and records in the lists are never changed once made: the lists are copied.
+    const { source: _source, bins, scanner, burst, guess, probePackets, damagedAtUs, changes, restarts, ...plain } = p;
+    return {
+      ...plain,
+      probePackets: { ...probePackets },
+      damagedAtUs: [...damagedAtUs],
+      changes: [...changes],
+      restarts: [...restarts],
+      bins: bins.checkpoint(),
+      scanner: scanner.checkpoint(),
+      burst: burst.checkpoint(),
+      guess: guess.checkpoint(),
+    };
+  }
+
+  /**
+   * `port` as `cp` has it (from `portCheckpoint`, of this doctor or another), reading `source`'s
+   * decoder and link monitor from now on: those must be at the same point of the stream (restored
+   * from their own checkpoints of that moment). Whatever this doctor held of the port is replaced.
+   */
+  restorePort(port: number, cp: PortCheckpoint, source: DoctorPortSource): void {
+    this.detach(port);
+    const p = this.#port(port);
+    const { bins, scanner, burst, guess, probePackets, damagedAtUs, changes, restarts, ...plain } = cp;
+    Object.assign(p, plain, {
+      port,
+      source,
+      probePackets: { ...probePackets },
+      damagedAtUs: [...damagedAtUs],
+      changes: [...changes],
+      restarts: [...restarts],
+    });
+    p.bins.restore(bins);
+    p.scanner.restore(scanner);
+    p.burst.restore(burst);
+    p.guess.restore(guess);
   }
 
   /**

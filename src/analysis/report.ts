@@ -10,11 +10,12 @@
  */
 import type { Capture } from '../capture/index.js';
 import { capturePorts } from '../capture/index.js';
-import { CHANNEL_COUNT, channelName, systemInfo, type LinkEpisode } from '../decoder/index.js';
+import { CHANNEL_COUNT, channelName, systemInfo, type LinkEpisode, type Resolution } from '../decoder/index.js';
 import { captureSpan } from './capture-pass.js';
 import type { Doctor } from './doctor.js';
 import { looksInternal, readPorts } from './resolution-key.js';
 import { decodePort, type PortPass } from './report-port.js';
+import { adoptPortMessage, type PortReadingMessage } from './report-port-message.js';
 import { LEVEL_ORDER, remoteFindings, statusOf } from './report-findings.js';
 import { MAX_LISTED_HOLDS, REPORT_BIN_US, REPORT_THRESHOLDS } from './report-thresholds.js';
 import { finite, plural, r1, r1n, r3 } from './report-text.js';
@@ -48,15 +49,27 @@ export function healthReport(capture: Capture, options: HealthReportOptions = {}
 }
 
 /**
+ * A port's final reading made elsewhere (another thread, `readPortMessage`), or undefined when
+ * nobody made that one: the report then decodes the port itself.
+ */
+export type ReadingsElsewhere = (
+  port: number,
+  resolution: 'auto' | Resolution,
+  from: 'user' | 'internal-remote',
+) => PortReadingMessage | undefined;
+
+/**
  * `healthReport`, with `doctor` (when given, for a timed capture) fed every port's bytes, events
  * and frames from the same decode: `diagnosedHealthReport` asks it for its findings after.
- * `span` is the capture's `captureSpan`, when the caller has it already.
+ * `span` is the capture's `captureSpan`, when the caller has it already; `elsewhere` gives
+ * readings made on other threads.
  */
 export function healthReportFeeding(
   capture: Capture,
   options: HealthReportOptions,
   doctor: Doctor | undefined,
   span: { startUs: number; endUs: number } = captureSpan(capture),
+  elsewhere?: ReadingsElsewhere,
 ): HealthReport {
   const ports = capturePorts(capture);
   const timed = capture.timing !== 'none';
@@ -68,7 +81,11 @@ export function healthReportFeeding(
     ports,
     options.resolution ?? 'auto',
     (port) => looksInternal(capture, port),
-    (port, resolution, from, final) => decodePort(capture, port, resolution, from, final ? pass : { ...pass, doctor: undefined }),
+    (port, resolution, from, final) => {
+      const made = final ? elsewhere?.(port, resolution, from) : undefined;
+      if (made !== undefined) return adoptPortMessage(capture, made, doctor);
+      return decodePort(capture, port, resolution, from, final ? pass : { ...pass, doctor: undefined });
+    },
   );
   const decoded = ports.flatMap((p) => read.get(p) ?? []);
 

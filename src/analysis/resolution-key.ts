@@ -23,11 +23,11 @@ export function resolutionKey(formats: Iterable<FormatInfo>): Resolution | undef
 const LOOK_AHEAD_BYTES = 1 << 16;
 
 /**
- * Whether a port's stream starts as an internal remote: its first bytes (up to 64 kB, until the
- * decoder locks) through a decoder of their own. Only an order to decode in: the key itself
+ * What a port's stream starts as: its first bytes (up to 64 kB, until the decoder locks) through
+ * a decoder of their own. Only an order to decode in and a guess of the key: the key itself
  * comes from the whole decode.
  */
-export function looksInternal(capture: Capture, port: number): boolean {
+function lookAhead(capture: Capture, port: number): FormatInfo {
   const decoder = new SpektrumDecoder();
   const { bytes, chunkEnds, chunkPorts } = capture;
   let from = 0;
@@ -43,7 +43,41 @@ export function looksInternal(capture: Capture, port: number): boolean {
     }
     from = to;
   }
-  return decoder.format.remote === 'internal';
+  return decoder.format;
+}
+
+/** Whether a port's stream starts as an internal remote (`lookAhead`). */
+export function looksInternal(capture: Capture, port: number): boolean {
+  return lookAhead(capture, port).remote === 'internal';
+}
+
+/** A reading `readPorts` asks its decode for. */
+export interface PortReadingAsked {
+  port: number;
+  resolution: 'auto' | Resolution;
+  from: 'user' | 'internal-remote';
+}
+
+/**
+ * The final readings `readPorts` (with `looksInternal` as its `leads`) will most likely ask for,
+ * in the order it asks, but for the first: what another thread can make while this one makes
+ * the first. A guess from each port's first bytes (`lookAhead`): the key the internal remote's
+ * start shows is the one its whole decode gives unless the remote changed its resolution.
+ */
+export function likelyReadings(capture: Capture, ports: readonly number[], resolution: 'auto' | Resolution): PortReadingAsked[] {
+  if (resolution !== 'auto' || ports.length < 2) return ports.slice(1).map((port) => ({ port, resolution, from: 'user' }));
+  const starts = new Map(ports.map((p) => [p, lookAhead(capture, p)]));
+  const lead = ports.filter((p) => starts.get(p)?.remote === 'internal');
+  const key = resolutionKey(lead.flatMap((p) => starts.get(p) ?? []));
+  const order = [...lead, ...ports.filter((p) => !lead.includes(p))];
+  return order
+    .slice(1)
+    .map(
+      (port): PortReadingAsked =>
+        key === undefined || lead.includes(port)
+          ? { port, resolution: 'auto', from: 'user' }
+          : { port, resolution: key, from: 'internal-remote' },
+    );
 }
 
 /** What a port's decode must show for the choice between readings. */

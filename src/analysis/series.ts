@@ -147,6 +147,42 @@ export class LinkSeries {
     const n = this.#intervalN.data[i] ?? 0;
     return n > 0 ? (this.#intervalSum.data[i] ?? 0) / n : NaN;
   }
+
+  /** The whole series as plain data (copies of its bins so far), for `restore` in another series of the same `binUs`. */
+  checkpoint(): LinkSeriesCheckpoint {
+    return {
+      binUs: this.binUs,
+      originUs: this.#origin,
+      bins: this.#bins,
+      sealed: this.#sealed,
+      columns: this.#columns.map((c) => c.data.slice(0, this.#bins)),
+    };
+  }
+
+  /**
+   * Back to where `checkpoint()` was taken.
+   * @throws {TypeError} when `cp` has another bin width
+   */
+  restore(cp: LinkSeriesCheckpoint): void {
+    if (cp.binUs !== this.binUs) throw new TypeError(`a series of ${cp.binUs} µs bins cannot restore into one of ${this.binUs} µs`);
+    this.#origin = cp.originUs;
+    this.#bins = cp.bins;
+    this.#sealed = cp.sealed;
+    this.#columns.forEach((c, i) => {
+      c.data = new Float64Array(Math.max(64, cp.bins)).fill(c.fill);
+      c.data.set(cp.columns[i] ?? []);
+    });
+  }
+}
+
+/** `LinkSeries.checkpoint()`. */
+export interface LinkSeriesCheckpoint {
+  readonly binUs: number;
+  readonly originUs: number;
+  readonly bins: number;
+  readonly sealed: number;
+  /** Frames, fades, lost, RSSI sum, RSSI count, RSSI minimum, interval sum, interval count: one value a bin. */
+  readonly columns: readonly Float64Array[];
 }
 
 /** A link monitor whose missed frames go into `series` too. */
