@@ -34,7 +34,8 @@ export type {
   Evidence,
   Severity,
 } from './doctor-types.js';
-export { diagnosedHealthReport } from './doctor-report.js';
+export { diagnosedHealthReport, diagnosedReportJobs } from './doctor-report.js';
+export { readPortMessage, sameReading, type PortReadingJob, type PortReadingMessage } from './report-port-message.js';
 export { doctorCapture, type DoctorCaptureOptions, type DoctorReport, type DoctorTimelineEntry } from './doctor-capture.js';
 export { doctorEvent } from './doctor-events.js';
 export {
@@ -56,7 +57,7 @@ export { captureSpan, decodeCapture, timingJitterUs, type DecodeCaptureOptions }
 export { resolutionKey } from './resolution-key.js';
 export { summarizeCapture, type CaptureSummary, type ChannelSummary } from './summary.js';
 export { LinkSeries, monitorWithSeries } from './series.js';
-export { healthReport } from './report.js';
+export { healthReport, type ReadingsElsewhere } from './report.js';
 export { formatClock, formatDuration } from './report-text.js';
 export { REPORT_BIN_US, REPORT_THRESHOLDS, SPIKE_MIN_JUMP_PERCENT, type ReportThresholds } from './report-thresholds.js';
 export type {

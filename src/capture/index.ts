@@ -31,7 +31,7 @@ export {
   hasCaptureMagic,
 } from './layout.js';
 export { CaptureWriter, encodeCapture, type CaptureRecordInput } from './writer.js';
-export { parseCapture } from './reader.js';
+export { parseCapture, type ReadOptions } from './reader.js';
 export { importRaw } from './raw.js';
 export { importSaleaeCsv } from './saleae.js';
 export { readCapture } from './sniff.js';

@@ -392,8 +392,8 @@ function readMeta(bytes: Uint8Array, start: number, end: number, issues: Capture
  *   to recover (it ends inside its header).
  * @throws {TypeError} when `bytes` is not a Uint8Array.
  */
-export function parseCapture(bytes: Uint8Array): ParsedCapture {
-  return readSscap(bytes, { crcBytes: 0, crcCombines: 0, probes: 0 });
+export function parseCapture(bytes: Uint8Array, options: ReadOptions = {}): ParsedCapture {
+  return readSscap(bytes, { crcBytes: 0, crcCombines: 0, probes: 0 }, options.shared === true);
 }
 
 /**
@@ -402,7 +402,7 @@ export function parseCapture(bytes: Uint8Array): ParsedCapture {
  */
 export function parseCaptureCounting(bytes: Uint8Array): { capture: ParsedCapture; work: CaptureReaderWork } {
   const work: CaptureReaderWork = { crcBytes: 0, crcCombines: 0, probes: 0 };
-  return { capture: readSscap(bytes, work), work };
+  return { capture: readSscap(bytes, work, false), work };
 }
 
 /** `array` when it is `length` long, a view of its first `length` elements when that wastes little, else a trimmed copy. */
@@ -441,7 +441,16 @@ function plannedSizes(bytes: Uint8Array, view: DataView, headerLength: number): 
   return p === n ? { records, data } : null;
 }
 
-function readSscap(bytes: Uint8Array, work: CaptureReaderWork): ParsedCapture {
+/** How `parseCapture` lays out what it reads. */
+export interface ReadOptions {
+  /**
+   * The data bytes and chunk columns in `SharedArrayBuffer`s, so that worker threads read them
+   * without a copy (what `satscope report` does on two cores). Default false.
+   */
+  shared?: boolean;
+}
+
+function readSscap(bytes: Uint8Array, work: CaptureReaderWork, shared: boolean): ParsedCapture {
   if (!(bytes instanceof Uint8Array)) throw new TypeError('parseCapture expects a Uint8Array');
   const view = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
   const probe = new RecordProbe(bytes, view, work);
@@ -458,11 +467,12 @@ function readSscap(bytes: Uint8Array, work: CaptureReaderWork): ParsedCapture {
   const maxRecords = Math.floor(room / RECORD_OVERHEAD);
   const maxData = Math.max(0, room - RECORD_OVERHEAD);
   const planned = plannedSizes(bytes, view, headerLength);
-  let data = new Uint8Array(planned?.data ?? maxData);
+  const buffer = (size: number): ArrayBufferLike => (shared ? new SharedArrayBuffer(size) : new ArrayBuffer(size));
+  let data = new Uint8Array(buffer(planned?.data ?? maxData));
   let dataView = new DataView(data.buffer);
-  let chunkEnds = new Uint32Array(planned?.records ?? maxRecords);
-  let chunkTimes = new Float64Array(planned?.records ?? maxRecords);
-  let chunkPorts = new Uint8Array(planned?.records ?? maxRecords);
+  let chunkEnds = new Uint32Array(buffer(4 * (planned?.records ?? maxRecords)));
+  let chunkTimes = new Float64Array(buffer(8 * (planned?.records ?? maxRecords)));
+  let chunkPorts = new Uint8Array(buffer(planned?.records ?? maxRecords));
   const events: CaptureEvent[] = [];
   let dataLength = 0;
   let chunks = 0;
@@ -521,11 +531,11 @@ function readSscap(bytes: Uint8Array, work: CaptureReaderWork): ParsedCapture {
       if (bytes[p + REC_OFF_TYPE] === RECORD_TYPE_DATA) {
         if (chunks === chunkEnds.length || dataLength + len > data.length) {
           // Not in a closure: the columns stay plain locals of this loop.
-          data = grown(new Uint8Array(maxData), data);
+          data = grown(new Uint8Array(buffer(maxData)), data);
           dataView = new DataView(data.buffer);
-          chunkEnds = grown(new Uint32Array(maxRecords), chunkEnds);
-          chunkTimes = grown(new Float64Array(maxRecords), chunkTimes);
-          chunkPorts = grown(new Uint8Array(maxRecords), chunkPorts);
+          chunkEnds = grown(new Uint32Array(buffer(4 * maxRecords)), chunkEnds);
+          chunkTimes = grown(new Float64Array(buffer(8 * maxRecords)), chunkTimes);
+          chunkPorts = grown(new Uint8Array(buffer(maxRecords)), chunkPorts);
         }
         // Short chunks (the usual case) are copied by hand, four bytes at a time: cheaper than
         // making a subarray for set().

@@ -6,7 +6,7 @@ import { CAPTURE_FILE_EXTENSION, isCaptureMagicPrefix } from './layout.js';
 import { CaptureFormatError } from './model.js';
 import type { Capture } from './model.js';
 import { importRaw } from './raw.js';
-import { looksLikeCaptureMagic, parseCapture } from './reader.js';
+import { looksLikeCaptureMagic, parseCapture, type ReadOptions } from './reader.js';
 import { CR, LF, bomLength, csvColumns, importSaleaeCsv, isBlank, quote } from './saleae.js';
 
 /** How much of a file the text check looks at. */
@@ -55,18 +55,21 @@ function hasExtension(fileName: string | undefined, ext: string): boolean {
  * 3. a `.bin` name, or content that is not text → `importRaw`;
  * 4. any other text (JSON, a README…) → `CaptureFormatError`.
  *
+ * `options.shared` puts an .sscap's columns in shared memory (`ReadOptions`); the imports of a
+ * CSV or raw bytes ignore it.
+ *
  * @throws {CaptureFormatError} for an empty file, a .sscap with nothing to recover (see
  *   `parseCapture`), or text that is not a Saleae async-serial CSV.
  * @throws {TypeError} when `bytes` is not a Uint8Array.
  */
-export function readCapture(bytes: Uint8Array, fileName?: string): Capture {
+export function readCapture(bytes: Uint8Array, fileName?: string, options: ReadOptions = {}): Capture {
   if (!(bytes instanceof Uint8Array)) throw new TypeError('readCapture expects a Uint8Array');
   const named = fileName ? ` (${fileName})` : '';
   if (bytes.length === 0) throw new CaptureFormatError(`empty file${named}: there is nothing to decode`);
   const isBin = hasExtension(fileName, '.bin');
   // A file shorter than the signature that matches its start is a cut-off .sscap, unless named .bin.
   if (looksLikeCaptureMagic(bytes) || (!isBin && isCaptureMagicPrefix(bytes)) || hasExtension(fileName, CAPTURE_FILE_EXTENSION)) {
-    return parseCapture(bytes);
+    return parseCapture(bytes, options);
   }
   const text = looksLikeText(bytes);
   const [ls, le] = firstLine(bytes);

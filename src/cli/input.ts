@@ -4,11 +4,12 @@
  */
 import { readFileSync } from 'node:fs';
 import { basename } from 'node:path';
-import { CaptureFormatError, readCapture, type Capture } from '../capture/index.js';
+import { CaptureFormatError, readCapture, type Capture, type ReadOptions } from '../capture/index.js';
 
 export type LoadedCapture = { capture: Capture } | { error: string; exitCode: 1 | 2 };
 
-export function loadCapture(file: string): LoadedCapture {
+/** `options.shared`: the columns in shared memory, for a command that hands them to worker threads (`ReadOptions`). */
+export function loadCapture(file: string, options: ReadOptions = {}): LoadedCapture {
   let bytes: Uint8Array;
   try {
     bytes = readFileSync(file);
@@ -25,7 +26,7 @@ export function loadCapture(file: string): LoadedCapture {
     return { error: `cannot read ${file}: ${why}`, exitCode: 2 };
   }
   try {
-    return { capture: readCapture(new Uint8Array(bytes.buffer, bytes.byteOffset, bytes.byteLength), basename(file)) };
+    return { capture: readCapture(new Uint8Array(bytes.buffer, bytes.byteOffset, bytes.byteLength), basename(file), options) };
   } catch (error) {
     if (error instanceof CaptureFormatError) return { error: `${file}: ${error.message}`, exitCode: 1 };
     throw error;

@@ -10,7 +10,8 @@ import { readFileSync, writeFileSync } from 'node:fs';
 import { basename } from 'node:path';
 import { captureChunks, capturePorts, type Capture, type CaptureChunk } from '../capture/index.js';
 import { SpektrumDecoder } from '../decoder/index.js';
-import { diagnosedHealthReport, reportHtml, summarizeCapture } from '../analysis/index.js';
+import { reportHtml, summarizeCapture } from '../analysis/index.js';
+import { threadedReport } from './report-threads.js';
 import { parseCommandLine, UsageError, type Args } from './args.js';
 import { loadCapture } from './input.js';
 import { formatJsonLine, formatCsvHeader, formatCsvLine, formatReportVerdict, formatSummary } from './format.js';
@@ -54,7 +55,8 @@ async function main(argv: string[]): Promise<number> {
     out.text(`${pkg.version}\n`);
     return finish(out, 0);
   }
-  const loaded = loadCapture(args.file);
+  // The report decodes ports on two threads, which read the columns where they are.
+  const loaded = loadCapture(args.file, { shared: args.command === 'report' });
   if ('error' in loaded) {
     process.stderr.write(`satscope: ${loaded.error}\n`);
     return loaded.exitCode;
@@ -165,7 +167,7 @@ async function finish(out: TextOutput, code: number): Promise<number> {
 /** `satscope report`: the health report of every port with the doctor's findings, as HTML or JSON, to stdout or --out. */
 async function report(capture: Capture, args: Args, out: TextOutput): Promise<number> {
   const name = basename(args.file);
-  const r = diagnosedHealthReport(capture, { resolution: args.resolution, name });
+  const r = threadedReport(capture, { resolution: args.resolution, name }).report;
   const text = args.json ? `${JSON.stringify(r, null, 2)}\n` : reportHtml(r);
   if (args.out !== null) {
     try {
