@@ -210,14 +210,12 @@ export class ArduPilotGuess {
     this.#samples = cp.samples;
   }
 
-  /** One frame's 16 bytes. */
-  frame(b: ArrayLike<number>): void {
-    const vtx =
-      ((((b[12] ?? 0) << 24) | ((b[13] ?? 0) << 16) | ((b[14] ?? 0) << 8) | (b[15] ?? 0)) & VTX_MASK) >>> 0 === VTX_MARKER &&
-      ((b[2] ?? 0) & 0x80) === 0;
+  /** One frame's seven raw slot words, as sent (`DecodedFrame.words`: bytes 2–15, big-endian). */
+  frame(w: ArrayLike<number>): void {
+    const vtx = ((((w[5] ?? 0) << 16) | (w[6] ?? 0)) & VTX_MASK) >>> 0 === VTX_MARKER && ((w[0] ?? 0) & 0x8000) === 0;
     const slots = vtx ? 5 : 7;
     for (let i = 0; i < slots; i++) {
-      const raw = ((b[2 + 2 * i] ?? 0) << 8) | (b[3 + 2 * i] ?? 0);
+      const raw = w[i] ?? 0;
       if (raw === 0xffff) continue;
       this.#cs10 |= 1 << ((raw >> 10) & 0xf);
       this.#cs11 |= 1 << ((raw >> 11) & 0xf);

@@ -287,7 +287,7 @@ export class Doctor {
     const slot = p.bins.slotOf(f);
     p.frames++;
     p.bins.addTo(slot, M_FRAME_BYTES, FRAME_SIZE);
-    p.guess.frame(f.bytes);
+    p.guess.frame(f.words);
     for (let i = 0; i < f.count; i++) {
       const id = f.ids[i] ?? 0;
       if (id >= 12) {
@@ -319,11 +319,15 @@ export class Doctor {
     // wrap: a wrap after a gap adds about as many fades as frames were missed.
     if (f.fades !== null && p.prevFades !== null && Number.isFinite(t) && Number.isFinite(p.prevFrameUs)) {
       const gap = t - p.prevFrameUs;
-      const modulus = f.remote === 'internal' ? 256 : 65536;
-      const period = link !== undefined && Number.isFinite(link.stats.nominalPeriodUs) ? link.stats.nominalPeriodUs : 22_000;
-      const expected = Math.max(0, Math.round(gap / period) - 1);
-      const wrapped = (f.fades - p.prevFades + modulus) % modulus;
-      const restarted = f.fades < p.prevFades && gap >= RESTART_MIN_GAP_US && Math.abs(wrapped - expected) > Math.max(8, 0.5 * expected);
+      // Only a counter that went down after a long gap can be a restart (the rest is per frame).
+      let restarted = false;
+      if (f.fades < p.prevFades && gap >= RESTART_MIN_GAP_US) {
+        const modulus = f.remote === 'internal' ? 256 : 65536;
+        const period = link !== undefined && Number.isFinite(link.stats.nominalPeriodUs) ? link.stats.nominalPeriodUs : 22_000;
+        const expected = Math.max(0, Math.round(gap / period) - 1);
+        const wrapped = (f.fades - p.prevFades + modulus) % modulus;
+        restarted = Math.abs(wrapped - expected) > Math.max(8, 0.5 * expected);
+      }
       if (restarted) p.restarts.push({ timeUs: t, from: p.prevFades, to: f.fades, gapUs: gap });
       else p.bins.addTo(slot, M_FADES, f.fadesDelta);
     }
