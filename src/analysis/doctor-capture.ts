@@ -10,6 +10,7 @@ import { Doctor } from './doctor.js';
 import type { DoctorCode, DoctorFinding, Severity } from './doctor-types.js';
 import { doctorEvent } from './doctor-events.js';
 import { SLICE_BYTES } from './capture-pass.js';
+import { portResolutions } from './resolution-key.js';
 
 export interface DoctorCaptureOptions {
   /** Resolution override for every port's decoder. Default 'auto'. */
@@ -142,8 +143,14 @@ export function doctorCapture(capture: Capture, options: DoctorCaptureOptions = 
   });
   const names = capture.meta.ports;
   const sources = new Map<number, { decoder: SpektrumDecoder; link: LinkMonitor }>();
+  // §8 as the health report applies it, so that the doctor reads each remote as the report does.
+  const settings = portResolutions(capture, options.resolution ?? 'auto');
   for (const port of sorted) {
-    const decoder = new SpektrumDecoder({ resolution: options.resolution ?? 'auto' });
+    const setting = settings.get(port);
+    const decoder = new SpektrumDecoder({
+      resolution: setting?.resolution ?? options.resolution ?? 'auto',
+      resolutionFrom: setting?.from ?? 'user',
+    });
     const link = new LinkMonitor({ jitterUs: capture.timing === 'per-chunk' ? USB_CHUNK_JITTER_US : 0 });
     sources.set(port, { decoder, link });
     const label = names?.[port]?.name;

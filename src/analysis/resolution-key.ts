@@ -3,7 +3,8 @@
  * remote takes from the internal one, and the order a whole capture's ports are decoded in so
  * that each is decoded once: the internal remote's port first, then the others with its key.
  */
-import type { Capture } from '../capture/index.js';
+import { capturePorts, type Capture } from '../capture/index.js';
+import { decodeCapture } from './capture-pass.js';
 import { SpektrumDecoder, systemInfo, type DecoderStats, type FormatInfo, type Resolution } from '../decoder/index.js';
 
 /**
@@ -175,4 +176,26 @@ function asWritten<T extends PortReading>(ports: readonly number[], decode: Port
     out.set(p, k.stats.frames >= mine.stats.frames ? decode(p, key, 'internal-remote', true) : decode(p, 'auto', 'user', true));
   });
   return out;
+}
+
+/**
+ * Each port's resolution setting as the health report reads the port (`readPorts`: the internal
+ * remote's key for the others, unless their own reading is better), for a surface that decodes
+ * the ports side by side and so cannot decode one before the other (`doctorCapture`). Decodes
+ * the ports as the report does, without what listens to the frames; a setting given by the user
+ * (or a single port) needs no decode.
+ */
+export function portResolutions(capture: Capture, resolution: 'auto' | Resolution): Map<number, PortReadingAsked> {
+  const ports = capturePorts(capture);
+  if (resolution !== 'auto' || ports.length < 2) return new Map(ports.map((port) => [port, { port, resolution, from: 'user' }]));
+  const read = readPorts(
+    ports,
+    resolution,
+    (port) => looksInternal(capture, port),
+    (port, r, from) => {
+      const { decoder } = decodeCapture(capture, { port, resolution: r, resolutionFrom: from }, () => {});
+      return { format: decoder.format, stats: decoder.stats, asked: { port, resolution: r, from } };
+    },
+  );
+  return new Map([...read].map(([port, reading]) => [port, reading.asked]));
 }
