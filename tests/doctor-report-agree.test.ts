@@ -40,7 +40,7 @@ const CAPTURES: [string, () => Capture][] = [
 ];
 
 /** What both say of a finding (the report keeps these of the doctor's). */
-const said = (f: { severity: string; confidence: string; title: string; evidence: { text: string }[] }) => ({
+const said = (f: { severity: string; confidence: string; title: string; evidence: readonly { text: string }[] }) => ({
   severity: f.severity,
   confidence: f.confidence,
   title: f.title,
@@ -51,7 +51,7 @@ describe('satscope doctor and the report agree', () => {
   for (const [name, make] of CAPTURES) {
     it(name, () => {
       const capture = make();
-      const report = diagnosedHealthReport(capture).diagnosis.map(said);
+      const report = (diagnosedHealthReport(capture).diagnosis ?? []).map(said);
       const doctor = doctorCapture(capture).findings.map(said);
       expect(report.length).toBeGreaterThan(0);
       expect(doctor).toEqual(report);
