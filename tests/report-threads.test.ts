@@ -1,11 +1,14 @@
 /**
- * `satscope report` on two threads (src/cli/report-threads.ts, run from the built package as
- * the command runs it): the report is byte for byte the one-thread report, its second port
+ * `satscope` on two threads (src/cli/report-threads.ts and input.ts, run from the built package
+ * as the command runs them): the report is byte for byte the one-thread report, its second port
  * really read by the worker thread; an .sscap read with `shared` has its columns in shared memory
- * (what the worker reads without a copy) and the same content.
+ * (what the worker reads without a copy) and the same content; a big capture read in two parts
+ * on two threads is the capture `readCapture` makes, and a damaged one is salvaged the same.
  */
-import { resolve } from 'node:path';
-import { describe, expect, it } from 'vitest';
+import { mkdtempSync, rmSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join, resolve } from 'node:path';
+import { afterAll, describe, expect, it } from 'vitest';
 import { diagnosedHealthReport, diagnosedReportJobs } from '../src/analysis/index.js';
 import { CaptureWriter, readCapture, type Capture } from '../src/capture/index.js';
 import { preset, simulate } from '../src/simulator/index.js';
@@ -56,5 +59,39 @@ describe('satscope report on two threads', () => {
     const small = threadedReport(capture, { name: 'two.sscap' });
     expect(small.fromWorker).toBe(0);
     expect(JSON.stringify(small.report)).toBe(alone);
+  });
+});
+
+describe('a big capture read on two threads', () => {
+  const bytes = file();
+  const dir = mkdtempSync(join(tmpdir(), 'satscope-parts-'));
+  afterAll(() => rmSync(dir, { recursive: true, force: true }));
+  const load = async (name: string, content: Uint8Array) => {
+    const path = join(dir, name);
+    writeFileSync(path, content);
+    const { loadCapture } = (await import(resolve(import.meta.dirname, '../dist/cli/input.js'))) as {
+      loadCapture: (file: string, options: object, partsMinBytes?: number) => { capture?: Capture; error?: string };
+    };
+    return loadCapture(path, {}, 0);
+  };
+  /** A capture's content, comparable across shared and plain memory. */
+  const content = (c: Capture | undefined) =>
+    c && { ...c, bytes: [...c.bytes], chunkEnds: [...c.chunkEnds], chunkTimesUs: [...c.chunkTimesUs], chunkPorts: [...c.chunkPorts] };
+
+  it('an intact .sscap: the capture readCapture makes, its columns in shared memory', async () => {
+    const loaded = await load('intact.sscap', bytes);
+    expect(loaded.capture?.bytes.buffer).toBeInstanceOf(SharedArrayBuffer);
+    expect(content(loaded.capture)).toEqual(content(readCapture(bytes, 'intact.sscap')));
+  });
+
+  it('a damaged one is salvaged as readCapture salvages it, and a file that is no capture is refused as ever', async () => {
+    const damaged = bytes.slice();
+    const at = Math.floor(bytes.length * 0.75);
+    damaged[at] = (damaged[at] ?? 0) ^ 0x40;
+    const loaded = await load('damaged.sscap', damaged);
+    expect(loaded.capture?.issues.length).toBeGreaterThan(0);
+    expect(content(loaded.capture)).toEqual(content(readCapture(damaged, 'damaged.sscap')));
+    const text = await load('notes.txt', new TextEncoder().encode('{"not": "a capture"}\n'));
+    expect(text.error).toMatch(/not a Saleae/);
   });
 });

@@ -32,6 +32,16 @@ export {
 } from './layout.js';
 export { CaptureWriter, encodeCapture, type CaptureRecordInput } from './writer.js';
 export { parseCapture, type ReadOptions } from './reader.js';
+export {
+  assembleParts,
+  partColumns,
+  planParts,
+  readPart,
+  type CaptureColumns,
+  type CapturePart,
+  type CapturePlan,
+  type PartRead,
+} from './parts.js';
 export { importRaw } from './raw.js';
 export { importSaleaeCsv } from './saleae.js';
 export { readCapture } from './sniff.js';

@@ -95,7 +95,7 @@ const CRC_DIRECT_MAX = 2 * CRC_INDEX_STEP;
  * (one every 64 bytes, built once) and the CRC-32 combination rule: at most 2 × 64 bytes and one
  * combination per candidate, linear overall.
  */
-class RecordProbe {
+export class RecordProbe {
   readonly #bytes: Uint8Array;
   readonly #view: DataView;
   readonly #n: number;
@@ -182,7 +182,7 @@ class RecordProbe {
 }
 
 /** The header as the reader understood it. */
-interface HeaderResult {
+export interface HeaderResult {
   meta: CaptureMeta;
   version: number;
   headerLength: number;
@@ -194,7 +194,7 @@ interface HeaderResult {
  * intact), the metadata is kept when it still reads, and the damage is reported as a
  * `bad-header` issue.
  */
-function readHeader(bytes: Uint8Array, view: DataView, probe: RecordProbe, issues: CaptureIssue[]): HeaderResult {
+export function readHeader(bytes: Uint8Array, view: DataView, probe: RecordProbe, issues: CaptureIssue[]): HeaderResult {
   const n = bytes.length;
   if (n === 0) throw new CaptureFormatError('not a SatScope capture: the file is empty');
   if (n < MAGIC_SIZE) {
@@ -537,13 +537,7 @@ function readSscap(bytes: Uint8Array, work: CaptureReaderWork, shared: boolean):
           chunkTimes = grown(new Float64Array(buffer(8 * maxRecords)), chunkTimes);
           chunkPorts = grown(new Uint8Array(buffer(maxRecords)), chunkPorts);
         }
-        // Short chunks (the usual case) are copied by hand, four bytes at a time: cheaper than
-        // making a subarray for set().
-        if (len <= 64) {
-          let k = 0;
-          for (; k + 4 <= len; k += 4) dataView.setInt32(dataLength + k, view.getInt32(payload + k));
-          for (; k < len; k++) data[dataLength + k] = bytes[payload + k] ?? 0;
-        } else data.set(bytes.subarray(payload, payload + len), dataLength);
+        copyPayload(data, dataView, dataLength, bytes, view, payload, len);
         dataLength += len;
         chunkEnds[chunks] = dataLength;
         chunkTimes[chunks] = timeUs;
@@ -594,6 +588,27 @@ function readSscap(bytes: Uint8Array, work: CaptureReaderWork, shared: boolean):
     version,
     headerLength,
   };
+}
+
+/**
+ * A record's `len` payload bytes from `payload` in the file to `at` in the data column. Short
+ * chunks (the usual case) are copied by hand, four bytes at a time: cheaper than making a
+ * subarray for set().
+ */
+export function copyPayload(
+  data: Uint8Array,
+  dataView: DataView,
+  at: number,
+  bytes: Uint8Array,
+  view: DataView,
+  payload: number,
+  len: number,
+): void {
+  if (len <= 64) {
+    let k = 0;
+    for (; k + 4 <= len; k += 4) dataView.setInt32(at + k, view.getInt32(payload + k));
+    for (; k < len; k++) data[at + k] = bytes[payload + k] ?? 0;
+  } else data.set(bytes.subarray(payload, payload + len), at);
 }
 
 /** A complete record header with a valid type and length (its CRC failed): a damaged record, not a stray sync byte. */

@@ -5,15 +5,14 @@
  * byte for byte the one a single thread makes: a reading guessed wrong, or one the worker could
  * not make, is decoded here instead.
  *
- * The report is synchronous, so this thread waits for a reading on a shared counter
- * (`Atomics.wait`) and takes the message off its port without an event loop
- * (`receiveMessageOnPort`).
+ * The report is synchronous, so this thread waits for a reading without an event loop
+ * (`WaitedWorker`).
  */
-import { MessageChannel, receiveMessageOnPort, Worker } from 'node:worker_threads';
 import { diagnosedHealthReport, diagnosedReportJobs, sameReading, type PortReadingMessage } from '../analysis/index.js';
 import type { HealthReport, HealthReportOptions } from '../analysis/index.js';
 import type { Capture } from '../capture/index.js';
 import type { ReportThreadData, ReportThreadResult } from './report-thread.js';
+import { WaitedWorker } from './waited-worker.js';
 
 /** Below this many bytes of data a second thread costs more to start than it saves. */
 export const THREADED_MIN_BYTES = 2 << 20;
@@ -30,38 +29,23 @@ export function threadedReport(
 ): { report: HealthReport; fromWorker: number } {
   const jobs = capture.bytes.length >= minBytes ? diagnosedReportJobs(capture, options) : [];
   if (jobs.length === 0) return { report: diagnosedHealthReport(capture, options), fromWorker: 0 };
-  const signal = new Int32Array(new SharedArrayBuffer(4));
-  const channel = new MessageChannel();
   const { kind, meta, timing, bytes, chunkEnds, chunkTimesUs, chunkPorts, byteTimesUs, events } = capture;
   const data: ReportThreadData = {
     capture: { kind, meta, timing, bytes, chunkEnds, chunkTimesUs, chunkPorts, byteTimesUs, events, issues: [] },
     jobs,
-    port: channel.port2,
-    signal,
   };
-  const worker = new Worker(new URL('./report-thread.js', import.meta.url), { workerData: data, transferList: [channel.port2] });
-  const results: ReportThreadResult[] = [];
-  /** Job `i`'s result, waiting for it (results come in the order of the jobs). */
-  const result = (i: number): ReportThreadResult | undefined => {
-    while (results.length <= i) {
-      const got = receiveMessageOnPort(channel.port1);
-      if (got !== undefined) results.push(got.message as ReportThreadResult);
-      else Atomics.wait(signal, 0, results.length);
-    }
-    return results[i];
-  };
+  const worker = new WaitedWorker<ReportThreadResult>(new URL('./report-thread.js', import.meta.url), data);
   let fromWorker = 0;
   try {
     const report = diagnosedHealthReport(capture, options, (port, resolution, from): PortReadingMessage | undefined => {
       const i = jobs.findIndex((job) => sameReading(job, port, resolution, from));
-      const r = i < 0 ? undefined : result(i);
+      const r = i < 0 ? undefined : worker.result(i);
       if (r === undefined || !('ok' in r)) return undefined;
       fromWorker++;
       return r.ok;
     });
     return { report, fromWorker };
   } finally {
-    channel.port1.close();
-    void worker.terminate();
+    worker.close();
   }
 }

@@ -1,0 +1,58 @@
+/**
+ * A worker thread whose results this thread waits for in the middle of synchronous work (the
+ * capture reader, the report), without an event loop: the worker posts each result on a port of
+ * its own and counts it in shared memory; this thread sleeps on the count (`Atomics.wait`) and
+ * takes the message off the port (`receiveMessageOnPort`). Results come in the order posted.
+ */
+import { MessageChannel, type MessagePort, receiveMessageOnPort, Worker, workerData } from 'node:worker_threads';
+
+/** What the worker gets besides its own data. */
+interface Link {
+  port: MessagePort;
+  /** Results posted so far. */
+  signal: Int32Array;
+}
+
+export class WaitedWorker<Result> {
+  readonly #worker: Worker;
+  readonly #port: MessagePort;
+  readonly #signal = new Int32Array(new SharedArrayBuffer(4));
+  readonly #results: Result[] = [];
+
+  /** Starts the worker module at `url` with `data` (structured-cloned; shared memory stays shared). */
+  constructor(url: URL, data: object) {
+    const channel = new MessageChannel();
+    this.#port = channel.port1;
+    const link: Link = { port: channel.port2, signal: this.#signal };
+    this.#worker = new Worker(url, { workerData: { ...data, link }, transferList: [channel.port2] });
+  }
+
+  /** Result `i` (from 0, in the order the worker posts them), waiting for it. */
+  result(i: number): Result | undefined {
+    while (this.#results.length <= i) {
+      const got = receiveMessageOnPort(this.#port);
+      if (got !== undefined) this.#results.push(got.message as Result);
+      else Atomics.wait(this.#signal, 0, this.#results.length);
+    }
+    return this.#results[i];
+  }
+
+  /** Stops the worker (whatever it was still doing). */
+  close(): void {
+    this.#port.close();
+    void this.#worker.terminate();
+  }
+}
+
+/** In the worker module: its data, and how it posts a result. */
+export function workerSide<Data>(): { data: Data; post: (result: unknown) => void } {
+  const { link, ...data } = workerData as Data & { link: Link };
+  return {
+    data: data as Data,
+    post: (result) => {
+      link.port.postMessage(result);
+      Atomics.add(link.signal, 0, 1);
+      Atomics.notify(link.signal, 0);
+    },
+  };
+}
