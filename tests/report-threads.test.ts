@@ -8,6 +8,7 @@
 import { mkdtempSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
+import { pathToFileURL } from 'node:url';
 import { afterAll, describe, expect, it } from 'vitest';
 import { diagnosedHealthReport, diagnosedReportJobs } from '../src/analysis/index.js';
 import { CaptureWriter, readCapture, type Capture } from '../src/capture/index.js';
@@ -93,5 +94,24 @@ describe('a big capture read on two threads', () => {
     expect(content(loaded.capture)).toEqual(content(readCapture(damaged, 'damaged.sscap')));
     const text = await load('notes.txt', new TextEncoder().encode('{"not": "a capture"}\n'));
     expect(text.error).toMatch(/not a Saleae/);
+  });
+});
+
+describe('waiting for a worker thread', () => {
+  it('a worker that ends without its result does not leave this thread waiting: the result is undefined', async () => {
+    const dir = mkdtempSync(join(tmpdir(), 'satscope-worker-'));
+    try {
+      const side = pathToFileURL(resolve(import.meta.dirname, '../dist/cli/waited-worker.js')).href;
+      const boom = join(dir, 'boom.mjs');
+      writeFileSync(boom, `import { workerSide } from '${side}';\nworkerSide();\nthrow new Error('boom');\n`);
+      const { WaitedWorker } = (await import(side)) as {
+        WaitedWorker: new (url: URL, data: object) => { result: (i: number) => unknown; close: () => void };
+      };
+      const worker = new WaitedWorker(pathToFileURL(boom), {});
+      expect(worker.result(0)).toBeUndefined();
+      worker.close();
+    } finally {
+      rmSync(dir, { recursive: true, force: true });
+    }
   });
 });

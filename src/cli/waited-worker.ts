@@ -2,21 +2,23 @@
  * A worker thread whose results this thread waits for in the middle of synchronous work (the
  * capture reader, the report), without an event loop: the worker posts each result on a port of
  * its own and counts it in shared memory; this thread sleeps on the count (`Atomics.wait`) and
- * takes the message off the port (`receiveMessageOnPort`). Results come in the order posted.
+ * takes the message off the port (`receiveMessageOnPort`). Results come in the order posted. A
+ * worker that ends without posting a result (it failed to load, threw, was stopped) counts its
+ * end as well, so that nobody waits for it for ever: the result is then undefined.
  */
 import { MessageChannel, type MessagePort, receiveMessageOnPort, Worker, workerData } from 'node:worker_threads';
 
 /** What the worker gets besides its own data. */
 interface Link {
   port: MessagePort;
-  /** Results posted so far. */
+  /** [0]: results posted so far, plus 1 once the worker ended; [1]: 1 once it ended. */
   signal: Int32Array;
 }
 
 export class WaitedWorker<Result> {
   readonly #worker: Worker;
   readonly #port: MessagePort;
-  readonly #signal = new Int32Array(new SharedArrayBuffer(4));
+  readonly #signal = new Int32Array(new SharedArrayBuffer(8));
   readonly #results: Result[] = [];
 
   /** Starts the worker module at `url` with `data` (structured-cloned; shared memory stays shared). */
@@ -27,12 +29,14 @@ export class WaitedWorker<Result> {
     this.#worker = new Worker(url, { workerData: { ...data, link }, transferList: [channel.port2] });
   }
 
-  /** Result `i` (from 0, in the order the worker posts them), waiting for it. */
+  /** Result `i` (from 0, in the order the worker posts them), waiting for it; undefined if the worker ended without it. */
   result(i: number): Result | undefined {
     while (this.#results.length <= i) {
+      const seen = Atomics.load(this.#signal, 0);
       const got = receiveMessageOnPort(this.#port);
       if (got !== undefined) this.#results.push(got.message as Result);
-      else Atomics.wait(this.#signal, 0, this.#results.length);
+      else if (Atomics.load(this.#signal, 1) === 1) return undefined;
+      else Atomics.wait(this.#signal, 0, seen);
     }
     return this.#results[i];
   }
@@ -47,6 +51,11 @@ export class WaitedWorker<Result> {
 /** In the worker module: its data, and how it posts a result. */
 export function workerSide<Data>(): { data: Data; post: (result: unknown) => void } {
   const { link, ...data } = workerData as Data & { link: Link };
+  process.on('exit', () => {
+    Atomics.store(link.signal, 1, 1);
+    Atomics.add(link.signal, 0, 1);
+    Atomics.notify(link.signal, 0);
+  });
   return {
     data: data as Data,
     post: (result) => {
