@@ -157,6 +157,7 @@ export function decodeCapture(
     doctor.detach(port);
     doctor.attach(port, { decoder, link, label: typeof label === 'string' && label !== '' ? label : `Port ${port}` });
   }
+  const { bytes, chunkEnds, chunkTimesUs, chunkPorts, byteTimesUs } = capture;
   const drain = (): void => {
     for (let f = decoder.next(); f !== undefined; f = decoder.next()) {
       link.frame(f);
@@ -165,9 +166,10 @@ export function decodeCapture(
       onFrame(f, link);
     }
   };
-  const push = (bytes: Uint8Array, time: number | Float64Array | undefined, unscanned: number): void => {
-    doctor?.bytes(port, bytes, time, unscanned);
-    decoder.push(bytes, time);
+  /** Bytes [from, to) of the capture, as they arrived (no view made: `pushRange`). */
+  const push = (from: number, to: number, time: number | Float64Array | undefined, unscanned: number): void => {
+    doctor?.bytes(port, bytes, time, unscanned, from, to);
+    decoder.pushRange(bytes, from, to, time);
     drain();
   };
   // The doctor's packet scan starts at chunk `scan.chunk`, byte `scan.offset` in it, when its
@@ -180,20 +182,16 @@ export function decodeCapture(
     Number.isFinite(end) &&
     !events.some((e) => /baud/i.test(e.text));
   const scan = judged ? firstScanned(capture, port, lineWindow(end).fromS * 1e6) : { chunk: 0, offset: 0 };
-  const { bytes, chunkEnds, chunkTimesUs, chunkPorts, byteTimesUs } = capture;
   let from = 0;
   for (let i = 0; i < chunkEnds.length; i++) {
     const to = chunkEnds[i] ?? from;
     if (chunkPorts[i] === port) {
       eventsBefore(i);
       if (byteTimesUs !== undefined) {
-        for (let s = from; s < to; s += SLICE_BYTES) {
-          const e = Math.min(s + SLICE_BYTES, to);
-          push(bytes.subarray(s, e), byteTimesUs.subarray(s, e), 0);
-        }
+        for (let s = from; s < to; s += SLICE_BYTES) push(s, Math.min(s + SLICE_BYTES, to), byteTimesUs, 0);
       } else {
         const t = chunkTimesUs[i] ?? NaN;
-        push(bytes.subarray(from, to), Number.isNaN(t) ? undefined : t, i < scan.chunk ? to - from : i === scan.chunk ? scan.offset : 0);
+        push(from, to, Number.isNaN(t) ? undefined : t, i < scan.chunk ? to - from : i === scan.chunk ? scan.offset : 0);
       }
     }
     from = to;

@@ -111,13 +111,6 @@ export class PacketScanner {
 
   constructor(readonly onPacket: (kind: PacketKind, endIndex: number) => void) {}
 
-  /**
-   * `count` bytes of the stream went by unscanned: the stream index moves on and what comes next
-   * is scanned as if the stream began there (no candidate pending, nothing remembered). Packets
-   * ending within `SCAN_MEMORY` bytes after may be missed or be chance ones; after that, when the
-   * bytes fed since hold no `startsCandidate` byte in their first `SCAN_MEMORY`, the scanner is in
-   * the very state it would be in had it scanned everything.
-   */
   /** The scanner's whole state (the last bytes, the candidates pending, the stream index), as copies. */
   checkpoint(): PacketScannerCheckpoint {
     return {
@@ -140,13 +133,21 @@ export class PacketScanner {
     this.lastSrxl2Type = cp.lastSrxl2Type;
   }
 
+  /**
+   * `count` bytes of the stream went by unscanned: the stream index moves on and what comes next
+   * is scanned as if the stream began there (no candidate pending, nothing remembered). Packets
+   * ending within `SCAN_MEMORY` bytes after may be missed or be chance ones; after that, when the
+   * bytes fed since hold no `startsCandidate` byte in their first `SCAN_MEMORY`, the scanner is in
+   * the very state it would be in had it scanned everything.
+   */
   pass(count: number): void {
     this.#n += count;
     this.#pending = 0;
     this.#ring.fill(0);
   }
 
-  push(bytes: Uint8Array): void {
+  /** The stream's next bytes: those of `bytes` from `start` to `end` (default all). */
+  push(bytes: Uint8Array, start = 0, end = bytes.length): void {
     // The state in locals for the loop (written back at the end): this runs on every byte, so
     // the usual byte (no packet ends here, none is pending, it starts none) costs a store, two
     // compares and one table lookup.
@@ -157,7 +158,7 @@ export class PacketScanner {
     const starts = (startKinds ??= buildStartKinds());
     let pending = this.#pending;
     let k = this.#n;
-    for (let i = 0; i < bytes.length; i++, k++) {
+    for (let i = start; i < end; i++, k++) {
       const b = bytes[i] as number;
       ring[k & mask] = b;
       // IBUS ends here? (0x20 0x40 31 bytes back.)

@@ -238,29 +238,31 @@ export class Doctor {
    * Bytes as they arrived: `time` is the chunk's arrival time (its last byte), per-byte times,
    * or nothing (then the last time seen on this port). The first `unscanned` of them are counted
    * but not scanned for foreign packets (`PacketScanner.pass`): for a caller that takes findings
-   * only at one time and knows those bytes cannot change them (see `decodeCapture`).
+   * only at one time and knows those bytes cannot change them (see `decodeCapture`). `start` and
+   * `end`: only those bytes of `bytes` (and of per-byte times, indexed alike) arrived.
    */
-  bytes(port: number, bytes: Uint8Array, time?: number | Float64Array, unscanned = 0): void {
-    if (bytes.length === 0) return;
+  bytes(port: number, bytes: Uint8Array, time?: number | Float64Array, unscanned = 0, start = 0, end = bytes.length): void {
+    const n = end - start;
+    if (n <= 0) return;
     const p = this.#port(port);
     let t: number;
     if (time instanceof Float64Array) {
       if (time.length !== bytes.length) throw new TypeError(`per-byte times have length ${time.length}, bytes ${bytes.length}`);
-      t = time[time.length - 1] ?? NaN;
-      if (this.#precise) for (let i = 0; i < time.length; i++) p.burst.event(time[i] ?? NaN);
+      t = time[end - 1] ?? NaN;
+      if (this.#precise) for (let i = start; i < end; i++) p.burst.event(time[i] ?? NaN);
       // Book per second: bytes of a chunk rarely straddle more than one.
-      for (let i = 0; i < time.length; i++) p.bins.add(M_BYTES, time[i] ?? NaN, 1);
-      this.#activity(p, time[0] ?? NaN, 0);
+      for (let i = start; i < end; i++) p.bins.add(M_BYTES, time[i] ?? NaN, 1);
+      this.#activity(p, time[start] ?? NaN, 0);
     } else {
       t = time ?? p.lastTimeUs;
-      p.bins.add(M_BYTES, t, bytes.length);
+      p.bins.add(M_BYTES, t, n);
     }
-    this.#activity(p, t, bytes.length);
+    this.#activity(p, t, n);
     p.scanTimeUs = t;
-    if (unscanned <= 0) p.scanner.push(bytes);
+    if (unscanned <= 0) p.scanner.push(bytes, start, end);
     else {
-      p.scanner.pass(Math.min(unscanned, bytes.length));
-      if (unscanned < bytes.length) p.scanner.push(bytes.subarray(unscanned));
+      p.scanner.pass(Math.min(unscanned, n));
+      if (unscanned < n) p.scanner.push(bytes, start + unscanned, end);
     }
   }
 

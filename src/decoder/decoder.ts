@@ -263,13 +263,25 @@ export class SpektrumDecoder {
    * @throws {TypeError} after `end()`, or when per-byte times do not match the bytes in length.
    */
   push(bytes: Uint8Array, time?: number | Float64Array): void {
+    this.pushRange(bytes, 0, bytes.length, time);
+  }
+
+  /**
+   * `push(bytes.subarray(start, end), time)` without making that view (an allocation a chunk):
+   * for a caller that holds a whole stream and feeds it chunk by chunk, such as a capture's
+   * columns. Per-byte times are indexed like `bytes`: those of [start, end) are taken.
+   * @throws {TypeError} as `push()`, and for a range that is not one of `bytes`.
+   */
+  pushRange(bytes: Uint8Array, start: number, end: number, time?: number | Float64Array): void {
     // `=== true` on the hot paths: optimised code tests a boolean field for every kind of falsy value otherwise.
     if (this.#ended === true) throw new TypeError('push() after end(): call reset() to decode a new stream');
-    // push() is kept small so that it is inlined into the caller's loop, and the time is stored
-    // here rather than passed on: a double handed from there to a call that is not inlined, or
-    // to `instanceof`, is boxed (a 16-byte heap number every push). See #append.
+    if (!(start >= 0 && start <= end && end <= bytes.length && (start | 0) === start && (end | 0) === end))
+      throw new TypeError(`[${start}, ${end}) is not a range of ${bytes.length} bytes`);
+    // push() and this are kept small so that they are inlined into the caller's loop, and the
+    // time is stored here rather than passed on: a double handed from there to a call that is
+    // not inlined, or to `instanceof`, is boxed (a 16-byte heap number every push). See #append.
     if (typeof time === 'number') {
-      const i = this.#append(bytes, null);
+      const i = this.#append(bytes, null, start, end);
       if (i >= 0) this.#chunkTimes[i] = time;
       return;
     }
@@ -277,7 +289,7 @@ export class SpektrumDecoder {
     if (perByte && time.length !== bytes.length) {
       throw new TypeError(`per-byte times have length ${time.length}, bytes ${bytes.length}`);
     }
-    const i = this.#append(bytes, perByte ? time : null);
+    const i = this.#append(bytes, perByte ? time : null, start, end);
     if (i >= 0) this.#chunkTimes[i] = perByte ? NaN : (time ?? NaN);
   }
 
@@ -291,8 +303,8 @@ export class SpektrumDecoder {
    * the caller's loop (a double time handed to a call that is not inlined is boxed, 16 bytes a
    * push), and it stays small enough only while this, its one callee, is never inlined into it.
    */
-  #append(bytes: Uint8Array, byteTimes: Float64Array | null): number {
-    const n = bytes.length;
+  #append(bytes: Uint8Array, byteTimes: Float64Array | null, start: number, end: number): number {
+    const n = end - start;
     if (n === 0) return -1;
     let times = this.#byteTimes;
     if (this.#head > 0 && (this.#tail + n > this.#buf.length || this.#head >= this.#buf.length >> 1)) {
@@ -318,10 +330,16 @@ export class SpektrumDecoder {
       }
     }
     const at = this.#tail;
-    this.#buf.set(bytes, at);
+    const whole = start === 0 && end === bytes.length;
+    if (whole) this.#buf.set(bytes, at);
+    else if (n <= 64) {
+      // A capture's chunk (the usual range): copied by hand, cheaper than a view for set().
+      const buf = this.#buf;
+      for (let k = 0; k < n; k++) buf[at + k] = bytes[start + k] as number;
+    } else this.#buf.set(bytes.subarray(start, end), at);
     if (byteTimes !== null) {
       if (times === null) this.#byteTimes = times = new Float64Array(this.#buf.length);
-      times.set(byteTimes, at);
+      times.set(whole ? byteTimes : byteTimes.subarray(start, end), at);
     }
     // The chunk record: compacted when the arrays are full and mostly done with, else grown.
     if (this.#chunkTail === this.#chunkEnds.length) {
