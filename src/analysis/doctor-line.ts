@@ -106,6 +106,8 @@ export class PacketScanner {
   readonly #pendingAt = new Float64Array(MAX_PENDING);
   readonly #pendingKind = new Uint8Array(MAX_PENDING);
   #pending = 0;
+  /** Whether bytes were scanned since the last `pass` (else the ring is still clear). */
+  #scanned = true;
   /** Last SRXL2 packet type seen (0x21 handshake, 0xCD control data…). */
   lastSrxl2Type = -1;
 
@@ -131,6 +133,7 @@ export class PacketScanner {
     this.#pendingKind.set(cp.pendingKind);
     this.#pending = cp.pending;
     this.lastSrxl2Type = cp.lastSrxl2Type;
+    this.#scanned = true;
   }
 
   /**
@@ -142,8 +145,10 @@ export class PacketScanner {
    */
   pass(count: number): void {
     this.#n += count;
+    if (!this.#scanned) return; // cleared already: a run of passes clears once
     this.#pending = 0;
     this.#ring.fill(0);
+    this.#scanned = false;
   }
 
   /** The stream's next bytes: those of `bytes` from `start` to `end` (default all). */
@@ -184,6 +189,7 @@ export class PacketScanner {
     }
     this.#pending = pending;
     this.#n = k;
+    if (end > start) this.#scanned = true;
   }
 
   /** An IBUS packet that may end at stream index `k` (its first byte is 0x20): checked and reported. */
