@@ -141,6 +141,19 @@ describe('a report with ports read on other threads', () => {
     expect(text).toBe(alone);
   });
 
+  it('a reading made for another clock, or without the doctor, is not used, and the report is the same', () => {
+    const capture = CAPTURES[0]?.[1]() as Capture;
+    const alone = json(diagnosedHealthReport(capture));
+    const jobs = diagnosedReportJobs(capture);
+    const later = jobs.map((job) => readPortMessage(capture, { ...job, endUs: job.endUs + 1_000_000 }));
+    const undiagnosed = jobs.map((job) => readPortMessage(capture, { ...job, doctor: null }));
+    for (const made of [later, undiagnosed]) {
+      const { text, used } = reportElsewhere(capture, made);
+      expect(used).toBe(jobs.length); // asked for and handed over, but not adopted
+      expect(text).toBe(alone);
+    }
+  });
+
   it("a doctor's port state restored into another doctor checkpoints the same again", () => {
     // Chunk times, and per-byte times (the doctor's burst clock runs only on those).
     for (const job of [1, 3].flatMap((i) => {

@@ -83,7 +83,14 @@ export function healthReportFeeding(
     (port) => looksInternal(capture, port),
     (port, resolution, from, final) => {
       const made = final ? elsewhere?.(port, resolution, from) : undefined;
-      if (made !== undefined) return adoptPortMessage(capture, made, doctor);
+      // Made for this very pass (the same clock, a doctor when this report has one), or not used.
+      if (
+        made !== undefined &&
+        Object.is(made.job.originUs, pass.originUs) &&
+        Object.is(made.job.endUs, pass.endUs) &&
+        (made.doctor === null) === (doctor === undefined)
+      )
+        return adoptPortMessage(capture, made, doctor);
       return decodePort(capture, port, resolution, from, final ? pass : { ...pass, doctor: undefined });
     },
   );
