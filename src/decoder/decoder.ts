@@ -142,6 +142,10 @@ export class SpektrumDecoder {
   #buf = new Uint8Array(INITIAL_CAPACITY);
   /** #buf as 32-bit words: a frame that starts at a multiple of 4 is copied in four moves. */
   #buf32 = new Uint32Array(this.#buf.buffer);
+  /** The buffer as a DataView, and the last `pushRange` source's (kept while it is fed from): short ranges are copied four bytes at a time. */
+  #bufView = new DataView(this.#buf.buffer);
+  #source: Uint8Array | null = null;
+  #sourceView: DataView | null = null;
   /**
    * Times are kept per pushed chunk, not per byte (filling a time for every byte cost a third of
    * the decoder's throughput): each chunk's end offset in the stream and its time, or NaN. Only
@@ -323,6 +327,7 @@ export class SpektrumDecoder {
       buf.set(this.#buf.subarray(0, this.#tail));
       this.#buf = buf;
       this.#buf32 = new Uint32Array(buf.buffer);
+      this.#bufView = new DataView(buf.buffer);
       if (times !== null) {
         const grown = new Float64Array(capacity);
         grown.set(times.subarray(0, this.#tail));
@@ -333,9 +338,17 @@ export class SpektrumDecoder {
     const whole = start === 0 && end === bytes.length;
     if (whole) this.#buf.set(bytes, at);
     else if (n <= 64) {
-      // A capture's chunk (the usual range): copied by hand, cheaper than a view for set().
-      const buf = this.#buf;
-      for (let k = 0; k < n; k++) buf[at + k] = bytes[start + k] as number;
+      // A capture's chunk (the usual range): copied by hand four bytes at a time, cheaper than a
+      // view for set(). The source's DataView is made once for all the ranges fed from it.
+      if (bytes !== this.#source) {
+        this.#source = bytes;
+        this.#sourceView = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
+      }
+      const from = this.#sourceView as DataView;
+      const to = this.#bufView;
+      let k = 0;
+      for (; k + 4 <= n; k += 4) to.setInt32(at + k, from.getInt32(start + k));
+      for (; k < n; k++) this.#buf[at + k] = bytes[start + k] as number;
     } else this.#buf.set(bytes.subarray(start, end), at);
     if (byteTimes !== null) {
       if (times === null) this.#byteTimes = times = new Float64Array(this.#buf.length);
@@ -379,6 +392,7 @@ export class SpektrumDecoder {
    */
   end(): void {
     this.#ended = true;
+    this.#source = this.#sourceView = null; // nothing more is copied from it
   }
 
   /**
@@ -412,6 +426,7 @@ export class SpektrumDecoder {
   /** Forgets everything: buffered bytes, lock, format and counters. */
   reset(): void {
     this.#head = this.#tail = this.#base = 0;
+    this.#source = this.#sourceView = null;
     this.#chunkHead = this.#chunkTail = 0;
     this.#ended = false;
     this.#locked = this.#everLocked = false;
@@ -1381,6 +1396,7 @@ export class SpektrumDecoder {
     this.#buf = new Uint8Array(capacity);
     this.#buf.set(cp.bytes);
     this.#buf32 = new Uint32Array(this.#buf.buffer);
+    this.#bufView = new DataView(this.#buf.buffer);
     this.#byteTimes = null;
     if (cp.byteTimes !== null) {
       this.#byteTimes = new Float64Array(capacity);
