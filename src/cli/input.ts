@@ -20,7 +20,7 @@ import {
   type ReadOptions,
 } from '../capture/index.js';
 import type { ReadThreadData, ReadThreadResult } from './read-thread.js';
-import { WaitedWorker } from './waited-worker.js';
+import { secondCore, WaitedWorker } from './waited-worker.js';
 
 export type LoadedCapture = { capture: Capture } | { error: string; exitCode: 1 | 2 };
 
@@ -82,7 +82,7 @@ export function loadCapture(file: string, options: ReadOptions = {}, partsMinByt
     return { error: `cannot read ${file}: ${why}`, exitCode: 2 };
   }
   try {
-    const parts = bytes.length >= partsMinBytes ? readInParts(bytes) : null;
+    const parts = bytes.length >= partsMinBytes && secondCore() ? readInParts(bytes) : null;
     return { capture: parts ?? readCapture(bytes, basename(file), options) };
   } catch (error) {
     if (error instanceof CaptureFormatError) return { error: `${file}: ${error.message}`, exitCode: 1 };

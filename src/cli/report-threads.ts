@@ -12,14 +12,14 @@ import { diagnosedHealthReport, diagnosedReportJobs, sameReading, type PortReadi
 import type { HealthReport, HealthReportOptions } from '../analysis/index.js';
 import type { Capture } from '../capture/index.js';
 import type { ReportThreadData, ReportThreadResult } from './report-thread.js';
-import { WaitedWorker } from './waited-worker.js';
+import { secondCore, WaitedWorker } from './waited-worker.js';
 
 /** Below this many bytes of data a second thread costs more to start than it saves. */
 export const THREADED_MIN_BYTES = 2 << 20;
 
 /**
  * `diagnosedHealthReport(capture, options)`, its ports decoded on two threads when the capture
- * is big enough (`minBytes`); `fromWorker`: how many port readings the report took from the
+ * is big enough (`minBytes`) and the machine has a second core; `fromWorker`: how many port readings the report took from the
  * worker thread.
  */
 export function threadedReport(
@@ -27,7 +27,7 @@ export function threadedReport(
   options: HealthReportOptions,
   minBytes = THREADED_MIN_BYTES,
 ): { report: HealthReport; fromWorker: number } {
-  const jobs = capture.bytes.length >= minBytes ? diagnosedReportJobs(capture, options) : [];
+  const jobs = capture.bytes.length >= minBytes && secondCore() ? diagnosedReportJobs(capture, options) : [];
   if (jobs.length === 0) return { report: diagnosedHealthReport(capture, options), fromWorker: 0 };
   const { kind, meta, timing, bytes, chunkEnds, chunkTimesUs, chunkPorts, byteTimesUs, events } = capture;
   const data: ReportThreadData = {

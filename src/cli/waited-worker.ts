@@ -6,7 +6,13 @@
  * worker that ends without posting a result (it failed to load, threw, was stopped) counts its
  * end as well, so that nobody waits for it for ever: the result is then undefined.
  */
+import { availableParallelism } from 'node:os';
 import { MessageChannel, type MessagePort, receiveMessageOnPort, Worker, workerData } from 'node:worker_threads';
+
+/** Whether a second thread can run beside this one (on one core they would only take turns). */
+export function secondCore(): boolean {
+  return availableParallelism() > 1;
+}
 
 /** What the worker gets besides its own data. */
 interface Link {
