@@ -1,11 +1,11 @@
 /**
- * The second thread of a big capture's reading (`readCaptureFile`): checks and copies one part
+ * The second thread of a big capture's reading (`loadCapture` in input.ts): checks and copies one part
  * of the file's records into the shared columns (`readPart`) and posts what it found.
  */
 import type { CaptureColumns, CapturePart, PartRead } from '../capture/index.js';
 import { workerSide } from './waited-worker.js';
 
-/** What `readCaptureFile` hands this thread: the file's bytes and the columns, both shared. */
+/** What `loadCapture` hands this thread: the file's bytes and the columns, both shared. */
 export interface ReadThreadData {
   bytes: Uint8Array;
   part: CapturePart;
