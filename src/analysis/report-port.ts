@@ -66,6 +66,14 @@ class IntervalTally {
   #counts = new Float64Array(INTERVAL_SLOTS);
   #distinct = 0;
   #column: Column | null = null;
+  /**
+   * An interval's 64 bits, mixed into its slot. Chunk times give intervals that differ only far
+   * below the µs (1388.888888835907 and 1388.8888890743256 µs both come a million times a day),
+   * so every bit counts: one probe a frame on the day capture. (Worked out in `add` itself: a
+   * double passed to a call V8 does not inline is boxed.)
+   */
+  readonly #value = new Float64Array(1);
+  readonly #bits = new Uint32Array(this.#value.buffer);
 
   /**
    * The link monitor's last ordinary interval, if it has one. (Read here rather than passed in:
@@ -80,7 +88,9 @@ class IntervalTally {
       return;
     }
     const v = value + 0; // −0 counts as 0
-    let slot = intervalHash(v);
+    this.#value[0] = v;
+    const bits = this.#bits;
+    let slot = Math.imul((bits[0] as number) ^ Math.imul(bits[1] as number, 0x9e3779b1), 0x85ebca6b) >>> (32 - INTERVAL_SLOT_BITS);
     for (;;) {
       const k = keys[slot] as number;
       if (k === v) {
@@ -117,20 +127,6 @@ class IntervalTally {
     const counts = Float64Array.from(order, (i) => this.#counts[i] ?? 0);
     return periodStats(values, counts, basis);
   }
-}
-
-/** A finite interval's bits, for `intervalHash`. */
-const hashValue = new Float64Array(1);
-const hashBits = new Uint32Array(hashValue.buffer);
-
-/**
- * A slot for a finite interval: its 64 bits mixed, as a table index. Chunk times give intervals
- * that differ only far below the µs (1388.888888835907 and 1388.8888890743256 µs both come a
- * million times a day), so every bit counts: one probe a frame on the day capture.
- */
-function intervalHash(v: number): number {
-  hashValue[0] = v;
-  return Math.imul((hashBits[0] as number) ^ Math.imul(hashBits[1] as number, 0x9e3779b1), 0x85ebca6b) >>> (32 - INTERVAL_SLOT_BITS);
 }
 
 /**
