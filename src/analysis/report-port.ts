@@ -66,6 +66,14 @@ class IntervalTally {
   #counts = new Float64Array(INTERVAL_SLOTS);
   #distinct = 0;
   #column: Column | null = null;
+  /**
+   * An interval's 64 bits, mixed into its slot. Chunk times give intervals that differ only far
+   * below the µs (1388.888888835907 and 1388.8888890743256 µs both come a million times a day),
+   * so every bit counts: one probe a frame on the day capture. (Worked out in `add` itself: a
+   * double passed to a call V8 does not inline is boxed.)
+   */
+  readonly #value = new Float64Array(1);
+  readonly #bits = new Uint32Array(this.#value.buffer);
 
   /**
    * The link monitor's last ordinary interval, if it has one. (Read here rather than passed in:
@@ -80,7 +88,9 @@ class IntervalTally {
       return;
     }
     const v = value + 0; // −0 counts as 0
-    let slot = intervalHash(v);
+    this.#value[0] = v;
+    const bits = this.#bits;
+    let slot = Math.imul((bits[0] as number) ^ Math.imul(bits[1] as number, 0x9e3779b1), 0x85ebca6b) >>> (32 - INTERVAL_SLOT_BITS);
     for (;;) {
       const k = keys[slot] as number;
       if (k === v) {
@@ -117,12 +127,6 @@ class IntervalTally {
     const counts = Float64Array.from(order, (i) => this.#counts[i] ?? 0);
     return periodStats(values, counts, basis);
   }
-}
-
-/** A slot for a finite interval: its integer part and its fraction mixed, as a table index. */
-function intervalHash(v: number): number {
-  const whole = Math.floor(v);
-  return (Math.imul(whole | 0, 0x9e3779b1) ^ Math.imul(((v - whole) * 0x10000) | 0, 0x85ebca6b)) >>> (32 - INTERVAL_SLOT_BITS);
 }
 
 /**
@@ -211,28 +215,63 @@ export interface PortPass {
   doctor: Doctor | undefined;
 }
 
-// What `PortTally` keeps of each channel, at `id × CH_STRIDE` in one Float64Array: its last
-// position and the resolution it was read at, and its last two appearances (% travel, µs, time,
-// frame index): B the newer, A the older; the frame being read is C. After a repeat (C had B's
-// value) A's value is B's and its time no longer matters (no spike can end on a repeat), so a
-// repeat only moves B's time (`CH_REPEAT` says A is B's value).
-const CH_POS = 0;
-const CH_RES = 1;
-const CH_PCT_B = 2;
+/**
+ * A position's µs and % travel at its resolution, looked up instead of worked out per value: at
+ * `2 × key` its `servoToPercent`, at `2 × key + 1` its `servoToMicros`, the very doubles those
+ * give, for every key below `VALUE_KEYS` (`valueKey`: every position 0–2047 at either
+ * resolution). Made on first use.
+ */
+let positionValues: Float64Array | undefined;
+const VALUE_KEYS = 4096;
+
+/** A channel value as one number: its position and the resolution it is read at (1024 or 2048). */
+function valueKey(position: number, resolution: Resolution): number {
+  return position * 2 + (resolution === 2048 ? 0 : 1);
+}
+
+function valueTable(): Float64Array {
+  if (positionValues === undefined) {
+    positionValues = new Float64Array(2 * VALUE_KEYS);
+    for (let pos = 0; pos < VALUE_KEYS / 2; pos++) {
+      for (const res of [1024, 2048] as const) {
+        const key = valueKey(pos, res);
+        positionValues[2 * key] = servoToPercent(pos, res);
+        positionValues[2 * key + 1] = servoToMicros(pos, res);
+      }
+    }
+  }
+  return positionValues;
+}
+
+// What `PortTally` keeps of each channel, at `id × CH_STRIDE` in one Float64Array. The spike test
+// reads three consecutive appearances A, B, C of a channel (C the one being read); it can only
+// pass when B is a value of its own between A and C (no repeat on either side) and
+// |B − A| ≥ SPIKE_MIN_JUMP_PERCENT, which is known when B comes. So B is marked a candidate then
+// (`CH_CANDIDATE`) and only a candidate keeps A's % travel, µs, time and frame index; anything
+// else only moves B's. A repeat of B only counts (`CH_REPEATS`) and moves B's time and frame
+// index: its µs is B's, summed when B's run ends (sums of whole µs are exact in any order).
+const CH_KEY = 0; // B's `valueKey` (−1 before the first appearance)
+const CH_REPEATS = 1; // appearances of B's value since B, not yet in CH_COUNT and CH_SUM
+const CH_PCT_B = 2; // NaN before the first appearance, so that nothing is a jump from it
 const CH_US_B = 3;
 const CH_AT_B = 4;
 const CH_IDX_B = 5;
-const CH_PCT_A = 6;
-const CH_US_A = 7;
-const CH_AT_A = 8;
-const CH_IDX_A = 9;
-const CH_REPEAT = 10;
+const CH_CANDIDATE = 6; // 1: B came right after A and |B − A| ≥ SPIKE_MIN_JUMP_PERCENT
+const CH_PCT_A = 7;
+const CH_US_A = 8;
+const CH_AT_A = 9;
+const CH_IDX_A = 10;
+const CH_COUNT = 11; // appearances, less CH_REPEATS
+const CH_SUM = 12; // µs summed over those
+const CH_MIN = 13;
+const CH_MAX = 14;
 const CH_STRIDE = 16;
 
 /**
  * One port's sums, frame by frame: what `decodePort` keeps. A class with fields rather than a
  * closure over local variables, so that its per-frame work stays in registers and plain loads;
- * each channel's state in one typed array, and nothing allocated per frame.
+ * each channel's state in one typed array, and nothing allocated per frame. `channels()` gives
+ * each channel's count, range and sum.
  */
 class PortTally {
   frames = 0;
@@ -245,14 +284,9 @@ class PortTally {
   rssiTotal = 0;
   fadeCounterMoved = false;
   readonly intervals = new IntervalTally();
-  /** Appearances of each channel (also: how many of A and B it has). */
-  readonly channelFrames = new Uint32Array(CHANNEL_COUNT);
-  readonly channelMin = new Float64Array(CHANNEL_COUNT).fill(Infinity);
-  readonly channelMax = new Float64Array(CHANNEL_COUNT).fill(-Infinity);
-  /** Sums of whole µs (servoToMicros rounds), so exact in any order. */
-  readonly channelSum = new Float64Array(CHANNEL_COUNT);
   readonly #ch = PortTally.#channels();
-  /** The frame being read: its time and index, for `#changed` (a double passed as an argument to a call V8 does not inline is boxed). */
+  readonly #values = valueTable();
+  /** The frame being read: its time and index, for `#spike` (a double passed as an argument to a call V8 does not inline is boxed). */
   readonly #frame = new Float64Array(2);
   readonly glitchesRaw: RawGlitch[] = [];
   glitchCount = 0;
@@ -261,7 +295,13 @@ class PortTally {
 
   static #channels(): Float64Array {
     const ch = new Float64Array(CHANNEL_COUNT * CH_STRIDE);
-    for (let id = 0; id < CHANNEL_COUNT; id++) ch[id * CH_STRIDE + CH_POS] = -1;
+    for (let id = 0; id < CHANNEL_COUNT; id++) {
+      const o = id * CH_STRIDE;
+      ch[o + CH_KEY] = -1;
+      ch[o + CH_PCT_B] = NaN;
+      ch[o + CH_MIN] = Infinity;
+      ch[o + CH_MAX] = -Infinity;
+    }
     return ch;
   }
 
@@ -283,89 +323,112 @@ class PortTally {
     }
     if (f.fades !== null && f.fades !== 0) this.fadeCounterMoved = true;
     const { ids, positions, count, resolution, index } = f;
-    this.#frame[0] = t;
-    this.#frame[1] = index;
     const ch = this.#ch;
-    const frames = this.channelFrames;
+    const values = this.#values;
     for (let i = 0; i < count; i++) {
       const id = ids[i] as number;
       const pos = positions[i] as number;
-      const res = channelResolution(id, resolution);
+      const key = valueKey(pos, channelResolution(id, resolution));
       const o = id * CH_STRIDE;
-      if (pos === ch[o + CH_POS] && res === ch[o + CH_RES]) {
-        // The value B had (about half of all appearances in a flight): the same µs and % travel,
-        // already within the channel's range, and no spike, since C returns exactly to B.
-        frames[id] = (frames[id] as number) + 1;
-        this.channelSum[id] = (this.channelSum[id] as number) + (ch[o + CH_US_B] as number);
+      if (key === ch[o + CH_KEY]) {
+        // B's value again (about half of all appearances in a flight): counted when B's run
+        // ends, and no spike, since C returns exactly to B.
+        ch[o + CH_REPEATS] = (ch[o + CH_REPEATS] as number) + 1;
         ch[o + CH_AT_B] = t;
         ch[o + CH_IDX_B] = index;
-        ch[o + CH_REPEAT] = 1;
-      } else this.#changed(id, pos, res);
+        continue;
+      }
+      let p: number;
+      let u: number;
+      if (key < VALUE_KEYS) {
+        p = values[2 * key] as number;
+        u = values[2 * key + 1] as number;
+      } else {
+        const res = channelResolution(id, resolution);
+        p = servoToPercent(pos, res);
+        u = servoToMicros(pos, res);
+      }
+      const repeats = ch[o + CH_REPEATS] as number;
+      const pB = ch[o + CH_PCT_B] as number;
+      if (ch[o + CH_CANDIDATE] === 1 && repeats === 0 && Math.abs(pB - p) >= SPIKE_MIN_JUMP_PERCENT) {
+        this.#frame[0] = t;
+        this.#frame[1] = index;
+        this.#spike(id, p, u);
+      }
+      const usB = ch[o + CH_US_B] as number;
+      ch[o + CH_COUNT] = (ch[o + CH_COUNT] as number) + repeats + 1;
+      ch[o + CH_SUM] = (ch[o + CH_SUM] as number) + (u + usB * repeats); // usB × 0 is 0: B's µs before B
+      if (u < (ch[o + CH_MIN] as number)) ch[o + CH_MIN] = u;
+      if (u > (ch[o + CH_MAX] as number)) ch[o + CH_MAX] = u;
+      if (Math.abs(p - pB) >= SPIKE_MIN_JUMP_PERCENT) {
+        // C is a jump from B (NaN before B: no jump): the next appearance may end a spike at C.
+        ch[o + CH_CANDIDATE] = 1;
+        ch[o + CH_PCT_A] = pB;
+        ch[o + CH_US_A] = usB;
+        ch[o + CH_AT_A] = ch[o + CH_AT_B] as number;
+        ch[o + CH_IDX_A] = ch[o + CH_IDX_B] as number;
+      } else ch[o + CH_CANDIDATE] = 0;
+      ch[o + CH_KEY] = key;
+      ch[o + CH_REPEATS] = 0;
+      ch[o + CH_PCT_B] = p;
+      ch[o + CH_US_B] = u;
+      ch[o + CH_AT_B] = t;
+      ch[o + CH_IDX_B] = index;
     }
   }
 
-  /** Channel `id` took a new value (or its first): range, sum, and a spike ending here. */
-  #changed(id: number, pos: number, res: Resolution): void {
+  /**
+   * Channel `id`'s candidate B, right after A and now left for C (% travel `p`, µs `u`) by at
+   * least SPIKE_MIN_JUMP_PERCENT: a spike when C is back near A, on the same side, in the window.
+   */
+  #spike(id: number, p: number, u: number): void {
     const t = this.#frame[0] as number;
     const index = this.#frame[1] as number;
     const ch = this.#ch;
     const o = id * CH_STRIDE;
-    const n = this.channelFrames[id] as number;
-    ch[o + CH_POS] = pos;
-    ch[o + CH_RES] = res;
-    const u = servoToMicros(pos, res);
-    const p = servoToPercent(pos, res);
-    this.channelFrames[id] = n + 1;
-    if (u < (this.channelMin[id] as number)) this.channelMin[id] = u;
-    if (u > (this.channelMax[id] as number)) this.channelMax[id] = u;
-    this.channelSum[id] = (this.channelSum[id] as number) + u;
-    if (n >= 2 && ch[o + CH_REPEAT] === 0) {
-      const pA = ch[o + CH_PCT_A] as number;
-      const pB = ch[o + CH_PCT_B] as number;
-      const atA = ch[o + CH_AT_A] as number;
-      const up = pB - pA;
-      const down = pB - p;
-      const span =
-        Number.isFinite(t) && Number.isFinite(atA)
-          ? t - atA <= SPIKE_WINDOW_US
-          : index - (ch[o + CH_IDX_A] as number) <= SPIKE_WINDOW_FRAMES;
-      if (
-        span &&
-        Math.abs(up) >= SPIKE_MIN_JUMP_PERCENT &&
-        Math.abs(down) >= SPIKE_MIN_JUMP_PERCENT &&
-        Math.sign(up) === Math.sign(down) &&
-        Math.abs(p - pA) <= SPIKE_RETURN_PERCENT
-      ) {
-        this.glitchCount++;
-        const frameIndex = ch[o + CH_IDX_B] as number;
-        if (frameIndex !== this.#lastGlitchFrame) this.glitchFrames++;
-        this.#lastGlitchFrame = frameIndex;
-        if (this.glitchesRaw.length < MAX_LISTED_GLITCHES) {
-          this.glitchesRaw.push({
-            kind: 'spike',
-            absUs: ch[o + CH_AT_B] as number,
-            frameIndex,
-            channel: id,
-            name: channelName(id),
-            beforeUs: ch[o + CH_US_A] as number,
-            spikeUs: ch[o + CH_US_B] as number,
-            afterUs: u,
-            jumpPercent: r1(up),
-          });
-        }
-      }
+    const pA = ch[o + CH_PCT_A] as number;
+    const pB = ch[o + CH_PCT_B] as number;
+    const atA = ch[o + CH_AT_A] as number;
+    const up = pB - pA;
+    const down = pB - p;
+    const span =
+      Number.isFinite(t) && Number.isFinite(atA) ? t - atA <= SPIKE_WINDOW_US : index - (ch[o + CH_IDX_A] as number) <= SPIKE_WINDOW_FRAMES;
+    if (!(span && Math.sign(up) === Math.sign(down) && Math.abs(p - pA) <= SPIKE_RETURN_PERCENT)) return;
+    this.glitchCount++;
+    const frameIndex = ch[o + CH_IDX_B] as number;
+    if (frameIndex !== this.#lastGlitchFrame) this.glitchFrames++;
+    this.#lastGlitchFrame = frameIndex;
+    if (this.glitchesRaw.length < MAX_LISTED_GLITCHES) {
+      this.glitchesRaw.push({
+        kind: 'spike',
+        absUs: ch[o + CH_AT_B] as number,
+        frameIndex,
+        channel: id,
+        name: channelName(id),
+        beforeUs: ch[o + CH_US_A] as number,
+        spikeUs: ch[o + CH_US_B] as number,
+        afterUs: u,
+        jumpPercent: r1(up),
+      });
     }
-    if (n >= 1) {
-      ch[o + CH_PCT_A] = ch[o + CH_PCT_B] as number;
-      ch[o + CH_US_A] = ch[o + CH_US_B] as number;
-      ch[o + CH_AT_A] = ch[o + CH_AT_B] as number;
-      ch[o + CH_IDX_A] = ch[o + CH_IDX_B] as number;
+  }
+
+  /** Each channel's appearances, lowest and highest µs (±Infinity without any) and µs summed. */
+  channels(): Pick<PortData, 'channelFrames' | 'channelMin' | 'channelMax' | 'channelSum'> {
+    const ch = this.#ch;
+    const channelFrames = new Uint32Array(CHANNEL_COUNT);
+    const channelMin = new Float64Array(CHANNEL_COUNT);
+    const channelMax = new Float64Array(CHANNEL_COUNT);
+    const channelSum = new Float64Array(CHANNEL_COUNT);
+    for (let id = 0; id < CHANNEL_COUNT; id++) {
+      const o = id * CH_STRIDE;
+      const repeats = ch[o + CH_REPEATS] as number;
+      channelFrames[id] = (ch[o + CH_COUNT] as number) + repeats;
+      channelMin[id] = ch[o + CH_MIN] as number;
+      channelMax[id] = ch[o + CH_MAX] as number;
+      channelSum[id] = (ch[o + CH_SUM] as number) + (repeats === 0 ? 0 : (ch[o + CH_US_B] as number) * repeats);
     }
-    ch[o + CH_PCT_B] = p;
-    ch[o + CH_US_B] = u;
-    ch[o + CH_AT_B] = t;
-    ch[o + CH_IDX_B] = index;
-    ch[o + CH_REPEAT] = 0;
+    return { channelFrames, channelMin, channelMax, channelSum };
   }
 }
 
@@ -408,10 +471,7 @@ export function decodePort(
     rssiHi: tally.rssiHi,
     rssiTotal: tally.rssiTotal,
     period: tally.intervals.stats(capture.timing === 'per-byte' ? 'per-byte' : 'per-chunk'),
-    channelFrames: tally.channelFrames,
-    channelMin: tally.channelMin,
-    channelMax: tally.channelMax,
-    channelSum: tally.channelSum,
+    ...tally.channels(),
     glitchesRaw: tally.glitchesRaw,
     glitchCount: tally.glitchCount,
     glitchFrames: tally.glitchFrames,
