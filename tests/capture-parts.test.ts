@@ -48,6 +48,16 @@ describe('reading an .sscap in parts', () => {
     }
   }
 
+  it('parts take about their shares of the file', () => {
+    const bytes = file();
+    const [a, b] = planParts(bytes, [2, 3])?.parts ?? [];
+    const share = ((a?.to ?? 0) - (a?.from ?? 0)) / ((b?.to ?? 0) - (a?.from ?? 0));
+    expect(share).toBeGreaterThan(0.39);
+    expect(share).toBeLessThan(0.41);
+    expect(() => planParts(bytes, [1, 0])).toThrow(TypeError);
+    expect(() => planParts(bytes, [])).toThrow(TypeError);
+  });
+
   it('parts meet at record boundaries and cover every record once', () => {
     const plan = planParts(file(), 4);
     const parts = plan?.parts ?? [];

@@ -61,11 +61,18 @@ export interface PartRead {
 const noWork = () => ({ crcBytes: 0, crcCombines: 0, probes: 0 });
 
 /**
- * `count` parts of about equal size, cut at record boundaries, when the header is intact and the
- * record headers lead from one to the next right to the end of the file; null otherwise (or when
- * the file is not a capture: `parseCapture` says why).
+ * Parts cut at record boundaries, as many as `shares` and each about its share of the file (2:
+ * two equal halves; [2, 3]: two fifths and three), when the header is intact and the record
+ * headers lead from one to the next right to the end of the file; null otherwise (or when the
+ * file is not a capture: `parseCapture` says why).
+ * @throws {TypeError} for shares that are not positive numbers
  */
-export function planParts(bytes: Uint8Array, count: number): CapturePlan | null {
+export function planParts(bytes: Uint8Array, shares: number | readonly number[]): CapturePlan | null {
+  const weights = typeof shares === 'number' ? new Array<number>(shares).fill(1) : shares;
+  if (weights.length === 0 || !weights.every((w) => w > 0 && Number.isFinite(w)))
+    throw new TypeError(`parts need positive shares, not ${String(shares)}`);
+  const total = weights.reduce((a, b) => a + b, 0);
+  const count = weights.length;
   const view = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
   const issues: Parameters<typeof readHeader>[3] = [];
   let header: ReturnType<typeof readHeader>;
@@ -77,12 +84,15 @@ export function planParts(bytes: Uint8Array, count: number): CapturePlan | null 
   if (issues.length > 0) return null;
   const n = bytes.length;
   const parts: CapturePart[] = [];
+  // Where each part but the last ends at the earliest, as a share of the records' bytes.
+  const cuts: number[] = [];
+  for (let i = 0, sum = 0; i < count - 1; i++) cuts.push((sum += weights[i] ?? 0) / total);
   let records = 0;
   let data = 0;
   let start = { from: header.headerLength, chunk: 0, dataAt: 0 };
   let p = header.headerLength;
   while (p + RECORD_OVERHEAD <= n && bytes[p] === SYNC0 && bytes[p + 1] === SYNC1) {
-    if (parts.length < count - 1 && p - header.headerLength >= ((n - header.headerLength) * (parts.length + 1)) / count) {
+    if (parts.length < count - 1 && p - header.headerLength >= (n - header.headerLength) * (cuts[parts.length] ?? 1)) {
       parts.push({ ...start, to: p });
       start = { from: p, chunk: records, dataAt: data };
     }

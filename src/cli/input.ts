@@ -46,7 +46,8 @@ function readBytes(file: string, big: number): Uint8Array {
 
 /** An intact .sscap read on two threads, or null (not one, or not intact: `readCapture` reads it). */
 function readInParts(bytes: Uint8Array): Capture | null {
-  const plan = planParts(bytes, 2);
+  // This thread has read the file and planned before the worker starts, so it takes the smaller part.
+  const plan = planParts(bytes, [2, 3]);
   const [mine, theirs] = plan?.parts ?? [];
   if (plan === null || mine === undefined || theirs === undefined) return null;
   const columns = partColumns(plan, true);
