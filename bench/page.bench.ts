@@ -627,11 +627,12 @@ async function traceTasks(page: Page): Promise<
     },
   });
   return async () => {
+    // The trace ends first: handing over the profile is a task of 100 ms or more of its own.
+    await cdp.send('Tracing.end');
+    await done;
     const { profile } = (await cdp.send('Profiler.stop')) as {
       profile: { nodes: ProfileNode[]; samples: number[]; timeDeltas: number[]; startTime: number };
     };
-    await cdp.send('Tracing.end');
-    await done;
     await cdp.detach();
     settle(true);
     // The profile's clock is the trace's (both are the browser's monotonic µs).
