@@ -439,39 +439,251 @@ async function traceMainThread(
   return { msPerSecond: top(byName, ms), longTasks: long.length, inLongTasksMs: top(inLong, 1000) };
 }
 
+/** A main-thread task with over 30 ms of the thread's CPU: when, how long, and what it was made of. */
+interface LongTask {
+  /** Seconds since the trace started. */
+  atS: number;
+  wallMs: number;
+  cpuMs: number;
+  /** Its nested work by kind (trace event names: FunctionCall, MajorGC, Layout…), ms of wall time, the largest first. */
+  kinds: Record<string, number>;
+  /** The script functions it called (the trace's FunctionCall and timer/animation-frame/message events), ms. */
+  calls: Record<string, number>;
+  /** Stack samples in it by their top frame (self), ms: the functions (or "(garbage collector)", "(program)") it ran. */
+  topFrames: Record<string, number>;
+  /** The same samples by their top four frames (callee < caller < …), ms. */
+  topStacks: Record<string, number>;
+  /** Seconds since the bench last asked for a heap sample (a full collection forced through CDP), if it did. */
+  sinceHeapSampleS?: number;
+  /** The task is that forced collection: the bench's work, not the page's. */
+  benchHeapSample?: true;
+}
+
+type TraceEvent = {
+  name: string;
+  ph: string;
+  ts: number;
+  dur?: number;
+  tdur?: number;
+  pid: number;
+  tid: number;
+  args?: {
+    name?: string;
+    data?: {
+      functionName?: string;
+      url?: string;
+      lineNumber?: number;
+      type?: string;
+      message?: string;
+    };
+  };
+};
+
+/** Where a script frame is: function, file and line. */
+const frameName = (f: { functionName?: string; url?: string; lineNumber?: number }) =>
+  `${f.functionName || '(anonymous)'} ${(f.url ?? '').split('/').pop() ?? ''}:${(f.lineNumber ?? -1) + 1}`;
+
+/** The pid of the renderer that runs the page and its decoder worker (Linux: its main thread's tid is the pid). */
+function rendererPid(): number | null {
+  for (const pid of descendants()) {
+    try {
+      if (!readFileSync(`/proc/${pid}/cmdline`, 'utf8').includes('--type=renderer')) continue;
+      const tasks = readdirSync(`/proc/${pid}/task`);
+      if (tasks.some((t) => readFileSync(`/proc/${pid}/task/${t}/comm`, 'utf8').startsWith('DedicatedWorker'))) return pid;
+    } catch {
+      // the process went away meanwhile
+    }
+  }
+  return null;
+}
+
 /**
- * Records the main thread's tasks until the returned function is called, from a trace (only the
- * tasks are kept): each task's wall time, as the `longtask` observer sees it, and the thread's
- * own CPU time in it. A task over 50 ms of wall time but under 50 ms of CPU is the thread
- * waiting for a core (descheduled on a loaded machine), not the page's work.
+ * Records the main thread's tasks until the returned function is called, from a trace: each
+ * task's wall time, as the `longtask` observer sees it, and the thread's own CPU time in it. A
+ * task over 50 ms of wall time but under 50 ms of CPU is the thread waiting for a core
+ * (descheduled on a loaded machine), not the page's work. A task that runs the full collection
+ * the bench itself asks for through CDP to sample the heap (`bench:heap-sample` in the trace) is
+ * counted apart: the page never does that, and the `longtask` observer does not see it.
+ *
+ * Each task with over 30 ms of the thread's CPU is described (`LongTask`): its nested trace
+ * events by kind and the script functions it called, and, from a CPU profile of the main thread
+ * over the whole run (sampled every ms) cut to the task's window, its samples by top frame and
+ * by their top four frames. Only a few seconds of the trace's events are kept at a time.
  */
-async function traceTasks(
-  page: Page,
-): Promise<() => Promise<{ overWallMs50: number; overCpuMs50: number; maxCpuMs: number; maxWallMs: number }>> {
+async function traceTasks(page: Page): Promise<
+  () => Promise<{
+    overWallMs50: number;
+    overCpuMs50: number;
+    maxCpuMs: number;
+    maxWallMs: number;
+    heapSampleTasksOverCpuMs50: number;
+    over30CpuMs: LongTask[];
+    dataLost?: boolean;
+  }>
+> {
   const cdp = await page.context().newCDPSession(page);
-  type TraceEvent = { name: string; ph: string; dur?: number; tdur?: number; tid: number; args?: { name?: string } };
-  let main: number | undefined;
-  const tasks: TraceEvent[] = [];
+  const pid = rendererPid();
+  /** Tasks with more of the thread's own CPU than this are described (the candidates for the page's own long tasks). */
+  const DESCRIBE_CPU_US = 30_000;
+  /** The main thread's events of the last few seconds (they come in chunks, roughly in time order). */
+  let recent: TraceEvent[] = [];
+  let latestUs = 0;
+  let originUs = Number.NaN;
+  const tasks: { ts: number; wallMs: number; cpuMs: number }[] = [];
+  /** The main thread's major collections (start, end), µs. */
+  const majorGCs: [number, number][] = [];
+  const pending: TraceEvent[] = [];
+  const described: (LongTask & { fromUs: number; toUs: number })[] = [];
+  const heapSamplesUs: number[] = [];
+  /** A heap sample's forced collection starts within this of its mark. */
+  const HEAP_SAMPLE_US = 0.5e6;
+  const afterHeapSample = (ts: number) => {
+    const before = heapSamplesUs.filter((t) => t <= ts).at(-1);
+    return before === undefined ? undefined : ts - before;
+  };
+  const ms = (m: Map<string, number>) =>
+    Object.fromEntries(
+      [...m.entries()]
+        .sort((x, y) => y[1] - x[1])
+        .slice(0, 10)
+        .map(([k, us]) => [k, round(us / 1000, 1)]),
+    );
+  const describe = (task: TraceEvent) => {
+    const end = task.ts + (task.dur ?? 0);
+    const kinds = new Map<string, number>();
+    const calls = new Map<string, number>();
+    for (const e of recent) {
+      if (e === task || e.ts < task.ts || e.ts >= end) continue;
+      kinds.set(e.name, (kinds.get(e.name) ?? 0) + (e.dur ?? 0));
+      const d = e.args?.data;
+      if (e.name === 'FunctionCall' && d !== undefined) calls.set(frameName(d), (calls.get(frameName(d)) ?? 0) + (e.dur ?? 0));
+      else if ((e.name === 'EventDispatch' || e.name === 'TimerFire' || e.name === 'FireAnimationFrame') && d?.type !== undefined)
+        calls.set(`${e.name} ${d.type}`, (calls.get(`${e.name} ${d.type}`) ?? 0) + (e.dur ?? 0));
+    }
+    const since = afterHeapSample(task.ts);
+    described.push({
+      atS: round((task.ts - originUs) / 1e6, 1),
+      wallMs: round((task.dur ?? 0) / 1000),
+      cpuMs: round((task.tdur ?? 0) / 1000),
+      kinds: ms(kinds),
+      calls: ms(calls),
+      topFrames: {},
+      topStacks: {},
+      ...(since === undefined ? {} : { sinceHeapSampleS: round(since / 1e6, 2) }),
+      fromUs: task.ts,
+      toUs: end,
+    });
+  };
+  const settle = (all: boolean) => {
+    for (let i = pending.length - 1; i >= 0; i--) {
+      const t = pending[i] as TraceEvent;
+      if (all || latestUs > t.ts + (t.dur ?? 0) + 2e6) {
+        describe(t);
+        pending.splice(i, 1);
+      }
+    }
+    // Keep 10 s of events (a task is described once the trace is 2 s past its end).
+    const keepFrom = latestUs - 10e6;
+    if (recent.length > 0 && (recent[0] as TraceEvent).ts < keepFrom - 10e6) recent = recent.filter((e) => e.ts >= keepFrom);
+  };
   // Playwright types trace events as string maps; they are JSON objects with numbers.
   cdp.on('Tracing.dataCollected', (e) => {
     for (const x of e.value as unknown as TraceEvent[]) {
-      if (x.ph === 'M' && x.name === 'thread_name' && x.args?.name === 'CrRendererMain') main = x.tid;
-      else if (x.ph === 'X' && x.name === 'RunTask' && (x.dur ?? 0) > 20_000) tasks.push(x);
+      if (x.pid !== pid || x.tid !== pid) continue;
+      if (Number.isNaN(originUs) && x.ts > 0) originUs = x.ts;
+      if (x.name === 'TimeStamp' && x.args?.data?.message === 'bench:heap-sample') heapSamplesUs.push(x.ts);
+      if (x.ph !== 'X') continue;
+      recent.push(x);
+      latestUs = Math.max(latestUs, x.ts);
+      if (x.name === 'MajorGC') majorGCs.push([x.ts, x.ts + (x.dur ?? 0)]);
+      if (x.name === 'RunTask' && (x.dur ?? 0) > 20_000) {
+        tasks.push({ ts: x.ts, wallMs: (x.dur ?? 0) / 1000, cpuMs: (x.tdur ?? 0) / 1000 });
+        if ((x.tdur ?? 0) > DESCRIBE_CPU_US) pending.push(x);
+      }
     }
+    settle(false);
   });
-  const done = new Promise<void>((resolve) => cdp.once('Tracing.tracingComplete', () => resolve()));
-  await cdp.send('Tracing.start', { categories: 'disabled-by-default-devtools.timeline', transferMode: 'ReportEvents' });
+  let dataLost = false;
+  const done = new Promise<void>((resolve) =>
+    cdp.once('Tracing.tracingComplete', (e: { dataLossOccurred?: boolean }) => {
+      dataLost = e.dataLossOccurred === true;
+      resolve();
+    }),
+  );
+  await cdp.send('Profiler.enable');
+  await cdp.send('Profiler.setSamplingInterval', { interval: 1000 });
+  // Starting the profiler is a task of its own on the main thread (V8 lists every compiled
+  // function: 30–50 ms of CPU, no script): over before the trace starts, so it is not counted.
+  await cdp.send('Profiler.start');
+  await page.waitForTimeout(1000);
+  // Read as it comes: a ring buffer that this reads faster than the page fills it (the default,
+  // record until full, stopped after about 5 minutes of these categories with dataLossOccurred).
+  await cdp.send('Tracing.start', {
+    transferMode: 'ReportEvents',
+    traceConfig: {
+      recordMode: 'recordContinuously',
+      traceBufferSizeInKb: 400_000,
+      includedCategories: ['devtools.timeline', 'disabled-by-default-devtools.timeline'],
+    },
+  });
   return async () => {
+    // The trace ends first: handing over the profile is a task of 100 ms or more of its own.
     await cdp.send('Tracing.end');
     await done;
+    const { profile } = (await cdp.send('Profiler.stop')) as {
+      profile: { nodes: ProfileNode[]; samples: number[]; timeDeltas: number[]; startTime: number };
+    };
     await cdp.detach();
-    const mine = tasks.filter((t) => t.tid === main);
-    const ms = (us: number | undefined) => (us ?? 0) / 1000;
+    settle(true);
+    // The profile's clock is the trace's (both are the browser's monotonic µs).
+    const nodes = new Map(profile.nodes.map((n) => [n.id, n]));
+    const parents = new Map<number, number>();
+    for (const n of profile.nodes) for (const c of n.children ?? []) parents.set(c, n.id);
+    let t = profile.startTime;
+    const times = profile.timeDeltas.map((d) => {
+      t += d;
+      return t;
+    });
+    for (const task of described) {
+      const top = new Map<string, number>();
+      const stacks = new Map<string, number>();
+      let last = task.fromUs;
+      profile.samples.forEach((id, i) => {
+        const at = times[i] ?? 0;
+        if (at < task.fromUs || at >= task.toUs) return;
+        const n = nodes.get(id);
+        const key = n === undefined ? '(unknown)' : frameName(n.callFrame);
+        const chain: string[] = [];
+        for (
+          let f = n;
+          f !== undefined && chain.length < 4 && f.callFrame.functionName !== '(root)';
+          f = nodes.get(parents.get(f.id) ?? -1)
+        )
+          chain.push(frameName(f.callFrame));
+        top.set(key, (top.get(key) ?? 0) + (at - last));
+        const stack = chain.join(' < ') || key;
+        stacks.set(stack, (stacks.get(stack) ?? 0) + (at - last));
+        last = at;
+      });
+      task.topFrames = ms(top);
+      task.topStacks = ms(stacks);
+    }
+    // The bench's own: a task just after a heap-sample mark that is mostly a major collection.
+    const heapSample = (x: { ts: number; wallMs: number }) => {
+      const since = afterHeapSample(x.ts);
+      const gc = majorGCs.filter(([a, b]) => a >= x.ts && b <= x.ts + x.wallMs * 1000).reduce((n, [a, b]) => n + b - a, 0);
+      return since !== undefined && since < HEAP_SAMPLE_US && gc > (x.wallMs * 1000) / 2;
+    };
+    for (const d of described) if (heapSample({ ts: d.fromUs, wallMs: d.wallMs })) d.benchHeapSample = true;
+    const page = tasks.filter((x) => !heapSample(x));
     return {
-      overWallMs50: mine.filter((t) => ms(t.dur) > 50).length,
-      overCpuMs50: mine.filter((t) => ms(t.tdur) > 50).length,
-      maxCpuMs: round(Math.max(0, ...mine.map((t) => ms(t.tdur)))),
-      maxWallMs: round(Math.max(0, ...mine.map((t) => ms(t.dur)))),
+      overWallMs50: page.filter((x) => x.wallMs > 50).length,
+      overCpuMs50: page.filter((x) => x.cpuMs > 50).length,
+      maxCpuMs: round(Math.max(0, ...page.map((x) => x.cpuMs))),
+      maxWallMs: round(Math.max(0, ...page.map((x) => x.wallMs))),
+      heapSampleTasksOverCpuMs50: tasks.filter((x) => heapSample(x) && x.cpuMs > 50).length,
+      over30CpuMs: described.sort((a, b) => a.atS - b.atS).map(({ fromUs, toUs, ...d }) => d),
+      ...(dataLost ? { dataLost } : {}),
     };
   };
 }
@@ -590,13 +802,16 @@ it(
         const worker = await WorkerTarget.attach(browser);
         const heapBefore = await pageHeap(page);
         const workerBefore = await worker?.heapMB();
-        await collect(page);
+        // The trace first: starting its profiler is a long task the page did not make.
         const stopTasks = await traceTasks(page);
+        await collect(page);
         const cpu0 = threadTimes();
         const samples: { s: number; pageMB: number }[] = [];
         const t0 = performance.now();
         for (let s = 60; s < FOUR_SECONDS; s += 60) {
           await page.waitForTimeout(Math.max(0, t0 + s * 1000 - performance.now()));
+          // Marked in the trace: the sample forces a full GC on the page's main thread.
+          await page.evaluate(() => console.timeStamp('bench:heap-sample'));
           samples.push({ s, pageMB: (await pageHeap(page)).used });
         }
         await page.waitForTimeout(Math.max(0, t0 + FOUR_SECONDS * 1000 - performance.now()));

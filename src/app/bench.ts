@@ -1,10 +1,10 @@
 /**
- * Measurement hooks for the page benchmark (only with ?bench in the URL): for each batch that
- * reaches the screen, the time from the bytes' arrival in the worker to the animation frame
- * that drew them, in ms; the last such frame (when, and the source clock it showed), so a seek
- * can be timed to the frame that drew its new position; and when the worker's reset and first
- * batch after it arrived, to split that time between the worker and the page. Read by bench/page.bench.ts
- * through window.__satscopeBench.
+ * Measurement hooks for the page benchmark (only with ?bench in the URL): for each batch with
+ * new bytes that reaches the screen, the time from the bytes' arrival in the worker to the
+ * animation frame that drew them, in ms; the last such frame (when, and the source clock it
+ * showed), so a seek can be timed to the frame that drew its new position; and when the
+ * worker's reset and first batch after it arrived, to split that time between the worker and
+ * the page. Read by bench/page.bench.ts through window.__satscopeBench.
  */
 import type { FromWorker } from '../worker/protocol.js';
 import { onFrame } from './frame-loop.js';
@@ -37,6 +37,8 @@ export function startBenchHooks(worker: Worker): void {
   });
   let version = -1;
   let shown = current();
+  /** The arrival time of the newest bytes already sampled: a batch without new bytes is no sample. */
+  let sampledArrivalMs = 0;
   // Registered after the views, so it runs after they drew in the same frame.
   onFrame((nowMs) => {
     const live = current();
@@ -44,6 +46,12 @@ export function startBenchHooks(worker: Worker): void {
     shown = live;
     version = live.version;
     bench.painted = { atMs: nowMs, clockUs: live.nowUs() };
-    if (live.lastArrivedMs > 0) bench.latencies.push(performance.timeOrigin + nowMs - live.lastArrivedMs);
+    // Only a batch that brought new bytes is a latency sample. While a remote is silent (a
+    // dropout) the worker still sends batches (the link state, the graph's empty buckets) that
+    // carry the last bytes' arrival: their age is how long the silence lasted, not a delay.
+    if (live.lastArrivedMs > 0 && live.lastArrivedMs !== sampledArrivalMs) {
+      sampledArrivalMs = live.lastArrivedMs;
+      bench.latencies.push(performance.timeOrigin + nowMs - live.lastArrivedMs);
+    }
   });
 }

@@ -9,6 +9,7 @@ import { useEffect, useRef } from 'preact/hooks';
 import uPlot from 'uplot';
 import { overview, replay, replayName, replaySpanUs, send } from '../../store.js';
 import { chartColors, theme } from '../../theme.js';
+import { readingPercent } from './reading.js';
 import './style.css';
 
 const SPEEDS = [
@@ -40,7 +41,7 @@ const readingText = computed(() => {
   const r = replay.value;
   const until = readUntil.value;
   if (r === null || until === null) return '';
-  return `Reading the capture: ${Math.floor((100 * (until - r.startUs)) / Math.max(1, r.endUs - r.startUs))} %`;
+  return `Reading the capture: ${readingPercent(until, r.startUs, r.endUs)}`;
 });
 const clockText = computed(() => {
   const r = replay.value;
