@@ -17,45 +17,13 @@ export interface Clock {
   cancel(handle: unknown): void;
 }
 
-/** A task `soon` runs, unless it was cancelled first. */
-class SoonTask {
-  cancelled = false;
-  constructor(readonly fn: () => void) {}
-}
-
-/**
- * Runs `fn` after what is already queued (messages, timers due), through a MessageChannel: a
- * `setTimeout(fn, 0)` that a timeout scheduled waits 4 ms or more once five are nested (HTML's
- * clamp), a tenth of the replay pass's 40 ms slices lost to waiting.
- */
-const soon = (() => {
-  let channel: MessageChannel | undefined;
-  const queue: SoonTask[] = [];
-  return (fn: () => void): SoonTask => {
-    if (channel === undefined) {
-      channel = new MessageChannel();
-      channel.port1.onmessage = () => {
-        const task = queue.shift();
-        if (task !== undefined && !task.cancelled) task.fn();
-      };
-    }
-    const task = new SoonTask(fn);
-    queue.push(task);
-    channel.port2.postMessage(null);
-    return task;
-  };
-})();
-
-/** The browser's clock: performance.now() and the timer functions (a zero delay through `soon`). */
+/** The browser's clock: performance.now() and the timer functions. */
 export const BROWSER_CLOCK: Clock = {
   now: () => performance.now(),
-  after: (ms, fn) => (ms > 0 ? setTimeout(fn, ms) : soon(fn)),
+  after: (ms, fn) => setTimeout(fn, ms),
   every: (ms, fn) => setInterval(fn, ms),
-  cancel: (handle) => {
-    if (handle instanceof SoonTask) handle.cancelled = true;
-    // clearTimeout and clearInterval share one pool of ids (HTML, Node alike): either clears both.
-    else clearTimeout(handle as ReturnType<typeof setTimeout> | undefined);
-  },
+  // clearTimeout and clearInterval share one pool of ids (HTML, Node alike): either clears both.
+  cancel: (handle) => clearTimeout(handle as ReturnType<typeof setTimeout> | undefined),
 };
 
 export interface Host {
