@@ -7,22 +7,11 @@
  */
 import { describe, expect, it } from 'vitest';
 import { diagnosedHealthReport, doctorCapture } from '../src/analysis/index.js';
-import { CaptureWriter, readCapture, type Capture } from '../src/capture/index.js';
+import type { Capture } from '../src/capture/index.js';
 import { preset, simulate } from '../src/simulator/index.js';
-import { concatBytes } from './bytes.js';
-import { usbChunks } from './feeds.js';
+import { recording } from './feeds.js';
 
 const SECOND = 1_000_000;
-
-/** Streams of several ports recorded as the page records them: 16 ms USB chunks, merged in time order. */
-function recording(ports: { bytes: Uint8Array; timesUs: Float64Array }[]): Capture {
-  const w = new CaptureWriter({ baudRate: 115200, source: 'test', ports: ports.map((_, i) => ({ name: `port ${i}` })) });
-  const records = ports.flatMap((p, port) => usbChunks(p.bytes, p.timesUs).map((c) => ({ ...c, port })));
-  records.sort((a, b) => a.timeUs - b.timeUs || a.port - b.port);
-  const parts = [w.header(), ...ports.map((_, port) => w.event('port opened', 0, port))];
-  for (const r of records) parts.push(w.data(r.bytes, r.timeUs, r.port));
-  return readCapture(concatBytes(parts), 'agree.sscap');
-}
 
 const CAPTURES: [string, () => Capture][] = [
   [

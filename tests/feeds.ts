@@ -1,5 +1,9 @@
 /** How the tests' bytes reach a decoder: as a USB adapter batches them, or with every byte's time. */
-import type { Capture } from '../src/capture/index.js';
+import { CaptureWriter, readCapture, type Capture } from '../src/capture/index.js';
+import { concatBytes } from './bytes.js';
+
+/** A stream with every byte's time, as the simulator makes it. */
+export type Stream = { bytes: Uint8Array; timesUs: Float64Array };
 
 /** What a USB adapter delivers from per-byte times: whatever arrived in each 16 ms window, stamped at its end. */
 export function usbChunks(bytes: Uint8Array, times: Float64Array, windowUs = 16_000): { bytes: Uint8Array; timeUs: number }[] {
@@ -29,4 +33,35 @@ export function perByteCapture(sim: { bytes: Uint8Array; timesUs: Float64Array }
     events: [],
     issues: [],
   };
+}
+
+/**
+ * Streams of several ports recorded as the page records them, as the bytes of an .sscap: 16 ms
+ * USB chunks merged in time order, each port named "port N" and opened at 0 (`timed: false`:
+ * without any time).
+ */
+export function recordingFile(ports: Stream[], timed = true): Uint8Array {
+  const w = new CaptureWriter({ baudRate: 115200, source: 'test', ports: ports.map((_, i) => ({ name: `port ${i}` })) });
+  const records = ports.flatMap((p, port) => usbChunks(p.bytes, p.timesUs).map((c) => ({ ...c, port })));
+  records.sort((a, b) => a.timeUs - b.timeUs || a.port - b.port);
+  const parts = [w.header(), ...ports.map((_, port) => w.event('port opened', timed ? 0 : NaN, port))];
+  for (const r of records) parts.push(w.data(r.bytes, timed ? r.timeUs : NaN, r.port));
+  return concatBytes(parts);
+}
+
+/** `recordingFile`, read. */
+export function recording(ports: Stream[], timed = true): Capture {
+  return readCapture(recordingFile(ports, timed), 'recording.sscap');
+}
+
+/** Streams one after another on one line, each shifted to start 20 ms after the last ended. */
+export function oneAfterAnother(streams: Stream[]): Stream {
+  const times: number[] = [];
+  let offset = 0;
+  for (const s of streams) {
+    const t0 = s.timesUs[0] ?? 0;
+    for (const t of s.timesUs) times.push(offset + t - t0);
+    offset = (times.at(-1) ?? 0) + 20_000;
+  }
+  return { bytes: concatBytes(streams.map((s) => s.bytes)), timesUs: Float64Array.from(times) };
 }

@@ -8,24 +8,12 @@ import { describe, expect, it } from 'vitest';
 import { diagnosedHealthReport, Doctor } from '../src/analysis/index.js';
 import { diagnosedReportJobs } from '../src/analysis/doctor-report.js';
 import { readPortMessage, sameReading, type PortReadingMessage } from '../src/analysis/report-port-message.js';
-import { CaptureWriter, readCapture, type Capture } from '../src/capture/index.js';
+import type { Capture } from '../src/capture/index.js';
 import { crsfStream, ibusStream, preset, receiveAs, simulate, srxlV1Stream } from '../src/simulator/index.js';
 import { concatBytes } from './bytes.js';
-import { usbChunks } from './feeds.js';
+import { oneAfterAnother, recording, type Stream } from './feeds.js';
 
 const SECOND = 1_000_000;
-
-type Stream = { bytes: Uint8Array; timesUs: Float64Array };
-
-/** Streams of several ports recorded as the page records them: 16 ms USB chunks, merged in time order. */
-function recording(ports: Stream[], timed = true): Capture {
-  const w = new CaptureWriter({ baudRate: 115200, source: 'test', ports: ports.map((_, i) => ({ name: `port ${i}` })) });
-  const records = ports.flatMap((p, port) => usbChunks(p.bytes, p.timesUs).map((c) => ({ ...c, port })));
-  records.sort((a, b) => a.timeUs - b.timeUs || a.port - b.port);
-  const parts = [w.header(), ...ports.map((_, port) => w.event('port opened', timed ? 0 : NaN, port))];
-  for (const r of records) parts.push(w.data(r.bytes, timed ? r.timeUs : NaN, r.port));
-  return readCapture(concatBytes(parts), 'elsewhere.sscap');
-}
 
 /** Ports with every byte's time, as a logic analyser records them: a chunk a port. */
 function perByte(ports: Stream[]): Capture {
@@ -42,18 +30,6 @@ function perByte(ports: Stream[]): Capture {
     events: [],
     issues: [],
   };
-}
-
-/** Streams one after another on one line, each shifted to start 20 ms after the last ended. */
-function oneAfterAnother(streams: Stream[]): Stream {
-  const times: number[] = [];
-  let offset = 0;
-  for (const s of streams) {
-    const t0 = s.timesUs[0] ?? 0;
-    for (const t of s.timesUs) times.push(offset + t - t0);
-    offset = (times.at(-1) ?? 0) + 20_000;
-  }
-  return { bytes: concatBytes(streams.map((s) => s.bytes)), timesUs: Float64Array.from(times) };
 }
 
 const CAPTURES: [string, () => Capture][] = [

@@ -9,35 +9,12 @@ import { existsSync, readFileSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 import { describe, expect, it } from 'vitest';
 import { diagnosedHealthReport, doctorCapture, summarizeCapture } from '../src/analysis/index.js';
-import { CaptureWriter, importSaleaeCsv, readCapture, type Capture } from '../src/capture/index.js';
+import { importSaleaeCsv, type Capture } from '../src/capture/index.js';
 import { ibusStream, preset, receiveAs, simulate, srxlV1Stream } from '../src/simulator/index.js';
-import { concatBytes } from './bytes.js';
-import { perByteCapture, usbChunks } from './feeds.js';
+import { oneAfterAnother, perByteCapture, recording } from './feeds.js';
 
 const SECOND = 1_000_000;
 const px4 = resolve(import.meta.dirname, '../../shared/captures/px4');
-
-/** Streams of several ports recorded as the page records them: 16 ms USB chunks, merged in time order. */
-function recording(ports: { bytes: Uint8Array; timesUs: Float64Array }[]): Capture {
-  const w = new CaptureWriter({ baudRate: 115200, source: 'test', ports: ports.map((_, i) => ({ name: `port ${i}` })) });
-  const records = ports.flatMap((p, port) => usbChunks(p.bytes, p.timesUs).map((c) => ({ ...c, port })));
-  records.sort((a, b) => a.timeUs - b.timeUs || a.port - b.port);
-  const parts = [w.header(), ...ports.map((_, port) => w.event('port opened', 0, port))];
-  for (const r of records) parts.push(w.data(r.bytes, r.timeUs, r.port));
-  return readCapture(concatBytes(parts), 'pinned.sscap');
-}
-
-/** Streams one after another on one line, each shifted to start 20 ms after the last ended. */
-function oneAfterAnother(streams: { bytes: Uint8Array; timesUs: Float64Array }[]): { bytes: Uint8Array; timesUs: Float64Array } {
-  const times: number[] = [];
-  let offset = 0;
-  for (const s of streams) {
-    const t0 = s.timesUs[0] ?? 0;
-    for (const t of s.timesUs) times.push(offset + t - t0);
-    offset = (times.at(-1) ?? 0) + 20_000;
-  }
-  return { bytes: concatBytes(streams.map((s) => s.bytes)), timesUs: Float64Array.from(times) };
-}
 
 const SIMULATED: [string, () => Capture][] = [
   [

@@ -11,10 +11,9 @@ import { join, resolve } from 'node:path';
 import { pathToFileURL } from 'node:url';
 import { afterAll, describe, expect, it } from 'vitest';
 import { diagnosedHealthReport, diagnosedReportJobs } from '../src/analysis/index.js';
-import { CaptureWriter, readCapture, type Capture } from '../src/capture/index.js';
+import { readCapture, type Capture } from '../src/capture/index.js';
 import { preset, simulate } from '../src/simulator/index.js';
-import { concatBytes } from './bytes.js';
-import { usbChunks } from './feeds.js';
+import { recordingFile } from './feeds.js';
 
 const SECOND = 1_000_000;
 const built = resolve(import.meta.dirname, '../dist/cli/report-threads.js');
@@ -25,12 +24,7 @@ function file(): Uint8Array {
     simulate(preset('dropouts-and-damage'), 20 * SECOND),
     simulate({ ...preset('dsmx-11ms-2048-external'), damage: { truncateRate: 0.01, bitFlipRate: 0.01 } }, 20 * SECOND),
   ];
-  const w = new CaptureWriter({ baudRate: 115200, source: 'test', ports: ports.map((_, i) => ({ name: `port ${i}` })) });
-  const records = ports.flatMap((p, port) => usbChunks(p.bytes, p.timesUs).map((c) => ({ ...c, port })));
-  records.sort((a, b) => a.timeUs - b.timeUs || a.port - b.port);
-  const parts = [w.header(), ...ports.map((_, port) => w.event('port opened', 0, port))];
-  for (const r of records) parts.push(w.data(r.bytes, r.timeUs, r.port));
-  return concatBytes(parts);
+  return recordingFile(ports);
 }
 
 describe('satscope report on two threads', () => {
