@@ -7,21 +7,9 @@
  * CRC fails, bytes between records) makes the plan or a part say so, and the file goes to
  * `parseCapture`, which salvages.
  */
-import {
-  RECORD_HEADER_SIZE,
-  RECORD_OVERHEAD,
-  RECORD_TYPE_DATA,
-  RECORD_TYPE_EVENT,
-  REC_OFF_LENGTH,
-  REC_OFF_PORT,
-  REC_OFF_TIME,
-  REC_OFF_TYPE,
-  MAX_RECORD_PAYLOAD,
-  SYNC0,
-  SYNC1,
-} from './layout.js';
+import { RECORD_HEADER_SIZE, RECORD_OVERHEAD, RECORD_TYPE_DATA, REC_OFF_PORT, REC_OFF_TIME, REC_OFF_TYPE } from './layout.js';
 import type { CaptureEvent, CaptureMeta, ParsedCapture } from './model.js';
-import { copyPayload, readHeader, RecordProbe } from './reader.js';
+import { copyPayload, plannedSizes, readHeader, RecordProbe } from './reader.js';
 import { utf8Decode } from './text.js';
 
 /** One run of records: file offsets [from, to), and the first chunk index and data offset it fills. */
@@ -82,32 +70,21 @@ export function planParts(bytes: Uint8Array, shares: number | readonly number[])
     return null;
   }
   if (issues.length > 0) return null;
-  const n = bytes.length;
-  const parts: CapturePart[] = [];
   // Where each part but the last ends at the earliest, as a share of the records' bytes.
   const cuts: number[] = [];
   for (let i = 0, sum = 0; i < count - 1; i++) cuts.push((sum += weights[i] ?? 0) / total);
-  let records = 0;
-  let data = 0;
-  let start = { from: header.headerLength, chunk: 0, dataAt: 0 };
-  let p = header.headerLength;
-  while (p + RECORD_OVERHEAD <= n && bytes[p] === SYNC0 && bytes[p + 1] === SYNC1) {
-    if (parts.length < count - 1 && p - header.headerLength >= (n - header.headerLength) * (cuts[parts.length] ?? 1)) {
-      parts.push({ ...start, to: p });
-      start = { from: p, chunk: records, dataAt: data };
-    }
-    const type = bytes[p + REC_OFF_TYPE];
-    const len = view.getUint32(p + REC_OFF_LENGTH, true);
-    if ((type !== RECORD_TYPE_DATA && type !== RECORD_TYPE_EVENT) || len > MAX_RECORD_PAYLOAD || p + RECORD_OVERHEAD + len > n) return null;
-    if (type === RECORD_TYPE_DATA) {
-      records++;
-      data += len;
-    }
-    p += RECORD_OVERHEAD + len;
-  }
-  if (p !== n) return null;
-  parts.push({ ...start, to: n });
-  return { meta: header.meta, version: header.version, headerLength: header.headerLength, records, data, parts };
+  const planned = plannedSizes(bytes, view, header.headerLength, cuts);
+  if (planned === null) return null;
+  const starts = [{ from: header.headerLength, chunk: 0, dataAt: 0 }, ...planned.starts];
+  const parts = starts.map((start, i): CapturePart => ({ ...start, to: starts[i + 1]?.from ?? bytes.length }));
+  return {
+    meta: header.meta,
+    version: header.version,
+    headerLength: header.headerLength,
+    records: planned.records,
+    data: planned.data,
+    parts,
+  };
 }
 
 /** Columns for `plan`'s capture, in shared memory when `shared` (so that threads fill them). */

@@ -418,17 +418,33 @@ function grown<T extends Uint8Array | Uint32Array | Float64Array>(to: T, from: T
   return to;
 }
 
+/** Where a run of records starts: its file offset, and the chunk index and data offset it fills from. */
+export interface RecordsStart {
+  readonly from: number;
+  readonly chunk: number;
+  readonly dataAt: number;
+}
+
 /**
  * The data records and payload bytes of a file whose record headers lead from one to the next
  * right to its end (sync marker, type, a length that fits), or null when they do not: read from
- * the headers alone, before any CRC is checked.
+ * the headers alone, before any CRC is checked. `cuts` (ascending shares of the records' bytes,
+ * 0–1) ask where the first record at or past each of them starts (`planParts`).
  */
-function plannedSizes(bytes: Uint8Array, view: DataView, headerLength: number): { records: number; data: number } | null {
+export function plannedSizes(
+  bytes: Uint8Array,
+  view: DataView,
+  headerLength: number,
+  cuts: readonly number[] = [],
+): { records: number; data: number; starts: RecordsStart[] } | null {
   const n = bytes.length;
+  const starts: RecordsStart[] = [];
   let records = 0;
   let data = 0;
   let p = headerLength;
   while (p + RECORD_OVERHEAD <= n && bytes[p] === SYNC0 && bytes[p + 1] === SYNC1) {
+    if (starts.length < cuts.length && p - headerLength >= (n - headerLength) * (cuts[starts.length] ?? 1))
+      starts.push({ from: p, chunk: records, dataAt: data });
     const type = bytes[p + REC_OFF_TYPE];
     const len = view.getUint32(p + REC_OFF_LENGTH, true);
     if ((type !== RECORD_TYPE_DATA && type !== RECORD_TYPE_EVENT) || len > MAX_RECORD_PAYLOAD || p + RECORD_OVERHEAD + len > n) return null;
@@ -438,7 +454,7 @@ function plannedSizes(bytes: Uint8Array, view: DataView, headerLength: number): 
     }
     p += RECORD_OVERHEAD + len;
   }
-  return p === n ? { records, data } : null;
+  return p === n ? { records, data, starts } : null;
 }
 
 /** How `parseCapture` lays out what it reads. */

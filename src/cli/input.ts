@@ -3,8 +3,8 @@
  * the words and exit codes every command uses (2: the file cannot be read, 1: not a capture).
  *
  * A big .sscap (`PARTS_MIN_BYTES` and up) is read on two threads when it is intact: its bytes
- * and columns in shared memory, each thread checking and copying half of its records
- * (`planParts`, `readPart`). The capture is the one `readCapture` makes; a damaged file, or a
+ * and columns in shared memory, each thread checking and copying a part of its records
+ * (`planParts`, `readPart`: this thread two fifths, having read the file and planned first). The capture is the one `readCapture` makes; a damaged file, or a
  * part the other thread could not read, is read here alone, salvaging as ever.
  */
 import { closeSync, fstatSync, openSync, readSync } from 'node:fs';
