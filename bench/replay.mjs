@@ -14,7 +14,7 @@
  * Measurement only: it asserts nothing.
  */
 import { spawnSync } from 'node:child_process';
-import { existsSync, readFileSync, rmSync, statSync } from 'node:fs';
+import { existsSync, openAsBlob, rmSync, statSync } from 'node:fs';
 import { loadavg, tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -140,11 +140,8 @@ async function child(bundle, path, seeks) {
   const worker = new Dispatcher(host);
   const base = held();
   const fileBytes = statSync(path).size;
-  // The page transfers the file's ArrayBuffer: the worker owns its only copy, and nothing else here keeps it.
-  let data = new Uint8Array(fileBytes);
-  data.set(readFileSync(path));
-  const message = { type: 'replay-open', name: path, data: data.buffer };
-  data = null;
+  // The page hands the worker the File, which the worker reads: here a Blob backed by the file.
+  const message = { type: 'replay-open', name: path, file: await openAsBlob(path) };
   const done = new Promise((resolve) => {
     complete = resolve;
   });

@@ -5,56 +5,17 @@
  * capture up to the target, as a decode fed every chunk up to there has them.
  */
 import { describe, expect, it } from 'vitest';
-import { type Capture, capturePorts, encodeCapture, readCapture } from '../src/capture/index.js';
-import { LinkMonitor, SpektrumDecoder, USB_CHUNK_JITTER_US } from '../src/decoder/index.js';
-import { preset, simulate } from '../src/simulator/index.js';
+import { capturePorts, readCapture } from '../src/capture/index.js';
 import { Dispatcher } from '../src/worker/dispatcher.js';
 import { overviewOf } from '../src/worker/overview.js';
 import { ReplayPass } from '../src/worker/replay-pass.js';
 import { type PreviewSizes, previewOf } from '../src/worker/replay-preview.js';
 import { captureSpan } from '../src/analysis/index.js';
 import type { Overview } from '../src/worker/protocol.js';
-import { usbChunks } from './feeds.js';
-import { FakeClock, fakeHost } from './worker-fakes.js';
-
-const MINUTE = 60e6;
-
-/** Two remotes for 12 minutes (longer than a fresh decode's 10-minute history), the internal one with dropouts and a failsafe. */
-function longCapture(): Uint8Array {
-  return longCaptureWithSeed(3);
-}
-
-function longCaptureWithSeed(seed: number): Uint8Array {
-  const a = simulate(
-    {
-      ...preset('dsmx-11ms-2048-internal'),
-      seed,
-      dropouts: [
-        { atUs: 2 * MINUTE, durationUs: 300_000 },
-        { atUs: 5 * MINUTE, durationUs: 1_500_000 },
-        { atUs: 9.5 * MINUTE, durationUs: 200_000 },
-      ],
-    },
-    12 * MINUTE,
-  );
-  const b = simulate({ ...preset('dsmx-11ms-2048-external'), seed: 4 }, 12 * MINUTE);
-  const records = [
-    ...usbChunks(a.bytes, a.timesUs).map((c) => ({ type: 'data' as const, bytes: c.bytes, timeUs: c.timeUs, port: 0 })),
-    ...usbChunks(b.bytes, b.timesUs).map((c) => ({ type: 'data' as const, bytes: c.bytes, timeUs: c.timeUs + 3, port: 1 })),
-  ].sort((x, y) => x.timeUs - y.timeUs);
-  return encodeCapture({ baudRate: 115200 }, records);
-}
+import { MINUTE, libraryUpTo, longCapture, longCaptureWithSeed } from './long-capture.js';
+import { FakeClock, ReadingClock, fakeHost } from './worker-fakes.js';
 
 const FILE = longCapture();
-
-/** A clock that moves 10 ms each time it is read, so the capture's decode goes in slices. */
-class ReadingClock extends FakeClock {
-  #extra = 0;
-  override now(): number {
-    this.#extra += 10;
-    return super.now() + this.#extra;
-  }
-}
 
 function open(clock: FakeClock, previewSizes?: PreviewSizes) {
   const fake = fakeHost(clock);
@@ -66,23 +27,11 @@ function open(clock: FakeClock, previewSizes?: PreviewSizes) {
   return { ...fake, worker, send };
 }
 
-/** What a library decoder and link monitor say about `port` fed every chunk of it that arrived by `untilUs`. */
-function libraryUpTo(capture: Capture, port: number, untilUs: number) {
-  const decoder = new SpektrumDecoder();
-  const link = new LinkMonitor({ jitterUs: USB_CHUNK_JITTER_US });
-  for (let i = 0; i < capture.chunkEnds.length; i++) {
-    if (capture.chunkPorts[i] !== port || (capture.chunkTimesUs[i] ?? Infinity) > untilUs) continue;
-    decoder.push(capture.bytes.subarray(i === 0 ? 0 : capture.chunkEnds[i - 1], capture.chunkEnds[i]), capture.chunkTimesUs[i]);
-    for (let f = decoder.next(); f !== undefined; f = decoder.next()) link.frame(f);
-  }
-  return { decoder: { ...decoder.stats }, link: { ...link.stats } };
-}
-
 describe('a long capture in the worker', () => {
   it('draws its overview as it is read: nothing after the part read, each part as the complete one has it, and complete at the end as made in one go', async () => {
     const clock = new ReadingClock();
     const { send, of } = open(clock);
-    await send({ type: 'replay-open', name: 'long.sscap', data: FILE.slice().buffer });
+    await send({ type: 'replay-open', name: 'long.sscap', file: new Blob([FILE.slice()]) });
     const first = of('overview')[0];
     expect(first?.overview.complete).toBe(false);
     for (let guard = 0; guard < 1000 && !of('overview').at(-1)?.overview.complete; guard++) clock.advance(10);
@@ -114,7 +63,7 @@ describe('a long capture in the worker', () => {
   it("seeks anywhere from a checkpoint: the counters and link figures are the whole capture's up to the target", async () => {
     const clock = new FakeClock();
     const { send, worker } = open(clock);
-    await send({ type: 'replay-open', name: 'long.sscap', data: FILE.slice().buffer }, { type: 'replay-pause' });
+    await send({ type: 'replay-open', name: 'long.sscap', file: new Blob([FILE.slice()]) }, { type: 'replay-pause' });
     const capture = readCapture(FILE, 'long.sscap');
     const start = worker.replay?.source.startUs ?? Number.NaN;
     // Past the fresh decode's 10 minutes, before and after the failsafe, backwards and forwards.
@@ -153,11 +102,11 @@ describe('a long capture in the worker', () => {
     expect(worker.registry.get(0)?.engine.link.stats.failsafes).toBe(1);
   });
 
-  it('previews a long file from its first records and its end, and the decode begun on them goes on with the whole capture to the same overview and checkpoints', () => {
+  it('previews a long file from its first records and its end, and the decode begun on them goes on with the whole capture to the same overview and checkpoints', async () => {
     const capture = readCapture(FILE, 'long.sscap');
     const ports = capturePorts(capture);
     const span = captureSpan(capture);
-    const preview = previewOf(FILE, { minBytes: 0, headBytes: 400_000, tailBytes: 20_000 });
+    const preview = await previewOf(new Blob([FILE.slice()]), { minBytes: 0, headBytes: 400_000, tailBytes: 20_000 });
     expect(preview).not.toBeNull();
     if (preview === null) return;
     expect([preview.startUs, preview.endUs]).toEqual([span.startUs, span.endUs]);
@@ -193,15 +142,15 @@ describe('a long capture in the worker', () => {
     expect(JSON.stringify(early.checkpoints.at(-1)?.ports.get(1)?.link)).toBe(JSON.stringify(whole.checkpoints.at(-1)?.ports.get(1)?.link));
   });
 
-  it('reads a file too short for a preview, or not a capture with chunk times, whole', () => {
-    expect(previewOf(FILE)).toBeNull();
-    expect(previewOf(new Uint8Array(1000), { minBytes: 0, headBytes: 400, tailBytes: 100 })).toBeNull();
+  it('reads a file too short for a preview, or not a capture with chunk times, whole', async () => {
+    expect(await previewOf(new Blob([FILE.slice()]))).toBeNull();
+    expect(await previewOf(new Blob([new Uint8Array(1000)]), { minBytes: 0, headBytes: 400, tailBytes: 100 })).toBeNull();
   });
 
   it("shows a long file's span and its first records' overview before reading it whole, then plays and seeks as one read whole", async () => {
     const clock = new FakeClock();
     const { send, posts, worker } = open(clock, { minBytes: 0, headBytes: 400_000, tailBytes: 20_000 });
-    await send({ type: 'replay-open', name: 'long.sscap', data: FILE.slice().buffer });
+    await send({ type: 'replay-open', name: 'long.sscap', file: new Blob([FILE.slice()]) });
     const capture = readCapture(FILE, 'long.sscap');
     const span = captureSpan(capture);
     // First: the span and a partial overview, nothing played; then the replay of the whole file.

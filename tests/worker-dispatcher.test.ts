@@ -78,7 +78,7 @@ describe('the dispatcher', () => {
     const { send, posts, of } = setup();
     const data = twoPortCapture();
     await send(
-      { type: 'replay-open', name: 'two.sscap', data },
+      { type: 'replay-open', name: 'two.sscap', file: new Blob([data]) },
       { type: 'replay-pause' },
       { type: 'replay-seek', timeUs: 2_000_000 },
       { type: 'set-label', source: 1, label: 'Tail' },
@@ -183,7 +183,7 @@ describe('the dispatcher', () => {
 
   it('plays a capture to its end at full speed on the fake clock, then freezes every source there', async () => {
     const { send, clock, of, worker, reports } = setup();
-    await send({ type: 'replay-open', name: 'two.sscap', data: twoPortCapture() }, { type: 'replay-speed', speed: 0 });
+    await send({ type: 'replay-open', name: 'two.sscap', file: new Blob([twoPortCapture()]) }, { type: 'replay-speed', speed: 0 });
     for (let i = 0; i < 100 && of('replay').at(-1)?.replay?.ended !== true; i++) clock.advance(10);
     const last = of('replay').at(-1)?.replay;
     expect(last).toMatchObject({ ended: true, playing: false });

@@ -56,6 +56,15 @@ export class FakeClock implements Clock {
   }
 }
 
+/** A clock that moves 10 ms each time it is read, so the capture's decode goes in slices. */
+export class ReadingClock extends FakeClock {
+  #extra = 0;
+  override now(): number {
+    this.#extra += 10;
+    return super.now() + this.#extra;
+  }
+}
+
 /** A host whose posts are kept, in order, with what they transferred. */
 export function fakeHost(clock = new FakeClock()) {
   const posts: FromWorker[] = [];

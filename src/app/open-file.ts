@@ -1,4 +1,4 @@
-/** Opening a capture file (button or drag-and-drop): its bytes go to the worker, transferred. */
+/** Opening a capture file (button or drag-and-drop): the File goes to the worker, which reads it. */
 import { notify, send } from './store.js';
 
 /** Captures over this size are refused with a message rather than freezing the tab. */
@@ -13,11 +13,10 @@ export async function openCapture(file: File): Promise<void> {
     notify('error', `Cannot open ${file.name}`, `It is ${(file.size / (1 << 20)).toFixed(0)} MB; SatScope opens captures up to 512 MB.`);
     return;
   }
-  const data = await file.arrayBuffer();
   // Marks on the performance timeline (DevTools, bench:page) split opening a capture into the
-  // page reading the file, the worker reading it, and the page drawing its overview.
+  // page handing the file over, the worker reading it, and the page drawing its overview.
   performance.mark('satscope:capture-read');
-  send({ type: 'replay-open', name: file.name, data }, [data]);
+  send({ type: 'replay-open', name: file.name, file });
 }
 
 /** The page's one file input (the toolbar's), which every "Open capture" button clicks. */

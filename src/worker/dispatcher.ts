@@ -17,6 +17,7 @@ import { Recorder } from './recorder.js';
 import { SourceRegistry } from './registry.js';
 import { ReplaySession } from './replay-session.js';
 import type { PreviewSizes } from './replay-preview.js';
+import { type PassHelperMaker, WORKER_PASS_HELPER } from './replay-split.js';
 import { type ReportMaker, WORKER_REPORT_MAKER, report } from './report.js';
 import { setResolution, shareResolution, tellMismatch } from './resolution.js';
 import { DemoSource } from './sources/demo.js';
@@ -28,6 +29,8 @@ export interface DispatcherOptions {
   makeReport?: ReportMaker;
   /** How much of a long capture is read first (tests, on small files); replay-preview.ts has the defaults. */
   previewSizes?: PreviewSizes;
+  /** The helper that decodes half the ports of a long capture (default: a worker, with a second core); null: none. */
+  passHelper?: PassHelperMaker | null;
 }
 
 export class Dispatcher {
@@ -40,6 +43,7 @@ export class Dispatcher {
   readonly sink: LiveSink;
   readonly #makeReport: ReportMaker;
   readonly #previewSizes: PreviewSizes | undefined;
+  readonly #passHelper: PassHelperMaker | undefined;
 
   constructor(
     readonly host: Host,
@@ -80,6 +84,7 @@ export class Dispatcher {
     });
     this.#makeReport = options.makeReport ?? WORKER_REPORT_MAKER;
     this.#previewSizes = options.previewSizes;
+    this.#passHelper = options.passHelper === null ? undefined : (options.passHelper ?? WORKER_PASS_HELPER);
   }
 
   /** A message from the page: queued behind those before it. */
@@ -156,12 +161,13 @@ export class Dispatcher {
         await recorder.discardRecovered();
         break;
       case 'replay-open':
-        await ReplaySession.open(message.name, message.data, {
+        await ReplaySession.open(message.name, message.file, {
           host,
           registry,
           diagnosis: this.diagnosis,
           batcher: this.batcher,
           previewSizes: this.#previewSizes,
+          passHelper: this.#passHelper,
         });
         break;
       case 'replay-play':

@@ -99,3 +99,32 @@ export function sumOverview(
   }
   return { t, fadeRate: fades, lost, failsafe, readUntilUs, complete };
 }
+
+/**
+ * Overviews of different ports of one capture on the same bins (a pass split between workers,
+ * replay-split.ts) added up: read as far as all of them are, complete when all are, failsafes in
+ * the parts' order. No parts: nothing read yet, from `originUs`.
+ */
+export function addOverviews(parts: readonly Overview[], originUs: number): Overview {
+  const complete = parts.length > 0 && parts.every((p) => p.complete);
+  const readUntilUs = parts.length === 0 ? originUs : Math.min(...parts.map((p) => p.readUntilUs));
+  const lengths = parts.map((p) => p.t.length);
+  const n = parts.length === 0 ? 0 : complete ? Math.max(...lengths) : Math.min(...lengths);
+  const longest = parts.find((p) => p.t.length >= n);
+  const t = new Float64Array(n);
+  const fadeRate = new Float32Array(n);
+  const lost = new Float32Array(n);
+  if (longest !== undefined) t.set(longest.t.subarray(0, n));
+  for (const p of parts) {
+    for (let b = 0; b < Math.min(n, p.t.length); b++) {
+      fadeRate[b] = (fadeRate[b] ?? 0) + (p.fadeRate[b] ?? 0);
+      lost[b] = (lost[b] ?? 0) + (p.lost[b] ?? 0);
+    }
+  }
+  const failsafe: Overview['failsafe'] = [];
+  for (const p of parts)
+    for (const f of p.failsafe)
+      if (complete) failsafe.push(f);
+      else if (f.startUs < readUntilUs) failsafe.push({ startUs: f.startUs, endUs: Math.min(f.endUs, readUntilUs) });
+  return { t, fadeRate, lost, failsafe, readUntilUs, complete };
+}

@@ -38,7 +38,8 @@ export type ToWorker =
   /** A health report of the capture being replayed, or of the live session's recording. */
   | { type: 'report'; format: 'html' | 'json' }
   | { type: 'discard-recovered' }
-  | { type: 'replay-open'; name: string; data: ArrayBuffer }
+  /** The worker reads the file itself (and a helper reads half the ports of a long capture from it too). */
+  | { type: 'replay-open'; name: string; file: Blob }
   | { type: 'replay-play' }
   | { type: 'replay-pause' }
   /** Playback speed; 0 = as fast as possible. */

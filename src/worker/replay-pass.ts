@@ -36,14 +36,32 @@ export interface Checkpoint {
   ports: Map<number, { decoder: DecoderCheckpoint; link: LinkCheckpoint }>;
 }
 
-export class ReplayPass {
+/** What the replay asks of its capture's decode, made here or split with a helper (replay-split.ts). */
+export interface OverviewPass {
+  readonly resolution: 'auto' | 1024 | 2048;
+  readonly done: boolean;
+  /** Nothing to decode here until a helper reports (it wakes the replay then). */
+  readonly waiting: boolean;
+  /** Decodes for about `budgetMs`; whether the pass is done. */
+  step(budgetMs: number, now: () => number): boolean;
+  overview(): Overview;
+  checkpointFor(targetUs: number, historyUs: number): Checkpoint | undefined;
+  /** The pass is dropped (the replay closed): anything it runs elsewhere stops. */
+  stop(): void;
+}
+
+export class ReplayPass implements OverviewPass {
   readonly checkpoints: Checkpoint[] = [];
-  /** The capture decoded; while `#prefix`, only the first records of the file (replay-preview.ts). */
-  #capture: Capture;
+  /**
+   * The capture decoded; while `#prefix`, only the first records of the file (replay-preview.ts);
+   * null: a file's records fed one by one as it is read (`feed`, replay-file-pass.ts).
+   */
+  #capture: Capture | null;
   #prefix: boolean;
   readonly #ports: PortPass[];
-  readonly #byPort = new Map<number, PortPass>();
-  /** The next chunk of the capture to feed. */
+  /** Each port's decode by port number (0–255), undefined for the ports not decoded here. */
+  readonly #byPort: (PortPass | undefined)[] = [];
+  /** The next chunk of the capture to feed (the count fed so far). */
   #chunk = 0;
   #fedUntilUs = Number.NEGATIVE_INFINITY;
   #nextCheckpointUs: number;
@@ -53,9 +71,10 @@ export class ReplayPass {
    * @param originUs, endUs the capture's span (`captureSpan`): bin 0 starts at the first, the links are judged at the last
    * @param prefix `capture` is the file's first records only: decoding stops at its end, and
    *   goes on once `continueWith` is given the whole capture
+   * @param capture null: the chunks come through `feed` (records of a file with chunk times)
    */
   constructor(
-    capture: Capture,
+    capture: Capture | null,
     readonly ports: readonly number[],
     readonly resolution: 'auto' | 1024 | 2048,
     readonly originUs: number,
@@ -69,11 +88,11 @@ export class ReplayPass {
       return {
         port,
         decoder: new SpektrumDecoder({ resolution }),
-        link: monitorWithSeries({ jitterUs: timingJitterUs(capture.timing) }, series),
+        link: monitorWithSeries({ jitterUs: timingJitterUs(capture?.timing ?? 'per-chunk') }, series),
         series,
       };
     });
-    for (const p of this.#ports) this.#byPort.set(p.port, p);
+    for (const p of this.#ports) this.#byPort[p.port] = p;
     this.#nextCheckpointUs = originUs + CHECKPOINT_US;
   }
 
@@ -81,9 +100,16 @@ export class ReplayPass {
     return this.#done;
   }
 
-  get capture(): Capture {
-    return this.#capture;
+  /** Everything is decoded here. */
+  readonly waiting = false;
+
+  /** Chunks fed so far. */
+  get chunks(): number {
+    return this.#chunk;
   }
+
+  /** Nothing runs elsewhere: nothing to stop. */
+  stop(): void {}
 
   /**
    * A pass begun on the file's first records goes on with the whole capture, when that starts
@@ -93,7 +119,7 @@ export class ReplayPass {
   continueWith(capture: Capture, ports: readonly number[], originUs: number, endUs: number): boolean {
     const head = this.#capture;
     const n = this.#chunk;
-    if (!this.#prefix || originUs !== this.originUs || endUs !== this.endUs || capture.chunkEnds.length < n) return false;
+    if (head === null || !this.#prefix || originUs !== this.originUs || endUs !== this.endUs || capture.chunkEnds.length < n) return false;
     if (ports.length !== this.ports.length || ports.some((p, k) => p !== this.ports[k])) return false;
     for (let i = 0; i < n; i++) {
       if (
@@ -114,27 +140,43 @@ export class ReplayPass {
    */
   step(budgetMs: number, now: () => number): boolean {
     if (this.#done) return true;
+    const capture = this.#capture;
+    if (capture === null) throw new Error('a pass fed records is stepped by feed(), not step()');
     const started = now();
-    const { bytes, chunkEnds, chunkTimesUs, chunkPorts } = this.#capture;
+    const { bytes, chunkEnds, chunkTimesUs, chunkPorts } = capture;
     const n = chunkEnds.length;
     let i = this.#chunk;
     while (i < n) {
-      const atUs = chunkTimesUs[i] ?? Number.NaN;
-      if (atUs >= this.#nextCheckpointUs) this.#checkpoint(i, atUs);
-      const p = this.#byPort.get(chunkPorts[i] ?? -1);
-      if (p !== undefined) {
-        // A range of the capture's bytes, not a view of them: a view a chunk is most of a chunk's cost.
-        p.decoder.pushRange(bytes, i === 0 ? 0 : (chunkEnds[i - 1] ?? 0), chunkEnds[i] ?? 0, Number.isNaN(atUs) ? undefined : atUs);
-        drain(p);
-      }
-      if (atUs > this.#fedUntilUs) this.#fedUntilUs = atUs;
+      // A range of the capture's bytes, not a view of them: a view a chunk is most of a chunk's cost.
+      this.feed(bytes, i === 0 ? 0 : (chunkEnds[i - 1] ?? 0), chunkEnds[i] ?? 0, chunkTimesUs[i] ?? Number.NaN, chunkPorts[i] ?? -1);
       i++;
       // The clock is read every 256 chunks: reading it costs more than a chunk.
       if ((i & 0xff) === 0 && now() - started >= budgetMs) break;
     }
-    this.#chunk = i;
     // A prefix's end is not the capture's: the rest comes with continueWith.
     if (i < n || this.#prefix) return false;
+    this.finish();
+    return true;
+  }
+
+  /**
+   * Feeds the next chunk: `bytes[start, end)` arrived on `port` at `atUs` (a port not decoded
+   * here only moves the checkpoints' clock, as in the capture's order it does).
+   */
+  feed(bytes: Uint8Array, start: number, end: number, atUs: number, port: number): void {
+    if (atUs >= this.#nextCheckpointUs) this.#checkpoint(this.#chunk, atUs);
+    const p = this.#byPort[port];
+    if (p !== undefined) {
+      p.decoder.pushRange(bytes, start, end, Number.isNaN(atUs) ? undefined : atUs);
+      drain(p);
+    }
+    if (atUs > this.#fedUntilUs) this.#fedUntilUs = atUs;
+    this.#chunk++;
+  }
+
+  /** The end of the stream: every decoder flushed, every link judged at the capture's end. */
+  finish(): void {
+    if (this.#done) return;
     for (const p of this.#ports) {
       p.decoder.end();
       drain(p);
@@ -142,7 +184,6 @@ export class ReplayPass {
       p.series.extendTo(this.endUs);
     }
     this.#done = true;
-    return true;
   }
 
   #checkpoint(chunk: number, atUs: number): void {

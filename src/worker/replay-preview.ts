@@ -5,7 +5,7 @@
  * a record a cut leaves). The start gives the records to decode first; the end gives where the
  * capture ends, so that the page can place the part read on the whole span at once.
  */
-import { type Capture, capturePorts, hasCaptureMagic, parseCapture } from '../capture/index.js';
+import { type Capture, type SlicedFile, capturePorts, hasCaptureMagic, parseCapture } from '../capture/index.js';
 import { captureSpan } from '../analysis/index.js';
 
 /** A file this large gets a preview: under it, reading it whole is as quick. */
@@ -33,23 +33,26 @@ export interface PreviewSizes {
 
 const SIZES: PreviewSizes = { minBytes: PREVIEW_MIN_BYTES, headBytes: PREVIEW_BYTES, tailBytes: TAIL_BYTES };
 
-/** The preview of `bytes`, or null when it is not a long .sscap with chunk times whose start and end read. */
-export function previewOf(bytes: Uint8Array, sizes: PreviewSizes = SIZES): Preview | null {
+/** The preview of `file`, or null when it is not a long .sscap with chunk times whose start and end read. */
+export async function previewOf(file: SlicedFile, sizes: PreviewSizes = SIZES): Promise<Preview | null> {
   const { minBytes, headBytes, tailBytes } = sizes;
-  if (bytes.length < Math.max(minBytes, headBytes + tailBytes) || !hasCaptureMagic(bytes)) return null;
+  const size = file.size;
+  if (size < Math.max(minBytes, headBytes + tailBytes)) return null;
   let head: Capture;
   let tail: Capture;
   try {
-    const start = parseCapture(bytes.subarray(0, headBytes));
+    const start = new Uint8Array(await file.slice(0, headBytes).arrayBuffer());
+    if (!hasCaptureMagic(start)) return null;
+    const parsed = parseCapture(start);
+    head = parsed;
     // The header as the reader found it, then the file's last bytes: a capture whose first record is cut.
-    const { headerLength } = start;
+    const { headerLength } = parsed;
     const end = new Uint8Array(headerLength + tailBytes);
-    end.set(bytes.subarray(0, headerLength));
-    end.set(bytes.subarray(bytes.length - tailBytes), headerLength);
-    head = start;
+    end.set(start.subarray(0, headerLength));
+    end.set(new Uint8Array(await file.slice(size - tailBytes, size).arrayBuffer()), headerLength);
     tail = parseCapture(end);
   } catch {
-    // Whatever is wrong, reading the whole file says it.
+    // Whatever is wrong (a damaged start, a file that cannot be read), reading the whole file says it.
     return null;
   }
   if (head.timing !== 'per-chunk' || tail.timing !== 'per-chunk') return null;

@@ -15,8 +15,9 @@ import { type Host, notice } from './host.js';
 import { overviewOf } from './overview.js';
 import type { Overview, ReplayStatus } from './protocol.js';
 import type { Driver, SourceRegistry } from './registry.js';
-import { type Checkpoint, ReplayPass } from './replay-pass.js';
+import { type Checkpoint, type OverviewPass, ReplayPass } from './replay-pass.js';
 import { type PreviewSizes, previewOf } from './replay-preview.js';
+import { HelperRun, type PassHelperMaker, SplitPass } from './replay-split.js';
 import { ReplaySource } from './sources/replay.js';
 
 /** The position moves every tick; the page needs it a few times a second. */
@@ -39,6 +40,8 @@ export interface ReplayParts {
   batcher: Batcher;
   /** How much of a long capture is read first (default: replay-preview.ts's). */
   previewSizes?: PreviewSizes | undefined;
+  /** Starts the helper that decodes half the ports of a long capture (replay-split.ts); none: one worker decodes all. */
+  passHelper?: PassHelperMaker | undefined;
 }
 
 export class ReplaySession implements Driver {
@@ -47,28 +50,55 @@ export class ReplaySession implements Driver {
   readonly #p: ReplayParts;
   #lastStatusMs = Number.NEGATIVE_INFINITY;
   /** The capture's decode for the overview and the checkpoints (null: the overview came at once, seeks decode afresh). */
-  readonly #pass: ReplayPass | null;
+  readonly #pass: OverviewPass | null;
   #passTimer: unknown;
   #lastOverviewMs = Number.NEGATIVE_INFINITY;
+  /** How far the last overview sent was read: one read less far (a split pass's halves catching up) is not sent. */
+  #sentUntilUs = Number.NEGATIVE_INFINITY;
+  #sentComplete = false;
   #passStartMs = Number.NaN;
   #stopped = false;
 
   /**
-   * Reads `data` and starts playing it, every source before it closed; null (the user told why)
-   * when it is not a capture.
+   * Reads `file` and starts playing it, every source before it closed; null (the user told why)
+   * when it is not a capture. A long capture's start and end are read first: its span and first
+   * records' overview are shown, and a helper starts on half its ports, while the rest is read.
    */
-  static async open(name: string, data: ArrayBuffer, parts: ReplayParts): Promise<ReplaySession | null> {
+  static async open(name: string, file: Blob, parts: ReplayParts): Promise<ReplaySession | null> {
     const { host, registry, diagnosis } = parts;
-    const bytes = new Uint8Array(data);
     // A long capture: its start decoded and shown on its whole span before all of it is read.
-    const preview = previewOf(bytes, parts.previewSizes);
+    const preview = await previewOf(file, parts.previewSizes);
     let early: ReplayPass | null = null;
+    let earlyUntilUs = Number.NEGATIVE_INFINITY;
+    let helper: HelperRun | null = null;
     if (preview !== null) {
       await registry.closeAll();
-      early = new ReplayPass(preview.head, preview.ports, registry.resolution, preview.startUs, preview.endUs, true);
+      // The later half of the ports (all but the first of two or three) go to the helper, which
+      // starts now: this worker reads the whole file first.
+      const { ports, startUs, endUs } = preview;
+      if (ports.length >= 2 && parts.passHelper !== undefined)
+        helper = HelperRun.start(parts.passHelper, {
+          file,
+          ports: ports.slice(ports.length >> 1),
+          resolution: registry.resolution,
+          originUs: startUs,
+          endUs,
+        });
+      early = new ReplayPass(preview.head, ports, registry.resolution, startUs, endUs, true);
       early.step(PASS_SLICE_MS, () => host.clock.now());
-      host.post({ type: 'replay', replay: readingStatus(name, preview.startUs, preview.endUs) });
-      postOverview(host, early.overview());
+      host.post({ type: 'replay', replay: readingStatus(name, startUs, endUs) });
+      const first = early.overview();
+      earlyUntilUs = first.readUntilUs;
+      postOverview(host, first);
+    }
+    let bytes: Uint8Array;
+    try {
+      bytes = new Uint8Array(await file.arrayBuffer());
+    } catch (error) {
+      notice(host, 'error', `Cannot open ${name}`, `The file could not be read (${String(error)}).`);
+      helper?.stop();
+      if (preview !== null) host.post({ type: 'replay', replay: null });
+      return null;
     }
     let capture: Capture;
     try {
@@ -77,6 +107,7 @@ export class ReplaySession implements Driver {
     } catch (error) {
       const why = error instanceof CaptureFormatError ? error.message : String(error);
       notice(host, 'error', `Cannot open ${name}`, why);
+      helper?.stop();
       if (preview !== null) host.post({ type: 'replay', replay: null });
       return null;
     }
@@ -90,20 +121,43 @@ export class ReplaySession implements Driver {
       );
     }
     const ports = capturePorts(capture);
-    let pass: ReplayPass | null = null;
+    let pass: OverviewPass | null = null;
     let overview: Overview | null = null;
     let periodUs = FRAME_PERIOD_11MS_US;
     const span = capture.timing === 'per-chunk' ? captureSpan(capture) : undefined;
-    if (span !== undefined && Number.isFinite(span.startUs)) {
+    // The helper's decode counts for an intact file read on the same span and ports.
+    const job = helper?.job;
+    const split =
+      job !== undefined &&
+      span !== undefined &&
+      capture.issues.length === 0 &&
+      span.startUs === job.originUs &&
+      span.endUs === job.endUs &&
+      job.ports.every((p) => ports.includes(p));
+    let session: ReplaySession | null = null;
+    if (helper !== null && split) {
+      const theirs = helper.job.ports;
+      pass = new SplitPass(
+        capture,
+        ports.filter((p) => !theirs.includes(p)),
+        helper,
+        () => {
+          if (session !== null) session.#readOn();
+        },
+      );
+    } else if (span !== undefined && Number.isFinite(span.startUs)) {
+      helper?.stop();
       // The preview's decode goes on where the whole capture starts as its first records did.
       pass =
         early?.continueWith(capture, ports, span.startUs, span.endUs) === true
           ? early
           : new ReplayPass(capture, ports, registry.resolution, span.startUs, span.endUs);
     } else {
+      helper?.stop();
       ({ overview, periodUs } = overviewOf(capture, ports, registry.resolution));
     }
-    const session = new ReplaySession(name, capture, periodUs, parts, pass);
+    session = new ReplaySession(name, capture, periodUs, parts, pass);
+    session.#sentUntilUs = earlyUntilUs;
     const r = session.source;
     await registry.use(session);
     diagnosis.replay(capture, r.startUs);
@@ -129,7 +183,7 @@ export class ReplaySession implements Driver {
     capture: Capture,
     periodUs: number,
     parts: ReplayParts,
-    pass: ReplayPass | null,
+    pass: OverviewPass | null,
   ) {
     this.#p = parts;
     this.#pass = pass;
@@ -173,19 +227,26 @@ export class ReplaySession implements Driver {
    */
   #readOn(now = false): void {
     const pass = this.#pass;
-    if (pass === null || pass.done || this.#stopped) return;
+    if (pass === null || this.#stopped || this.#passTimer !== undefined) return;
     const { host } = this.#p;
     if (Number.isNaN(this.#passStartMs)) this.#passStartMs = host.clock.now();
     const slice = (): void => {
       this.#passTimer = undefined;
       if (this.#stopped) return;
+      if (this.#sentComplete) return;
       const done = pass.step(PASS_SLICE_MS, () => host.clock.now());
       const nowMs = host.clock.now();
       if (done || nowMs - this.#lastOverviewMs >= Math.max(OVERVIEW_EVERY_MS, (nowMs - this.#passStartMs) / 4)) {
-        this.#lastOverviewMs = nowMs;
-        postOverview(host, pass.overview());
+        const overview = pass.overview();
+        if (overview.complete || overview.readUntilUs > this.#sentUntilUs) {
+          this.#lastOverviewMs = nowMs;
+          this.#sentUntilUs = overview.readUntilUs;
+          this.#sentComplete = overview.complete;
+          postOverview(host, overview);
+        }
       }
-      if (!done) this.#passTimer = host.clock.after(0, slice);
+      // Waiting for the helper: its next report wakes this (replay-split.ts).
+      if (!done && !pass.waiting) this.#passTimer = host.clock.after(0, slice);
     };
     if (now) slice();
     else this.#passTimer = host.clock.after(0, slice);
@@ -193,6 +254,7 @@ export class ReplaySession implements Driver {
 
   async stop(): Promise<void> {
     this.#stopped = true;
+    this.#pass?.stop();
     this.#p.host.clock.cancel(this.#passTimer);
     this.#passTimer = undefined;
     this.source.stop();

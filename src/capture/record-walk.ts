@@ -1,0 +1,132 @@
+/**
+ * The data records of an intact .sscap, read from a Blob (a File) a slice at a time and handed
+ * over where they lie in the slice: no payload copied, no CRC checked, no columns kept. For a
+ * reader that learns elsewhere whether the file is intact: the replay's helper decodes some ports
+ * this way while the worker reads the whole file with `parseCapture`, and its decode counts only
+ * if that read found nothing damaged (src/worker/replay-split.ts).
+ */
+import {
+  CRC_SIZE,
+  HEADER_FIXED_SIZE,
+  MAX_META_BYTES,
+  MAX_RECORD_PAYLOAD,
+  OFF_META_LENGTH,
+  RECORD_HEADER_SIZE,
+  RECORD_OVERHEAD,
+  RECORD_TYPE_DATA,
+  RECORD_TYPE_EVENT,
+  REC_OFF_LENGTH,
+  REC_OFF_PORT,
+  REC_OFF_TIME,
+  REC_OFF_TYPE,
+  SYNC0,
+  SYNC1,
+} from './layout.js';
+import { CaptureFormatError } from './model.js';
+import { RecordProbe, readHeader } from './reader.js';
+
+/** Read at a time: the header (its metadata is at most 1 MiB) and a few hundred thousand records. */
+const SLICE_BYTES = 16 << 20;
+
+/** What is read: a Blob or File (the library takes no DOM types). */
+export interface SlicedFile {
+  readonly size: number;
+  slice(start: number, end: number): { arrayBuffer(): Promise<ArrayBuffer> };
+}
+
+/** One data record: its payload is `bytes[start, end)`, recorded at `timeUs` on `port`. */
+export type RecordSink = (bytes: Uint8Array, start: number, end: number, timeUs: number, port: number) => void;
+
+/** What a walk to the end found: the data records (the capture's chunks) and their payload bytes. */
+export interface WalkedRecords {
+  chunks: number;
+  dataBytes: number;
+}
+
+/**
+ * Hands every data record of `file` to `sink`, in the file's order; after each slice, asks
+ * `goOn` (false: stop, and resolve null). Events are skipped (they are not chunks).
+ * @throws {CaptureFormatError} when the header is damaged or the records do not lead from one to
+ *   the next to the end of the file (the file is not intact: parseCapture salvages it)
+ */
+export async function walkDataRecords(
+  file: SlicedFile,
+  sink: RecordSink,
+  goOn: () => boolean | Promise<boolean> = () => true,
+  sliceBytes = SLICE_BYTES,
+): Promise<WalkedRecords | null> {
+  const size = file.size;
+  const read = async (from: number, length: number): Promise<Uint8Array> =>
+    new Uint8Array(await file.slice(from, Math.min(size, from + length)).arrayBuffer());
+  // The first read holds the whole header, as long as its fixed part says it is.
+  const fixed = await read(0, HEADER_FIXED_SIZE);
+  const metaLength = fixed.length < HEADER_FIXED_SIZE ? 0 : new DataView(fixed.buffer).getUint32(OFF_META_LENGTH, true);
+  let bytes = await read(0, Math.max(sliceBytes, HEADER_FIXED_SIZE + Math.min(metaLength, MAX_META_BYTES) + CRC_SIZE));
+  let view = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
+  const issues: Parameters<typeof readHeader>[3] = [];
+  const { headerLength } = readHeader(bytes, view, new RecordProbe(bytes, view, { crcBytes: 0, crcCombines: 0, probes: 0 }), issues);
+  if (issues.length > 0) throw new CaptureFormatError(`the capture's header is damaged: ${issues[0]?.message ?? ''}`);
+  /** File offset of bytes[0], and how far the file is read (the next slice is read while this one is walked). */
+  let at = 0;
+  let readTo = bytes.length;
+  const ahead = (): Promise<Uint8Array> | null => {
+    if (readTo >= size) return null;
+    const next = read(readTo, sliceBytes);
+    // A walk that stops or fails before it needs the slice leaves no unhandled rejection.
+    next.catch(() => undefined);
+    return next;
+  };
+  let next = ahead();
+  let p = headerLength;
+  let chunks = 0;
+  let dataBytes = 0;
+  for (;;) {
+    const n = bytes.length;
+    while (p + RECORD_HEADER_SIZE <= n) {
+      const type = bytes[p + REC_OFF_TYPE];
+      const len = view.getUint32(p + REC_OFF_LENGTH, true);
+      if (
+        bytes[p] !== SYNC0 ||
+        bytes[p + 1] !== SYNC1 ||
+        (type !== RECORD_TYPE_DATA && type !== RECORD_TYPE_EVENT) ||
+        len > MAX_RECORD_PAYLOAD
+      )
+        throw new CaptureFormatError(`no intact record header at offset ${at + p}`);
+      const total = RECORD_OVERHEAD + len;
+      if (p + total > n) break;
+      if (type === RECORD_TYPE_DATA) {
+        sink(
+          bytes,
+          p + RECORD_HEADER_SIZE,
+          p + RECORD_HEADER_SIZE + len,
+          view.getFloat64(p + REC_OFF_TIME, true),
+          bytes[p + REC_OFF_PORT] ?? 0,
+        );
+        chunks++;
+        dataBytes += len;
+      }
+      p += total;
+    }
+    if (next === null) {
+      if (p !== n) throw new CaptureFormatError(`the file ends inside a record at offset ${at + p}`);
+      return { chunks, dataBytes };
+    }
+    if (!(await goOn())) return null;
+    const more = await next;
+    readTo += more.length;
+    next = ahead();
+    // A record not yet whole at the end of this slice goes on in the next: the two joined.
+    if (p === n) {
+      bytes = more;
+      at = readTo - more.length;
+    } else {
+      const joined = new Uint8Array(n - p + more.length);
+      joined.set(bytes.subarray(p));
+      joined.set(more, n - p);
+      bytes = joined;
+      at += p;
+    }
+    view = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
+    p = 0;
+  }
+}

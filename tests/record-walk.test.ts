@@ -1,0 +1,73 @@
+/**
+ * Walking an intact .sscap's data records from a Blob a slice at a time (record-walk.ts): the
+ * same chunks parseCapture reads, whatever the slice size; a file that is not intact is refused.
+ */
+import { describe, expect, it } from 'vitest';
+import { encodeCapture, parseCapture, walkDataRecords } from '../src/capture/index.js';
+
+/** Data records of 1–40 bytes (one of 3000) on three ports, an event every 50, one record far bigger than a slice. */
+function file(): Uint8Array {
+  const records: Parameters<typeof encodeCapture>[1][number][] = [];
+  let seed = 7;
+  const next = () => (seed = (seed * 1103515245 + 12345) >>> 0);
+  for (let k = 0; k < 600; k++) {
+    if (k % 50 === 0) records.push({ type: 'event', text: `event ${k}`, timeUs: k * 1000, port: k % 3 });
+    const length = k === 300 ? 3000 : 1 + (next() % 40);
+    records.push({ type: 'data', bytes: Uint8Array.from({ length }, () => next() & 0xff), timeUs: k * 1000 + 0.5, port: k % 3 });
+  }
+  return encodeCapture({ baudRate: 115200 }, records);
+}
+
+async function walk(bytes: Uint8Array, sliceBytes?: number) {
+  const got: { bytes: number[]; timeUs: number; port: number }[] = [];
+  const walked = await walkDataRecords(
+    new Blob([bytes.slice()]),
+    (b, start, end, timeUs, port) => got.push({ bytes: Array.from(b.subarray(start, end)), timeUs, port }),
+    () => true,
+    sliceBytes,
+  );
+  return { walked, got };
+}
+
+describe('walking the data records of an intact capture', () => {
+  const bytes = file();
+  const capture = parseCapture(bytes);
+  const want = Array.from(capture.chunkEnds, (end, i) => ({
+    bytes: Array.from(capture.bytes.subarray(i === 0 ? 0 : capture.chunkEnds[i - 1], end)),
+    timeUs: capture.chunkTimesUs[i],
+    port: capture.chunkPorts[i],
+  }));
+
+  it('hands over the chunks parseCapture reads, in order, with their counts, for any slice size', async () => {
+    expect(capture.issues).toEqual([]);
+    expect(want.length).toBe(600);
+    for (const slice of [1, 17, 100, 4096, undefined]) {
+      const { walked, got } = await walk(bytes, slice);
+      expect({ slice, walked }).toEqual({ slice, walked: { chunks: 600, dataBytes: capture.bytes.length } });
+      expect(got).toEqual(want);
+    }
+  });
+
+  it('stops when asked between slices', async () => {
+    let slices = 0;
+    const walked = await walkDataRecords(
+      new Blob([bytes.slice()]),
+      () => {},
+      () => ++slices < 3,
+      1000,
+    );
+    expect([walked, slices]).toEqual([null, 3]);
+  });
+
+  it('refuses a file whose records do not lead to its end, or whose header is damaged', async () => {
+    const cut = bytes.subarray(0, bytes.length - 3);
+    await expect(walk(cut, 1000)).rejects.toThrow(/ends inside a record/);
+    const stray = new Uint8Array(bytes.length + 1);
+    stray.set(bytes.subarray(0, 5000));
+    stray.set(bytes.subarray(5000), 5001);
+    await expect(walk(stray, 1000)).rejects.toThrow(/no intact record header/);
+    const header = bytes.slice();
+    header[20] = (header[20] ?? 0) ^ 1;
+    await expect(walk(header, 1000)).rejects.toThrow(/header is damaged/);
+  });
+});

@@ -1,0 +1,203 @@
+/**
+ * A long capture's replay pass split with a helper (replay-split.ts, replay-file-pass.ts): the
+ * helper decodes the later half of the ports straight from the file while the worker reads it
+ * and decodes the rest. The overview grows as both read and ends as one decode makes it; seeks
+ * from the merged checkpoints give the whole capture's counters up to the target. A helper that
+ * fails, disagrees, or read a damaged file counts for nothing: the worker decodes its ports.
+ */
+import { describe, expect, it } from 'vitest';
+import { capturePorts, readCapture, type SlicedFile } from '../src/capture/index.js';
+import { Dispatcher } from '../src/worker/dispatcher.js';
+import { overviewOf } from '../src/worker/overview.js';
+import type { Overview } from '../src/worker/protocol.js';
+import { type FilePassJob, type FilePassReport, passOverFile } from '../src/worker/replay-file-pass.js';
+import type { PassHelperMaker } from '../src/worker/replay-split.js';
+import { MINUTE, libraryUpTo, longCapture } from './long-capture.js';
+import { ReadingClock, fakeHost } from './worker-fakes.js';
+
+const FILE = longCapture();
+const PREVIEW = { minBytes: 0, headBytes: 60_000, tailBytes: 20_000 };
+
+/** Turns for the helper: each read of the file waits for one, so that it and the worker take turns. */
+class Turns {
+  #waiting: (() => void)[] = [];
+  wait(): Promise<void> {
+    return new Promise((resolve) => this.#waiting.push(resolve));
+  }
+  give(): void {
+    this.#waiting.shift()?.();
+  }
+}
+
+/** A clock whose zero-delay timers wait 1 ms: one slice of the worker's decode a millisecond. */
+class SlicingClock extends ReadingClock {
+  override after(ms: number, fn: () => void): number {
+    return super.after(Math.max(1, ms), fn);
+  }
+}
+
+const turns = new Turns();
+
+/** The helper on this thread: the same code, reading a slice a turn; `change` alters what it reports. */
+function helperHere(change: (r: FilePassReport) => FilePassReport = (r) => r) {
+  const jobs: FilePassJob[] = [];
+  const runs = { reports: 0, done: false, stoppedEarly: false };
+  const make: PassHelperMaker = (job, onReport) => {
+    jobs.push(job);
+    let stopped = false;
+    let t = 0;
+    const file = job.file;
+    const slowly: SlicedFile = {
+      size: file.size,
+      slice: (start, end) => ({
+        arrayBuffer: async () => {
+          await turns.wait();
+          return file.slice(start, end).arrayBuffer();
+        },
+      }),
+    };
+    void passOverFile(
+      { ...job, file: slowly },
+      (r) => {
+        if (stopped) return;
+        runs.reports++;
+        if (r.type === 'done') runs.done = true;
+        onReport(change(r));
+      },
+      // 100 ms a read of the clock: a report about every other slice.
+      () => (t += 100),
+      () => stopped,
+      16 << 10,
+    );
+    return {
+      stop: () => {
+        if (!runs.done) runs.stoppedEarly = true;
+        stopped = true;
+      },
+    };
+  };
+  return { make, jobs, runs };
+}
+
+/** Opens `file` in a worker with `make` as its helper and runs both until the overview is complete. */
+async function openSplit(file: Uint8Array, make: PassHelperMaker | null, previewSizes = PREVIEW) {
+  const clock = new SlicingClock();
+  const fake = fakeHost(clock);
+  const worker = new Dispatcher(fake.host, { previewSizes, passHelper: make });
+  worker.receive({ type: 'replay-open', name: 'long.sscap', file: new Blob([file.slice()]) });
+  await worker.queue.idle();
+  for (let guard = 0; guard < 20_000 && !fake.of('overview').at(-1)?.overview.complete; guard++) {
+    // A slice of the worker's decode, and a turn for the helper's.
+    clock.advance(1);
+    turns.give();
+    await new Promise((resolve) => setTimeout(resolve, 0));
+  }
+  const overviews = fake.of('overview').map((m) => m.overview);
+  const send = async (...messages: Parameters<Dispatcher['receive']>[0][]): Promise<void> => {
+    for (const m of messages) worker.receive(m);
+    await worker.queue.idle();
+  };
+  return { worker, overviews, send };
+}
+
+function expectOverviewsAsOneDecode(overviews: Overview[], file: Uint8Array): void {
+  const capture = readCapture(file, 'long.sscap');
+  const once = overviewOf(capture, capturePorts(capture), 'auto').overview;
+  const last = overviews.at(-1) as Overview;
+  expect(last.complete).toBe(true);
+  expect([Array.from(last.t), Array.from(last.fadeRate), Array.from(last.lost), last.failsafe]).toEqual([
+    Array.from(once.t),
+    Array.from(once.fadeRate),
+    Array.from(once.lost),
+    once.failsafe,
+  ]);
+  let before = Number.NEGATIVE_INFINITY;
+  for (const o of overviews.slice(0, -1)) {
+    // It grows, and shows only what every port has been read up to, as the whole decode has it.
+    expect(o.complete).toBe(false);
+    expect(o.readUntilUs).toBeGreaterThan(before);
+    before = o.readUntilUs;
+    // Every bin before readUntilUs drawn, none after it (the bins are whole seconds from the start).
+    expect(o.readUntilUs).toBe((once.t[0] ?? 0) + o.t.length * 1e6);
+    for (let b = 0; b < o.t.length; b++)
+      expect([b, o.t[b], o.fadeRate[b], o.lost[b]]).toEqual([b, once.t[b], once.fadeRate[b], once.lost[b]]);
+    for (const f of o.failsafe) expect(f.endUs).toBeLessThanOrEqual(o.readUntilUs);
+  }
+}
+
+/** Seeks back and forth: both remotes' counters are those of a decode fed everything up to the target. */
+async function expectSeeksExact(split: Awaited<ReturnType<typeof openSplit>>, file: Uint8Array): Promise<void> {
+  const capture = readCapture(file, 'long.sscap');
+  const start = split.worker.replay?.source.startUs ?? Number.NaN;
+  await split.send({ type: 'replay-pause' });
+  for (const at of [11.2, 3.5, 7.25, 0.5, 10.9]) {
+    const target = start + at * MINUTE;
+    await split.send({ type: 'replay-seek', timeUs: target });
+    for (const port of [0, 1]) {
+      const engine = split.worker.registry.get(port)?.engine;
+      const want = libraryUpTo(capture, port, target);
+      expect({ at, port, decoder: { ...engine?.decoder.stats } }).toEqual({ at, port, decoder: want.decoder });
+      const l = engine?.link.stats;
+      expect({ at, port, fades: l?.fades, missed: l?.missedFrames, lost: l?.lostFrames, failsafes: l?.failsafes }).toEqual({
+        at,
+        port,
+        fades: want.link.fades,
+        missed: want.link.missedFrames,
+        lost: want.link.lostFrames,
+        failsafes: want.link.failsafes,
+      });
+    }
+  }
+}
+
+describe('a long capture decoded on two workers', () => {
+  it('gives the helper the later port, draws the merged overview as it grows, ends as one decode, and seeks from merged checkpoints', async () => {
+    const helper = helperHere();
+    const split = await openSplit(FILE, helper.make);
+    expect(helper.jobs.map((j) => j.ports)).toEqual([[1]]);
+    expect(helper.runs.done).toBe(true);
+    expect(helper.runs.stoppedEarly).toBe(false);
+    expect(helper.runs.reports).toBeGreaterThan(3);
+    expect(split.overviews.length).toBeGreaterThan(3);
+    expectOverviewsAsOneDecode(split.overviews, FILE);
+    await expectSeeksExact(split, FILE);
+  });
+
+  it('decodes the helper’s ports itself when the helper fails, and the result is the same', async () => {
+    const helper = helperHere((r) => (r.type === 'done' ? { type: 'failed', why: 'the helper ran out of memory' } : r));
+    const split = await openSplit(FILE, helper.make);
+    expect(helper.runs.done).toBe(true);
+    expectOverviewsAsOneDecode(split.overviews, FILE);
+    await expectSeeksExact(split, FILE);
+  });
+
+  it('drops a helper whose checkpoints fall on other chunks, or who walked other records', async () => {
+    const moved = helperHere((r) =>
+      r.type === 'failed' ? r : { ...r, checkpoints: r.checkpoints.map((c) => ({ ...c, chunk: c.chunk + 1 })) },
+    );
+    const a = await openSplit(FILE, moved.make);
+    expect(moved.runs.stoppedEarly).toBe(true);
+    expectOverviewsAsOneDecode(a.overviews, FILE);
+    await expectSeeksExact(a, FILE);
+    const miscounted = helperHere((r) => (r.type === 'done' ? { ...r, chunks: r.chunks - 1 } : r));
+    const b = await openSplit(FILE, miscounted.make);
+    expectOverviewsAsOneDecode(b.overviews, FILE);
+    await expectSeeksExact(b, FILE);
+  });
+
+  it('does not use the helper for a damaged file, and starts none for a file read whole at once', async () => {
+    const damaged = FILE.slice();
+    // A bit flipped in a record halfway through: the reader drops that record.
+    damaged[damaged.length >> 1] = (damaged[damaged.length >> 1] ?? 0) ^ 0x10;
+    expect(readCapture(damaged, 'long.sscap').issues.length).toBeGreaterThan(0);
+    const helper = helperHere();
+    const split = await openSplit(damaged, helper.make);
+    expect(helper.jobs.length).toBe(1);
+    expect(helper.runs.stoppedEarly || !helper.runs.done).toBe(true);
+    expectOverviewsAsOneDecode(split.overviews, damaged);
+    const none = helperHere();
+    const alone = await openSplit(FILE, none.make, { ...PREVIEW, minBytes: FILE.length + 1 });
+    expect(none.jobs.length).toBe(0);
+    expectOverviewsAsOneDecode(alone.overviews, FILE);
+  });
+});
