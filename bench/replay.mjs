@@ -23,7 +23,9 @@ const args = process.argv.slice(2);
 const arg = (name, fallback) => (args.includes(name) ? args[args.indexOf(name) + 1] : fallback);
 
 if (args[0] === '--child') {
-  await child(args[1], args[2], Number(args[3]));
+  await child(args[1], args[2], Number(args[3]), args[4] === 'helper');
+} else if (args[0] === '--helper') {
+  await helperThread(args[1]);
 } else {
   await main();
 }
@@ -35,6 +37,7 @@ async function main() {
   await build({
     input: {
       dispatcher: fileURLToPath(new URL('../src/worker/dispatcher.ts', import.meta.url)),
+      'file-pass': fileURLToPath(new URL('../src/worker/replay-file-pass.ts', import.meta.url)),
       decoder: fileURLToPath(new URL('../src/decoder/index.ts', import.meta.url)),
     },
     platform: 'node',
@@ -57,25 +60,28 @@ async function main() {
       console.log(`${d}: ${path} missing (node bench/day.mjs --only ${d})`);
       continue;
     }
-    const run = spawnSync(
-      process.execPath,
-      ['--expose-gc', '--max-old-space-size=8192', fileURLToPath(import.meta.url), '--child', bundle, path, String(seeks)],
-      {
-        encoding: 'utf8',
-        stdio: ['ignore', 'pipe', 'inherit'],
-      },
-    );
-    if (run.status !== 0) {
-      console.log(`${d}: child failed (${run.status ?? run.signal})`);
-      continue;
+    // Each file twice, interleaved: the worker alone, and with a helper thread on half the ports.
+    for (const helper of ['alone', 'helper']) {
+      const run = spawnSync(
+        process.execPath,
+        ['--expose-gc', '--max-old-space-size=8192', fileURLToPath(import.meta.url), '--child', bundle, path, String(seeks), helper],
+        {
+          encoding: 'utf8',
+          stdio: ['ignore', 'pipe', 'inherit'],
+        },
+      );
+      if (run.status !== 0) {
+        console.log(`${d}: child failed (${run.status ?? run.signal})`);
+        continue;
+      }
+      const r = JSON.parse(run.stdout.trim().split('\n').at(-1));
+      const mb = (n) => (n / 1e6).toFixed(1);
+      const range = (x, digits) => `${x.median.toFixed(digits)} (${x.min.toFixed(digits)}–${x.max.toFixed(digits)})`;
+      console.log(
+        `${d} ${helper} | ${mb(r.fileBytes)} | ${r.firstS.toFixed(2)} | ${r.openS.toFixed(2)} | ${r.openRatio.toFixed(2)} | ${mb(r.heldBytes)} | ${(r.heldBytes / r.fileBytes).toFixed(2)} | ` +
+          `${range(r.seekMs, 0)} | ${range(r.seekRatio, 2)} | ${r.seekMs.n}`,
+      );
     }
-    const r = JSON.parse(run.stdout.trim().split('\n').at(-1));
-    const mb = (n) => (n / 1e6).toFixed(1);
-    const range = (x, digits) => `${x.median.toFixed(digits)} (${x.min.toFixed(digits)}–${x.max.toFixed(digits)})`;
-    console.log(
-      `${d} | ${mb(r.fileBytes)} | ${r.firstS.toFixed(2)} | ${r.openS.toFixed(2)} | ${r.openRatio.toFixed(2)} | ${mb(r.heldBytes)} | ${(r.heldBytes / r.fileBytes).toFixed(2)} | ` +
-        `${range(r.seekMs, 0)} | ${range(r.seekRatio, 2)} | ${r.seekMs.n}`,
-    );
   }
   console.log(`load after: ${load()}`);
   rmSync(bundle, { recursive: true, force: true });
@@ -120,7 +126,18 @@ function bareDecodeMs(SpektrumDecoder, capture, fromUs, toUs) {
   return performance.now() - started;
 }
 
-async function child(bundle, path, seeks) {
+/** The replay helper on a thread of its own (the page's is a worker: src/worker/replay-helper-worker.ts). */
+async function helperThread(bundle) {
+  const { parentPort } = await import('node:worker_threads');
+  const { passOverFile } = await import(join(bundle, 'file-pass.mjs'));
+  // A file-backed Blob cannot be posted to a thread in Node: the helper opens the file itself.
+  parentPort.once('message', async ({ path, ...job }) => {
+    const file = await openAsBlob(path);
+    void passOverFile({ ...job, file }, (r, transfer) => parentPort.postMessage(r, transfer), () => performance.now());
+  });
+}
+
+async function child(bundle, path, seeks, withHelper) {
   const { Dispatcher } = await import(join(bundle, 'dispatcher.mjs'));
   const { SpektrumDecoder } = await import(join(bundle, 'decoder.mjs'));
   // One-shot timers run (the capture's decode goes on in slices); the replay's ticks never do.
@@ -137,7 +154,18 @@ async function child(bundle, path, seeks) {
     clock,
     timeOriginMs: 0,
   };
-  const worker = new Dispatcher(host);
+  const { Worker } = await import('node:worker_threads');
+  const passHelper = withHelper
+    ? (job, onReport) => {
+        const thread = new Worker(fileURLToPath(import.meta.url), { argv: ['--helper', bundle] });
+        thread.on('message', onReport);
+        thread.on('error', (e) => onReport({ type: 'failed', why: String(e) }));
+        const { file, ...rest } = job;
+        thread.postMessage({ ...rest, path });
+        return { stop: () => void thread.terminate() };
+      }
+    : null;
+  const worker = new Dispatcher(host, { passHelper });
   const base = held();
   const fileBytes = statSync(path).size;
   // The page hands the worker the File, which the worker reads: here a Blob backed by the file.
