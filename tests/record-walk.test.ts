@@ -18,13 +18,12 @@ function file(): Uint8Array {
   return encodeCapture({ baudRate: 115200 }, records);
 }
 
-async function walk(bytes: Uint8Array, sliceBytes?: number) {
+async function walk(bytes: Uint8Array, sliceBytes?: number, checked = true) {
   const got: { bytes: number[]; timeUs: number; port: number }[] = [];
   const walked = await walkDataRecords(
     new Blob([bytes.slice()]),
     (b, start, end, timeUs, port) => got.push({ bytes: Array.from(b.subarray(start, end)), timeUs, port }),
-    () => true,
-    sliceBytes,
+    { ...(sliceBytes === undefined ? {} : { sliceBytes }), checked: () => checked },
   );
   return { walked, got };
 }
@@ -50,13 +49,23 @@ describe('walking the data records of an intact capture', () => {
 
   it('stops when asked between slices', async () => {
     let slices = 0;
-    const walked = await walkDataRecords(
-      new Blob([bytes.slice()]),
-      () => {},
-      () => ++slices < 3,
-      1000,
-    );
+    const walked = await walkDataRecords(new Blob([bytes.slice()]), () => {}, { goOn: () => ++slices < 3, sliceBytes: 1000 });
     expect([walked, slices]).toEqual([null, 3]);
+  });
+
+  it('checks the CRC of the records asked for', async () => {
+    // A payload byte of the 101st data record (port 100 % 3 = 1) flipped.
+    let p = capture.headerLength;
+    const view = new DataView(bytes.buffer, bytes.byteOffset);
+    for (let data = 0; ; ) {
+      if (bytes[p + 2] === 1 && data++ === 100) break;
+      p += 20 + view.getUint32(p + 4, true);
+    }
+    const damaged = bytes.slice();
+    damaged[p + 16] = (damaged[p + 16] ?? 0) ^ 4;
+    const blob = () => new Blob([damaged]);
+    await expect(walkDataRecords(blob(), () => {}, { checked: (port) => port === 1 })).rejects.toThrow(`damaged record at offset ${p}`);
+    await expect(walkDataRecords(blob(), () => {}, { checked: (port) => port !== 1 })).resolves.toMatchObject({ chunks: 600 });
   });
 
   it('refuses a file whose records do not lead to its end, or whose header is damaged', async () => {
@@ -65,7 +74,7 @@ describe('walking the data records of an intact capture', () => {
     const stray = new Uint8Array(bytes.length + 1);
     stray.set(bytes.subarray(0, 5000));
     stray.set(bytes.subarray(5000), 5001);
-    await expect(walk(stray, 1000)).rejects.toThrow(/no intact record header/);
+    await expect(walk(stray, 1000, false)).rejects.toThrow(/no intact record header/);
     const header = bytes.slice();
     header[20] = (header[20] ?? 0) ^ 1;
     await expect(walk(header, 1000)).rejects.toThrow(/header is damaged/);

@@ -1,9 +1,10 @@
 /**
  * The data records of an intact .sscap, read from a Blob (a File) a slice at a time and handed
- * over where they lie in the slice: no payload copied, no CRC checked, no columns kept. For a
- * reader that learns elsewhere whether the file is intact: the replay's helper decodes some ports
- * this way while the worker reads the whole file with `parseCapture`, and its decode counts only
- * if that read found nothing damaged (src/worker/replay-split.ts).
+ * over where they lie in the slice: no payload copied, no columns kept, and the CRC checked only
+ * of the records the reader asks for. For a reader that learns elsewhere whether the whole file
+ * is intact: the replay decodes a long capture's ports this way in two workers, each checking
+ * the records it decodes, and the decode counts only if `parseCapture` then finds nothing
+ * damaged (src/worker/replay-split.ts).
  */
 import {
   CRC_SIZE,
@@ -22,6 +23,7 @@ import {
   SYNC0,
   SYNC1,
 } from './layout.js';
+import { crc32 } from './crc32.js';
 import { CaptureFormatError } from './model.js';
 import { RecordProbe, readHeader } from './reader.js';
 
@@ -43,18 +45,25 @@ export interface WalkedRecords {
   dataBytes: number;
 }
 
+/** How a walk goes. */
+export interface WalkOptions {
+  /** Asked after each slice: false stops the walk (it resolves null). Default: on to the end. */
+  goOn?: () => boolean | Promise<boolean>;
+  /** Whether a data record on `port` has its CRC-32 checked. Default: none is. */
+  checked?: (port: number) => boolean;
+  /** Read at a time (tests). Default 16 MiB. */
+  sliceBytes?: number;
+}
+
 /**
- * Hands every data record of `file` to `sink`, in the file's order; after each slice, asks
- * `goOn` (false: stop, and resolve null). Events are skipped (they are not chunks).
- * @throws {CaptureFormatError} when the header is damaged or the records do not lead from one to
- *   the next to the end of the file (the file is not intact: parseCapture salvages it)
+ * Hands every data record of `file` to `sink`, in the file's order. Events are skipped (they are
+ * not chunks).
+ * @throws {CaptureFormatError} when the header is damaged, the records do not lead from one to
+ *   the next to the end of the file, or a record checked fails its CRC (the file is not intact:
+ *   parseCapture salvages it)
  */
-export async function walkDataRecords(
-  file: SlicedFile,
-  sink: RecordSink,
-  goOn: () => boolean | Promise<boolean> = () => true,
-  sliceBytes = SLICE_BYTES,
-): Promise<WalkedRecords | null> {
+export async function walkDataRecords(file: SlicedFile, sink: RecordSink, options: WalkOptions = {}): Promise<WalkedRecords | null> {
+  const { goOn = () => true, checked = () => false, sliceBytes = SLICE_BYTES } = options;
   const size = file.size;
   const read = async (from: number, length: number): Promise<Uint8Array> =>
     new Uint8Array(await file.slice(from, Math.min(size, from + length)).arrayBuffer());
@@ -95,13 +104,11 @@ export async function walkDataRecords(
       const total = RECORD_OVERHEAD + len;
       if (p + total > n) break;
       if (type === RECORD_TYPE_DATA) {
-        sink(
-          bytes,
-          p + RECORD_HEADER_SIZE,
-          p + RECORD_HEADER_SIZE + len,
-          view.getFloat64(p + REC_OFF_TIME, true),
-          bytes[p + REC_OFF_PORT] ?? 0,
-        );
+        const port = bytes[p + REC_OFF_PORT] ?? 0;
+        const end = p + RECORD_HEADER_SIZE + len;
+        if (checked(port) && crc32(bytes, p + REC_OFF_TYPE, end) !== view.getUint32(end, true))
+          throw new CaptureFormatError(`damaged record at offset ${at + p} (its CRC-32 check failed)`);
+        sink(bytes, p + RECORD_HEADER_SIZE, end, view.getFloat64(p + REC_OFF_TIME, true), port);
         chunks++;
         dataBytes += len;
       }

@@ -97,7 +97,12 @@ export function sumOverview(
     fades[b] = f;
     lost[b] = l;
   }
-  return { t, fadeRate: fades, lost, failsafe, readUntilUs, complete };
+  return { t, fadeRate: fades, lost, failsafe: inTimeOrder(failsafe), readUntilUs, complete };
+}
+
+/** Failsafe episodes by start (then end): the same list however the ports were split. */
+function inTimeOrder(failsafe: Overview['failsafe']): Overview['failsafe'] {
+  return failsafe.sort((a, b) => a.startUs - b.startUs || a.endUs - b.endUs);
 }
 
 /**
@@ -126,5 +131,5 @@ export function addOverviews(parts: readonly Overview[], originUs: number): Over
     for (const f of p.failsafe)
       if (complete) failsafe.push(f);
       else if (f.startUs < readUntilUs) failsafe.push({ startUs: f.startUs, endUs: Math.min(f.endUs, readUntilUs) });
-  return { t, fadeRate, lost, failsafe, readUntilUs, complete };
+  return { t, fadeRate, lost, failsafe: inTimeOrder(failsafe), readUntilUs, complete };
 }

@@ -14,6 +14,13 @@ export interface FilePassJob {
   /** A File (Blob) in the browser. */
   file: SlicedFile;
   ports: number[];
+  /**
+   * Records on these ports have their CRC checked too (besides those of `ports`): ports the file's
+   * start did not show, whose records may be ours with a damaged port byte.
+   */
+  alsoChecked: number[];
+  /** Read at a time (tests; default walkDataRecords's). */
+  sliceBytes?: number | undefined;
   resolution: 'auto' | 1024 | 2048;
   originUs: number;
   endUs: number;
@@ -30,14 +37,12 @@ const PROGRESS_MS = 250;
 /**
  * Decodes `job`, reporting as it goes; `stopped` is asked between slices (true: it ends quietly).
  * Never throws: whatever goes wrong is a `failed` report, and the worker decodes those ports itself.
- * @param sliceBytes read at a time (tests; default walkDataRecords's)
  */
 export async function passOverFile(
   job: FilePassJob,
   report: (r: FilePassReport, transfer: Transferable[]) => void,
   now: () => number,
   stopped: () => boolean = () => false,
-  sliceBytes?: number,
 ): Promise<void> {
   try {
     const pass = new ReplayPass(null, job.ports, job.resolution, job.originUs, job.endUs);
@@ -49,20 +54,23 @@ export async function passOverFile(
       return { overview: pass.overview(), checkpoints };
     };
     const transfer = (o: Overview): Transferable[] => [o.t.buffer, o.fadeRate.buffer, o.lost.buffer];
-    const walked = await walkDataRecords(
-      job.file,
-      (bytes, start, end, timeUs, port) => pass.feed(bytes, start, end, timeUs, port),
-      () => {
-        if (stopped()) return false;
-        if (now() - lastMs >= PROGRESS_MS) {
-          lastMs = now();
-          const r = news();
-          report({ type: 'progress', ...r }, transfer(r.overview));
-        }
-        return true;
-      },
-      sliceBytes,
-    );
+    const { ports, alsoChecked, sliceBytes } = job;
+    // Every record decoded here is checked: nothing from a damaged one is ever shown.
+    const checked = (port: number): boolean => ports.includes(port) || alsoChecked.includes(port);
+    const goOn = (): boolean => {
+      if (stopped()) return false;
+      if (now() - lastMs >= PROGRESS_MS) {
+        lastMs = now();
+        const r = news();
+        report({ type: 'progress', ...r }, transfer(r.overview));
+      }
+      return true;
+    };
+    const walked = await walkDataRecords(job.file, (bytes, start, end, timeUs, port) => pass.feed(bytes, start, end, timeUs, port), {
+      goOn,
+      checked,
+      ...(sliceBytes === undefined ? {} : { sliceBytes }),
+    });
     if (walked === null) return;
     pass.finish();
     const r = news();

@@ -29,6 +29,8 @@ export interface PreviewSizes {
   minBytes: number;
   headBytes: number;
   tailBytes: number;
+  /** Then read at a time by the passes that decode it straight from the file (replay-split.ts; default 16 MiB). */
+  sliceBytes?: number;
 }
 
 const SIZES: PreviewSizes = { minBytes: PREVIEW_MIN_BYTES, headBytes: PREVIEW_BYTES, tailBytes: TAIL_BYTES };

@@ -17,7 +17,7 @@ import type { Overview, ReplayStatus } from './protocol.js';
 import type { Driver, SourceRegistry } from './registry.js';
 import { type Checkpoint, type OverviewPass, ReplayPass } from './replay-pass.js';
 import { type PreviewSizes, previewOf } from './replay-preview.js';
-import { HelperRun, type PassHelperMaker, SplitPass } from './replay-split.js';
+import { HelperRun, type PassHelperMaker, SplitPass, inThisWorker } from './replay-split.js';
 import { ReplaySource } from './sources/replay.js';
 
 /** The position moves every tick; the page needs it a few times a second. */
@@ -52,11 +52,7 @@ export class ReplaySession implements Driver {
   /** The capture's decode for the overview and the checkpoints (null: the overview came at once, seeks decode afresh). */
   readonly #pass: OverviewPass | null;
   #passTimer: unknown;
-  #lastOverviewMs = Number.NEGATIVE_INFINITY;
-  /** How far the last overview sent was read: one read less far (a split pass's halves catching up) is not sent. */
-  #sentUntilUs = Number.NEGATIVE_INFINITY;
-  #sentComplete = false;
-  #passStartMs = Number.NaN;
+  readonly #sender: OverviewSender;
   #stopped = false;
 
   /**
@@ -68,35 +64,36 @@ export class ReplaySession implements Driver {
     const { host, registry, diagnosis } = parts;
     // A long capture: its start decoded and shown on its whole span before all of it is read.
     const preview = await previewOf(file, parts.previewSizes);
+    const sender = new OverviewSender(host);
     let early: ReplayPass | null = null;
-    let earlyUntilUs = Number.NEGATIVE_INFINITY;
-    let helper: HelperRun | null = null;
+    let split: SplitPass | null = null;
+    let session: ReplaySession | null = null;
     if (preview !== null) {
       await registry.closeAll();
-      // The later half of the ports (all but the first of two or three) go to the helper, which
-      // starts now: this worker reads the whole file first.
       const { ports, startUs, endUs } = preview;
-      if (ports.length >= 2 && parts.passHelper !== undefined)
-        helper = HelperRun.start(parts.passHelper, {
-          file,
-          ports: ports.slice(ports.length >> 1),
-          resolution: registry.resolution,
-          originUs: startUs,
-          endUs,
-        });
-      early = new ReplayPass(preview.head, ports, registry.resolution, startUs, endUs, true);
-      early.step(PASS_SLICE_MS, () => host.clock.now());
       host.post({ type: 'replay', replay: readingStatus(name, startUs, endUs) });
-      const first = early.overview();
-      earlyUntilUs = first.readUntilUs;
-      postOverview(host, first);
+      const halves = splitPass(file, preview.ports, startUs, endUs, parts, () => {
+        // Until the capture is read the overview is drawn from here, after from the replay's slices.
+        if (session !== null) session.#readOn();
+        else if (split !== null && sender.due()) sender.offer(split.overview());
+      });
+      split = halves?.pass ?? null;
+      if (halves === null) {
+        early = new ReplayPass(preview.head, ports, registry.resolution, startUs, endUs, true);
+        early.step(PASS_SLICE_MS, () => host.clock.now());
+        sender.offer(early.overview());
+      } else {
+        // This worker's half is decoded before the file is read whole and parsed (which would
+        // hold it up for seconds): the overview first, playback after.
+        await halves.mine.ended;
+      }
     }
     let bytes: Uint8Array;
     try {
       bytes = new Uint8Array(await file.arrayBuffer());
     } catch (error) {
       notice(host, 'error', `Cannot open ${name}`, `The file could not be read (${String(error)}).`);
-      helper?.stop();
+      split?.stop();
       if (preview !== null) host.post({ type: 'replay', replay: null });
       return null;
     }
@@ -107,7 +104,7 @@ export class ReplaySession implements Driver {
     } catch (error) {
       const why = error instanceof CaptureFormatError ? error.message : String(error);
       notice(host, 'error', `Cannot open ${name}`, why);
-      helper?.stop();
+      split?.stop();
       if (preview !== null) host.post({ type: 'replay', replay: null });
       return null;
     }
@@ -125,43 +122,26 @@ export class ReplaySession implements Driver {
     let overview: Overview | null = null;
     let periodUs = FRAME_PERIOD_11MS_US;
     const span = capture.timing === 'per-chunk' ? captureSpan(capture) : undefined;
-    // The helper's decode counts for an intact file read on the same span and ports.
-    const job = helper?.job;
-    const split =
-      job !== undefined &&
-      span !== undefined &&
-      capture.issues.length === 0 &&
-      span.startUs === job.originUs &&
-      span.endUs === job.endUs &&
-      job.ports.every((p) => ports.includes(p));
-    let session: ReplaySession | null = null;
-    if (helper !== null && split) {
-      const theirs = helper.job.ports;
-      pass = new SplitPass(
-        capture,
-        ports.filter((p) => !theirs.includes(p)),
-        helper,
-        () => {
-          if (session !== null) session.#readOn();
-        },
-      );
+    if (split !== null && span !== undefined) {
+      // The halves count if the capture read whole agrees with them (replay-split.ts).
+      split.adopt(capture, ports, span);
+      pass = split;
     } else if (span !== undefined && Number.isFinite(span.startUs)) {
-      helper?.stop();
+      split?.stop();
       // The preview's decode goes on where the whole capture starts as its first records did.
       pass =
         early?.continueWith(capture, ports, span.startUs, span.endUs) === true
           ? early
           : new ReplayPass(capture, ports, registry.resolution, span.startUs, span.endUs);
     } else {
-      helper?.stop();
+      split?.stop();
       ({ overview, periodUs } = overviewOf(capture, ports, registry.resolution));
     }
-    session = new ReplaySession(name, capture, periodUs, parts, pass);
-    session.#sentUntilUs = earlyUntilUs;
+    session = new ReplaySession(name, capture, periodUs, parts, pass, sender);
     const r = session.source;
     await registry.use(session);
     diagnosis.replay(capture, r.startUs);
-    if (overview !== null) postOverview(host, overview);
+    if (overview !== null) sender.offer(overview);
     else session.#readOn(true);
     if (!r.recordedTiming) {
       notice(
@@ -184,9 +164,11 @@ export class ReplaySession implements Driver {
     periodUs: number,
     parts: ReplayParts,
     pass: OverviewPass | null,
+    sender: OverviewSender,
   ) {
     this.#p = parts;
     this.#pass = pass;
+    this.#sender = sender;
     const { host, registry } = parts;
     this.source = new ReplaySource(
       capture,
@@ -229,23 +211,13 @@ export class ReplaySession implements Driver {
     const pass = this.#pass;
     if (pass === null || this.#stopped || this.#passTimer !== undefined) return;
     const { host } = this.#p;
-    if (Number.isNaN(this.#passStartMs)) this.#passStartMs = host.clock.now();
+    const sender = this.#sender;
     const slice = (): void => {
       this.#passTimer = undefined;
-      if (this.#stopped) return;
-      if (this.#sentComplete) return;
+      if (this.#stopped || sender.complete) return;
       const done = pass.step(PASS_SLICE_MS, () => host.clock.now());
-      const nowMs = host.clock.now();
-      if (done || nowMs - this.#lastOverviewMs >= Math.max(OVERVIEW_EVERY_MS, (nowMs - this.#passStartMs) / 4)) {
-        const overview = pass.overview();
-        if (overview.complete || overview.readUntilUs > this.#sentUntilUs) {
-          this.#lastOverviewMs = nowMs;
-          this.#sentUntilUs = overview.readUntilUs;
-          this.#sentComplete = overview.complete;
-          postOverview(host, overview);
-        }
-      }
-      // Waiting for the helper: its next report wakes this (replay-split.ts).
+      if (done || sender.due()) sender.offer(pass.overview());
+      // Waiting for a half decoded elsewhere: its next report wakes this (replay-split.ts).
       if (!done && !pass.waiting) this.#passTimer = host.clock.after(0, slice);
     };
     if (now) slice();
@@ -366,6 +338,73 @@ export class ReplaySession implements Driver {
       },
     });
   }
+}
+
+/**
+ * A capture's growing overview sent to the page: at most every OVERVIEW_EVERY_MS, and no more
+ * often than a quarter of the time the reading has taken so far (the page draws the whole of it
+ * each time, so a long capture's reading costs it a handful of draws); never one read less far
+ * than the last (the halves of a split pass catching up), and nothing after the complete one.
+ */
+class OverviewSender {
+  readonly #host: Host;
+  readonly #startMs: number;
+  #lastMs = Number.NEGATIVE_INFINITY;
+  #sentUntilUs = Number.NEGATIVE_INFINITY;
+  complete = false;
+
+  constructor(host: Host) {
+    this.#host = host;
+    this.#startMs = host.clock.now();
+  }
+
+  /** Whether an overview would be sent now (so that one is worth making). */
+  due(): boolean {
+    const nowMs = this.#host.clock.now();
+    return !this.complete && nowMs - this.#lastMs >= Math.max(OVERVIEW_EVERY_MS, (nowMs - this.#startMs) / 4);
+  }
+
+  offer(overview: Overview): void {
+    if (this.complete || !(overview.complete || overview.readUntilUs > this.#sentUntilUs)) return;
+    this.#lastMs = this.#host.clock.now();
+    this.#sentUntilUs = overview.readUntilUs;
+    this.complete = overview.complete;
+    postOverview(this.#host, overview);
+  }
+}
+
+/**
+ * The pass of a long capture of two ports or more on two workers (replay-split.ts), started on
+ * the file: the first half of the ports here, the later half in a helper; null without a helper.
+ */
+function splitPass(
+  file: Blob,
+  ports: number[],
+  originUs: number,
+  endUs: number,
+  parts: ReplayParts,
+  wake: () => void,
+): { pass: SplitPass; mine: HelperRun } | null {
+  if (ports.length < 2 || parts.passHelper === undefined) return null;
+  const half = ports.length >> 1;
+  const { resolution } = parts.registry;
+  const sliceBytes = parts.previewSizes?.sliceBytes;
+  const job = (mine: number[], alsoChecked: number[]) => ({ file, ports: mine, alsoChecked, resolution, originUs, endUs, sliceBytes });
+  const theirs = HelperRun.start(parts.passHelper, job(ports.slice(half), []));
+  if (theirs === null) return null;
+  // This half also checks records on ports the file's start did not show: ours with a damaged port byte, perhaps.
+  const mine = HelperRun.start(
+    inThisWorker(parts.host.clock),
+    job(
+      ports.slice(0, half),
+      [...Array(256).keys()].filter((p) => !ports.includes(p)),
+    ),
+  );
+  if (mine === null) {
+    theirs.stop();
+    return null;
+  }
+  return { pass: new SplitPass([mine, theirs], resolution, originUs, endUs, wake), mine };
 }
 
 function postOverview(host: Host, overview: Overview): void {
