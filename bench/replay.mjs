@@ -38,6 +38,7 @@ async function main() {
     input: {
       dispatcher: fileURLToPath(new URL('../src/worker/dispatcher.ts', import.meta.url)),
       'file-pass': fileURLToPath(new URL('../src/worker/replay-file-pass.ts', import.meta.url)),
+      'arriving-file': fileURLToPath(new URL('../src/worker/arriving-file.ts', import.meta.url)),
       decoder: fileURLToPath(new URL('../src/decoder/index.ts', import.meta.url)),
     },
     platform: 'node',
@@ -130,10 +131,20 @@ function bareDecodeMs(SpektrumDecoder, capture, fromUs, toUs) {
 async function helperThread(bundle) {
   const { parentPort } = await import('node:worker_threads');
   const { passOverFile } = await import(join(bundle, 'file-pass.mjs'));
-  // A file-backed Blob cannot be posted to a thread in Node: the helper opens the file itself.
-  parentPort.once('message', async ({ path, ...job }) => {
-    const file = await openAsBlob(path);
-    void passOverFile({ ...job, file }, (r, transfer) => parentPort.postMessage(r, transfer), () => performance.now());
+  const { ArrivingFile } = await import(join(bundle, 'arriving-file.mjs'));
+  let file = null;
+  // As src/worker/replay-helper-worker.ts: its job, then the file's pieces as the worker reads them.
+  parentPort.on('message', (m) => {
+    if (m.job) {
+      file = new ArrivingFile(m.job.size);
+      void passOverFile(
+        m.job,
+        file,
+        (r, transfer) => parentPort.postMessage(r, transfer),
+        () => performance.now(),
+      );
+    } else if (m.piece) file.push(m.piece);
+    else file.fail(new Error(m.failed));
   });
 }
 
@@ -160,9 +171,12 @@ async function child(bundle, path, seeks, withHelper) {
         const thread = new Worker(fileURLToPath(import.meta.url), { argv: ['--helper', bundle] });
         thread.on('message', onReport);
         thread.on('error', (e) => onReport({ type: 'failed', why: String(e) }));
-        const { file, ...rest } = job;
-        thread.postMessage({ ...rest, path });
-        return { stop: () => void thread.terminate() };
+        thread.postMessage({ job });
+        return {
+          feed: (piece) => thread.postMessage({ piece }, [piece.buffer]),
+          fail: (why) => thread.postMessage({ failed: why }),
+          stop: () => void thread.terminate(),
+        };
       }
     : null;
   const worker = new Dispatcher(host, { passHelper });

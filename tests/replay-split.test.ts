@@ -11,6 +11,7 @@ import { Dispatcher } from '../src/worker/dispatcher.js';
 import { overviewOf } from '../src/worker/overview.js';
 import type { Overview } from '../src/worker/protocol.js';
 import { type FilePassJob, type FilePassReport, passOverFile } from '../src/worker/replay-file-pass.js';
+import { ArrivingFile } from '../src/worker/arriving-file.js';
 import type { PassHelperMaker } from '../src/worker/replay-split.js';
 import { MINUTE, libraryUpTo, longCapture } from './long-capture.js';
 import { ReadingClock, fakeHost } from './worker-fakes.js';
@@ -63,8 +64,11 @@ function helperHere(change: (r: FilePassReport) => FilePassReport = (r) => r) {
     jobs.push(job);
     let stopped = false;
     let t = 0;
+    // What it is fed arrives as in the helper worker: a copy of each piece.
+    const file = new ArrivingFile(job.size);
     void passOverFile(
       job,
+      file,
       (r) => {
         if (stopped) return;
         runs.reports++;
@@ -76,6 +80,8 @@ function helperHere(change: (r: FilePassReport) => FilePassReport = (r) => r) {
       () => stopped,
     );
     return {
+      feed: (piece) => file.push(piece.slice()),
+      fail: (why) => file.fail(new Error(why)),
       stop: () => {
         runs.stops++;
         runs.dropped = runs.stops > (runs.done ? 1 : 0);

@@ -1,18 +1,17 @@
 /**
- * The helper's half of a long capture's replay pass (replay-split.ts): some of its ports decoded
- * straight from the file's records as the file is read a slice at a time, while the worker reads
- * the whole file and decodes the others. It sends what the worker merges: the overview of its
- * ports so far and the checkpoints made since the last report, then the same at the end with the
- * count of chunks and bytes it walked, which the worker checks against the capture it read.
+ * One half of a long capture's replay pass (replay-split.ts): some of its ports decoded straight
+ * from the file's records as the file arrives, in the worker or in its helper. It reports what
+ * the worker merges: the overview of its ports so far and the checkpoints made since the last
+ * report, then the same at the end with the count of chunks and bytes it walked, which the
+ * worker checks against the capture it reads.
  */
 import { type SlicedFile, walkDataRecords } from '../capture/index.js';
 import type { Overview } from './protocol.js';
 import { type Checkpoint, ReplayPass } from './replay-pass.js';
 
-/** What the helper decodes: `ports` of `file`, on the span the worker's pass uses. */
+/** What a half decodes: `ports` of a file of `size` bytes, on the span the worker's pass uses. */
 export interface FilePassJob {
-  /** A File (Blob) in the browser. */
-  file: SlicedFile;
+  size: number;
   ports: number[];
   /**
    * Records on these ports have their CRC checked too (besides those of `ports`): ports the file's
@@ -35,11 +34,13 @@ export type FilePassReport =
 const PROGRESS_MS = 250;
 
 /**
- * Decodes `job`, reporting as it goes; `stopped` is asked between slices (true: it ends quietly).
- * Never throws: whatever goes wrong is a `failed` report, and the worker decodes those ports itself.
+ * Decodes `job` from `file`, reporting as it goes; `stopped` is asked between slices (true: it
+ * ends quietly). Never throws: whatever goes wrong is a `failed` report, and the worker decodes
+ * those ports itself.
  */
 export async function passOverFile(
   job: FilePassJob,
+  file: SlicedFile,
   report: (r: FilePassReport, transfer: Transferable[]) => void,
   now: () => number,
   stopped: () => boolean = () => false,
@@ -56,7 +57,9 @@ export async function passOverFile(
     const transfer = (o: Overview): Transferable[] => [o.t.buffer, o.fadeRate.buffer, o.lost.buffer];
     const { ports, alsoChecked, sliceBytes } = job;
     // Every record decoded here is checked: nothing from a damaged one is ever shown.
-    const checked = (port: number): boolean => ports.includes(port) || alsoChecked.includes(port);
+    const check = new Uint8Array(256);
+    for (const port of [...ports, ...alsoChecked]) check[port] = 1;
+    const checked = (port: number): boolean => check[port] === 1;
     const goOn = (): boolean => {
       if (stopped()) return false;
       if (now() - lastMs >= PROGRESS_MS) {
@@ -66,7 +69,7 @@ export async function passOverFile(
       }
       return true;
     };
-    const walked = await walkDataRecords(job.file, (bytes, start, end, timeUs, port) => pass.feed(bytes, start, end, timeUs, port), {
+    const walked = await walkDataRecords(file, (bytes, start, end, timeUs, port) => pass.feed(bytes, start, end, timeUs, port), {
       goOn,
       checked,
       ...(sliceBytes === undefined ? {} : { sliceBytes }),

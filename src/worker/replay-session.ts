@@ -67,6 +67,7 @@ export class ReplaySession implements Driver {
     const sender = new OverviewSender(host);
     let early: ReplayPass | null = null;
     let split: SplitPass | null = null;
+    let bytes: Uint8Array | null = null;
     let session: ReplaySession | null = null;
     if (preview !== null) {
       await registry.closeAll();
@@ -74,8 +75,12 @@ export class ReplaySession implements Driver {
       host.post({ type: 'replay', replay: readingStatus(name, startUs, endUs) });
       const halves = splitPass(file, preview.ports, startUs, endUs, parts, () => {
         // Until the capture is read the overview is drawn from here, after from the replay's slices.
+        // Complete once both halves are (every record checked): the parse is not waited for.
         if (session !== null) session.#readOn();
-        else if (split !== null && sender.due()) sender.offer(split.overview());
+        else if (split !== null) {
+          const overview = split.overview();
+          if (overview.complete || sender.due()) sender.offer(overview);
+        }
       });
       split = halves?.pass ?? null;
       if (halves === null) {
@@ -83,14 +88,21 @@ export class ReplaySession implements Driver {
         early.step(PASS_SLICE_MS, () => host.clock.now());
         sender.offer(early.overview());
       } else {
-        // This worker's half is decoded before the file is read whole and parsed (which would
-        // hold it up for seconds): the overview first, playback after.
-        await halves.mine.ended;
+        try {
+          // Read once, piece by piece, each piece to both halves as it comes; this worker's half
+          // is decoded before the parse (which would hold it up for seconds): the overview first.
+          bytes = await readInPieces(file, halves.mine, halves.theirs, parts.previewSizes?.sliceBytes);
+          await halves.mine.ended;
+        } catch (error) {
+          notice(host, 'error', `Cannot open ${name}`, `The file could not be read (${String(error)}).`);
+          split?.stop();
+          host.post({ type: 'replay', replay: null });
+          return null;
+        }
       }
     }
-    let bytes: Uint8Array;
     try {
-      bytes = new Uint8Array(await file.arrayBuffer());
+      bytes ??= new Uint8Array(await file.arrayBuffer());
     } catch (error) {
       notice(host, 'error', `Cannot open ${name}`, `The file could not be read (${String(error)}).`);
       split?.stop();
@@ -384,12 +396,20 @@ function splitPass(
   endUs: number,
   parts: ReplayParts,
   wake: () => void,
-): { pass: SplitPass; mine: HelperRun } | null {
+): { pass: SplitPass; mine: HelperRun; theirs: HelperRun } | null {
   if (ports.length < 2 || parts.passHelper === undefined) return null;
   const half = ports.length >> 1;
   const { resolution } = parts.registry;
   const sliceBytes = parts.previewSizes?.sliceBytes;
-  const job = (mine: number[], alsoChecked: number[]) => ({ file, ports: mine, alsoChecked, resolution, originUs, endUs, sliceBytes });
+  const job = (mine: number[], alsoChecked: number[]) => ({
+    size: file.size,
+    ports: mine,
+    alsoChecked,
+    resolution,
+    originUs,
+    endUs,
+    sliceBytes,
+  });
   const theirs = HelperRun.start(parts.passHelper, job(ports.slice(half), []));
   if (theirs === null) return null;
   // This half also checks records on ports the file's start did not show: ours with a damaged port byte, perhaps.
@@ -404,7 +424,39 @@ function splitPass(
     theirs.stop();
     return null;
   }
-  return { pass: new SplitPass([mine, theirs], resolution, originUs, endUs, wake), mine };
+  return { pass: new SplitPass([mine, theirs], resolution, originUs, endUs, wake), mine, theirs };
+}
+
+/** Read at a time from the File: its pieces are what the halves of a split pass are fed. */
+const PIECE_BYTES = 16 << 20;
+
+/**
+ * `file` read once, a piece at a time (the next read under way while this piece is decoded),
+ * into one buffer; each piece is handed to both halves as it arrives: this worker's the piece,
+ * the helper's a copy (transferred). A read that fails fails both.
+ */
+async function readInPieces(file: Blob, mine: HelperRun, theirs: HelperRun, pieceBytes = PIECE_BYTES): Promise<Uint8Array> {
+  const size = file.size;
+  const whole = new Uint8Array(size);
+  const read = (at: number): Promise<ArrayBuffer> => file.slice(at, Math.min(size, at + pieceBytes)).arrayBuffer();
+  try {
+    let next = size > 0 ? read(0) : null;
+    for (let at = 0; next !== null; ) {
+      const piece = new Uint8Array(await next);
+      if (piece.length === 0) throw new Error(`the file ended after ${at} of ${size} bytes`);
+      const end = Math.min(size, at + piece.length);
+      next = end < size ? read(end) : null;
+      whole.set(piece.subarray(0, end - at), at);
+      theirs.feed(piece.slice(0, end - at));
+      mine.feed(piece);
+      at = end;
+    }
+  } catch (error) {
+    mine.fail(String(error));
+    theirs.fail(String(error));
+    throw error;
+  }
+  return whole;
 }
 
 function postOverview(host: Host, overview: Overview): void {

@@ -13,28 +13,46 @@ import type { Capture } from '../capture/index.js';
 import type { Clock } from './host.js';
 import { addOverviews } from './overview.js';
 import type { Overview } from './protocol.js';
+import { ArrivingFile } from './arriving-file.js';
 import { type FilePassJob, type FilePassReport, passOverFile } from './replay-file-pass.js';
 import { CHECKPOINT_US, type Checkpoint, type OverviewPass, ReplayPass } from './replay-pass.js';
 
-/** Starts a helper on `job`, its reports to `onReport`; null when there is none to start (one core, no workers). */
-export type PassHelperMaker = (job: FilePassJob, onReport: (r: FilePassReport) => void) => { stop(): void } | null;
+/** A pass at work: `feed` hands it the file's next piece (which it may keep or transfer), `fail` says the file could not be read. */
+export interface PassHandle {
+  feed(piece: Uint8Array): void;
+  fail(why: string): void;
+  stop(): void;
+}
 
-/** The browser's: a module worker, when there is a second core for it. */
+/** Starts a pass on `job`, its reports to `onReport`; null when there is none to start (one core, no workers). */
+export type PassHelperMaker = (job: FilePassJob, onReport: (r: FilePassReport) => void) => PassHandle | null;
+
+/** What the helper worker is sent: its job, then the file's pieces in order (or that the file failed). */
+export type HelperMessage = { job: FilePassJob } | { piece: Uint8Array } | { failed: string };
+
+/** The browser's: a module worker, when there is a second core for it. Pieces are transferred. */
 export const WORKER_PASS_HELPER: PassHelperMaker = (job, onReport) => {
   if (typeof Worker === 'undefined' || typeof navigator === 'undefined' || (navigator.hardwareConcurrency ?? 1) < 2) return null;
   const helper = new Worker(new URL('./replay-helper-worker.ts', import.meta.url), { type: 'module', name: 'satscope-replay-helper' });
   helper.addEventListener('message', (event: MessageEvent<FilePassReport>) => onReport(event.data));
   helper.addEventListener('error', (event) => onReport({ type: 'failed', why: event.message || 'the replay helper failed' }));
-  helper.postMessage(job);
-  return { stop: () => helper.terminate() };
+  const send = (m: HelperMessage, transfer: Transferable[] = []): void => helper.postMessage(m, transfer);
+  send({ job });
+  return {
+    feed: (piece) => send({ piece }, [piece.buffer]),
+    fail: (why) => send({ failed: why }),
+    stop: () => helper.terminate(),
+  };
 };
 
-/** The same pass in this worker, between its other tasks (it awaits each slice of the file). */
+/** The same pass in this worker, between its other tasks (it awaits each piece of the file). */
 export function inThisWorker(clock: Clock): PassHelperMaker {
   return (job, onReport) => {
     let stopped = false;
+    const file = new ArrivingFile(job.size);
     void passOverFile(
       job,
+      file,
       (r) => {
         if (!stopped) onReport(r);
       },
@@ -42,8 +60,11 @@ export function inThisWorker(clock: Clock): PassHelperMaker {
       () => stopped,
     );
     return {
+      feed: (piece) => file.push(piece),
+      fail: (why) => file.fail(new Error(why)),
       stop: () => {
         stopped = true;
+        file.fail(new Error('stopped'));
       },
     };
   };
@@ -62,7 +83,7 @@ export class HelperRun {
   /** Settles when the pass is done, has failed or was stopped. */
   readonly ended: Promise<void>;
   #end: () => void = () => {};
-  readonly #handle: { stop(): void };
+  readonly #handle: PassHandle;
 
   /** The pass started on `job`, or null when `make` has none. */
   static start(make: PassHelperMaker, job: FilePassJob): HelperRun | null {
@@ -77,7 +98,7 @@ export class HelperRun {
 
   private constructor(
     readonly job: FilePassJob,
-    handle: { stop(): void },
+    handle: PassHandle,
   ) {
     this.#handle = handle;
     this.ended = new Promise((resolve) => {
@@ -100,6 +121,16 @@ export class HelperRun {
       }
     }
     this.onReport();
+  }
+
+  /** The file's next piece (kept or transferred: the caller lets go of it). */
+  feed(piece: Uint8Array): void {
+    if (!this.done && this.failed === null) this.#handle.feed(piece);
+  }
+
+  /** The file could not be read to its end. */
+  fail(why: string): void {
+    this.#handle.fail(why);
   }
 
   stop(): void {
