@@ -86,6 +86,8 @@ export async function walkDataRecords(file: SlicedFile, sink: RecordSink, option
     return next;
   };
   let next = ahead();
+  /** A slice to go on with, after the record joined across its start. */
+  let queued: { bytes: Uint8Array; at: number; p: number } | null = null;
   let p = headerLength;
   let chunks = 0;
   let dataBytes = 0;
@@ -114,26 +116,57 @@ export async function walkDataRecords(file: SlicedFile, sink: RecordSink, option
       }
       p += total;
     }
+    if (queued !== null) {
+      if (p !== n) throw new CaptureFormatError(`no intact record at offset ${at + p}`);
+      ({ bytes, at, p } = queued);
+      queued = null;
+      view = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
+      continue;
+    }
     if (next === null) {
       if (p !== n) throw new CaptureFormatError(`the file ends inside a record at offset ${at + p}`);
       return { chunks, dataBytes };
     }
     if (!(await goOn())) return null;
     const more = await next;
+    const moreAt = readTo;
     readTo += more.length;
     next = ahead();
-    // A record not yet whole at the end of this slice goes on in the next: the two joined.
-    if (p === n) {
+    const rest = n - p;
+    const total = rest === 0 ? 0 : straddling(bytes, p, rest, more);
+    if (rest === 0) {
       bytes = more;
-      at = readTo - more.length;
+      at = moreAt;
+    } else if (total - rest <= more.length) {
+      // The record not yet whole at the end of this slice, joined with its end from the next
+      // (a few dozen bytes, not the next slice copied); the next slice goes on after it.
+      const record = new Uint8Array(total);
+      record.set(bytes.subarray(p));
+      record.set(more.subarray(0, total - rest), rest);
+      queued = { bytes: more, at: moreAt, p: total - rest };
+      bytes = record;
+      at += p;
     } else {
-      const joined = new Uint8Array(n - p + more.length);
+      // A record longer than what is read so far: the two joined, and read on.
+      const joined = new Uint8Array(rest + more.length);
       joined.set(bytes.subarray(p));
-      joined.set(more, n - p);
+      joined.set(more, rest);
       bytes = joined;
       at += p;
     }
     view = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
     p = 0;
   }
+}
+
+/**
+ * The size of the record starting at `p` whose first `rest` bytes end `bytes`, its length field
+ * read across into `more` if need be; Infinity when it cannot be known (no length there, or one
+ * too large: the walk then finds the header damaged).
+ */
+function straddling(bytes: Uint8Array, p: number, rest: number, more: Uint8Array): number {
+  const at = (i: number): number => (i < rest ? (bytes[p + i] ?? 0) : (more[i - rest] ?? 0));
+  if (rest + more.length < REC_OFF_LENGTH + 4) return Number.POSITIVE_INFINITY;
+  const len = (at(REC_OFF_LENGTH) | (at(REC_OFF_LENGTH + 1) << 8) | (at(REC_OFF_LENGTH + 2) << 16) | (at(REC_OFF_LENGTH + 3) << 24)) >>> 0;
+  return len > MAX_RECORD_PAYLOAD ? Number.POSITIVE_INFINITY : RECORD_OVERHEAD + len;
 }
