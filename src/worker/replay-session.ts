@@ -57,8 +57,9 @@ export class ReplaySession implements Driver {
 
   /**
    * Reads `file` and starts playing it, every source before it closed; null (the user told why)
-   * when it is not a capture. A long capture's start and end are read first: its span and first
-   * records' overview are shown, and a helper starts on half its ports, while the rest is read.
+   * when it is not a capture. A long capture's start and end are read first: its span is shown
+   * at once; with a helper, its ports are decoded in two halves as the file is read (the
+   * overview first, replay-split.ts), else its first records are.
    */
   static async open(name: string, file: Blob, parts: ReplayParts): Promise<ReplaySession | null> {
     const { host, registry, diagnosis } = parts;
@@ -69,6 +70,12 @@ export class ReplaySession implements Driver {
     let split: SplitPass | null = null;
     let bytes: Uint8Array | null = null;
     let session: ReplaySession | null = null;
+    const cannotOpen = (why: string): null => {
+      notice(host, 'error', `Cannot open ${name}`, why);
+      split?.stop();
+      if (preview !== null) host.post({ type: 'replay', replay: null });
+      return null;
+    };
     if (preview !== null) {
       await registry.closeAll();
       const { ports, startUs, endUs } = preview;
@@ -94,31 +101,21 @@ export class ReplaySession implements Driver {
           bytes = await readInPieces(file, halves.mine, halves.theirs, parts.previewSizes?.sliceBytes);
           await halves.mine.ended;
         } catch (error) {
-          notice(host, 'error', `Cannot open ${name}`, `The file could not be read (${String(error)}).`);
-          split?.stop();
-          host.post({ type: 'replay', replay: null });
-          return null;
+          return cannotOpen(`The file could not be read (${String(error)}).`);
         }
       }
     }
     try {
       bytes ??= new Uint8Array(await file.arrayBuffer());
     } catch (error) {
-      notice(host, 'error', `Cannot open ${name}`, `The file could not be read (${String(error)}).`);
-      split?.stop();
-      if (preview !== null) host.post({ type: 'replay', replay: null });
-      return null;
+      return cannotOpen(`The file could not be read (${String(error)}).`);
     }
     let capture: Capture;
     try {
       // The file itself is not kept: the capture holds what replay and a report need.
       capture = readCapture(bytes, name);
     } catch (error) {
-      const why = error instanceof CaptureFormatError ? error.message : String(error);
-      notice(host, 'error', `Cannot open ${name}`, why);
-      split?.stop();
-      if (preview !== null) host.post({ type: 'replay', replay: null });
-      return null;
+      return cannotOpen(error instanceof CaptureFormatError ? error.message : String(error));
     }
     if (preview === null) await registry.closeAll();
     if (capture.issues.length > 0) {
