@@ -38,7 +38,6 @@ async function main() {
     input: {
       dispatcher: fileURLToPath(new URL('../src/worker/dispatcher.ts', import.meta.url)),
       'file-pass': fileURLToPath(new URL('../src/worker/replay-file-pass.ts', import.meta.url)),
-      'arriving-file': fileURLToPath(new URL('../src/worker/arriving-file.ts', import.meta.url)),
       decoder: fileURLToPath(new URL('../src/decoder/index.ts', import.meta.url)),
     },
     platform: 'node',
@@ -130,22 +129,13 @@ function bareDecodeMs(SpektrumDecoder, capture, fromUs, toUs) {
 /** The replay helper on a thread of its own (the page's is a worker: src/worker/replay-helper-worker.ts). */
 async function helperThread(bundle) {
   const { parentPort } = await import('node:worker_threads');
-  const { passOverFile } = await import(join(bundle, 'file-pass.mjs'));
-  const { ArrivingFile } = await import(join(bundle, 'arriving-file.mjs'));
-  let file = null;
+  const { helperReceiver } = await import(join(bundle, 'file-pass.mjs'));
   // As src/worker/replay-helper-worker.ts: its job, then the file's pieces as the worker reads them.
-  parentPort.on('message', (m) => {
-    if (m.job) {
-      file = new ArrivingFile(m.job.size);
-      void passOverFile(
-        m.job,
-        file,
-        (r, transfer) => parentPort.postMessage(r, transfer),
-        () => performance.now(),
-      );
-    } else if (m.piece) file.push(m.piece);
-    else file.fail(new Error(m.failed));
-  });
+  const receive = helperReceiver(
+    (r, transfer) => parentPort.postMessage(r, transfer),
+    () => performance.now(),
+  );
+  parentPort.on('message', receive);
 }
 
 async function child(bundle, path, seeks, withHelper) {

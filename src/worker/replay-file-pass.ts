@@ -7,6 +7,7 @@
  */
 import { type SlicedFile, walkDataRecords } from '../capture/index.js';
 import type { Overview } from './protocol.js';
+import { ArrivingFile } from './arriving-file.js';
 import { type Checkpoint, ReplayPass } from './replay-pass.js';
 
 /** What a half decodes: `ports` of a file of `size` bytes, on the span the worker's pass uses. */
@@ -81,4 +82,22 @@ export async function passOverFile(
   } catch (error) {
     report({ type: 'failed', why: error instanceof Error ? error.message : String(error) }, []);
   }
+}
+
+/** What a helper is sent: its job, then the file's pieces in order (or that the file failed). */
+export type HelperMessage = { job: FilePassJob } | { piece: Uint8Array } | { failed: string };
+
+/**
+ * A helper's side (replay-helper-worker.ts, and bench/replay.mjs's thread): the messages it is
+ * sent, its reports to `post`.
+ */
+export function helperReceiver(post: (r: FilePassReport, transfer: Transferable[]) => void, now: () => number): (m: HelperMessage) => void {
+  let file: ArrivingFile | null = null;
+  return (m) => {
+    if ('job' in m) {
+      file = new ArrivingFile(m.job.size);
+      void passOverFile(m.job, file, post, now);
+    } else if ('piece' in m) file?.push(m.piece);
+    else file?.fail(new Error(m.failed));
+  };
 }

@@ -4,23 +4,12 @@
  * as the worker reads them.
  */
 /// <reference lib="webworker" />
-import { ArrivingFile } from './arriving-file.js';
-import { passOverFile } from './replay-file-pass.js';
-import type { HelperMessage } from './replay-split.js';
+import { type HelperMessage, helperReceiver } from './replay-file-pass.js';
 
 const scope = self as unknown as DedicatedWorkerGlobalScope;
-let file: ArrivingFile | null = null;
+const receive = helperReceiver(
+  (r, transfer) => scope.postMessage(r, transfer),
+  () => performance.now(),
+);
 
-scope.addEventListener('message', (event: MessageEvent<HelperMessage>) => {
-  const m = event.data;
-  if ('job' in m) {
-    file = new ArrivingFile(m.job.size);
-    void passOverFile(
-      m.job,
-      file,
-      (r, transfer) => scope.postMessage(r, transfer),
-      () => performance.now(),
-    );
-  } else if ('piece' in m) file?.push(m.piece);
-  else file?.fail(new Error(m.failed));
-});
+scope.addEventListener('message', (event: MessageEvent<HelperMessage>) => receive(event.data));

@@ -14,7 +14,7 @@ import type { Clock } from './host.js';
 import { addOverviews } from './overview.js';
 import type { Overview } from './protocol.js';
 import { ArrivingFile } from './arriving-file.js';
-import { type FilePassJob, type FilePassReport, passOverFile } from './replay-file-pass.js';
+import { type FilePassJob, type FilePassReport, type HelperMessage, passOverFile } from './replay-file-pass.js';
 import { CHECKPOINT_US, type Checkpoint, type OverviewPass, ReplayPass } from './replay-pass.js';
 
 /** A pass at work: `feed` hands it the file's next piece (which it may keep or transfer), `fail` says the file could not be read. */
@@ -26,9 +26,6 @@ export interface PassHandle {
 
 /** Starts a pass on `job`, its reports to `onReport`; null when there is none to start (one core, no workers). */
 export type PassHelperMaker = (job: FilePassJob, onReport: (r: FilePassReport) => void) => PassHandle | null;
-
-/** What the helper worker is sent: its job, then the file's pieces in order (or that the file failed). */
-export type HelperMessage = { job: FilePassJob } | { piece: Uint8Array } | { failed: string };
 
 /** The browser's: a module worker, when there is a second core for it. Pieces are transferred. */
 export const WORKER_PASS_HELPER: PassHelperMaker = (job, onReport) => {
