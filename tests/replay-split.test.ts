@@ -55,24 +55,37 @@ class SlicingClock extends ReadingClock {
 
 const turns = new Turns();
 
-/** The helper on this thread: the same code; `change` alters what it reports. */
-function helperHere(change: (r: FilePassReport) => FilePassReport = (r) => r) {
+/**
+ * The helper on this thread: the same code; `change` alters what it reports; each of its reads
+ * waits for `turnsPerRead` turns (2: it walks at half the pace the worker reads).
+ */
+function helperHere(change: (r: FilePassReport) => FilePassReport = (r) => r, turnsPerRead = 0) {
   const jobs: FilePassJob[] = [];
   /** dropped: stopped other than once when done (the pass drops a helper by stopping it). */
-  const runs = { reports: 0, done: false, stops: 0, dropped: false };
+  const runs = { reports: 0, done: false, stops: 0, dropped: false, fed: 0, walkedTo: 0, mostAhead: 0 };
   const make: PassHelperMaker = (job, onReport) => {
     jobs.push(job);
     let stopped = false;
     let t = 0;
     // What it is fed arrives as in the helper worker: a copy of each piece.
     const file = new ArrivingFile(job.size);
+    const paced: SlicedFile = {
+      size: file.size,
+      slice: (start, end) => ({
+        arrayBuffer: async () => {
+          for (let k = 0; k < turnsPerRead; k++) await turns.wait();
+          return file.slice(start, end).arrayBuffer();
+        },
+      }),
+    };
     void passOverFile(
       job,
-      file,
+      paced,
       (r) => {
         if (stopped) return;
         runs.reports++;
         if (r.type === 'done') runs.done = true;
+        if (r.type === 'walked') runs.walkedTo = r.to;
         onReport(change(r));
       },
       // 100 ms a read of the clock: a report about every other slice.
@@ -80,7 +93,11 @@ function helperHere(change: (r: FilePassReport) => FilePassReport = (r) => r) {
       () => stopped,
     );
     return {
-      feed: (piece) => file.push(piece.slice()),
+      feed: (piece) => {
+        runs.fed += piece.length;
+        runs.mostAhead = Math.max(runs.mostAhead, runs.fed - runs.walkedTo);
+        file.push(piece.slice());
+      },
       fail: (why) => file.fail(new Error(why)),
       stop: () => {
         runs.stops++;
@@ -180,6 +197,14 @@ describe('a long capture decoded on two workers', () => {
     expect(helper.runs.done).toBe(true);
     expect(helper.runs.dropped).toBe(false);
     expect(helper.runs.reports).toBeGreaterThan(3);
+    // A helper at half the worker's pace is sent no more than a few pieces ahead of where it has
+    // got (the file is 3.9 MB, the pieces 16 kB), and the result is the same.
+    const slow = helperHere(undefined, 2);
+    const paced = await openSplit(FILE, slow.make);
+    expect(slow.runs.dropped).toBe(false);
+    expect(slow.runs.mostAhead).toBeGreaterThan(2 * PREVIEW.sliceBytes);
+    expect(slow.runs.mostAhead).toBeLessThanOrEqual(5 * PREVIEW.sliceBytes);
+    expectOverviewsAsOneDecode(paced.overviews, FILE);
     expect(split.overviews.length).toBeGreaterThan(3);
     expectOverviewsAsOneDecode(split.overviews, FILE);
     await expectSeeksExact(split, FILE);
@@ -195,7 +220,7 @@ describe('a long capture decoded on two workers', () => {
 
   it('drops a helper whose checkpoints fall on other chunks, or who walked other records', async () => {
     const moved = helperHere((r) =>
-      r.type === 'failed' ? r : { ...r, checkpoints: r.checkpoints.map((c) => ({ ...c, chunk: c.chunk + 1 })) },
+      r.type === 'failed' || r.type === 'walked' ? r : { ...r, checkpoints: r.checkpoints.map((c) => ({ ...c, chunk: c.chunk + 1 })) },
     );
     const a = await openSplit(FILE, moved.make);
     expect(moved.runs.dropped).toBe(true);

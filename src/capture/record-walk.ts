@@ -47,8 +47,8 @@ export interface WalkedRecords {
 
 /** How a walk goes. */
 export interface WalkOptions {
-  /** Asked after each slice: false stops the walk (it resolves null). Default: on to the end. */
-  goOn?: () => boolean | Promise<boolean>;
+  /** Asked after each slice, with the file offset walked to: false stops the walk (it resolves null). Default: on to the end. */
+  goOn?: (walkedTo: number) => boolean | Promise<boolean>;
   /** Whether a data record on `port` has its CRC-32 checked. Default: none is. */
   checked?: (port: number) => boolean;
   /** Read at a time (tests). Default 16 MiB. */
@@ -127,7 +127,7 @@ export async function walkDataRecords(file: SlicedFile, sink: RecordSink, option
       if (p !== n) throw new CaptureFormatError(`the file ends inside a record at offset ${at + p}`);
       return { chunks, dataBytes };
     }
-    if (!(await goOn())) return null;
+    if (!(await goOn(at + p))) return null;
     const more = await next;
     const moreAt = readTo;
     readTo += more.length;

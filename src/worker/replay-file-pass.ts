@@ -27,6 +27,8 @@ export interface FilePassJob {
 }
 
 export type FilePassReport =
+  /** After each slice: how far into the file the walk has got (the worker sends no more than a few slices ahead of it). */
+  | { type: 'walked'; to: number }
   | { type: 'progress'; overview: Overview; checkpoints: Checkpoint[] }
   | { type: 'done'; overview: Overview; checkpoints: Checkpoint[]; chunks: number; dataBytes: number }
   | { type: 'failed'; why: string };
@@ -61,8 +63,9 @@ export async function passOverFile(
     const check = new Uint8Array(256);
     for (const port of [...ports, ...alsoChecked]) check[port] = 1;
     const checked = (port: number): boolean => check[port] === 1;
-    const goOn = (): boolean => {
+    const goOn = (walkedTo: number): boolean => {
       if (stopped()) return false;
+      report({ type: 'walked', to: walkedTo }, []);
       if (now() - lastMs >= PROGRESS_MS) {
         lastMs = now();
         const r = news();

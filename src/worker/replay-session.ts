@@ -426,11 +426,14 @@ function splitPass(
 
 /** Read at a time from the File: its pieces are what the halves of a split pass are fed. */
 const PIECE_BYTES = 16 << 20;
+/** Pieces the helper may be sent ahead of where it has got. */
+const AHEAD_PIECES = 3;
 
 /**
  * `file` read once, a piece at a time (the next read under way while this piece is decoded),
- * into one buffer; each piece is handed to both halves as it arrives: this worker's the piece,
- * the helper's a copy (transferred). A read that fails fails both.
+ * into one buffer; each piece is handed to both halves as it arrives: this worker's a view of
+ * the buffer, the helper's the piece itself (transferred), never more than AHEAD_PIECES ahead
+ * of where the helper has got. A read that fails fails both.
  */
 async function readInPieces(file: Blob, mine: HelperRun, theirs: HelperRun, pieceBytes = PIECE_BYTES): Promise<Uint8Array> {
   const size = file.size;
@@ -444,8 +447,10 @@ async function readInPieces(file: Blob, mine: HelperRun, theirs: HelperRun, piec
       const end = Math.min(size, at + piece.length);
       next = end < size ? read(end) : null;
       whole.set(piece.subarray(0, end - at), at);
-      theirs.feed(piece.slice(0, end - at));
-      mine.feed(piece);
+      mine.feed(whole.subarray(at, end));
+      // Never more than a few pieces ahead of the helper: they would pile up in its memory.
+      await theirs.reached(at - AHEAD_PIECES * pieceBytes);
+      theirs.feed(piece);
       at = end;
     }
   } catch (error) {

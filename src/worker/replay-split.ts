@@ -105,9 +105,15 @@ export class HelperRun {
 
   #report(r: FilePassReport): void {
     if (this.done || this.failed !== null) return;
+    if (r.type === 'walked') {
+      this.#walkedTo = r.to;
+      this.#wakeReader();
+      return;
+    }
     if (r.type === 'failed') {
       this.failed = r.why;
       this.#end();
+      this.#wakeReader();
     } else {
       this.checkpoints.push(...r.checkpoints);
       this.overview = r.overview;
@@ -120,6 +126,25 @@ export class HelperRun {
     this.onReport();
   }
 
+  /** How far into the file the pass has walked. */
+  #walkedTo = 0;
+  #reader: (() => void) | null = null;
+
+  #wakeReader(): void {
+    const go = this.#reader;
+    this.#reader = null;
+    go?.();
+  }
+
+  /** Settles once the pass has walked to `offset` of the file, or has ended (pieces beyond it would only pile up). */
+  async reached(offset: number): Promise<void> {
+    while (this.#walkedTo < offset && !this.done && this.failed === null && !this.#stopped) {
+      await new Promise<void>((resolve) => {
+        this.#reader = resolve;
+      });
+    }
+  }
+
   /** The file's next piece (kept or transferred: the caller lets go of it). */
   feed(piece: Uint8Array): void {
     if (!this.done && this.failed === null) this.#handle.feed(piece);
@@ -130,9 +155,13 @@ export class HelperRun {
     this.#handle.fail(why);
   }
 
+  #stopped = false;
+
   stop(): void {
+    this.#stopped = true;
     this.#handle.stop();
     this.#end();
+    this.#wakeReader();
   }
 }
 
