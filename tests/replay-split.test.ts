@@ -12,7 +12,7 @@ import { overviewOf } from '../src/worker/overview.js';
 import type { Overview } from '../src/worker/protocol.js';
 import { type FilePassJob, type FilePassReport, passOverFile } from '../src/worker/replay-file-pass.js';
 import { ArrivingFile } from '../src/worker/arriving-file.js';
-import type { PassHelperMaker } from '../src/worker/replay-split.js';
+import type { PassHelperMaker } from '../src/worker/replay-helper.js';
 import { MINUTE, libraryUpTo, longCapture } from './long-capture.js';
 import { ReadingClock, fakeHost } from './worker-fakes.js';
 

@@ -17,7 +17,7 @@ import { Recorder } from './recorder.js';
 import { SourceRegistry } from './registry.js';
 import { ReplaySession } from './replay-session.js';
 import type { PreviewSizes } from './replay-preview.js';
-import { type PassHelperMaker, WORKER_PASS_HELPER } from './replay-split.js';
+import { type PassHelperMaker, WORKER_PASS_HELPER } from './replay-helper.js';
 import { type ReportMaker, WORKER_REPORT_MAKER, report } from './report.js';
 import { setResolution, shareResolution, tellMismatch } from './resolution.js';
 import { DemoSource } from './sources/demo.js';

@@ -17,7 +17,8 @@ import type { Overview, ReplayStatus } from './protocol.js';
 import type { Driver, SourceRegistry } from './registry.js';
 import { type Checkpoint, type OverviewPass, ReplayPass } from './replay-pass.js';
 import { type PreviewSizes, previewOf } from './replay-preview.js';
-import { HelperRun, type PassHelperMaker, SplitPass, inThisWorker } from './replay-split.js';
+import type { PassHelperMaker } from './replay-helper.js';
+import { type SplitPass, readInPieces, startSplit } from './replay-split.js';
 import { ReplaySource } from './sources/replay.js';
 
 /** The position moves every tick; the page needs it a few times a second. */
@@ -80,7 +81,9 @@ export class ReplaySession implements Driver {
       await registry.closeAll();
       const { ports, startUs, endUs } = preview;
       host.post({ type: 'replay', replay: readingStatus(name, startUs, endUs) });
-      const halves = splitPass(file, preview.ports, startUs, endUs, parts, () => {
+      const { resolution } = registry;
+      const span = { originUs: startUs, endUs, resolution };
+      const halves = startSplit(file, ports, span, parts.passHelper, host.clock, parts.previewSizes?.sliceBytes, () => {
         // Until the capture is read the overview is drawn from here, after from the replay's slices.
         // Complete once both halves are (every record checked): the parse is not waited for.
         if (session !== null) session.#readOn();
@@ -380,85 +383,6 @@ class OverviewSender {
     this.complete = overview.complete;
     postOverview(this.#host, overview);
   }
-}
-
-/**
- * The pass of a long capture of two ports or more on two workers (replay-split.ts), started on
- * the file: the first half of the ports here, the later half in a helper; null without a helper.
- */
-function splitPass(
-  file: Blob,
-  ports: number[],
-  originUs: number,
-  endUs: number,
-  parts: ReplayParts,
-  wake: () => void,
-): { pass: SplitPass; mine: HelperRun; theirs: HelperRun } | null {
-  if (ports.length < 2 || parts.passHelper === undefined) return null;
-  const half = ports.length >> 1;
-  const { resolution } = parts.registry;
-  const sliceBytes = parts.previewSizes?.sliceBytes;
-  const job = (mine: number[], alsoChecked: number[]) => ({
-    size: file.size,
-    ports: mine,
-    alsoChecked,
-    resolution,
-    originUs,
-    endUs,
-    sliceBytes,
-  });
-  const theirs = HelperRun.start(parts.passHelper, job(ports.slice(half), []));
-  if (theirs === null) return null;
-  // This half also checks records on ports the file's start did not show: ours with a damaged port byte, perhaps.
-  const mine = HelperRun.start(
-    inThisWorker(parts.host.clock),
-    job(
-      ports.slice(0, half),
-      [...Array(256).keys()].filter((p) => !ports.includes(p)),
-    ),
-  );
-  if (mine === null) {
-    theirs.stop();
-    return null;
-  }
-  return { pass: new SplitPass([mine, theirs], resolution, originUs, endUs, wake), mine, theirs };
-}
-
-/** Read at a time from the File: its pieces are what the halves of a split pass are fed. */
-const PIECE_BYTES = 16 << 20;
-/** Pieces the helper may be sent ahead of where it has got. */
-const AHEAD_PIECES = 3;
-
-/**
- * `file` read once, a piece at a time (the next read under way while this piece is decoded),
- * into one buffer; each piece is handed to both halves as it arrives: this worker's a view of
- * the buffer, the helper's the piece itself (transferred), never more than AHEAD_PIECES ahead
- * of where the helper has got. A read that fails fails both.
- */
-async function readInPieces(file: Blob, mine: HelperRun, theirs: HelperRun, pieceBytes = PIECE_BYTES): Promise<Uint8Array> {
-  const size = file.size;
-  const whole = new Uint8Array(size);
-  const read = (at: number): Promise<ArrayBuffer> => file.slice(at, Math.min(size, at + pieceBytes)).arrayBuffer();
-  try {
-    let next = size > 0 ? read(0) : null;
-    for (let at = 0; next !== null; ) {
-      const piece = new Uint8Array(await next);
-      if (piece.length === 0) throw new Error(`the file ended after ${at} of ${size} bytes`);
-      const end = Math.min(size, at + piece.length);
-      next = end < size ? read(end) : null;
-      whole.set(piece.subarray(0, end - at), at);
-      mine.feed(whole.subarray(at, end));
-      // Never more than a few pieces ahead of the helper: they would pile up in its memory.
-      await theirs.reached(at - AHEAD_PIECES * pieceBytes);
-      theirs.feed(piece);
-      at = end;
-    }
-  } catch (error) {
-    mine.fail(String(error));
-    theirs.fail(String(error));
-    throw error;
-  }
-  return whole;
 }
 
 function postOverview(host: Host, overview: Overview): void {

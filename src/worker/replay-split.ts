@@ -2,7 +2,8 @@
  * A long capture's replay pass on two cores, overview first: as soon as the file's start and end
  * are read, its ports are decoded straight from the file (replay-file-pass.ts) in two halves,
  * the first half in this worker and the later half in a helper worker, and the overview is drawn
- * from both as they go. The file is read whole and parsed for playback after this worker's half.
+ * from both as they go. The file is read once, in pieces handed to both halves as they come
+ * (readInPieces), into the buffer parsed for playback after this worker's half is done.
  *
  * The halves count only for a capture `parseCapture` found intact, on the same span, with every
  * checkpoint on the chunk the capture's own order puts it (`checkpointChunks`) and with the
@@ -13,157 +14,8 @@ import type { Capture } from '../capture/index.js';
 import type { Clock } from './host.js';
 import { addOverviews } from './overview.js';
 import type { Overview } from './protocol.js';
-import { ArrivingFile } from './arriving-file.js';
-import { type FilePassJob, type FilePassReport, type HelperMessage, passOverFile } from './replay-file-pass.js';
+import { HelperRun, type PassHelperMaker, inThisWorker } from './replay-helper.js';
 import { CHECKPOINT_US, type Checkpoint, type OverviewPass, ReplayPass } from './replay-pass.js';
-
-/** A pass at work: `feed` hands it the file's next piece (which it may keep or transfer), `fail` says the file could not be read. */
-export interface PassHandle {
-  feed(piece: Uint8Array): void;
-  fail(why: string): void;
-  stop(): void;
-}
-
-/** Starts a pass on `job`, its reports to `onReport`; null when there is none to start (one core, no workers). */
-export type PassHelperMaker = (job: FilePassJob, onReport: (r: FilePassReport) => void) => PassHandle | null;
-
-/** The browser's: a module worker, when there is a second core for it. Pieces are transferred. */
-export const WORKER_PASS_HELPER: PassHelperMaker = (job, onReport) => {
-  if (typeof Worker === 'undefined' || typeof navigator === 'undefined' || (navigator.hardwareConcurrency ?? 1) < 2) return null;
-  const helper = new Worker(new URL('./replay-helper-worker.ts', import.meta.url), { type: 'module', name: 'satscope-replay-helper' });
-  helper.addEventListener('message', (event: MessageEvent<FilePassReport>) => onReport(event.data));
-  helper.addEventListener('error', (event) => onReport({ type: 'failed', why: event.message || 'the replay helper failed' }));
-  const send = (m: HelperMessage, transfer: Transferable[] = []): void => helper.postMessage(m, transfer);
-  send({ job });
-  return {
-    feed: (piece) => send({ piece }, [piece.buffer]),
-    fail: (why) => send({ failed: why }),
-    stop: () => helper.terminate(),
-  };
-};
-
-/** The same pass in this worker, between its other tasks (it awaits each piece of the file). */
-export function inThisWorker(clock: Clock): PassHelperMaker {
-  return (job, onReport) => {
-    let stopped = false;
-    const file = new ArrivingFile(job.size);
-    void passOverFile(
-      job,
-      file,
-      (r) => {
-        if (!stopped) onReport(r);
-      },
-      () => clock.now(),
-      () => stopped,
-    );
-    return {
-      feed: (piece) => file.push(piece),
-      fail: (why) => file.fail(new Error(why)),
-      stop: () => {
-        stopped = true;
-        file.fail(new Error('stopped'));
-      },
-    };
-  };
-}
-
-/** A file pass at work on some ports, and what it has reported so far. */
-export class HelperRun {
-  readonly checkpoints: Checkpoint[] = [];
-  overview: Overview | null = null;
-  done = false;
-  failed: string | null = null;
-  /** What the pass walked (once done): the capture's chunk count and data bytes, if intact. */
-  walked = { chunks: Number.NaN, dataBytes: Number.NaN };
-  /** Called after each report. */
-  onReport: () => void = () => {};
-  /** Settles when the pass is done, has failed or was stopped. */
-  readonly ended: Promise<void>;
-  #end: () => void = () => {};
-  readonly #handle: PassHandle;
-
-  /** The pass started on `job`, or null when `make` has none. */
-  static start(make: PassHelperMaker, job: FilePassJob): HelperRun | null {
-    let run: HelperRun | null = null;
-    const handle = make(job, (r) => {
-      if (run !== null) run.#report(r);
-    });
-    if (handle === null) return null;
-    run = new HelperRun(job, handle);
-    return run;
-  }
-
-  private constructor(
-    readonly job: FilePassJob,
-    handle: PassHandle,
-  ) {
-    this.#handle = handle;
-    this.ended = new Promise((resolve) => {
-      this.#end = resolve;
-    });
-  }
-
-  #report(r: FilePassReport): void {
-    if (this.done || this.failed !== null) return;
-    if (r.type === 'walked') {
-      this.#walkedTo = r.to;
-      this.#wakeReader();
-      return;
-    }
-    if (r.type === 'failed') {
-      this.failed = r.why;
-      this.#end();
-      this.#wakeReader();
-    } else {
-      this.checkpoints.push(...r.checkpoints);
-      this.overview = r.overview;
-      if (r.type === 'done') {
-        this.done = true;
-        this.walked = { chunks: r.chunks, dataBytes: r.dataBytes };
-        this.stop();
-      }
-    }
-    this.onReport();
-  }
-
-  /** How far into the file the pass has walked. */
-  #walkedTo = 0;
-  #reader: (() => void) | null = null;
-
-  #wakeReader(): void {
-    const go = this.#reader;
-    this.#reader = null;
-    go?.();
-  }
-
-  /** Settles once the pass has walked to `offset` of the file, or has ended (pieces beyond it would only pile up). */
-  async reached(offset: number): Promise<void> {
-    while (this.#walkedTo < offset && !this.done && this.failed === null && !this.#stopped) {
-      await new Promise<void>((resolve) => {
-        this.#reader = resolve;
-      });
-    }
-  }
-
-  /** The file's next piece (kept or transferred: the caller lets go of it). */
-  feed(piece: Uint8Array): void {
-    if (!this.done && this.failed === null) this.#handle.feed(piece);
-  }
-
-  /** The file could not be read to its end. */
-  fail(why: string): void {
-    this.#handle.fail(why);
-  }
-
-  #stopped = false;
-
-  stop(): void {
-    this.#stopped = true;
-    this.#handle.stop();
-    this.#end();
-    this.#wakeReader();
-  }
-}
 
 /**
  * Where the replay pass's checkpoints fall in `capture` (ReplayPass's rule: before the first
@@ -331,4 +183,83 @@ export class SplitPass implements OverviewPass {
   stop(): void {
     for (const run of this.#runs) run.stop();
   }
+}
+
+/**
+ * The pass of a long capture of two ports or more on two workers (replay-split.ts), started on
+ * the file: the first half of the ports here, the later half in a helper; null without a helper.
+ */
+export function startSplit(
+  file: Blob,
+  ports: number[],
+  span: { originUs: number; endUs: number; resolution: 'auto' | 1024 | 2048 },
+  helper: PassHelperMaker | undefined,
+  clock: Clock,
+  sliceBytes: number | undefined,
+  wake: () => void,
+): { pass: SplitPass; mine: HelperRun; theirs: HelperRun } | null {
+  if (ports.length < 2 || helper === undefined) return null;
+  const half = ports.length >> 1;
+  const { originUs, endUs, resolution } = span;
+  const job = (mine: number[], alsoChecked: number[]) => ({
+    size: file.size,
+    ports: mine,
+    alsoChecked,
+    resolution,
+    originUs,
+    endUs,
+    sliceBytes,
+  });
+  const theirs = HelperRun.start(helper, job(ports.slice(half), []));
+  if (theirs === null) return null;
+  // This half also checks records on ports the file's start did not show: ours with a damaged port byte, perhaps.
+  const mine = HelperRun.start(
+    inThisWorker(clock),
+    job(
+      ports.slice(0, half),
+      [...Array(256).keys()].filter((p) => !ports.includes(p)),
+    ),
+  );
+  if (mine === null) {
+    theirs.stop();
+    return null;
+  }
+  return { pass: new SplitPass([mine, theirs], resolution, originUs, endUs, wake), mine, theirs };
+}
+
+/** Read at a time from the File: its pieces are what the halves of a split pass are fed. */
+const PIECE_BYTES = 16 << 20;
+/** Pieces the helper may be sent ahead of where it has got. */
+const AHEAD_PIECES = 3;
+
+/**
+ * `file` read once, a piece at a time (the next read under way while this piece is decoded),
+ * into one buffer; each piece is handed to both halves as it arrives: this worker's a view of
+ * the buffer, the helper's the piece itself (transferred), never more than AHEAD_PIECES ahead
+ * of where the helper has got. A read that fails fails both.
+ */
+export async function readInPieces(file: Blob, mine: HelperRun, theirs: HelperRun, pieceBytes = PIECE_BYTES): Promise<Uint8Array> {
+  const size = file.size;
+  const whole = new Uint8Array(size);
+  const read = (at: number): Promise<ArrayBuffer> => file.slice(at, Math.min(size, at + pieceBytes)).arrayBuffer();
+  try {
+    let next = size > 0 ? read(0) : null;
+    for (let at = 0; next !== null; ) {
+      const piece = new Uint8Array(await next);
+      if (piece.length === 0) throw new Error(`the file ended after ${at} of ${size} bytes`);
+      const end = Math.min(size, at + piece.length);
+      next = end < size ? read(end) : null;
+      whole.set(piece.subarray(0, end - at), at);
+      mine.feed(whole.subarray(at, end));
+      // Never more than a few pieces ahead of the helper: they would pile up in its memory.
+      await theirs.reached(at - AHEAD_PIECES * pieceBytes);
+      theirs.feed(piece);
+      at = end;
+    }
+  } catch (error) {
+    mine.fail(String(error));
+    theirs.fail(String(error));
+    throw error;
+  }
+  return whole;
 }

@@ -1,0 +1,158 @@
+/**
+ * A file pass (replay-file-pass.ts) at work on some ports of a long capture, in a helper worker
+ * or in this one, fed the file's pieces as they are read, and what it has reported so far: the
+ * halves of a split replay pass (replay-split.ts).
+ */
+import { ArrivingFile } from './arriving-file.js';
+import type { Clock } from './host.js';
+import type { Overview } from './protocol.js';
+import { type FilePassJob, type FilePassReport, type HelperMessage, passOverFile } from './replay-file-pass.js';
+import type { Checkpoint } from './replay-pass.js';
+
+/** A pass at work: `feed` hands it the file's next piece (which it may keep or transfer), `fail` says the file could not be read. */
+export interface PassHandle {
+  feed(piece: Uint8Array): void;
+  fail(why: string): void;
+  stop(): void;
+}
+
+/** Starts a pass on `job`, its reports to `onReport`; null when there is none to start (one core, no workers). */
+export type PassHelperMaker = (job: FilePassJob, onReport: (r: FilePassReport) => void) => PassHandle | null;
+
+/** The browser's: a module worker, when there is a second core for it. Pieces are transferred. */
+export const WORKER_PASS_HELPER: PassHelperMaker = (job, onReport) => {
+  if (typeof Worker === 'undefined' || typeof navigator === 'undefined' || (navigator.hardwareConcurrency ?? 1) < 2) return null;
+  const helper = new Worker(new URL('./replay-helper-worker.ts', import.meta.url), { type: 'module', name: 'satscope-replay-helper' });
+  helper.addEventListener('message', (event: MessageEvent<FilePassReport>) => onReport(event.data));
+  helper.addEventListener('error', (event) => onReport({ type: 'failed', why: event.message || 'the replay helper failed' }));
+  const send = (m: HelperMessage, transfer: Transferable[] = []): void => helper.postMessage(m, transfer);
+  send({ job });
+  return {
+    feed: (piece) => send({ piece }, [piece.buffer]),
+    fail: (why) => send({ failed: why }),
+    stop: () => helper.terminate(),
+  };
+};
+
+/** The same pass in this worker, between its other tasks (it awaits each piece of the file). */
+export function inThisWorker(clock: Clock): PassHelperMaker {
+  return (job, onReport) => {
+    let stopped = false;
+    const file = new ArrivingFile(job.size);
+    void passOverFile(
+      job,
+      file,
+      (r) => {
+        if (!stopped) onReport(r);
+      },
+      () => clock.now(),
+      () => stopped,
+    );
+    return {
+      feed: (piece) => file.push(piece),
+      fail: (why) => file.fail(new Error(why)),
+      stop: () => {
+        stopped = true;
+        file.fail(new Error('stopped'));
+      },
+    };
+  };
+}
+
+/** A file pass at work on some ports, and what it has reported so far. */
+export class HelperRun {
+  readonly checkpoints: Checkpoint[] = [];
+  overview: Overview | null = null;
+  done = false;
+  failed: string | null = null;
+  /** What the pass walked (once done): the capture's chunk count and data bytes, if intact. */
+  walked = { chunks: Number.NaN, dataBytes: Number.NaN };
+  /** Called after each report. */
+  onReport: () => void = () => {};
+  /** Settles when the pass is done, has failed or was stopped. */
+  readonly ended: Promise<void>;
+  #end: () => void = () => {};
+  readonly #handle: PassHandle;
+
+  /** The pass started on `job`, or null when `make` has none. */
+  static start(make: PassHelperMaker, job: FilePassJob): HelperRun | null {
+    let run: HelperRun | null = null;
+    const handle = make(job, (r) => {
+      if (run !== null) run.#report(r);
+    });
+    if (handle === null) return null;
+    run = new HelperRun(job, handle);
+    return run;
+  }
+
+  private constructor(
+    readonly job: FilePassJob,
+    handle: PassHandle,
+  ) {
+    this.#handle = handle;
+    this.ended = new Promise((resolve) => {
+      this.#end = resolve;
+    });
+  }
+
+  #report(r: FilePassReport): void {
+    if (this.done || this.failed !== null) return;
+    if (r.type === 'walked') {
+      this.#walkedTo = r.to;
+      this.#wakeReader();
+      return;
+    }
+    if (r.type === 'failed') {
+      this.failed = r.why;
+      this.#end();
+      this.#wakeReader();
+    } else {
+      this.checkpoints.push(...r.checkpoints);
+      this.overview = r.overview;
+      if (r.type === 'done') {
+        this.done = true;
+        this.walked = { chunks: r.chunks, dataBytes: r.dataBytes };
+        this.stop();
+      }
+    }
+    this.onReport();
+  }
+
+  /** How far into the file the pass has walked. */
+  #walkedTo = 0;
+  #reader: (() => void) | null = null;
+
+  #wakeReader(): void {
+    const go = this.#reader;
+    this.#reader = null;
+    go?.();
+  }
+
+  /** Settles once the pass has walked to `offset` of the file, or has ended (pieces beyond it would only pile up). */
+  async reached(offset: number): Promise<void> {
+    while (this.#walkedTo < offset && !this.done && this.failed === null && !this.#stopped) {
+      await new Promise<void>((resolve) => {
+        this.#reader = resolve;
+      });
+    }
+  }
+
+  /** The file's next piece (kept or transferred: the caller lets go of it). */
+  feed(piece: Uint8Array): void {
+    if (!this.done && this.failed === null) this.#handle.feed(piece);
+  }
+
+  /** The file could not be read to its end. */
+  fail(why: string): void {
+    this.#handle.fail(why);
+  }
+
+  #stopped = false;
+
+  stop(): void {
+    this.#stopped = true;
+    this.#handle.stop();
+    this.#end();
+    this.#wakeReader();
+  }
+}
