@@ -12,6 +12,7 @@ import { REMOTE_LABELS, type SourceStatus } from '../../../worker/protocol.js';
 import { onFrame } from '../../frame-loop.js';
 import type { Live } from '../../live.js';
 import { allLives, select, selected, send, sources } from '../../store.js';
+import { setText } from '../../text.js';
 import { drawEpisodes } from '../../timeline.js';
 import { AlignedColumns } from './columns.js';
 import { agoAxis, hoverCursor, keyboardCursor, legendTime, legendValue, showNewest, valueAxis, valueScale } from '../../axes.js';
@@ -201,7 +202,7 @@ export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
         };
         for (const c of row.querySelectorAll<HTMLElement>('[data-cell]')) {
           const v = values[c.dataset.cell ?? ''] ?? '';
-          if (c.textContent !== v) c.textContent = v;
+          setText(c, v);
           if (c.dataset.cell === 'state' && c.className !== `state-chip ${v}`) c.className = `state-chip ${v}`;
         }
       });
