@@ -9,6 +9,7 @@ import type { Signal } from '@preact/signals';
 import { useEffect, useRef } from 'preact/hooks';
 import uPlot from 'uplot';
 import 'uplot/dist/uPlot.min.css';
+import { layeredChart } from '../../axes-layer.js';
 import { onFrame } from '../../frame-loop.js';
 import type { Live, SeriesBuffer } from '../../live.js';
 import { current, status } from '../../store.js';
@@ -58,7 +59,7 @@ function specs(rssi: boolean): ChartSpec[] {
 }
 
 function makeChart(el: HTMLElement, spec: ChartSpec, width: number, sync: uPlot.SyncPubSub): uPlot {
-  const opts: uPlot.Options = {
+  const opts = (): uPlot.Options => ({
     width,
     height: HEIGHT,
     cursor: hoverCursor(sync.key),
@@ -78,8 +79,8 @@ function makeChart(el: HTMLElement, spec: ChartSpec, width: number, sync: uPlot.
         value: legendValue(spec.unit, spec.digits),
       },
     ],
-  };
-  return new uPlot(opts, [[], []], el);
+  });
+  return layeredChart(opts, [[], []], el);
 }
 
 export function Graphs({ windowUs }: { windowUs: Signal<number> }) {

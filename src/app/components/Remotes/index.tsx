@@ -7,8 +7,8 @@
  */
 import { type Signal, useComputed } from '@preact/signals';
 import { useEffect, useRef } from 'preact/hooks';
-import uPlot from 'uplot';
 import { REMOTE_LABELS, type SourceStatus } from '../../../worker/protocol.js';
+import { layeredChart } from '../../axes-layer.js';
 import { onFrame } from '../../frame-loop.js';
 import type { Live } from '../../live.js';
 import { allLives, select, selected, send, sources } from '../../store.js';
@@ -115,8 +115,8 @@ export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
     const box = chart.current;
     if (box === null || list.length < 2) return undefined;
     const order = list.map((s) => s.id);
-    const plot = new uPlot(
-      {
+    const plot = layeredChart(
+      () => ({
         width: Math.max(200, box.clientWidth),
         height: 120,
         legend: { show: true, live: true },
@@ -133,7 +133,7 @@ export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
             value: legendValue('/s', 1),
           })),
         ],
-      },
+      }),
       [[], ...order.map(() => [])],
       box,
     );
