@@ -10,7 +10,7 @@ import { useEffect, useRef } from 'preact/hooks';
 import uPlot from 'uplot';
 import 'uplot/dist/uPlot.min.css';
 import { layeredChart } from '../../axes-layer.js';
-import { onFrame } from '../../frame-loop.js';
+import { chartTurn, onFrame } from '../../frame-loop.js';
 import type { Live, SeriesBuffer } from '../../live.js';
 import { current, status } from '../../store.js';
 import {
@@ -120,6 +120,8 @@ export function Graphs({ windowUs }: { windowUs: Signal<number> }) {
       // New buckets come ten times a second; between them the axis slides with time, redrawn
       // five times a second. Other batches (every few ms) change nothing the graphs show.
       if (live === drawn && s.epoch === epoch && s.appended === appended && nowMs - drawnAt < 200) return;
+      // Not in the same frame as the remotes' chart (the three graphs redraw together).
+      if (!chartTurn()) return;
       drawn = live;
       epoch = s.epoch;
       appended = s.appended;

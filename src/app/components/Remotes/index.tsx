@@ -9,7 +9,7 @@ import { type Signal, useComputed } from '@preact/signals';
 import { useEffect, useRef } from 'preact/hooks';
 import { REMOTE_LABELS, type SourceStatus } from '../../../worker/protocol.js';
 import { layeredChart } from '../../axes-layer.js';
-import { onFrame } from '../../frame-loop.js';
+import { chartTurn, onFrame } from '../../frame-loop.js';
 import type { Live } from '../../live.js';
 import { allLives, select, selected, send, sources } from '../../store.js';
 import { setText } from '../../text.js';
@@ -143,7 +143,8 @@ export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
     const aligned = new AlignedColumns(order.length);
     let drawnAt = 0;
     const stop = onFrame((nowMs) => {
-      if (nowMs - drawnAt < 200) return;
+      // Not in the same frame as the graphs' redraw.
+      if (nowMs - drawnAt < 200 || !chartTurn()) return;
       drawnAt = nowMs;
       const lives = allLives();
       const first = order[0] === undefined ? undefined : lives.get(order[0]);
