@@ -84,25 +84,23 @@ export function layeredChart(options: () => uPlot.Options, data: uPlot.AlignedDa
           (u) => {
             const x = u.scales.x;
             const y = u.scales.y;
-            // No range yet (no data): nothing to label.
-            if (
-              x === undefined ||
-              y === undefined ||
-              ![x.min, x.max, y.min, y.max].every((v) => typeof v === 'number' && Number.isFinite(v))
-            )
-              return;
-            redrawn.update(axesKey(u, x, y), () => {
-              span = (x.max ?? 1) - (x.min ?? 0);
-              yMin = y.min ?? 0;
-              yMax = y.max ?? 1;
-              // batch() draws at once, not in a microtask: the copy below takes the new axes.
-              layer.batch(() => {
-                if (layer.width !== u.width || layer.height !== u.height) layer.setSize({ width: u.width, height: u.height });
-                layer.setScale('x', { min: 0, max: span });
-                layer.setScale('y', { min: yMin, max: yMax });
+            // No range (no data yet, a new source): the axes stay as they were last drawn.
+            const ranged =
+              x !== undefined && y !== undefined && [x.min, x.max, y.min, y.max].every((v) => typeof v === 'number' && Number.isFinite(v));
+            if (ranged) {
+              redrawn.update(axesKey(u, x, y), () => {
+                span = (x.max ?? 1) - (x.min ?? 0);
+                yMin = y.min ?? 0;
+                yMax = y.max ?? 1;
+                // batch() draws at once, not in a microtask: the copy below takes the new axes.
+                layer.batch(() => {
+                  if (layer.width !== u.width || layer.height !== u.height) layer.setSize({ width: u.width, height: u.height });
+                  layer.setScale('x', { min: 0, max: span });
+                  layer.setScale('y', { min: yMin, max: yMax });
+                });
               });
-            });
-            u.ctx.drawImage(layer.ctx.canvas, 0, 0);
+            }
+            if (redrawn.draws > 0) u.ctx.drawImage(layer.ctx.canvas, 0, 0);
           },
         ],
         destroy: [...(own.hooks?.destroy ?? []), () => layer.destroy()],
