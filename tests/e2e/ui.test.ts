@@ -384,6 +384,35 @@ describe.skipIf(skip !== null)('the page on any screen', () => {
     await page.context().close();
   });
 
+  it("draws the graphs' axis labels when the axes change, not on every redraw as the data slides", async () => {
+    const { page } = await open({ width: 1280, height: 800 });
+    await demoRunning(page);
+    await page.waitForTimeout(1000);
+    // Every canvas's redraws (uPlot clears the canvas for each) and text drawn, over three seconds.
+    const counts = await page.evaluate(async () => {
+      const c = { clears: 0, texts: 0 };
+      const proto = CanvasRenderingContext2D.prototype;
+      const { clearRect, fillText } = proto;
+      proto.clearRect = function (...args: Parameters<typeof clearRect>) {
+        c.clears++;
+        clearRect.apply(this, args);
+      };
+      proto.fillText = function (...args: Parameters<typeof fillText>) {
+        c.texts++;
+        fillText.apply(this, args);
+      };
+      await new Promise((resolve) => setTimeout(resolve, 3000));
+      proto.clearRect = clearRect;
+      proto.fillText = fillText;
+      return c;
+    });
+    // Three graphs ten times a second and the remotes' chart five: about 100 redraws. Each drew
+    // its 10–15 labels again when the axes were part of it; now only a change of range does.
+    expect(counts.clears).toBeGreaterThan(50);
+    expect(counts.texts).toBeLessThan(counts.clears);
+    await page.context().close();
+  });
+
   it('counts empty slots and VTX frames in the inspector, as the decoder does', async () => {
     const bytes = new Uint8Array(readFileSync(vtxCapture));
     const expected = summarizeCapture(readCapture(bytes, 'vtx.sscap')).decoder;

@@ -10,12 +10,20 @@ import { useEffect, useRef } from 'preact/hooks';
 import { channelName, channelResolution, PULSE_MAX_US, PULSE_MIN_US, servoToMicros, servoToPercent } from '../../../decoder/index.js';
 import { onFrame } from '../../frame-loop.js';
 import { current } from '../../store.js';
+import { setText } from '../../text.js';
 import './style.css';
 
 /** A channel is stale when it has not come for this long (a few frame pairs). */
 const STALE_US = 100_000;
 const SPAN_US = PULSE_MAX_US - PULSE_MIN_US;
 const left = (us: number) => `${(((us - PULSE_MIN_US) / SPAN_US) * 100).toFixed(3)}%`;
+/**
+ * The fill from `a` to `b` µs, as a clip of a fill that spans the whole track: a new clip is
+ * only painted, where a new left and width would lay the bar out again at 91 Hz.
+ */
+const span = (a: number, b: number) =>
+  `inset(0 ${(((PULSE_MAX_US - b) / SPAN_US) * 100).toFixed(3)}% 0 ${(((a - PULSE_MIN_US) / SPAN_US) * 100).toFixed(3)}% round 2px)`;
+const EMPTY = 'inset(0 100% 0 0)';
 
 interface Row {
   root: HTMLElement;
@@ -63,12 +71,12 @@ export function ChannelBars({ ids, label }: { ids: number[]; label: string }) {
         row.shown = key;
         row.root.classList.toggle('stale', stale);
         row.root.classList.toggle('never', never);
-        row.age.textContent = ageText;
+        setText(row.age, ageText);
         if (never) {
-          row.us.textContent = '—';
-          row.raw.textContent = '';
-          row.pct.textContent = '';
-          row.fill.style.left = row.fill.style.width = '0';
+          setText(row.us, '—');
+          setText(row.raw, '');
+          setText(row.pct, '');
+          row.fill.style.clipPath = EMPTY;
           // A meter must have a value: a channel that never came is a labelled image until it does.
           row.root.setAttribute('role', 'img');
           row.root.setAttribute('aria-label', `${channelName(id)}: no data`);
@@ -78,13 +86,10 @@ export function ChannelBars({ ids, label }: { ids: number[]; label: string }) {
         }
         const us = servoToMicros(pos, resolution);
         const pct = servoToPercent(pos, resolution);
-        row.us.textContent = `${us} µs`;
-        row.raw.textContent = String(pos);
-        row.pct.textContent = `${pct >= 0 ? '+' : '−'}${Math.abs(pct).toFixed(1)} %`;
-        const a = Math.min(us, 1500);
-        const b = Math.max(us, 1500);
-        row.fill.style.left = left(a);
-        row.fill.style.width = `${(((b - a) / SPAN_US) * 100).toFixed(3)}%`;
+        setText(row.us, `${us} µs`);
+        setText(row.raw, String(pos));
+        setText(row.pct, `${pct >= 0 ? '+' : '−'}${Math.abs(pct).toFixed(1)} %`);
+        row.fill.style.clipPath = span(Math.min(us, 1500), Math.max(us, 1500));
         if (!row.metered) {
           // What does not change while the channel comes: set once, not on every frame.
           row.root.setAttribute('role', 'meter');

@@ -8,6 +8,7 @@ import { useEffect, useRef } from 'preact/hooks';
 import { onFrame } from '../../frame-loop.js';
 import type { Live } from '../../live.js';
 import { current } from '../../store.js';
+import { setText } from '../../text.js';
 import './style.css';
 
 type Key = 'frames' | 'bytes' | 'resyncs' | 'discarded' | 'bad' | 'empty' | 'vtx' | 'fades' | 'missed' | 'period' | 'rssi';
@@ -77,7 +78,7 @@ export function Counters() {
         const v = values[key];
         const hidden = v === null;
         if (dd.hidden !== hidden) dd.hidden = dt.hidden = hidden;
-        if (v !== null && dd.textContent !== v) dd.textContent = v;
+        if (v !== null) setText(dd, v);
         const warn = warns && v !== null && /^[1-9]/.test(v);
         if (dd.classList.contains('warn') !== warn) dd.classList.toggle('warn', warn);
       }

@@ -9,7 +9,8 @@ import type { Signal } from '@preact/signals';
 import { useEffect, useRef } from 'preact/hooks';
 import uPlot from 'uplot';
 import 'uplot/dist/uPlot.min.css';
-import { onFrame } from '../../frame-loop.js';
+import { layeredChart } from '../../axes-layer.js';
+import { chartTurn, onFrame } from '../../frame-loop.js';
 import type { Live, SeriesBuffer } from '../../live.js';
 import { current, status } from '../../store.js';
 import {
@@ -58,7 +59,7 @@ function specs(rssi: boolean): ChartSpec[] {
 }
 
 function makeChart(el: HTMLElement, spec: ChartSpec, width: number, sync: uPlot.SyncPubSub): uPlot {
-  const opts: uPlot.Options = {
+  const opts = (): uPlot.Options => ({
     width,
     height: HEIGHT,
     cursor: hoverCursor(sync.key),
@@ -78,8 +79,8 @@ function makeChart(el: HTMLElement, spec: ChartSpec, width: number, sync: uPlot.
         value: legendValue(spec.unit, spec.digits),
       },
     ],
-  };
-  return new uPlot(opts, [[], []], el);
+  });
+  return layeredChart(opts, [[], []], el);
 }
 
 export function Graphs({ windowUs }: { windowUs: Signal<number> }) {
@@ -119,6 +120,8 @@ export function Graphs({ windowUs }: { windowUs: Signal<number> }) {
       // New buckets come ten times a second; between them the axis slides with time, redrawn
       // five times a second. Other batches (every few ms) change nothing the graphs show.
       if (live === drawn && s.epoch === epoch && s.appended === appended && nowMs - drawnAt < 200) return;
+      // Not in the same frame as the remotes' chart (the three graphs redraw together).
+      if (!chartTurn()) return;
       drawn = live;
       epoch = s.epoch;
       appended = s.appended;

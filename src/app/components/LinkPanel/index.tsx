@@ -8,6 +8,7 @@ import { useEffect, useRef } from 'preact/hooks';
 import { onFrame } from '../../frame-loop.js';
 import type { Live } from '../../live.js';
 import { current, linkEnded, linkMismatch, linkState, resolutionOverride } from '../../store.js';
+import { setText } from '../../text.js';
 import { drawEpisodes } from '../../timeline.js';
 import { TopFinding } from '../Diagnosis/index.js';
 import './style.css';
@@ -55,13 +56,13 @@ export function LinkPanel({ windowUs }: { windowUs: Signal<number> }) {
       const now = live.nowUs();
       const text = l === null ? 'none yet' : `${ago(now - l.lastFrameUs)} ago`;
       if (text !== shown && since.current !== null) {
-        since.current.textContent = text;
+        setText(since.current, text);
         shown = text;
       }
       // The counts change with the batch that changed them, as the counters beside them do.
       const episodes = l === null ? 'none' : `${l.holds} holds · ${l.failsafes} failsafes`;
       if (episodes !== shownEpisodes && counts.current !== null) {
-        counts.current.textContent = episodes;
+        setText(counts.current, episodes);
         shownEpisodes = episodes;
       }
       // The timeline moves with time: redrawn four times a second (and at once for another

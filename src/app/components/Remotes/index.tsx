@@ -7,11 +7,12 @@
  */
 import { type Signal, useComputed } from '@preact/signals';
 import { useEffect, useRef } from 'preact/hooks';
-import uPlot from 'uplot';
 import { REMOTE_LABELS, type SourceStatus } from '../../../worker/protocol.js';
-import { onFrame } from '../../frame-loop.js';
+import { layeredChart } from '../../axes-layer.js';
+import { chartTurn, onFrame } from '../../frame-loop.js';
 import type { Live } from '../../live.js';
 import { allLives, select, selected, send, sources } from '../../store.js';
+import { setText } from '../../text.js';
 import { drawEpisodes } from '../../timeline.js';
 import { AlignedColumns } from './columns.js';
 import { agoAxis, hoverCursor, keyboardCursor, legendTime, legendValue, showNewest, valueAxis, valueScale } from '../../axes.js';
@@ -114,8 +115,8 @@ export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
     const box = chart.current;
     if (box === null || list.length < 2) return undefined;
     const order = list.map((s) => s.id);
-    const plot = new uPlot(
-      {
+    const plot = layeredChart(
+      () => ({
         width: Math.max(200, box.clientWidth),
         height: 120,
         legend: { show: true, live: true },
@@ -132,7 +133,7 @@ export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
             value: legendValue('/s', 1),
           })),
         ],
-      },
+      }),
       [[], ...order.map(() => [])],
       box,
     );
@@ -142,7 +143,8 @@ export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
     const aligned = new AlignedColumns(order.length);
     let drawnAt = 0;
     const stop = onFrame((nowMs) => {
-      if (nowMs - drawnAt < 200) return;
+      // Not in the same frame as the graphs' redraw.
+      if (nowMs - drawnAt < 200 || !chartTurn()) return;
       drawnAt = nowMs;
       const lives = allLives();
       const first = order[0] === undefined ? undefined : lives.get(order[0]);
@@ -201,7 +203,7 @@ export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
         };
         for (const c of row.querySelectorAll<HTMLElement>('[data-cell]')) {
           const v = values[c.dataset.cell ?? ''] ?? '';
-          if (c.textContent !== v) c.textContent = v;
+          setText(c, v);
           if (c.dataset.cell === 'state' && c.className !== `state-chip ${v}`) c.className = `state-chip ${v}`;
         }
       });
