@@ -32,6 +32,8 @@ export class ArrivingFile implements SlicedFile {
   /** The file could not be read: every read waiting or to come fails with `error`. */
   fail(error: unknown): void {
     this.#failed = error ?? new Error('the file could not be read');
+    // Nothing more is read: what is held is let go (a piece may be a view of a whole file).
+    this.#pieces = [];
     this.#wake();
   }
 
@@ -47,8 +49,9 @@ export class ArrivingFile implements SlicedFile {
 
   /** Bytes [start, end) once they have arrived, copied. Reads go forward: pieces before `start` are let go. */
   async #read(start: number, end: number): Promise<ArrayBuffer> {
-    while (this.#arrived < end) {
+    for (;;) {
       if (this.#failed !== null) throw this.#failed;
+      if (this.#arrived >= end) break;
       await new Promise<void>((resolve) => this.#waiting.push(resolve));
     }
     while (this.#pieces.length > 0 && this.#firstAt + (this.#pieces[0]?.length ?? 0) <= start) {

@@ -99,10 +99,11 @@ export class ReplaySession implements Driver {
         sender.offer(early.overview());
       } else {
         try {
-          // Read once, piece by piece, each piece to both halves as it comes; this worker's half
-          // is decoded before the parse (which would hold it up for seconds): the overview first.
+          // Read once, piece by piece, each piece to both halves as it comes: the overview first.
           bytes = await readInPieces(file, halves.mine, halves.theirs, parts.previewSizes?.sliceBytes);
-          await halves.mine.ended;
+          // Both halves before the parse, which holds this worker up for seconds: the helper's
+          // last report would wait for it, and the overview with it.
+          await Promise.all([halves.mine.ended, halves.theirs.ended]);
         } catch (error) {
           return cannotOpen(`The file could not be read (${String(error)}).`);
         }

@@ -231,6 +231,8 @@ export function startSplit(
 const PIECE_BYTES = 16 << 20;
 /** Pieces the helper may be sent ahead of where it has got. */
 const AHEAD_PIECES = 3;
+/** Reads of the File under way at once. */
+const READS_AHEAD = 3;
 
 /**
  * `file` read once, a piece at a time (the next read under way while this piece is decoded),
@@ -241,14 +243,22 @@ const AHEAD_PIECES = 3;
 export async function readInPieces(file: Blob, mine: HelperRun, theirs: HelperRun, pieceBytes = PIECE_BYTES): Promise<Uint8Array> {
   const size = file.size;
   const whole = new Uint8Array(size);
-  const read = (at: number): Promise<ArrayBuffer> => file.slice(at, Math.min(size, at + pieceBytes)).arrayBuffer();
+  // Several reads under way: the browser reads on while this worker decodes its half.
+  const reads: Promise<ArrayBuffer>[] = [];
+  let asked = 0;
+  const askMore = (): void => {
+    while (reads.length < READS_AHEAD && asked < size) {
+      reads.push(file.slice(asked, Math.min(size, asked + pieceBytes)).arrayBuffer());
+      asked = Math.min(size, asked + pieceBytes);
+    }
+  };
   try {
-    let next = size > 0 ? read(0) : null;
-    for (let at = 0; next !== null; ) {
-      const piece = new Uint8Array(await next);
+    askMore();
+    for (let at = 0; at < size; ) {
+      const piece = new Uint8Array(await (reads.shift() as Promise<ArrayBuffer>));
+      askMore();
       if (piece.length === 0) throw new Error(`the file ended after ${at} of ${size} bytes`);
       const end = Math.min(size, at + piece.length);
-      next = end < size ? read(end) : null;
       whole.set(piece.subarray(0, end - at), at);
       mine.feed(whole.subarray(at, end));
       // Never more than a few pieces ahead of the helper: they would pile up in its memory.
@@ -257,6 +267,7 @@ export async function readInPieces(file: Blob, mine: HelperRun, theirs: HelperRu
       at = end;
     }
   } catch (error) {
+    for (const r of reads) r.catch(() => undefined);
     mine.fail(String(error));
     theirs.fail(String(error));
     throw error;
