@@ -16,6 +16,17 @@ import type { Overview } from './protocol.js';
 export const CHECKPOINT_US = 60e6;
 
 /**
+ * The rule for where checkpoints fall: a chunk arriving at `atUs` at or past `nextUs` gets one
+ * before it, and the next is due a whole interval on, however long the silence before it.
+ * Returns the next due time (`nextUs` itself when this chunk gets none).
+ */
+export function checkpointDue(nextUs: number, atUs: number): number {
+  let next = nextUs;
+  while (next <= atUs) next += CHECKPOINT_US;
+  return next;
+}
+
+/**
  * How far behind the slowest port's last frame the overview is drawn while the pass runs: frames
  * found missing are confirmed over ledger windows (0.5 s) and placed where they were due.
  */
@@ -190,8 +201,7 @@ export class ReplayPass implements OverviewPass {
     const ports = new Map<number, { decoder: DecoderCheckpoint; link: LinkCheckpoint }>();
     for (const p of this.#ports) ports.set(p.port, { decoder: p.decoder.checkpoint(), link: p.link.checkpoint() });
     this.checkpoints.push({ chunk, fedUntilUs: this.#fedUntilUs, ports });
-    // The next one a whole interval on, however long the silence before this chunk.
-    while (this.#nextCheckpointUs <= atUs) this.#nextCheckpointUs += CHECKPOINT_US;
+    this.#nextCheckpointUs = checkpointDue(this.#nextCheckpointUs, atUs);
   }
 
   /**

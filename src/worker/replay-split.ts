@@ -15,11 +15,11 @@ import type { Clock } from './host.js';
 import { addOverviews } from './overview.js';
 import type { Overview } from './protocol.js';
 import { HelperRun, type PassHelperMaker, inThisWorker } from './replay-helper.js';
-import { CHECKPOINT_US, type Checkpoint, type OverviewPass, ReplayPass } from './replay-pass.js';
+import { CHECKPOINT_US, type Checkpoint, type OverviewPass, ReplayPass, checkpointDue } from './replay-pass.js';
 
 /**
- * Where the replay pass's checkpoints fall in `capture` (ReplayPass's rule: before the first
- * chunk at or past each CHECKPOINT_US from `originUs`), and the latest arrival fed before each.
+ * Where the replay pass's checkpoints fall in `capture` (its rule, `checkpointDue`, from
+ * `originUs`), and the latest arrival fed before each.
  */
 export function checkpointChunks(capture: Capture, originUs: number): { chunk: number; fedUntilUs: number }[] {
   const out: { chunk: number; fedUntilUs: number }[] = [];
@@ -28,9 +28,10 @@ export function checkpointChunks(capture: Capture, originUs: number): { chunk: n
   let fed = Number.NEGATIVE_INFINITY;
   for (let i = 0; i < times.length; i++) {
     const t = times[i] ?? Number.NaN;
-    if (t >= next) {
+    const due = checkpointDue(next, t);
+    if (due !== next) {
       out.push({ chunk: i, fedUntilUs: fed });
-      while (next <= t) next += CHECKPOINT_US;
+      next = due;
     }
     if (t > fed) fed = t;
   }
@@ -235,7 +236,7 @@ const AHEAD_PIECES = 3;
 const READS_AHEAD = 3;
 
 /**
- * `file` read once, a piece at a time (the next read under way while this piece is decoded),
+ * `file` read once, a piece at a time (READS_AHEAD reads under way while this worker decodes),
  * into one buffer; each piece is handed to both halves as it arrives: this worker's a view of
  * the buffer, the helper's the piece itself (transferred), never more than AHEAD_PIECES ahead
  * of where the helper has got. A read that fails fails both.
