@@ -418,6 +418,22 @@ function grown<T extends Uint8Array | Uint32Array | Float64Array>(to: T, from: T
   return to;
 }
 
+/**
+ * The size of the record whose header starts at `p` (its sync marker, a known type, a length
+ * that may be), or -1 when none starts there; whether it fits in `bytes` is the caller's to see.
+ * `bytes` must hold the header's first RECORD_HEADER_SIZE bytes.
+ */
+export function recordSize(bytes: Uint8Array, view: DataView, p: number): number {
+  const type = bytes[p + REC_OFF_TYPE];
+  const len = view.getUint32(p + REC_OFF_LENGTH, true);
+  return bytes[p] === SYNC0 &&
+    bytes[p + 1] === SYNC1 &&
+    (type === RECORD_TYPE_DATA || type === RECORD_TYPE_EVENT) &&
+    len <= MAX_RECORD_PAYLOAD
+    ? RECORD_OVERHEAD + len
+    : -1;
+}
+
 /** Where a run of records starts: its file offset, and the chunk index and data offset it fills from. */
 export interface RecordsStart {
   readonly from: number;
@@ -442,17 +458,16 @@ export function plannedSizes(
   let records = 0;
   let data = 0;
   let p = headerLength;
-  while (p + RECORD_OVERHEAD <= n && bytes[p] === SYNC0 && bytes[p + 1] === SYNC1) {
+  while (p + RECORD_OVERHEAD <= n) {
     if (starts.length < cuts.length && p - headerLength >= (n - headerLength) * (cuts[starts.length] ?? 1))
       starts.push({ from: p, chunk: records, dataAt: data });
-    const type = bytes[p + REC_OFF_TYPE];
-    const len = view.getUint32(p + REC_OFF_LENGTH, true);
-    if ((type !== RECORD_TYPE_DATA && type !== RECORD_TYPE_EVENT) || len > MAX_RECORD_PAYLOAD || p + RECORD_OVERHEAD + len > n) return null;
-    if (type === RECORD_TYPE_DATA) {
+    const size = recordSize(bytes, view, p);
+    if (size < 0 || p + size > n) return null;
+    if (bytes[p + REC_OFF_TYPE] === RECORD_TYPE_DATA) {
       records++;
-      data += len;
+      data += size - RECORD_OVERHEAD;
     }
-    p += RECORD_OVERHEAD + len;
+    p += size;
   }
   return p === n ? { records, data, starts } : null;
 }

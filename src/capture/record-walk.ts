@@ -15,17 +15,14 @@ import {
   RECORD_HEADER_SIZE,
   RECORD_OVERHEAD,
   RECORD_TYPE_DATA,
-  RECORD_TYPE_EVENT,
   REC_OFF_LENGTH,
   REC_OFF_PORT,
   REC_OFF_TIME,
   REC_OFF_TYPE,
-  SYNC0,
-  SYNC1,
 } from './layout.js';
 import { crc32 } from './crc32.js';
 import { CaptureFormatError } from './model.js';
-import { RecordProbe, readHeader } from './reader.js';
+import { RecordProbe, readHeader, recordSize } from './reader.js';
 
 /** Read at a time: the header (its metadata is at most 1 MiB) and a few hundred thousand records. */
 const SLICE_BYTES = 16 << 20;
@@ -94,25 +91,17 @@ export async function walkDataRecords(file: SlicedFile, sink: RecordSink, option
   for (;;) {
     const n = bytes.length;
     while (p + RECORD_HEADER_SIZE <= n) {
-      const type = bytes[p + REC_OFF_TYPE];
-      const len = view.getUint32(p + REC_OFF_LENGTH, true);
-      if (
-        bytes[p] !== SYNC0 ||
-        bytes[p + 1] !== SYNC1 ||
-        (type !== RECORD_TYPE_DATA && type !== RECORD_TYPE_EVENT) ||
-        len > MAX_RECORD_PAYLOAD
-      )
-        throw new CaptureFormatError(`no intact record header at offset ${at + p}`);
-      const total = RECORD_OVERHEAD + len;
+      const total = recordSize(bytes, view, p);
+      if (total < 0) throw new CaptureFormatError(`no intact record header at offset ${at + p}`);
       if (p + total > n) break;
-      if (type === RECORD_TYPE_DATA) {
+      if (bytes[p + REC_OFF_TYPE] === RECORD_TYPE_DATA) {
         const port = bytes[p + REC_OFF_PORT] ?? 0;
-        const end = p + RECORD_HEADER_SIZE + len;
+        const end = p + total - CRC_SIZE;
         if (checked(port) && crc32(bytes, p + REC_OFF_TYPE, end) !== view.getUint32(end, true))
           throw new CaptureFormatError(`damaged record at offset ${at + p} (its CRC-32 check failed)`);
         sink(bytes, p + RECORD_HEADER_SIZE, end, view.getFloat64(p + REC_OFF_TIME, true), port);
         chunks++;
-        dataBytes += len;
+        dataBytes += total - RECORD_OVERHEAD;
       }
       p += total;
     }

@@ -16,11 +16,6 @@ export class ArrivingFile implements SlicedFile {
 
   constructor(readonly size: number) {}
 
-  /** How many bytes have arrived. */
-  get arrived(): number {
-    return this.#arrived;
-  }
-
   /** The next bytes of the file (kept, not copied). */
   push(piece: Uint8Array): void {
     if (piece.length === 0) return;

@@ -108,7 +108,7 @@ function inTimeOrder(failsafe: Overview['failsafe']): Overview['failsafe'] {
 /**
  * Overviews of different ports of one capture on the same bins (a pass split between workers,
  * replay-split.ts) added up: read as far as all of them are, complete when all are, failsafes in
- * the parts' order. No parts: nothing read yet, from `originUs`.
+ * time order. No parts: nothing read yet, from `originUs`.
  */
 export function addOverviews(parts: readonly Overview[], originUs: number): Overview {
   const complete = parts.length > 0 && parts.every((p) => p.complete);

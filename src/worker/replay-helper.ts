@@ -73,6 +73,10 @@ export class HelperRun {
   readonly ended: Promise<void>;
   #end: () => void = () => {};
   readonly #handle: PassHandle;
+  #stopped = false;
+  /** How far into the file the pass has walked, and the reading waiting for it to walk further. */
+  #walkedTo = 0;
+  #reader: (() => void) | null = null;
 
   /** The pass started on `job`, or null when `make` has none. */
   static start(make: PassHelperMaker, job: FilePassJob): HelperRun | null {
@@ -118,10 +122,6 @@ export class HelperRun {
     this.onReport();
   }
 
-  /** How far into the file the pass has walked. */
-  #walkedTo = 0;
-  #reader: (() => void) | null = null;
-
   #wakeReader(): void {
     const go = this.#reader;
     this.#reader = null;
@@ -146,8 +146,6 @@ export class HelperRun {
   fail(why: string): void {
     this.#handle.fail(why);
   }
-
-  #stopped = false;
 
   stop(): void {
     this.#stopped = true;

@@ -114,11 +114,6 @@ export class ReplayPass implements OverviewPass {
   /** Everything is decoded here. */
   readonly waiting = false;
 
-  /** Chunks fed so far. */
-  get chunks(): number {
-    return this.#chunk;
-  }
-
   /** Nothing runs elsewhere: nothing to stop. */
   stop(): void {}
 
