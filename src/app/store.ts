@@ -27,6 +27,8 @@ export const overview = signal<Overview | null>(null);
 /** The replayed capture's name (null: no replay), and its length, µs: they change per capture, not with every status. */
 export const replayName = computed(() => replay.value?.name ?? null);
 export const replaySpanUs = computed(() => (replay.value === null ? 0 : replay.value.endUs - replay.value.startUs));
+/** A capture's file is still being read: nothing plays, and there is no link state or finding yet (not a receiver waiting). */
+export const replayReading = computed(() => replay.value?.reading === true);
 export const notices = signal<Notice[]>([]);
 export const resolutionOverride = signal<'auto' | 1024 | 2048>('auto');
 /** The frame inspector's last snapshot of the selected remote (null: none asked for yet). */

@@ -151,6 +151,11 @@ export interface ReplayStatus {
   recordedTiming: boolean;
   /** The replay reached the end: the clock stops there and every state is frozen as it was. */
   ended: boolean;
+  /**
+   * The file is still being read (a long capture, its span known from its start and end): nothing
+   * is played, no link state or finding exists yet, and commands wait until it is read.
+   */
+  reading: boolean;
 }
 
 /**

@@ -348,6 +348,7 @@ export class ReplaySession implements Driver {
         issues: c.issues.map((i) => i.message),
         recordedTiming: r.recordedTiming,
         ended: r.ended,
+        reading: false,
       },
     });
   }
@@ -405,5 +406,6 @@ function readingStatus(name: string, startUs: number, endUs: number): ReplayStat
     issues: [],
     recordedTiming: true,
     ended: false,
+    reading: true,
   };
 }

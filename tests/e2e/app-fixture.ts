@@ -2,11 +2,13 @@
  * What every browser test of the page needs: the built page (dist-app/, made by `npm run build`)
  * served on 127.0.0.1, Debian's Chromium, and a place for screenshots.
  */
-import { existsSync, mkdirSync, writeFileSync } from 'node:fs';
+import { closeSync, existsSync, mkdirSync, openSync, writeFileSync, writeSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 import type { Browser, Page } from 'playwright-core';
 import { CaptureWriter } from '../../src/capture/index.js';
+import { Simulator, preset } from '../../src/simulator/index.js';
 import { concatBytes } from '../bytes.js';
+import { usbChunks } from '../feeds.js';
 import { chromiumAvailable, launchChromium, startStaticServer, type LaunchChromiumOptions, type StaticServer } from './harness/browser.js';
 import { installSerialPolicy } from './harness/policy.js';
 import { openFakeSerialPort, type FakeSerialPort } from './harness/pty-serial.js';
@@ -94,4 +96,31 @@ export function writeCapture(path: string, chunks: { bytes: Uint8Array; timeUs: 
   writeFileSync(path, concatBytes([writer.header(), ...chunks.map((c) => writer.data(c.bytes, c.timeUs))]));
 }
 
-export { usbChunks } from '../feeds.js';
+/**
+ * Writes a capture of two remotes at 11 ms lasting `durationUs` to `path`, a minute of records
+ * at a time (long enough for the page's long-capture path: over 32 MB is about two hours).
+ */
+export function writeLongCapture(path: string, durationUs: number): void {
+  const writer = new CaptureWriter({ baudRate: 115200, source: 'test', ports: [{ name: 'internal' }, { name: 'external' }] });
+  const sims = [
+    new Simulator({ ...preset('dsmx-11ms-2048-internal'), seed: 21 }),
+    new Simulator({ ...preset('dsmx-11ms-2048-external'), seed: 22 }),
+  ];
+  const fd = openSync(path, 'w');
+  try {
+    writeSync(fd, writer.header());
+    const start = sims[0]?.scenario.timing.startUs ?? 0;
+    for (let t = start; t < start + durationUs; t += 60e6) {
+      const records = sims.flatMap((sim, port) => {
+        const { bytes, timesUs } = sim.generate(Math.min(t + 60e6, start + durationUs));
+        return usbChunks(bytes, timesUs).map((c) => ({ ...c, port }));
+      });
+      records.sort((a, b) => a.timeUs - b.timeUs || a.port - b.port);
+      writeSync(fd, concatBytes(records.map((r) => writer.data(r.bytes, r.timeUs, r.port))));
+    }
+  } finally {
+    closeSync(fd);
+  }
+}
+
+export { usbChunks };

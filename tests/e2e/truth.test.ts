@@ -16,7 +16,16 @@ import { LinkMonitor, SpektrumDecoder, USB_CHUNK_JITTER_US } from '../../src/dec
 import { summarizeCapture } from '../../src/analysis/index.js';
 import { preset, simulate } from '../../src/simulator/index.js';
 import { resolutionSource } from '../../src/app/components/SystemBadge/words.js';
-import { SHARED_CAPTURES, browserUnavailable, shot, startApp, usbChunks, writeCapture, type AppSession } from './app-fixture.js';
+import {
+  SHARED_CAPTURES,
+  browserUnavailable,
+  shot,
+  startApp,
+  usbChunks,
+  writeCapture,
+  writeLongCapture,
+  type AppSession,
+} from './app-fixture.js';
 
 const skip = browserUnavailable();
 if (skip !== null) console.warn(`skipping the honest-state page tests: ${skip}`);
@@ -241,6 +250,44 @@ describe.skipIf(skip !== null)('seeking in a long capture', () => {
     expect(errors).toEqual([]);
     await page.context().close();
   });
+});
+
+describe.skipIf(skip !== null)('a capture being read', () => {
+  it("says the capture is being read, never a receiver's wiring hint, until it plays", async () => {
+    // Two hours of two remotes: over 32 MB, so the page shows its span and overview while it reads.
+    const path = join(dir, 'two-hours.sscap');
+    writeLongCapture(path, 2 * 3600e6);
+    const { page, errors } = await open('?demo=0');
+    await page.getByTestId('empty-state').waitFor();
+    // Every state and hint the link panel shows, and whether Play could be pressed then.
+    await page.evaluate(() => {
+      const seen: string[] = [];
+      (window as unknown as { seen: string[] }).seen = seen;
+      const note = (): void => {
+        const state = document.querySelector('[data-testid="link-state"]')?.textContent ?? null;
+        if (state === null) return;
+        const hint = document.querySelector('[data-testid="link-hint"]')?.textContent ?? '';
+        const play = document.querySelector<HTMLButtonElement>('section.replay button.primary');
+        const line = `${state} | ${hint} | ${play === null ? 'no bar' : play.disabled ? 'disabled' : 'enabled'}`;
+        if (seen[seen.length - 1] !== line) seen.push(line);
+      };
+      new MutationObserver(note).observe(document.body, { subtree: true, childList: true, characterData: true, attributes: true });
+    });
+    await page.setInputFiles('input[type=file]', path);
+    await page
+      .getByTestId('link-state')
+      .filter({ hasText: /^Live$/ })
+      .waitFor({ timeout: 60_000 });
+    const seen = await page.evaluate(() => (window as unknown as { seen: string[] }).seen);
+    const reading = seen.findIndex((l) => l.startsWith('Reading | Reading the capture'));
+    expect(reading, seen.join('\n')).toBeGreaterThanOrEqual(0);
+    // From the file's span on: no wiring hint, and Play only once the capture plays.
+    const after = seen.slice(reading);
+    expect(after.filter((l) => l.includes('grey DATA wire'))).toEqual([]);
+    expect(after.filter((l) => l.startsWith('Reading') && !l.endsWith('disabled'))).toEqual([]);
+    expect(errors).toEqual([]);
+    await page.context().close();
+  }, 90_000);
 });
 
 /** What the library's decoder and link monitor say fed every chunk of port 0 that arrived by `untilUs`. */

@@ -9,7 +9,7 @@
 import { signal } from '@preact/signals';
 import { useState } from 'preact/hooks';
 import type { DoctorFinding, FlightStack } from '../../../analysis/index.js';
-import { diagnosis, send, sources } from '../../store.js';
+import { diagnosis, replayReading, send, sources } from '../../store.js';
 import './style.css';
 
 const STACKS: readonly FlightStack[] = ['Betaflight', 'iNav', 'ArduPilot', 'PX4'];
@@ -143,8 +143,9 @@ export function DiagnosisPanel() {
   const opened = (f: DoctorFinding, i: number): boolean => toggled[keyOf(f)] ?? (i === 0 && f.severity === 'problem');
   const which = stack.value;
   const paste = settingsFor(findings, which);
-  const empty =
-    d === null || (d.mode === 'live' && sources.value.length === 0)
+  const empty = replayReading.value
+    ? 'Reading the capture: findings appear once it plays.'
+    : d === null || (d.mode === 'live' && sources.value.length === 0)
       ? 'Connect a receiver: findings appear here as the evidence comes in.'
       : d.mode === 'replay'
         ? 'Nothing wrong found at this point of the capture.'

@@ -7,7 +7,7 @@ import { computed, type Signal } from '@preact/signals';
 import { useEffect, useRef } from 'preact/hooks';
 import { onFrame } from '../../frame-loop.js';
 import type { Live } from '../../live.js';
-import { current, linkEnded, linkMismatch, linkState, resolutionOverride } from '../../store.js';
+import { current, linkEnded, linkMismatch, linkState, replayReading, resolutionOverride, status } from '../../store.js';
 import { setText } from '../../text.js';
 import { drawEpisodes } from '../../timeline.js';
 import { TopFinding } from '../Diagnosis/index.js';
@@ -30,15 +30,21 @@ function ago(us: number): string {
 // The state, its hint and the panel's colour as signals bound to the DOM: a Live/Hold flip
 // changes two texts and a class, and re-renders nothing.
 const sectionClass = computed(() => `link ${linkState.value}`);
-const label = computed(() => LABEL[linkState.value]);
+// A capture being read has no link yet, and a replayed port no frame yet: that is said, not a
+// receiver's "waiting" with its wiring hint.
+const label = computed(() => (replayReading.value ? 'Reading' : LABEL[linkState.value]));
 // A replay at its end keeps its last state, frozen, and says it ended; a forced resolution
 // that matches no frame is not link loss.
 const hint = computed(() =>
-  linkEnded.value
-    ? 'Replay ended: the state at the end of the capture'
-    : linkMismatch.value !== null
-      ? `Forced ${resolutionOverride.value}: no frame matches; the stream looks like ${linkMismatch.value}`
-      : HINT[linkState.value],
+  replayReading.value
+    ? 'Reading the capture: its link state shows once the whole file is read and it plays.'
+    : linkEnded.value
+      ? 'Replay ended: the state at the end of the capture'
+      : linkMismatch.value !== null
+        ? `Forced ${resolutionOverride.value}: no frame matches; the stream looks like ${linkMismatch.value}`
+        : linkState.value === 'waiting' && status.value.kind === 'replay'
+          ? 'No frame yet at this point of the capture.'
+          : HINT[linkState.value],
 );
 
 export function LinkPanel({ windowUs }: { windowUs: Signal<number> }) {

@@ -7,7 +7,7 @@
 import { computed, useComputed, useSignal } from '@preact/signals';
 import { useEffect, useRef } from 'preact/hooks';
 import uPlot from 'uplot';
-import { overview, replay, replayName, replaySpanUs, send } from '../../store.js';
+import { overview, replay, replayName, replayReading, replaySpanUs, send } from '../../store.js';
 import { chartColors, theme } from '../../theme.js';
 import { readingPercent } from './reading.js';
 import './style.css';
@@ -40,8 +40,10 @@ const readUntil = computed(() => {
 const readingText = computed(() => {
   const r = replay.value;
   const until = readUntil.value;
-  if (r === null || until === null) return '';
-  return `Reading the capture: ${readingPercent(until, r.startUs, r.endUs)}`;
+  if (r === null) return '';
+  if (until !== null) return `Reading the capture: ${readingPercent(until, r.startUs, r.endUs)}`;
+  // The overview is whole; the file is still being read into what plays and seeks.
+  return r.reading ? 'Preparing playback…' : '';
 });
 const clockText = computed(() => {
   const r = replay.value;
@@ -135,6 +137,8 @@ export function ReplayBar() {
           <button
             type="button"
             class="primary"
+            // It plays by itself once the file is read.
+            disabled={replayReading.value}
             onClick={() => {
               // At the end, play starts over.
               const r = replay.peek();
