@@ -42,7 +42,14 @@ describe('walking the data records of an intact capture', () => {
     expect(want.length).toBe(600);
     for (const slice of [1, 17, 100, 4096, undefined]) {
       const { walked, got } = await walk(bytes, slice);
-      expect({ slice, walked }).toEqual({ slice, walked: { chunks: 600, dataBytes: capture.bytes.length } });
+      expect({ slice, walked }).toEqual({
+        slice,
+        walked: {
+          chunks: 600,
+          dataBytes: capture.bytes.length,
+          header: { meta: capture.meta, version: capture.version, headerLength: capture.headerLength },
+        },
+      });
       expect(got).toEqual(want);
     }
   });
@@ -66,6 +73,26 @@ describe('walking the data records of an intact capture', () => {
     const blob = () => new Blob([damaged]);
     await expect(walkDataRecords(blob(), () => {}, { checked: (port) => port === 1 })).rejects.toThrow(`damaged record at offset ${p}`);
     await expect(walkDataRecords(blob(), () => {}, { checked: (port) => port !== 1 })).resolves.toMatchObject({ chunks: 600 });
+  });
+
+  it('hands over the event records when asked, where they lie among the data records, each checked', async () => {
+    const seen: { text: string; timeUs: number; port: number; chunkIndex: number }[] = [];
+    let chunks = 0;
+    const events = async (file: Uint8Array) =>
+      walkDataRecords(new Blob([file.slice()]), () => chunks++, {
+        sliceBytes: 100,
+        event: (b, start, end, timeUs, port) =>
+          seen.push({ text: new TextDecoder().decode(b.subarray(start, end)), timeUs, port, chunkIndex: chunks }),
+      });
+    await events(bytes);
+    expect(seen).toEqual(capture.events);
+    expect(seen.length).toBe(12);
+    // The text of the fifth event changed: its CRC fails, whether or not data records are checked.
+    const damaged = bytes.slice();
+    const at = Buffer.from(damaged).indexOf('event 200');
+    damaged[at + 6] = '7'.charCodeAt(0);
+    await expect(events(damaged)).rejects.toThrow(/damaged record at offset/);
+    await expect(walk(damaged, 100)).resolves.toMatchObject({ walked: { chunks: 600 } });
   });
 
   it('refuses a file whose records do not lead to its end, or whose header is damaged', async () => {

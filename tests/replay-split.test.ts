@@ -6,7 +6,7 @@
  * fails, disagrees, or read a damaged file counts for nothing: the worker decodes its ports.
  */
 import { describe, expect, it } from 'vitest';
-import { capturePorts, parseCapture, readCapture, type SlicedFile } from '../src/capture/index.js';
+import { type Capture, capturePorts, parseCapture, readCapture, type SlicedFile } from '../src/capture/index.js';
 import { Dispatcher } from '../src/worker/dispatcher.js';
 import { overviewOf } from '../src/worker/overview.js';
 import type { Overview } from '../src/worker/protocol.js';
@@ -32,6 +32,9 @@ class Turns {
   }
 }
 
+/** Reads of a whole file (the file read again to be parsed), counted by slowFile. */
+let wholeReads = 0;
+
 /** `bytes` as a File whose every read waits for a turn. */
 function slowFile(bytes: Uint8Array): Blob {
   const blob = new Blob([bytes.slice()]);
@@ -39,6 +42,7 @@ function slowFile(bytes: Uint8Array): Blob {
     size: b.size,
     slice: (start, end) => slow(b.slice(start, end)),
     arrayBuffer: async () => {
+      if (b.size === bytes.length) wholeReads++;
       await turns.wait();
       return b.arrayBuffer();
     },
@@ -113,6 +117,7 @@ function helperHere(change: (r: FilePassReport) => FilePassReport = (r) => r, tu
 async function openSplit(file: Uint8Array, make: PassHelperMaker | null, previewSizes = PREVIEW) {
   const clock = new SlicingClock();
   const fake = fakeHost(clock);
+  wholeReads = 0;
   const worker = new Dispatcher(fake.host, { previewSizes, passHelper: make });
   worker.receive({ type: 'replay-open', name: 'long.sscap', file: slowFile(file) });
   // The helper's turns go on while the file is opened: its half is drawn from before that ends.
@@ -132,7 +137,20 @@ async function openSplit(file: Uint8Array, make: PassHelperMaker | null, preview
     for (const m of messages) worker.receive(m);
     await worker.queue.idle();
   };
-  return { worker, overviews, send };
+  return { worker, overviews, send, wholeReads };
+}
+
+/** The capture the replay plays is the one the reader reads from `file` (columns, events, issues). */
+function expectCaptureAsRead(split: Awaited<ReturnType<typeof openSplit>>, file: Uint8Array): void {
+  const plain = (c: Capture) => ({
+    ...c,
+    bytes: Buffer.from(c.bytes).toString('base64'),
+    chunkEnds: Array.from(c.chunkEnds),
+    chunkTimesUs: Array.from(c.chunkTimesUs),
+    chunkPorts: Array.from(c.chunkPorts),
+  });
+  const capture = split.worker.replay?.source.capture;
+  expect(capture === undefined ? undefined : plain(capture)).toEqual(plain(readCapture(file, 'long.sscap')));
 }
 
 function expectOverviewsAsOneDecode(overviews: Overview[], file: Uint8Array): void {
@@ -207,6 +225,9 @@ describe('a long capture decoded on two workers', () => {
     expectOverviewsAsOneDecode(paced.overviews, FILE);
     expect(split.overviews.length).toBeGreaterThan(3);
     expectOverviewsAsOneDecode(split.overviews, FILE);
+    // The capture played is the one the worker's half kept as it walked: the file is not read again.
+    expect([split.wholeReads, paced.wholeReads]).toEqual([0, 0]);
+    expectCaptureAsRead(split, FILE);
     await expectSeeksExact(split, FILE);
   });
 
@@ -215,6 +236,9 @@ describe('a long capture decoded on two workers', () => {
     const split = await openSplit(FILE, helper.make);
     expect(helper.runs.done).toBe(true);
     expectOverviewsAsOneDecode(split.overviews, FILE);
+    // Without the helper's word that its records are intact, the file is read again and parsed.
+    expect(split.wholeReads).toBe(1);
+    expectCaptureAsRead(split, FILE);
     await expectSeeksExact(split, FILE);
   });
 
@@ -246,6 +270,9 @@ describe('a long capture decoded on two workers', () => {
     expect(helper.jobs.length).toBe(1);
     expect(helper.runs.dropped).toBe(true);
     expectOverviewsAsOneDecode(split.overviews, damaged);
+    // Parsed, salvaged: the damaged record is dropped and said to be.
+    expect(split.wholeReads).toBe(1);
+    expectCaptureAsRead(split, damaged);
     // A port byte flipped (port 0 → 1) halfway: the helper's half would take that record for its own.
     const moved = FILE.slice();
     const movedView = new DataView(moved.buffer);
@@ -254,6 +281,8 @@ describe('a long capture decoded on two workers', () => {
     moved[at + 3] = 1;
     const flipped = await openSplit(moved, helperHere().make);
     expectOverviewsAsOneDecode(flipped.overviews, moved);
+    expect(flipped.wholeReads).toBe(1);
+    expectCaptureAsRead(flipped, moved);
     const none = helperHere();
     const alone = await openSplit(FILE, none.make, { ...PREVIEW, minBytes: FILE.length + 1 });
     expect(none.jobs.length).toBe(0);

@@ -42,7 +42,15 @@ export {
   type CapturePlan,
   type PartRead,
 } from './parts.js';
-export { type RecordSink, type SlicedFile, type WalkedRecords, type WalkOptions, walkDataRecords } from './record-walk.js';
+export {
+  type RecordSink,
+  type SlicedFile,
+  type WalkedHeader,
+  type WalkedRecords,
+  type WalkOptions,
+  walkDataRecords,
+} from './record-walk.js';
+export { CaptureBuilder } from './capture-builder.js';
 export { importRaw } from './raw.js';
 export { importSaleaeCsv } from './saleae.js';
 export { readCapture } from './sniff.js';

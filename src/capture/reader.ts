@@ -406,7 +406,7 @@ export function parseCaptureCounting(bytes: Uint8Array): { capture: ParsedCaptur
 }
 
 /** `array` when it is `length` long, a view of its first `length` elements when that wastes little, else a trimmed copy. */
-function trimTo<T extends Uint8Array | Uint32Array | Float64Array>(array: T, length: number): T {
+export function trimTo<T extends Uint8Array | Uint32Array | Float64Array>(array: T, length: number): T {
   if (array.length === length) return array;
   // A view avoids holding the file's data twice at the peak; a copy frees a mostly empty buffer.
   return (length >= array.length * 0.75 ? array.subarray(0, length) : array.slice(0, length)) as T;

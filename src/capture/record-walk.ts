@@ -3,8 +3,8 @@
  * over where they lie in the slice: no payload copied, no columns kept, and the CRC checked only
  * of the records the reader asks for. For a reader that learns elsewhere whether the whole file
  * is intact: the replay decodes a long capture's ports this way in two workers, each checking
- * the records it decodes, and the decode counts only if `parseCapture` then finds nothing
- * damaged (src/worker/replay-split.ts).
+ * the records it decodes, one of them keeping the capture (capture-builder.ts), which counts
+ * only if both walked to the end (src/worker/replay-split.ts).
  */
 import {
   CRC_SIZE,
@@ -21,7 +21,7 @@ import {
   REC_OFF_TYPE,
 } from './layout.js';
 import { crc32 } from './crc32.js';
-import { CaptureFormatError } from './model.js';
+import { CaptureFormatError, type CaptureMeta } from './model.js';
 import { RecordProbe, readHeader, recordSize } from './reader.js';
 
 /** Read at a time: the header (its metadata is at most 1 MiB) and a few hundred thousand records. */
@@ -36,10 +36,18 @@ export interface SlicedFile {
 /** One data record: its payload is `bytes[start, end)`, recorded at `timeUs` on `port`. */
 export type RecordSink = (bytes: Uint8Array, start: number, end: number, timeUs: number, port: number) => void;
 
-/** What a walk to the end found: the data records (the capture's chunks) and their payload bytes. */
+/** The file's header, as parseCapture reads it. */
+export interface WalkedHeader {
+  meta: CaptureMeta;
+  version: number;
+  headerLength: number;
+}
+
+/** What a walk to the end found: the data records (the capture's chunks) and their payload bytes, and the header. */
 export interface WalkedRecords {
   chunks: number;
   dataBytes: number;
+  header: WalkedHeader;
 }
 
 /** How a walk goes. */
@@ -48,19 +56,21 @@ export interface WalkOptions {
   goOn?: (walkedTo: number) => boolean | Promise<boolean>;
   /** Whether a data record on `port` has its CRC-32 checked. Default: none is. */
   checked?: (port: number) => boolean;
+  /** Gets the event records too, in the file's order among the data records, each checked (its CRC-32). Default: they are skipped. */
+  event?: RecordSink;
   /** Read at a time (tests). Default 16 MiB. */
   sliceBytes?: number;
 }
 
 /**
- * Hands every data record of `file` to `sink`, in the file's order. Events are skipped (they are
- * not chunks).
+ * Hands every data record of `file` to `sink`, in the file's order, and its event records to
+ * `options.event` if given (events are not chunks).
  * @throws {CaptureFormatError} when the header is damaged, the records do not lead from one to
  *   the next to the end of the file, or a record checked fails its CRC (the file is not intact:
  *   parseCapture salvages it)
  */
 export async function walkDataRecords(file: SlicedFile, sink: RecordSink, options: WalkOptions = {}): Promise<WalkedRecords | null> {
-  const { goOn = () => true, checked = () => false, sliceBytes = SLICE_BYTES } = options;
+  const { goOn = () => true, checked = () => false, event, sliceBytes = SLICE_BYTES } = options;
   const size = file.size;
   const read = async (from: number, length: number): Promise<Uint8Array> =>
     new Uint8Array(await file.slice(from, Math.min(size, from + length)).arrayBuffer());
@@ -70,7 +80,12 @@ export async function walkDataRecords(file: SlicedFile, sink: RecordSink, option
   let bytes = await read(0, Math.max(sliceBytes, HEADER_FIXED_SIZE + Math.min(metaLength, MAX_META_BYTES) + CRC_SIZE));
   let view = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
   const issues: Parameters<typeof readHeader>[3] = [];
-  const { headerLength } = readHeader(bytes, view, new RecordProbe(bytes, view, { crcBytes: 0, crcCombines: 0, probes: 0 }), issues);
+  const { meta, version, headerLength } = readHeader(
+    bytes,
+    view,
+    new RecordProbe(bytes, view, { crcBytes: 0, crcCombines: 0, probes: 0 }),
+    issues,
+  );
   if (issues.length > 0) throw new CaptureFormatError(`the capture's header is damaged: ${issues[0]?.message ?? ''}`);
   /** File offset of bytes[0], and how far the file is read (the next slice is read while this one is walked). */
   let at = 0;
@@ -102,6 +117,11 @@ export async function walkDataRecords(file: SlicedFile, sink: RecordSink, option
         sink(bytes, p + RECORD_HEADER_SIZE, end, view.getFloat64(p + REC_OFF_TIME, true), port);
         chunks++;
         dataBytes += total - RECORD_OVERHEAD;
+      } else if (event !== undefined) {
+        const end = p + total - CRC_SIZE;
+        if (crc32(bytes, p + REC_OFF_TYPE, end) !== view.getUint32(end, true))
+          throw new CaptureFormatError(`damaged record at offset ${at + p} (its CRC-32 check failed)`);
+        event(bytes, p + RECORD_HEADER_SIZE, end, view.getFloat64(p + REC_OFF_TIME, true), bytes[p + REC_OFF_PORT] ?? 0);
       }
       p += total;
     }
@@ -114,7 +134,7 @@ export async function walkDataRecords(file: SlicedFile, sink: RecordSink, option
     }
     if (next === null) {
       if (p !== n) throw new CaptureFormatError(`the file ends inside a record at offset ${at + p}`);
-      return { chunks, dataBytes };
+      return { chunks, dataBytes, header: { meta, version, headerLength } };
     }
     if (!(await goOn(at + p))) return null;
     const more = await next;

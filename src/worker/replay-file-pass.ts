@@ -5,7 +5,7 @@
  * report, then the same at the end with the count of chunks and bytes it walked, which the
  * worker checks against the capture it reads.
  */
-import { type SlicedFile, walkDataRecords } from '../capture/index.js';
+import { CaptureBuilder, type ParsedCapture, type SlicedFile, walkDataRecords } from '../capture/index.js';
 import type { Overview } from './protocol.js';
 import { ArrivingFile } from './arriving-file.js';
 import { type Checkpoint, ReplayPass } from './replay-pass.js';
@@ -21,6 +21,11 @@ export interface FilePassJob {
   alsoChecked: number[];
   /** Read at a time (tests; default walkDataRecords's). */
   sliceBytes?: number | undefined;
+  /**
+   * The capture is kept as its records are walked (CaptureBuilder), and handed over when done:
+   * this worker's half, so that the file need not be read and parsed again for playback.
+   */
+  keep?: boolean | undefined;
   resolution: 'auto' | 1024 | 2048;
   originUs: number;
   endUs: number;
@@ -30,7 +35,15 @@ export type FilePassReport =
   /** After each slice: how far into the file the walk has got (the worker sends no more than a few slices ahead of it). */
   | { type: 'walked'; to: number }
   | { type: 'progress'; overview: Overview; checkpoints: Checkpoint[] }
-  | { type: 'done'; overview: Overview; checkpoints: Checkpoint[]; chunks: number; dataBytes: number }
+  | {
+      type: 'done';
+      overview: Overview;
+      checkpoints: Checkpoint[];
+      chunks: number;
+      dataBytes: number;
+      /** Every record walked, for a job that keeps them: the capture, if every record on every port proves intact. */
+      kept?: ParsedCapture | undefined;
+    }
   | { type: 'failed'; why: string };
 
 /** A report at most this often: the worker draws the overview about once a second. */
@@ -58,13 +71,16 @@ export async function passOverFile(
       return { overview: pass.overview(), checkpoints };
     };
     const transfer = (o: Overview): Transferable[] => [o.t.buffer, o.fadeRate.buffer, o.lost.buffer];
-    const { ports, alsoChecked, sliceBytes } = job;
+    const { ports, alsoChecked, sliceBytes, size } = job;
+    const kept = job.keep === true ? new CaptureBuilder() : null;
     // Every record decoded here is checked: nothing from a damaged one is ever shown.
     const check = new Uint8Array(256);
     for (const port of [...ports, ...alsoChecked]) check[port] = 1;
     const checked = (port: number): boolean => check[port] === 1;
     const goOn = (walkedTo: number): boolean => {
       if (stopped()) return false;
+      // The first slice tells how much of the file is records' payload: room for the rest at that rate.
+      kept?.expect(walkedTo, size);
       report({ type: 'walked', to: walkedTo }, []);
       if (now() - lastMs >= PROGRESS_MS) {
         lastMs = now();
@@ -73,15 +89,26 @@ export async function passOverFile(
       }
       return true;
     };
-    const walked = await walkDataRecords(file, (bytes, start, end, timeUs, port) => pass.feed(bytes, start, end, timeUs, port), {
-      goOn,
-      checked,
-      ...(sliceBytes === undefined ? {} : { sliceBytes }),
-    });
+    const walked = await walkDataRecords(
+      file,
+      kept === null
+        ? (bytes, start, end, timeUs, port) => pass.feed(bytes, start, end, timeUs, port)
+        : (bytes, start, end, timeUs, port) => {
+            pass.feed(bytes, start, end, timeUs, port);
+            kept.data(bytes, start, end, timeUs, port);
+          },
+      {
+        goOn,
+        checked,
+        ...(kept === null ? {} : { event: (bytes, start, end, timeUs, port) => kept.event(bytes, start, end, timeUs, port) }),
+        ...(sliceBytes === undefined ? {} : { sliceBytes }),
+      },
+    );
     if (walked === null) return;
     pass.finish();
     const r = news();
-    report({ type: 'done', ...r, ...walked }, transfer(r.overview));
+    const { chunks, dataBytes, header } = walked;
+    report({ type: 'done', ...r, chunks, dataBytes, kept: kept?.capture(header) }, transfer(r.overview));
   } catch (error) {
     report({ type: 'failed', why: error instanceof Error ? error.message : String(error) }, []);
   }

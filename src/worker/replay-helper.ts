@@ -3,6 +3,7 @@
  * or in this one, fed the file's pieces as they are read, and what it has reported so far: the
  * halves of a split replay pass (replay-split.ts).
  */
+import type { ParsedCapture } from '../capture/index.js';
 import { ArrivingFile } from './arriving-file.js';
 import type { Clock } from './host.js';
 import type { Overview } from './protocol.js';
@@ -67,6 +68,8 @@ export class HelperRun {
   failed: string | null = null;
   /** What the pass walked (once done): the capture's chunk count and data bytes, if intact. */
   walked = { chunks: Number.NaN, dataBytes: Number.NaN };
+  /** The capture the pass kept from its walk (a job that keeps it, once done; see replay-split.ts for when it counts). */
+  kept: ParsedCapture | null = null;
   /** Called after each report. */
   onReport: () => void = () => {};
   /** Settles when the pass is done, has failed or was stopped. */
@@ -116,6 +119,7 @@ export class HelperRun {
       if (r.type === 'done') {
         this.done = true;
         this.walked = { chunks: r.chunks, dataBytes: r.dataBytes };
+        this.kept = r.kept ?? null;
         this.stop();
       }
     }

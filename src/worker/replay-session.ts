@@ -18,7 +18,7 @@ import type { Driver, SourceRegistry } from './registry.js';
 import { type Checkpoint, type OverviewPass, ReplayPass } from './replay-pass.js';
 import { type PreviewSizes, previewOf } from './replay-preview.js';
 import type { PassHelperMaker } from './replay-helper.js';
-import { type SplitPass, readInPieces, startSplit } from './replay-split.js';
+import { type SplitPass, keptCapture, readInPieces, startSplit } from './replay-split.js';
 import { ReplaySource } from './sources/replay.js';
 
 /** The position moves every tick; the page needs it a few times a second. */
@@ -69,7 +69,7 @@ export class ReplaySession implements Driver {
     const sender = new OverviewSender(host);
     let early: ReplayPass | null = null;
     let split: SplitPass | null = null;
-    let bytes: Uint8Array | null = null;
+    let capture: Capture | null = null;
     let session: ReplaySession | null = null;
     const cannotOpen = (why: string): null => {
       notice(host, 'error', `Cannot open ${name}`, why);
@@ -100,26 +100,28 @@ export class ReplaySession implements Driver {
       } else {
         try {
           // Read once, piece by piece, each piece to both halves as it comes: the overview first.
-          bytes = await readInPieces(file, halves.mine, halves.theirs, parts.previewSizes?.sliceBytes);
-          // Both halves before the parse, which holds this worker up for seconds: the helper's
-          // last report would wait for it, and the overview with it.
+          await readInPieces(file, halves.mine, halves.theirs, parts.previewSizes?.sliceBytes);
           await Promise.all([halves.mine.ended, halves.theirs.ended]);
         } catch (error) {
           return cannotOpen(`The file could not be read (${String(error)}).`);
         }
+        // An intact file is kept as this worker's half walked it; anything else is read again and parsed.
+        capture = keptCapture(halves.mine, halves.theirs);
       }
     }
-    try {
-      bytes ??= new Uint8Array(await file.arrayBuffer());
-    } catch (error) {
-      return cannotOpen(`The file could not be read (${String(error)}).`);
-    }
-    let capture: Capture;
-    try {
-      // The file itself is not kept: the capture holds what replay and a report need.
-      capture = readCapture(bytes, name);
-    } catch (error) {
-      return cannotOpen(error instanceof CaptureFormatError ? error.message : String(error));
+    if (capture === null) {
+      let bytes: Uint8Array;
+      try {
+        bytes = new Uint8Array(await file.arrayBuffer());
+      } catch (error) {
+        return cannotOpen(`The file could not be read (${String(error)}).`);
+      }
+      try {
+        // The file itself is not kept: the capture holds what replay and a report need.
+        capture = readCapture(bytes, name);
+      } catch (error) {
+        return cannotOpen(error instanceof CaptureFormatError ? error.message : String(error));
+      }
     }
     if (preview === null) await registry.closeAll();
     if (capture.issues.length > 0) {

@@ -3,14 +3,16 @@
  * are read, its ports are decoded straight from the file (replay-file-pass.ts) in two halves,
  * the first half in this worker and the later half in a helper worker, and the overview is drawn
  * from both as they go. The file is read once, in pieces handed to both halves as they come
- * (readInPieces), into the buffer parsed for playback after this worker's half is done.
+ * (readInPieces); this worker's half keeps the capture as it walks it (`keptCapture`), so that
+ * it plays as soon as both halves are done. A file that does not prove intact is read again
+ * and parsed (salvaged) as any other.
  *
- * The halves count only for a capture `parseCapture` found intact, on the same span, with every
+ * The halves count only for a capture found intact, on the same span, with every
  * checkpoint on the chunk the capture's own order puts it (`checkpointChunks`) and with the
  * capture's chunk and byte counts. A half that fails or disagrees is decoded again from the
  * capture, here; the overview and seeks are then exactly the one-worker pass's.
  */
-import type { Capture } from '../capture/index.js';
+import type { Capture, ParsedCapture } from '../capture/index.js';
 import type { Clock } from './host.js';
 import { addOverviews } from './overview.js';
 import type { Overview } from './protocol.js';
@@ -214,13 +216,16 @@ export function startSplit(
   const theirs = HelperRun.start(helper, job(ports.slice(half), []));
   if (theirs === null) return null;
   // This half also checks records on ports the file's start did not show: ours with a damaged port byte, perhaps.
-  const mine = HelperRun.start(
-    inThisWorker(clock),
-    job(
+  // It keeps the capture as it walks (the file is not parsed again), and walks it in short
+  // slices: between them the pieces read go on to the helper.
+  const mine = HelperRun.start(inThisWorker(clock), {
+    ...job(
       ports.slice(0, half),
       [...Array(256).keys()].filter((p) => !ports.includes(p)),
     ),
-  );
+    sliceBytes: sliceBytes ?? HERE_SLICE_BYTES,
+    keep: true,
+  });
   if (mine === null) {
     theirs.stop();
     return null;
@@ -228,22 +233,37 @@ export function startSplit(
   return { pass: new SplitPass([mine, theirs], resolution, originUs, endUs, wake), mine, theirs };
 }
 
+/**
+ * The capture this worker's half kept as it walked the file, when it is the capture parseCapture
+ * would read: both halves walked the file to its end, this one checking every record but those
+ * on the helper's ports (events too), the helper checking those; so nothing in it is damaged.
+ * Null otherwise: the file is then read and parsed (and salvaged) as any other.
+ */
+export function keptCapture(mine: HelperRun, theirs: HelperRun): ParsedCapture | null {
+  return mine.done && theirs.done && mine.failed === null && theirs.failed === null ? mine.kept : null;
+}
+
 /** Read at a time from the File: its pieces are what the halves of a split pass are fed. */
 const PIECE_BYTES = 16 << 20;
+/**
+ * This worker's half walks its pieces this much at a time: the pieces read meanwhile are passed
+ * on to the helper between slices, not after a whole piece (the helper waited for them for about
+ * a second of the day capture's five).
+ */
+const HERE_SLICE_BYTES = 1 << 20;
 /** Pieces the helper may be sent ahead of where it has got. */
 const AHEAD_PIECES = 3;
 /** Reads of the File under way at once. */
 const READS_AHEAD = 3;
 
 /**
- * `file` read once, a piece at a time (READS_AHEAD reads under way while this worker decodes),
- * into one buffer; each piece is handed to both halves as it arrives: this worker's a view of
- * the buffer, the helper's the piece itself (transferred), never more than AHEAD_PIECES ahead
- * of where the helper has got. A read that fails fails both.
+ * `file` read once, a piece at a time (READS_AHEAD reads under way while this worker decodes);
+ * each piece is handed to both halves as it arrives: this worker's a copy, the helper's the piece
+ * itself (transferred), never more than AHEAD_PIECES ahead of where the helper has got. A read
+ * that fails fails both. Nothing is kept here: this worker's half keeps the capture.
  */
-export async function readInPieces(file: Blob, mine: HelperRun, theirs: HelperRun, pieceBytes = PIECE_BYTES): Promise<Uint8Array> {
+export async function readInPieces(file: Blob, mine: HelperRun, theirs: HelperRun, pieceBytes = PIECE_BYTES): Promise<void> {
   const size = file.size;
-  const whole = new Uint8Array(size);
   // Several reads under way: the browser reads on while this worker decodes its half.
   const reads: Promise<ArrayBuffer>[] = [];
   let asked = 0;
@@ -260,8 +280,7 @@ export async function readInPieces(file: Blob, mine: HelperRun, theirs: HelperRu
       askMore();
       if (piece.length === 0) throw new Error(`the file ended after ${at} of ${size} bytes`);
       const end = Math.min(size, at + piece.length);
-      whole.set(piece.subarray(0, end - at), at);
-      mine.feed(whole.subarray(at, end));
+      mine.feed(piece.slice(0, end - at));
       // Never more than a few pieces ahead of the helper: they would pile up in its memory.
       await theirs.reached(at - AHEAD_PIECES * pieceBytes);
       theirs.feed(piece);
@@ -273,5 +292,4 @@ export async function readInPieces(file: Blob, mine: HelperRun, theirs: HelperRu
     theirs.fail(String(error));
     throw error;
   }
-  return whole;
 }
