@@ -31,9 +31,10 @@ function file(timed: boolean): Uint8Array {
 /** The capture a builder keeps from a walk of `bytes`, its room guessed after the first slice when `guess`. */
 async function kept(bytes: Uint8Array, sliceBytes: number | undefined, guess: boolean): Promise<ParsedCapture> {
   const builder = new CaptureBuilder();
-  const walked = await walkDataRecords(new Blob([bytes.slice()]), (b, s, e, t, p) => builder.data(b, s, e, t, p), {
+  const walked = await walkDataRecords(new Blob([bytes.slice()]), () => {}, {
     checked: () => true,
-    event: (b, s, e, t, p) => builder.event(b, s, e, t, p),
+    eventsChecked: true,
+    runs: (b, view, from, to) => builder.records(b, view, from, to),
     goOn: (to) => {
       if (guess) builder.expect(to, bytes.length);
       return true;

@@ -75,23 +75,27 @@ describe('walking the data records of an intact capture', () => {
     await expect(walkDataRecords(blob(), () => {}, { checked: (port) => port !== 1 })).resolves.toMatchObject({ chunks: 600 });
   });
 
-  it('hands over the event records when asked, where they lie among the data records, each checked', async () => {
-    const seen: { text: string; timeUs: number; port: number; chunkIndex: number }[] = [];
-    let chunks = 0;
-    const events = async (file: Uint8Array) =>
-      walkDataRecords(new Blob([file.slice()]), () => chunks++, {
-        sliceBytes: 100,
-        event: (b, start, end, timeUs, port) =>
-          seen.push({ text: new TextDecoder().decode(b.subarray(start, end)), timeUs, port, chunkIndex: chunks }),
+  it('hands over the runs of whole records walked, events among them, and checks the events when asked', async () => {
+    const runs = async (file: Uint8Array, sliceBytes: number, eventsChecked: boolean) => {
+      const got: number[] = [];
+      await walkDataRecords(new Blob([file.slice()]), () => {}, {
+        sliceBytes,
+        eventsChecked,
+        runs: (b, view, from, to) => {
+          expect(view.buffer).toBe(b.buffer);
+          got.push(...b.subarray(from, to));
+        },
       });
-    await events(bytes);
-    expect(seen).toEqual(capture.events);
-    expect(seen.length).toBe(12);
-    // The text of the fifth event changed: its CRC fails, whether or not data records are checked.
+      return Uint8Array.from(got);
+    };
+    // The runs, one after the other, are every record of the file (one cut across slices joined whole).
+    for (const slice of [100, 4096]) expect(await runs(bytes, slice, true)).toEqual(bytes.subarray(capture.headerLength));
+    // The text of the fifth event changed: its CRC fails when events are checked, whether or not data records are.
     const damaged = bytes.slice();
     const at = Buffer.from(damaged).indexOf('event 200');
     damaged[at + 6] = '7'.charCodeAt(0);
-    await expect(events(damaged)).rejects.toThrow(/damaged record at offset/);
+    await expect(runs(damaged, 100, true)).rejects.toThrow(/damaged record at offset/);
+    await expect(runs(damaged, 100, false)).resolves.toHaveLength(bytes.length - capture.headerLength);
     await expect(walk(damaged, 100)).resolves.toMatchObject({ walked: { chunks: 600 } });
   });
 

@@ -6,6 +6,15 @@
  * the same columns, events, timing and header. It cannot tell an intact file from a damaged
  * one; whoever feeds it must know (a walk that ended, every CRC checked).
  */
+import {
+  RECORD_HEADER_SIZE,
+  RECORD_OVERHEAD,
+  RECORD_TYPE_DATA,
+  REC_OFF_LENGTH,
+  REC_OFF_PORT,
+  REC_OFF_TIME,
+  REC_OFF_TYPE,
+} from './layout.js';
 import type { CaptureEvent, ParsedCapture } from './model.js';
 import { copyPayload, trimTo } from './reader.js';
 import type { WalkedHeader } from './record-walk.js';
@@ -18,9 +27,6 @@ const FIRST_BYTES = 1 << 16;
 export class CaptureBuilder {
   #data = new Uint8Array(FIRST_BYTES);
   #dataView = new DataView(this.#data.buffer);
-  /** The slice records are copied from, and a view of it (made once per slice, not per record). */
-  #from: Uint8Array | null = null;
-  #fromView: DataView<ArrayBufferLike> = new DataView(new ArrayBuffer(0));
   #ends = new Uint32Array(FIRST_RECORDS);
   #times = new Float64Array(FIRST_RECORDS);
   #ports = new Uint8Array(FIRST_RECORDS);
@@ -42,33 +48,52 @@ export class CaptureBuilder {
     this.#grow(Math.ceil(this.#dataLength * scale), Math.ceil(this.#chunks * scale));
   }
 
-  /** A data record: its payload `bytes[start, end)`, recorded at `timeUs` on `port`. */
-  data(bytes: Uint8Array, start: number, end: number, timeUs: number, port: number): void {
-    const len = end - start;
-    if (this.#chunks === this.#ends.length || this.#dataLength + len > this.#data.length)
-      this.#grow(this.#dataLength + len, this.#chunks + 1);
-    if (bytes !== this.#from) {
-      this.#from = bytes;
-      this.#fromView = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
+  /**
+   * Records one after the other, `bytes[from, to)` (`view` over `bytes`), their headers read
+   * intact: each data record's payload goes to the columns, each event to the events.
+   */
+  records(bytes: Uint8Array, view: DataView, from: number, to: number): void {
+    let data = this.#data;
+    let dataView = this.#dataView;
+    let ends = this.#ends;
+    let times = this.#times;
+    let ports = this.#ports;
+    let at = this.#dataLength;
+    let i = this.#chunks;
+    let anyTime = this.#anyTime;
+    for (let p = from; p < to; ) {
+      const len = view.getUint32(p + REC_OFF_LENGTH, true);
+      const timeUs = view.getFloat64(p + REC_OFF_TIME, true);
+      const port = bytes[p + REC_OFF_PORT] ?? 0;
+      const payload = p + RECORD_HEADER_SIZE;
+      if (bytes[p + REC_OFF_TYPE] === RECORD_TYPE_DATA) {
+        if (i === ends.length || at + len > data.length) {
+          this.#dataLength = at;
+          this.#chunks = i;
+          this.#grow(at + len, i + 1);
+          ({ data, dataView: dataView, ends, times, ports } = this.#columns());
+        }
+        copyPayload(data, dataView, at, bytes, view, payload, len);
+        at += len;
+        ends[i] = at;
+        times[i] = timeUs;
+        ports[i] = port;
+        i++;
+        if (!Number.isNaN(timeUs)) anyTime = true;
+      } else this.#events.push({ timeUs, port, text: utf8Decode(bytes, payload, payload + len), chunkIndex: i });
+      p += RECORD_OVERHEAD + len;
     }
-    const at = this.#dataLength;
-    copyPayload(this.#data, this.#dataView, at, bytes, this.#fromView, start, len);
-    this.#dataLength = at + len;
-    const i = this.#chunks++;
-    this.#ends[i] = at + len;
-    this.#times[i] = timeUs;
-    this.#ports[i] = port;
-    if (!Number.isNaN(timeUs)) this.#anyTime = true;
+    this.#dataLength = at;
+    this.#chunks = i;
+    this.#anyTime = anyTime;
   }
 
-  /** An event record: its text (UTF-8) `bytes[start, end)`, recorded at `timeUs` on `port`, among the chunks where it came. */
-  event(bytes: Uint8Array, start: number, end: number, timeUs: number, port: number): void {
-    this.#events.push({ timeUs, port, text: utf8Decode(bytes, start, end), chunkIndex: this.#chunks });
+  #columns() {
+    return { data: this.#data, dataView: this.#dataView, ends: this.#ends, times: this.#times, ports: this.#ports };
   }
 
   /** The capture of every record fed, with `header`'s metadata; the builder is not to be fed after. */
   capture(header: WalkedHeader): ParsedCapture {
-    this.#from = null; // the last slice is not held
     const n = this.#chunks;
     return {
       kind: 'sscap',

@@ -56,21 +56,26 @@ export interface WalkOptions {
   goOn?: (walkedTo: number) => boolean | Promise<boolean>;
   /** Whether a data record on `port` has its CRC-32 checked. Default: none is. */
   checked?: (port: number) => boolean;
-  /** Gets the event records too, in the file's order among the data records, each checked (its CRC-32). Default: they are skipped. */
-  event?: RecordSink;
+  /** Whether event records have their CRC-32 checked. Default: they are skipped unread. */
+  eventsChecked?: boolean;
+  /**
+   * Gets each run of whole records walked, events too: `bytes[from, to)` of a slice, records one
+   * after the other, their headers checked (and their CRCs, as asked), after `sink` has had them.
+   */
+  runs?: (bytes: Uint8Array, view: DataView, from: number, to: number) => void;
   /** Read at a time (tests). Default 16 MiB. */
   sliceBytes?: number;
 }
 
 /**
- * Hands every data record of `file` to `sink`, in the file's order, and its event records to
- * `options.event` if given (events are not chunks).
+ * Hands every data record of `file` to `sink`, in the file's order (events are not chunks; the
+ * runs of records, `options.runs`, hold them too).
  * @throws {CaptureFormatError} when the header is damaged, the records do not lead from one to
  *   the next to the end of the file, or a record checked fails its CRC (the file is not intact:
  *   parseCapture salvages it)
  */
 export async function walkDataRecords(file: SlicedFile, sink: RecordSink, options: WalkOptions = {}): Promise<WalkedRecords | null> {
-  const { goOn = () => true, checked = () => false, event, sliceBytes = SLICE_BYTES } = options;
+  const { goOn = () => true, checked = () => false, eventsChecked = false, runs, sliceBytes = SLICE_BYTES } = options;
   const size = file.size;
   const read = async (from: number, length: number): Promise<Uint8Array> =>
     new Uint8Array(await file.slice(from, Math.min(size, from + length)).arrayBuffer());
@@ -105,6 +110,7 @@ export async function walkDataRecords(file: SlicedFile, sink: RecordSink, option
   let dataBytes = 0;
   for (;;) {
     const n = bytes.length;
+    const run = p;
     while (p + RECORD_HEADER_SIZE <= n) {
       const total = recordSize(bytes, view, p);
       if (total < 0) throw new CaptureFormatError(`no intact record header at offset ${at + p}`);
@@ -117,14 +123,14 @@ export async function walkDataRecords(file: SlicedFile, sink: RecordSink, option
         sink(bytes, p + RECORD_HEADER_SIZE, end, view.getFloat64(p + REC_OFF_TIME, true), port);
         chunks++;
         dataBytes += total - RECORD_OVERHEAD;
-      } else if (event !== undefined) {
+      } else if (eventsChecked) {
         const end = p + total - CRC_SIZE;
         if (crc32(bytes, p + REC_OFF_TYPE, end) !== view.getUint32(end, true))
           throw new CaptureFormatError(`damaged record at offset ${at + p} (its CRC-32 check failed)`);
-        event(bytes, p + RECORD_HEADER_SIZE, end, view.getFloat64(p + REC_OFF_TIME, true), bytes[p + REC_OFF_PORT] ?? 0);
       }
       p += total;
     }
+    if (p > run) runs?.(bytes, view, run, p);
     if (queued !== null) {
       if (p !== n) throw new CaptureFormatError(`no intact record at offset ${at + p}`);
       ({ bytes, at, p } = queued);

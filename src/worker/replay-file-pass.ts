@@ -89,21 +89,17 @@ export async function passOverFile(
       }
       return true;
     };
-    const walked = await walkDataRecords(
-      file,
-      kept === null
-        ? (bytes, start, end, timeUs, port) => pass.feed(bytes, start, end, timeUs, port)
-        : (bytes, start, end, timeUs, port) => {
-            pass.feed(bytes, start, end, timeUs, port);
-            kept.data(bytes, start, end, timeUs, port);
-          },
-      {
-        goOn,
-        checked,
-        ...(kept === null ? {} : { event: (bytes, start, end, timeUs, port) => kept.event(bytes, start, end, timeUs, port) }),
-        ...(sliceBytes === undefined ? {} : { sliceBytes }),
-      },
-    );
+    const walked = await walkDataRecords(file, (bytes, start, end, timeUs, port) => pass.feed(bytes, start, end, timeUs, port), {
+      goOn,
+      checked,
+      ...(kept === null
+        ? {}
+        : {
+            eventsChecked: true,
+            runs: (bytes: Uint8Array, view: DataView, from: number, to: number) => kept.records(bytes, view, from, to),
+          }),
+      ...(sliceBytes === undefined ? {} : { sliceBytes }),
+    });
     if (walked === null) return;
     pass.finish();
     const r = news();
