@@ -3,26 +3,30 @@
  * the words and exit codes every command uses (2: the file cannot be read, 1: not a capture).
  *
  * A big .sscap (`PARTS_MIN_BYTES` and up) is read on two threads when it is intact: its bytes
- * and columns in shared memory, each thread checking and copying a part of its records
- * (`planParts`, `readPart`: this thread two fifths, having read the file and planned first). The capture is the one `readCapture` makes; a damaged file, or a
- * part the other thread could not read, is read here alone, salvaging as ever.
+ * and columns in shared memory, its records cut into parts (`planParts`) that both threads take
+ * in turn, each checking and copying the parts it takes (`readPart`). The capture is the one
+ * `readCapture` makes; a damaged file, or a part the other thread could not read, is read here
+ * alone, salvaging as ever.
  */
 import { closeSync, fstatSync, openSync, readSync } from 'node:fs';
 import { basename } from 'node:path';
 import {
   assembleParts,
   CaptureFormatError,
+  type CapturePart,
   partColumns,
   planParts,
   readCapture,
   readPart,
   type Capture,
+  type PartRead,
   type ReadOptions,
 } from '../capture/index.js';
 import type { ReadThreadData, ReadThreadResult } from './read-thread.js';
 import { secondCore, WaitedWorker } from './waited-worker.js';
 
-export type LoadedCapture = { capture: Capture } | { error: string; exitCode: 1 | 2 };
+/** The capture, and how many of its parts the second thread read (0: read on this thread alone). */
+export type LoadedCapture = { capture: Capture; partsThere: number } | { error: string; exitCode: 1 | 2 };
 
 /** Files from this size on are read on two threads when they are intact .sscap captures. */
 export const PARTS_MIN_BYTES = 32 << 20;
@@ -44,19 +48,43 @@ function readBytes(file: string, big: number): Uint8Array {
   }
 }
 
-/** An intact .sscap read on two threads, or null (not one, or not intact: `readCapture` reads it). */
-function readInParts(bytes: Uint8Array): Capture | null {
-  // This thread has read the file and planned before the worker starts, so it takes the smaller part.
-  const plan = planParts(bytes, [2, 3]);
-  const [mine, theirs] = plan?.parts ?? [];
-  if (plan === null || mine === undefined || theirs === undefined) return null;
+/**
+ * Parts the records are cut into for two threads to take in turn: enough that neither waits long
+ * for the other at the end (the other thread starts later, and machines differ), few enough that
+ * taking one costs nothing.
+ */
+const PARTS = 16;
+
+/** An intact .sscap read on two threads, and how many parts the other read; or null (not one, or not intact: `readCapture` reads it). */
+function readInParts(bytes: Uint8Array): { capture: Capture; partsThere: number } | null {
+  const plan = planParts(bytes, PARTS);
+  if (plan === null) return null;
+  const { parts } = plan;
   const columns = partColumns(plan, true);
-  const data: ReadThreadData = { bytes, part: theirs, columns };
+  const taken = new Int32Array(new SharedArrayBuffer(4));
+  const data: ReadThreadData = { bytes, parts, columns, taken };
   const worker = new WaitedWorker<ReadThreadResult>(new URL('./read-thread.js', import.meta.url), data);
   try {
-    const here = readPart(bytes, mine, columns);
-    const there = here.intact ? worker.result(0) : undefined;
-    return there !== undefined && 'ok' in there ? assembleParts(plan, columns, [here, there.ok]) : null;
+    // Both threads take the next part not taken until none is left; one that is not intact stops both.
+    const reads: (PartRead | undefined)[] = new Array(parts.length);
+    let mine = 0;
+    for (let k = Atomics.add(taken, 0, 1); k < parts.length; k = Atomics.add(taken, 0, 1)) {
+      const read = readPart(bytes, parts[k] as CapturePart, columns);
+      if (!read.intact) {
+        Atomics.store(taken, 0, parts.length);
+        return null;
+      }
+      reads[k] = read;
+      mine++;
+    }
+    // Then the other thread's, one result per part it took.
+    for (let i = 0; i < parts.length - mine; i++) {
+      const there = worker.result(i);
+      if (there === undefined || !('ok' in there) || !there.ok.intact) return null;
+      reads[there.k] = there.ok;
+    }
+    const capture = reads.every((r) => r !== undefined) ? assembleParts(plan, columns, reads) : null;
+    return capture === null ? null : { capture, partsThere: parts.length - mine };
   } finally {
     worker.close();
   }
@@ -84,7 +112,7 @@ export function loadCapture(file: string, options: ReadOptions = {}, partsMinByt
   }
   try {
     const parts = bytes.length >= partsMinBytes && secondCore() ? readInParts(bytes) : null;
-    return { capture: parts ?? readCapture(bytes, basename(file), options) };
+    return parts ?? { capture: readCapture(bytes, basename(file), options), partsThere: 0 };
   } catch (error) {
     if (error instanceof CaptureFormatError) return { error: `${file}: ${error.message}`, exitCode: 1 };
     throw error;
