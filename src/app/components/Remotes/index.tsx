@@ -246,7 +246,7 @@ export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
       <div class="lanes" ref={lanes} role="group" aria-label="Hold and failsafe episodes per remote">
         {list.map((s, i) => (
           <div key={s.id} class="lane">
-            <span class="lane-label" style={{ color: colors[i % colors.length] }}>
+            <span class="lane-label" style={{ color: colors[i % colors.length] }} title={s.label}>
               {s.label}
             </span>
             <div class="lane-strip" />
