@@ -19,6 +19,7 @@ import { type Checkpoint, type OverviewPass, ReplayPass } from './replay-pass.js
 import { type PreviewSizes, previewOf } from './replay-preview.js';
 import type { PassHelperMaker } from './replay-helper.js';
 import { type SplitPass, keptCapture, readInPieces, startSplit } from './replay-split.js';
+import { OverviewSender } from './overview-sender.js';
 import { ReplaySource } from './sources/replay.js';
 
 /** The position moves every tick; the page needs it a few times a second. */
@@ -27,12 +28,6 @@ const STATUS_MS = 200;
 const SEEK_HISTORY_US = 60e6;
 /** The capture is decoded for this long at a time, then messages and playback go through. */
 const PASS_SLICE_MS = 40;
-/**
- * The growing overview is sent at most this often, and no more often than a quarter of the time
- * the reading has taken so far: the page draws the whole of it each time, so a long capture's
- * few dozen seconds of reading cost it a handful of draws, not one a second.
- */
-const OVERVIEW_EVERY_MS = 1000;
 
 export interface ReplayParts {
   host: Host;
@@ -354,43 +349,6 @@ export class ReplaySession implements Driver {
       },
     });
   }
-}
-
-/**
- * A capture's growing overview sent to the page: at most every OVERVIEW_EVERY_MS, and no more
- * often than a quarter of the time the reading has taken so far (the page draws the whole of it
- * each time, so a long capture's reading costs it a handful of draws); never one read less far
- * than the last (the halves of a split pass catching up), and nothing after the complete one.
- */
-class OverviewSender {
-  readonly #host: Host;
-  readonly #startMs: number;
-  #lastMs = Number.NEGATIVE_INFINITY;
-  #sentUntilUs = Number.NEGATIVE_INFINITY;
-  complete = false;
-
-  constructor(host: Host) {
-    this.#host = host;
-    this.#startMs = host.clock.now();
-  }
-
-  /** Whether an overview would be sent now (so that one is worth making). */
-  due(): boolean {
-    const nowMs = this.#host.clock.now();
-    return !this.complete && nowMs - this.#lastMs >= Math.max(OVERVIEW_EVERY_MS, (nowMs - this.#startMs) / 4);
-  }
-
-  offer(overview: Overview): void {
-    if (this.complete || !(overview.complete || overview.readUntilUs > this.#sentUntilUs)) return;
-    this.#lastMs = this.#host.clock.now();
-    this.#sentUntilUs = overview.readUntilUs;
-    this.complete = overview.complete;
-    postOverview(this.#host, overview);
-  }
-}
-
-function postOverview(host: Host, overview: Overview): void {
-  host.post({ type: 'overview', overview }, [overview.t.buffer, overview.fadeRate.buffer, overview.lost.buffer]);
 }
 
 /** The replay's status while a long capture's file is still being read: its span, nothing played. */
