@@ -283,6 +283,17 @@ describe('a long capture decoded on two workers', () => {
     expectOverviewsAsOneDecode(flipped.overviews, moved);
     expect(flipped.wholeReads).toBe(1);
     expectCaptureAsRead(flipped, moved);
+    // Cut off inside its last record (a recording that stopped): every record before the cut is
+    // intact, so both halves count; the file is parsed for playback, and the cut is said.
+    const cut = FILE.subarray(0, FILE.length - 7);
+    expect(readCapture(cut, 'long.sscap').issues.map((i) => i.kind)).toEqual(['truncated-record']);
+    const whole = helperHere();
+    const cutOff = await openSplit(cut, whole.make);
+    expect(whole.runs.dropped).toBe(false);
+    expectOverviewsAsOneDecode(cutOff.overviews, cut);
+    expect(cutOff.wholeReads).toBe(1);
+    expectCaptureAsRead(cutOff, cut);
+    await expectSeeksExact(cutOff, cut);
     const none = helperHere();
     const alone = await openSplit(FILE, none.make, { ...PREVIEW, minBytes: FILE.length + 1 });
     expect(none.jobs.length).toBe(0);

@@ -48,6 +48,12 @@ export interface WalkedRecords {
   chunks: number;
   dataBytes: number;
   header: WalkedHeader;
+  /**
+   * The file ends inside a record starting here (a recording cut off): the records before it are
+   * all that was walked. Whether the rest is a cut record or something else is for the reader
+   * to say (parseCapture's `truncated-record`).
+   */
+  cutAt?: number;
 }
 
 /** How a walk goes. */
@@ -71,8 +77,8 @@ export interface WalkOptions {
  * Hands every data record of `file` to `sink`, in the file's order (events are not chunks; the
  * runs of records, `options.runs`, hold them too).
  * @throws {CaptureFormatError} when the header is damaged, the records do not lead from one to
- *   the next to the end of the file, or a record checked fails its CRC (the file is not intact:
- *   parseCapture salvages it)
+ *   the next to the end of the file (or to where it ends inside one: `cutAt`), or a record
+ *   checked fails its CRC (the file is not intact: parseCapture salvages it)
  */
 export async function walkDataRecords(file: SlicedFile, sink: RecordSink, options: WalkOptions = {}): Promise<WalkedRecords | null> {
   const { goOn = () => true, checked = () => false, eventsChecked = false, runs, sliceBytes = SLICE_BYTES } = options;
@@ -139,8 +145,8 @@ export async function walkDataRecords(file: SlicedFile, sink: RecordSink, option
       continue;
     }
     if (next === null) {
-      if (p !== n) throw new CaptureFormatError(`the file ends inside a record at offset ${at + p}`);
-      return { chunks, dataBytes, header: { meta, version, headerLength } };
+      const walked = { chunks, dataBytes, header: { meta, version, headerLength } };
+      return p === n ? walked : { ...walked, cutAt: at + p };
     }
     if (!(await goOn(at + p))) return null;
     const more = await next;

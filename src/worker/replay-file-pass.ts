@@ -41,6 +41,8 @@ export type FilePassReport =
       checkpoints: Checkpoint[];
       chunks: number;
       dataBytes: number;
+      /** Where the file ends inside a record (`WalkedRecords.cutAt`): what was walked ends there. */
+      cutAt?: number | undefined;
       /** Every record walked, for a job that keeps them: the capture, if every record on every port proves intact. */
       kept?: ParsedCapture | undefined;
     }
@@ -103,8 +105,10 @@ export async function passOverFile(
     if (walked === null) return;
     pass.finish();
     const r = news();
-    const { chunks, dataBytes, header } = walked;
-    report({ type: 'done', ...r, chunks, dataBytes, kept: kept?.capture(header) }, transfer(r.overview));
+    const { chunks, dataBytes, header, cutAt } = walked;
+    // A file that ends inside a record is not intact: it is parsed, and its cut said.
+    const capture = cutAt === undefined ? kept?.capture(header) : undefined;
+    report({ type: 'done', ...r, chunks, dataBytes, cutAt, kept: capture }, transfer(r.overview));
   } catch (error) {
     report({ type: 'failed', why: error instanceof Error ? error.message : String(error) }, []);
   }

@@ -66,8 +66,8 @@ export class HelperRun {
   overview: Overview | null = null;
   done = false;
   failed: string | null = null;
-  /** What the pass walked (once done): the capture's chunk count and data bytes, if intact. */
-  walked = { chunks: Number.NaN, dataBytes: Number.NaN };
+  /** What the pass walked (once done): the capture's chunk count and data bytes, if intact, and where the file ends inside a record. */
+  walked: { chunks: number; dataBytes: number; cutAt?: number | undefined } = { chunks: Number.NaN, dataBytes: Number.NaN };
   /** The capture the pass kept from its walk (a job that keeps it, once done; see replay-split.ts for when it counts). */
   kept: ParsedCapture | null = null;
   /** Called after each report. */
@@ -118,7 +118,7 @@ export class HelperRun {
       this.overview = r.overview;
       if (r.type === 'done') {
         this.done = true;
-        this.walked = { chunks: r.chunks, dataBytes: r.dataBytes };
+        this.walked = { chunks: r.chunks, dataBytes: r.dataBytes, cutAt: r.cutAt };
         this.kept = r.kept ?? null;
         this.stop();
       }

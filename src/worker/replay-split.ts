@@ -79,7 +79,7 @@ export class SplitPass implements OverviewPass {
    */
   adopt(capture: Capture, ports: readonly number[], span: { startUs: number; endUs: number }): void {
     this.#capture = capture;
-    if (capture.issues.length > 0 || span.startUs !== this.originUs || span.endUs !== this.endUs) {
+    if (!this.#intactAsWalked(capture) || span.startUs !== this.originUs || span.endUs !== this.endUs) {
       for (const run of this.#runs) this.#drop(run);
     }
     this.#truth = checkpointChunks(capture, this.originUs);
@@ -88,6 +88,16 @@ export class SplitPass implements OverviewPass {
     const rest = ports.filter((p) => !covered.has(p) && !this.#orphans.includes(p));
     this.#decodeHere([...this.#orphans, ...rest]);
     this.#orphans = [];
+  }
+
+  /**
+   * Whether the capture is intact as far as the runs walked: with no issue at all, or (a recording
+   * cut off) only the reader's `truncated-record` where every run found the file ending inside one.
+   */
+  #intactAsWalked(capture: Capture): boolean {
+    const [issue, ...more] = capture.issues;
+    if (issue === undefined) return this.#runs.every((r) => r.walked.cutAt === undefined);
+    return more.length === 0 && issue.kind === 'truncated-record' && this.#runs.every((r) => r.walked.cutAt === issue.offset);
   }
 
   get done(): boolean {
