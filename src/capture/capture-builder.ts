@@ -16,8 +16,7 @@ import {
   REC_OFF_TYPE,
 } from './layout.js';
 import type { CaptureEvent, ParsedCapture } from './model.js';
-import { copyPayload, trimTo } from './reader.js';
-import type { WalkedHeader } from './record-walk.js';
+import { copyPayload, type HeaderResult, trimTo } from './reader.js';
 import { utf8Decode } from './text.js';
 
 /** Room for this many records and payload bytes at first: then as `expect` guesses, growing by half as needed. */
@@ -93,7 +92,7 @@ export class CaptureBuilder {
   }
 
   /** The capture of every record fed, with `header`'s metadata; the builder is not to be fed after. */
-  capture(header: WalkedHeader): ParsedCapture {
+  capture(header: HeaderResult): ParsedCapture {
     const n = this.#chunks;
     return {
       kind: 'sscap',

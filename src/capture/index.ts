@@ -45,7 +45,6 @@ export {
 export {
   type RecordSink,
   type SlicedFile,
-  type WalkedHeader,
   type WalkedRecords,
   type WalkOptions,
   walkDataRecords,

@@ -21,8 +21,8 @@ import {
   REC_OFF_TYPE,
 } from './layout.js';
 import { crc32 } from './crc32.js';
-import { CaptureFormatError, type CaptureMeta } from './model.js';
-import { RecordProbe, readHeader, recordSize } from './reader.js';
+import { CaptureFormatError } from './model.js';
+import { type HeaderResult, RecordProbe, readHeader, recordSize } from './reader.js';
 
 /** Read at a time: the header (its metadata is at most 1 MiB) and a few hundred thousand records. */
 const SLICE_BYTES = 16 << 20;
@@ -36,18 +36,12 @@ export interface SlicedFile {
 /** One data record: its payload is `bytes[start, end)`, recorded at `timeUs` on `port`. */
 export type RecordSink = (bytes: Uint8Array, start: number, end: number, timeUs: number, port: number) => void;
 
-/** The file's header, as parseCapture reads it. */
-export interface WalkedHeader {
-  meta: CaptureMeta;
-  version: number;
-  headerLength: number;
-}
-
 /** What a walk to the end found: the data records (the capture's chunks) and their payload bytes, and the header. */
 export interface WalkedRecords {
   chunks: number;
   dataBytes: number;
-  header: WalkedHeader;
+  /** The file's header, as parseCapture reads it. */
+  header: HeaderResult;
   /**
    * The file ends inside a record starting here (a recording cut off): the records before it are
    * all that was walked. Whether the rest is a cut record or something else is for the reader
