@@ -22,8 +22,8 @@ export interface FilePassJob {
   /** Read at a time (tests; default walkDataRecords's). */
   sliceBytes?: number | undefined;
   /**
-   * The capture is kept as its records are walked (CaptureBuilder), and handed over when done:
-   * this worker's half, so that the file need not be read and parsed again for playback.
+   * The capture is kept as its records are walked (CaptureBuilder), and handed over when done
+   * (the helper's half), so that the file need not be read and parsed again for playback.
    */
   keep?: boolean | undefined;
   resolution: 'auto' | 1024 | 2048;
@@ -108,7 +108,10 @@ export async function passOverFile(
     const { chunks, dataBytes, header, cutAt } = walked;
     // A file that ends inside a record is not intact: it is parsed, and its cut said.
     const capture = cutAt === undefined ? kept?.capture(header) : undefined;
-    report({ type: 'done', ...r, chunks, dataBytes, cutAt, kept: capture }, transfer(r.overview));
+    // The columns go to the worker without a copy (from a helper worker: transferred).
+    const columns =
+      capture === undefined ? [] : [capture.bytes, capture.chunkEnds, capture.chunkTimesUs, capture.chunkPorts].map((c) => c.buffer);
+    report({ type: 'done', ...r, chunks, dataBytes, cutAt, kept: capture }, [...transfer(r.overview), ...(columns as ArrayBuffer[])]);
   } catch (error) {
     report({ type: 'failed', why: error instanceof Error ? error.message : String(error) }, []);
   }

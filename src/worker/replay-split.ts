@@ -3,9 +3,9 @@
  * are read, its ports are decoded straight from the file (replay-file-pass.ts) in two halves,
  * the first half in this worker and the later half in a helper worker, and the overview is drawn
  * from both as they go. The file is read once, in pieces handed to both halves as they come
- * (readInPieces); this worker's half keeps the capture as it walks it (`keptCapture`), so that
- * it plays as soon as both halves are done. A file that does not prove intact is read again
- * and parsed (salvaged) as any other.
+ * (readInPieces); the helper's half keeps the capture as it walks it (`keptCapture`), and hands
+ * it over at the end without a copy, so that it plays as soon as both halves are done. A file
+ * that does not prove intact is read again and parsed (salvaged) as any other.
  *
  * The halves count only for a capture found intact (or cut off inside its last record, where
  * both halves found the file ending), on the same span, with every
@@ -224,18 +224,18 @@ export function startSplit(
     endUs,
     sliceBytes,
   });
-  const theirs = HelperRun.start(helper, job(ports.slice(half), []));
+  // The helper keeps the capture as it walks (the file is not parsed again; the columns are
+  // transferred here at the end): this worker's half also reads the file and passes it on.
+  const theirs = HelperRun.start(helper, { ...job(ports.slice(half), []), keep: true });
   if (theirs === null) return null;
-  // This half also checks records on ports the file's start did not show: ours with a damaged port byte, perhaps.
-  // It keeps the capture as it walks (the file is not parsed again), and walks it in short
-  // slices: between them the pieces read go on to the helper.
+  // This half also checks records on ports the file's start did not show: ours with a damaged
+  // port byte, perhaps. It walks in short slices: between them the pieces read go on to the helper.
   const mine = HelperRun.start(inThisWorker(clock), {
     ...job(
       ports.slice(0, half),
       [...Array(256).keys()].filter((p) => !ports.includes(p)),
     ),
     sliceBytes: sliceBytes ?? HERE_SLICE_BYTES,
-    keep: true,
   });
   if (mine === null) {
     theirs.stop();
@@ -245,13 +245,18 @@ export function startSplit(
 }
 
 /**
- * The capture this worker's half kept as it walked the file, when it is the capture parseCapture
- * would read: both halves walked the file to its end, this one checking every record but those
- * on the helper's ports (events too), the helper checking those; so nothing in it is damaged.
- * Null otherwise: the file is then read and parsed (and salvaged) as any other.
+ * The capture the helper kept as it walked the file, when it is the capture parseCapture would
+ * read: both halves walked the file to its end, this worker's checking every record but those
+ * on the helper's ports, the helper checking those and the events; so nothing in it is damaged.
+ * It must also hold what this worker's half walked (its chunks and bytes; the checkpoints are
+ * checked against it next, `adopt`). Null otherwise: the file is then read and parsed (and
+ * salvaged) as any other.
  */
 export function keptCapture(mine: HelperRun, theirs: HelperRun): ParsedCapture | null {
-  return mine.done && theirs.done && mine.failed === null && theirs.failed === null ? mine.kept : null;
+  const kept = theirs.kept;
+  if (kept === null || !mine.done || !theirs.done || mine.failed !== null || theirs.failed !== null) return null;
+  const { chunks, dataBytes } = mine.walked;
+  return kept.chunkEnds.length === chunks && kept.bytes.length === dataBytes ? kept : null;
 }
 
 /** Read at a time from the File: its pieces are what the halves of a split pass are fed. */
@@ -271,7 +276,7 @@ const READS_AHEAD = 3;
  * `file` read once, a piece at a time (READS_AHEAD reads under way while this worker decodes);
  * each piece is handed to both halves as it arrives: this worker's a copy, the helper's the piece
  * itself (transferred), never more than AHEAD_PIECES ahead of where the helper has got. A read
- * that fails fails both. Nothing is kept here: this worker's half keeps the capture.
+ * that fails fails both. Nothing is kept here: the helper's half keeps the capture.
  */
 export async function readInPieces(file: Blob, mine: HelperRun, theirs: HelperRun, pieceBytes = PIECE_BYTES): Promise<void> {
   const size = file.size;
