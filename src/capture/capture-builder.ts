@@ -70,7 +70,7 @@ export class CaptureBuilder {
           this.#dataLength = at;
           this.#chunks = i;
           this.#grow(at + len, i + 1);
-          ({ data, dataView: dataView, ends, times, ports } = this.#columns());
+          ({ data, dataView, ends, times, ports } = this.#columns());
         }
         copyPayload(data, dataView, at, bytes, view, payload, len);
         at += len;
