@@ -6,6 +6,7 @@
  * `satscope info` gives for the same file. Needs the built page (`npm run build`) and Debian's
  * Chromium.
  */
+import { spawnSync } from 'node:child_process';
 import { existsSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
@@ -17,6 +18,7 @@ import { summarizeCapture } from '../../src/analysis/index.js';
 import { preset, simulate } from '../../src/simulator/index.js';
 import { resolutionSource } from '../../src/app/components/SystemBadge/words.js';
 import {
+  ROOT,
   SHARED_CAPTURES,
   browserUnavailable,
   shot,
@@ -253,10 +255,15 @@ describe.skipIf(skip !== null)('seeking in a long capture', () => {
 });
 
 describe.skipIf(skip !== null)('a capture being read', () => {
-  it("says the capture is being read, never a receiver's wiring hint, until it plays", async () => {
-    // Two hours of two remotes: over 32 MB, so the page shows its span and overview while it reads.
-    const path = join(dir, 'two-hours.sscap');
+  // Two hours of two remotes: over 32 MB, so the page shows its span and overview while it reads,
+  // and decodes it on two workers, the helper keeping the capture (src/worker/replay-split.ts).
+  let path = '';
+  beforeAll(() => {
+    path = join(dir, 'two-hours.sscap');
     writeLongCapture(path, 2 * 3600e6);
+  });
+
+  it("says the capture is being read, never a receiver's wiring hint, until it plays", async () => {
     const { page, errors } = await open('?demo=0');
     await page.getByTestId('empty-state').waitFor();
     // Every state and hint the link panel shows, and whether Play could be pressed then.
@@ -285,6 +292,28 @@ describe.skipIf(skip !== null)('a capture being read', () => {
     const after = seen.slice(reading);
     expect(after.filter((l) => l.includes('grey DATA wire'))).toEqual([]);
     expect(after.filter((l) => l.startsWith('Reading') && !l.endsWith('disabled'))).toEqual([]);
+    expect(errors).toEqual([]);
+    await page.context().close();
+  }, 90_000);
+
+  it('reports on it exactly as satscope report does: the capture the helper kept is the one the CLI reads', async () => {
+    const { page, errors } = await open('?demo=0');
+    await page.setInputFiles('input[type=file]', path);
+    await page
+      .getByTestId('link-state')
+      .filter({ hasText: /^Live$/ })
+      .waitFor({ timeout: 60_000 });
+    const json = page.waitForEvent('download', { timeout: 60_000 });
+    await page.getByRole('button', { name: 'Report', exact: true }).click();
+    await page.getByRole('button', { name: 'Report as data (JSON)' }).click();
+    const saved = join(dir, 'two-hours.page.json');
+    await (await json).saveAs(saved);
+    const cli = spawnSync(process.execPath, [join(ROOT, 'dist/cli/main.js'), 'report', '--json', path], {
+      encoding: 'utf8',
+      maxBuffer: 64 << 20,
+    });
+    expect(cli.status).toBe(0);
+    expect(readFileSync(saved, 'utf8')).toBe(cli.stdout);
     expect(errors).toEqual([]);
     await page.context().close();
   }, 90_000);
