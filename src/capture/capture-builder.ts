@@ -16,7 +16,8 @@ import {
   REC_OFF_TYPE,
 } from './layout.js';
 import type { CaptureEvent, ParsedCapture } from './model.js';
-import { copyPayload, type HeaderResult, trimTo } from './reader.js';
+import type { HeaderResult } from './reader.js';
+import { copyPayload, trimTo } from './records.js';
 import { utf8Decode } from './text.js';
 
 /** Room for this many records and payload bytes at first: then as `expect` guesses, growing by half as needed. */

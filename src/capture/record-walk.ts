@@ -22,7 +22,8 @@ import {
 } from './layout.js';
 import { crc32 } from './crc32.js';
 import { CaptureFormatError } from './model.js';
-import { type HeaderResult, RecordProbe, readHeader, recordSize } from './reader.js';
+import { type HeaderResult, RecordProbe, readHeader } from './reader.js';
+import { recordSize } from './records.js';
 
 /** Read at a time: the header (its metadata is at most 1 MiB) and a few hundred thousand records. */
 const SLICE_BYTES = 16 << 20;
