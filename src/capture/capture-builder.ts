@@ -17,7 +17,7 @@ import {
 } from './layout.js';
 import type { CaptureEvent, ParsedCapture } from './model.js';
 import type { HeaderResult } from './reader.js';
-import { copyPayload, trimTo } from './records.js';
+import { copyPayload, grown, trimTo } from './records.js';
 import { utf8Decode } from './text.js';
 
 /** Room for this many records and payload bytes at first: then as `expect` guesses, growing by half as needed. */
@@ -113,19 +113,14 @@ export class CaptureBuilder {
   /** Room for at least `bytes` and `records`, by half as much again. */
   #grow(bytes: number, records: number): void {
     if (bytes > this.#data.length) {
-      this.#data = copied(new Uint8Array(Math.max(bytes, Math.ceil(this.#data.length * 1.5))), this.#data, this.#dataLength);
+      this.#data = grown(new Uint8Array(Math.max(bytes, Math.ceil(this.#data.length * 1.5))), this.#data.subarray(0, this.#dataLength));
       this.#dataView = new DataView(this.#data.buffer);
     }
     if (records > this.#ends.length) {
       const size = Math.max(records, Math.ceil(this.#ends.length * 1.5));
-      this.#ends = copied(new Uint32Array(size), this.#ends, this.#chunks);
-      this.#times = copied(new Float64Array(size), this.#times, this.#chunks);
-      this.#ports = copied(new Uint8Array(size), this.#ports, this.#chunks);
+      this.#ends = grown(new Uint32Array(size), this.#ends.subarray(0, this.#chunks));
+      this.#times = grown(new Float64Array(size), this.#times.subarray(0, this.#chunks));
+      this.#ports = grown(new Uint8Array(size), this.#ports.subarray(0, this.#chunks));
     }
   }
-}
-
-function copied<T extends Uint8Array | Uint32Array | Float64Array>(to: T, from: T, length: number): T {
-  to.set(from.subarray(0, length));
-  return to;
 }

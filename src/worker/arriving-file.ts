@@ -27,7 +27,7 @@ export class ArrivingFile implements SlicedFile {
   /** The file could not be read: every read waiting or to come fails with `error`. */
   fail(error: unknown): void {
     this.#failed = error ?? new Error('the file could not be read');
-    // Nothing more is read: what is held is let go (a piece may be a view of a whole file).
+    // Nothing more is read: what is held is let go.
     this.#pieces = [];
     this.#wake();
   }

@@ -156,9 +156,7 @@ export class SplitPass implements OverviewPass {
         agrees = a !== undefined && b !== undefined && a.chunk === b.chunk && a.fedUntilUs === b.fedUntilUs;
       }
       this.#matched.set(run, k);
-      if (agrees && run.done)
-        agrees =
-          k === truth.length && run.walked.chunks === this.#capture.chunkEnds.length && run.walked.dataBytes === this.#capture.bytes.length;
+      if (agrees && run.done) agrees = k === truth.length && walkedAll(run, this.#capture);
       if (!agrees) this.#drop(run);
     }
   }
@@ -255,8 +253,12 @@ export function startSplit(
 export function keptCapture(mine: HelperRun, theirs: HelperRun): ParsedCapture | null {
   const kept = theirs.kept;
   if (kept === null || !mine.done || !theirs.done || mine.failed !== null || theirs.failed !== null) return null;
-  const { chunks, dataBytes } = mine.walked;
-  return kept.chunkEnds.length === chunks && kept.bytes.length === dataBytes ? kept : null;
+  return walkedAll(mine, kept) ? kept : null;
+}
+
+/** Whether a run walked every chunk and byte of `capture` (its counts, as it reported them when done). */
+function walkedAll(run: HelperRun, capture: Capture): boolean {
+  return run.walked.chunks === capture.chunkEnds.length && run.walked.dataBytes === capture.bytes.length;
 }
 
 /** Read at a time from the File: its pieces are what the halves of a split pass are fed. */
