@@ -3,11 +3,18 @@ import { AlignedColumns } from '../src/app/components/Remotes/columns.js';
 import { SeriesBuffer } from '../src/app/live.js';
 import type { Batch } from '../src/worker/protocol.js';
 
-/** A batch's series of `n` 100 ms buckets from `fromUs`, fade rate `rate(i)` (NaN: no value). */
-function buckets(fromUs: number, n: number, rate: (i: number) => number = (i) => i): Batch['series'] {
+/** A batch's series of `n` 100 ms buckets from `fromUs`, fade rate `rate(i)` (NaN: no value), the last `open` of them provisional. */
+function buckets(fromUs: number, n: number, rate: (i: number) => number = (i) => i, open = 0): Batch['series'] {
   const t = Float64Array.from({ length: n }, (_, i) => fromUs + i * 100_000);
   const fadeRate = Float32Array.from({ length: n }, (_, i) => rate(i));
-  return { t, fadeRate, rssi: new Float32Array(n).fill(Number.NaN), periodMs: new Float32Array(n).fill(11), lost: new Float32Array(n) };
+  return {
+    settled: n - open,
+    t,
+    fadeRate,
+    rssi: new Float32Array(n).fill(Number.NaN),
+    periodMs: new Float32Array(n).fill(11),
+    lost: new Float32Array(n),
+  };
 }
 
 describe('the graph series of a remote', () => {
@@ -22,6 +29,21 @@ describe('the graph series of a remote', () => {
     expect(s.rssi).toEqual([null, null, null]);
     expect(s.appended).toBe(3);
     expect(s.indexAt(1.05)).toBe(1);
+  });
+
+  it("replaces the provisional buckets with the next batch's, and counts only final ones as appended", () => {
+    const s = new SeriesBuffer();
+    s.append(buckets(0, 4, () => 1, 2));
+    expect(s.t).toEqual([0, 0.1, 0.2, 0.3]);
+    expect([s.appended, s.provisional]).toEqual([2, 2]);
+    // The open buckets again, one now final and changed, and one more open.
+    s.append(buckets(200_000, 3, () => 5, 2));
+    expect(s.t).toEqual([0, 0.1, 0.2, 0.3, 0.4]);
+    expect(s.fadeRate).toEqual([1, 1, 5, 5, 5]);
+    expect([s.appended, s.provisional]).toEqual([3, 2]);
+    expect(s.unreadSince(2)).toBe(3);
+    s.clear();
+    expect([s.length, s.appended, s.provisional]).toEqual([0, 0, 0]);
   });
 
   it('keeps the same arrays as it grows, and drops what is older than ten minutes in one step', () => {
@@ -69,6 +91,17 @@ describe('the remotes on one time axis', () => {
       [null, null, 1, 1, 3],
       [2, 2, null, null, null],
     ]);
+  });
+
+  it("reads a remote's provisional buckets again when the next batch replaced them", () => {
+    const a = new SeriesBuffer();
+    a.append(buckets(0, 3, () => 1, 2));
+    const cols = new AlignedColumns(1);
+    cols.update([a]);
+    expect(cols.columns).toEqual([[1, 1, 1]]);
+    a.append(buckets(100_000, 3, (i) => 4 + i, 1));
+    cols.update([a]);
+    expect(cols.columns).toEqual([[1, 4, 5, 6]]);
   });
 
   it('starts over when a remote is cleared or replaced, so nothing of the old source stays', () => {

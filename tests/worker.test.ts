@@ -9,26 +9,50 @@ import { captureSpan } from '../src/analysis/index.js';
 import type { Batch } from '../src/worker/protocol.js';
 import { preset, simulate } from '../src/simulator/index.js';
 import { Engine, SETTLE_US } from '../src/worker/engine.js';
+import { SeriesBuffer } from '../src/app/live.js';
 import { ReplaySource } from '../src/worker/sources/replay.js';
 import { openProblem } from '../src/worker/sources/serial.js';
 import { usbChunks, perByteCapture } from './feeds.js';
 import { SimulatedClock } from './worker-fakes.js';
 
 interface Collected {
+  /** The final buckets. */
   series: { t: number[]; fadeRate: number[]; lost: number[]; periodMs: number[] };
+  /** The buckets as the page holds them after each batch (final and provisional). */
+  page: SeriesBuffer;
+  /** Each batch's missed frames and fades, and the lost frames and fades the page's buckets hold then. */
+  shown: { missed: number; lost: number; fades: number; fadesShown: number }[];
   episodes: Batch['episodes'];
   last: Batch | null;
 }
 
+const sum = (xs: readonly number[]): number => xs.reduce((a, b) => a + b, 0);
+
 function collector(engine: Engine) {
-  const c: Collected = { series: { t: [], fadeRate: [], lost: [], periodMs: [] }, episodes: [], last: null };
+  const c: Collected = {
+    series: { t: [], fadeRate: [], lost: [], periodMs: [] },
+    page: new SeriesBuffer(),
+    shown: [],
+    episodes: [],
+    last: null,
+  };
   const take = (now: number) => {
     const out = engine.batch(now);
     if (out === null) return;
-    c.series.t.push(...out.batch.series.t);
-    c.series.fadeRate.push(...out.batch.series.fadeRate);
-    c.series.lost.push(...out.batch.series.lost);
-    c.series.periodMs.push(...out.batch.series.periodMs);
+    const s = out.batch.series;
+    const n = s.settled;
+    c.series.t.push(...s.t.subarray(0, n));
+    c.series.fadeRate.push(...s.fadeRate.subarray(0, n));
+    c.series.lost.push(...s.lost.subarray(0, n));
+    c.series.periodMs.push(...s.periodMs.subarray(0, n));
+    c.page.append(s);
+    const link = out.batch.link;
+    c.shown.push({
+      missed: link.missedFrames,
+      lost: sum(c.page.lost),
+      fades: link.fades,
+      fadesShown: Math.round(sum(c.page.fadeRate) * 0.1),
+    });
     c.episodes.push(...out.batch.episodes);
     c.last = out.batch;
   };
@@ -69,7 +93,14 @@ describe('the engine', () => {
     expect(periods.filter((p) => p > 9 && p < 13).length).toBeGreaterThan(periods.length * 0.8);
   });
 
-  it('hands a bucket to the page only once missing frames can no longer be placed in it', () => {
+  it('holds, after every batch, the missed frames and fades the counters say in the buckets the page shows', () => {
+    const { shown, engine } = run('dropouts-failsafe', 3, 3_200_000);
+    expect(engine.link.stats.missedFrames).toBeGreaterThan(20);
+    expect(shown.filter((b) => b.missed > 0 && b.missed < engine.link.stats.missedFrames).length).toBeGreaterThan(5);
+    for (const b of shown) expect({ lost: b.lost, fades: b.fadesShown }).toEqual({ lost: b.missed, fades: b.fades });
+  });
+
+  it('marks a bucket final only once missing frames can no longer be placed in it', () => {
     const sim = simulate({ ...preset('dsmx-11ms-2048-internal'), seed: 2 }, 3_000_000);
     const engine = new Engine({ resolution: 'auto', jitterUs: 20_000 });
     const { c, take } = collector(engine);

@@ -21,6 +21,10 @@ const gap = (v: number): number | null => (Number.isNaN(v) ? null : v);
  * in the form uPlot draws (seconds, gaps as null), and the graphs hand the same arrays to uPlot
  * on every redraw, which draws only what its x scale shows. Nothing is rebuilt per redraw; what
  * is older than the longest window is dropped in one step once 2.5 minutes of it piled up.
+ *
+ * The newest buckets are provisional (still open in the worker: a missed frame may yet be
+ * placed in them) and each batch replaces them, so the graphs always hold what the counters
+ * count.
  */
 export class SeriesBuffer {
   /** Bucket start in seconds of the source clock (uPlot's x), ascending. */
@@ -31,8 +35,10 @@ export class SeriesBuffer {
   readonly rssi: (number | null)[] = [];
   readonly periodMs: (number | null)[] = [];
   readonly lost: number[] = [];
-  /** Buckets appended since the last clear (including those dropped since): what is new to a reader. */
+  /** Final buckets appended since the last clear (including those dropped since): what is new to a reader. */
   appended = 0;
+  /** The last this many buckets are provisional: a reader reads them again after each append. */
+  provisional = 0;
   /** Counts clears, so a reader that kept a position knows to start over. */
   epoch = 0;
 
@@ -41,6 +47,7 @@ export class SeriesBuffer {
   }
 
   append(s: Batch['series']): void {
+    if (this.provisional > 0) for (const col of this.#columns()) col.length -= this.provisional;
     s.t.forEach((t, i) => {
       this.t.push(t / 1e6);
       this.fadeRate.push(s.fadeRate[i] ?? 0);
@@ -48,16 +55,26 @@ export class SeriesBuffer {
       this.periodMs.push(gap(s.periodMs[i] ?? Number.NaN));
       this.lost.push(s.lost[i] ?? 0);
     });
-    this.appended += s.t.length;
+    this.appended += s.settled;
+    this.provisional = s.t.length - s.settled;
     if (this.t.length > WINDOW_BUCKETS + SLACK_BUCKETS) {
       const drop = this.t.length - WINDOW_BUCKETS;
       for (const col of this.#columns()) col.splice(0, drop);
     }
   }
 
+  /**
+   * How many of the newest buckets a reader that last read at `appended` must (re)read: the
+   * final ones appended since, and the provisional ones.
+   */
+  unreadSince(appended: number): number {
+    return Math.min(this.appended - appended + this.provisional, this.t.length);
+  }
+
   clear(): void {
     for (const col of this.#columns()) col.length = 0;
     this.appended = 0;
+    this.provisional = 0;
     this.epoch++;
   }
 

@@ -213,7 +213,12 @@ export class Engine {
     return Number.NaN;
   }
 
-  /** Buckets that end by `untilUs`, with the newer ones before it that have settled. */
+  /**
+   * The buckets not handed out yet, up to the one holding `untilUs`: first those that have
+   * settled (final), then the open ones as counted so far (provisional: the page shows them and
+   * replaces them with the next batch's), so the graphs hold every fade and missed frame the
+   * counters do.
+   */
   #takeSeries(untilUs: number): Batch['series'] {
     const s = this.series;
     let last = Number.isFinite(untilUs) && !Number.isNaN(s.originUs) ? s.binOf(untilUs - SETTLE_US) : -1;
@@ -222,8 +227,10 @@ export class Engine {
     s.extendTo(untilUs);
     last = Math.min(last, s.bins);
     const from = this.#nextBin;
-    const n = Math.max(0, last - from);
+    const settled = Math.max(0, last - from);
+    const n = Math.max(settled, s.bins - from);
     const out = {
+      settled,
       t: new Float64Array(n),
       fadeRate: new Float32Array(n),
       rssi: new Float32Array(n),
@@ -239,7 +246,7 @@ export class Engine {
       out.periodMs[k] = iv / 1000;
       out.lost[k] = s.lost(b);
     }
-    this.#nextBin = from + n;
+    this.#nextBin = from + settled;
     return out;
   }
 
@@ -258,7 +265,7 @@ export class Engine {
     const retracted = this.link.takeRetracted();
     for (const id of retracted) this.#sent.delete(id);
     const series = this.#takeSeries(now);
-    if (!this.#changed && before === this.link.state && episodes.length === 0 && retracted.length === 0 && series.t.length === 0)
+    if (!this.#changed && before === this.link.state && episodes.length === 0 && retracted.length === 0 && series.settled === 0)
       return null;
     this.#changed = false;
     const l = this.link.stats;

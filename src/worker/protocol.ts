@@ -117,8 +117,12 @@ export interface Batch {
     emptySlots: number;
     vtxFrames: number;
   };
-  /** Completed graph buckets: start time, fades/s, mean RSSI (NaN without), mean frame interval ms (NaN if <2 frames), lost frames. */
-  series: { t: Float64Array; fadeRate: Float32Array; rssi: Float32Array; periodMs: Float32Array; lost: Float32Array };
+  /**
+   * Graph buckets not sent before: start time, fades/s, mean RSSI (NaN without), mean frame
+   * interval ms (NaN if <2 frames), lost frames. The first `settled` are final; the rest are the
+   * buckets still open up to `nowUs`, as counted so far, which the next batch's replace.
+   */
+  series: { settled: number; t: Float64Array; fadeRate: Float32Array; rssi: Float32Array; periodMs: Float32Array; lost: Float32Array };
   /** Hold and failsafe episodes that started, ended or were re-dated since the last batch. */
   episodes: { id: number; kind: 'hold' | 'failsafe'; startUs: number; endUs: number | null }[];
   /** Ids of holds withdrawn: a silence the frames after it showed was the adapter holding bytes back. */

@@ -1,8 +1,8 @@
 /**
  * Every remote's fade rate on one x axis, for the Remotes chart: the remotes' buckets share one
  * 100 ms grid on one clock, so the axis is that grid and each remote is a column on it. The
- * columns grow: each redraw takes only the buckets a remote gained since the last one and
- * writes them in place; nothing is merged, sorted or rebuilt per redraw. A bucket a remote did
+ * columns grow: each redraw takes only the buckets a remote gained since the last one (and its
+ * provisional ones again) and writes them in place; nothing is merged, sorted or rebuilt per redraw. A bucket a remote did
  * not send stays null, a gap in its line (nothing is drawn where nothing arrived).
  */
 import { BUCKET_US } from '../../../worker/protocol.js';
@@ -43,7 +43,7 @@ export class AlignedColumns {
     this.#readers.forEach((reader, r) => {
       const s = reader.series;
       if (s === undefined) return;
-      const fresh = Math.min(s.appended - reader.appended, s.length);
+      const fresh = s.unreadSince(reader.appended);
       for (let i = s.length - fresh; i < s.length; i++) {
         const t = s.t[i];
         if (t !== undefined) this.#put(r, Math.round(t / BUCKET_S), s.fadeRate[i] ?? null);
