@@ -9,7 +9,7 @@
  * Chunks are read straight from the capture's columns (no object per chunk), and the capture's
  * span (`captureSpan`) is one pass over its chunk times, taken once by the caller.
  */
-import type { Capture, CaptureEvent, CaptureTiming } from '../capture/index.js';
+import { captureFact, type Capture, type CaptureEvent, type CaptureTiming } from '../capture/index.js';
 import { BYTE_TIME_US, SpektrumDecoder, USB_CHUNK_JITTER_US, type DecodedFrame, type DecoderOptions } from '../decoder/index.js';
 import type { LinkMonitor } from '../decoder/index.js';
 import type { Doctor } from './doctor.js';
@@ -58,9 +58,14 @@ export const SLICE_BYTES = 256;
  * The earliest and latest time recorded in a capture on any port (data bytes and events), on
  * the capture's clock, µs; NaN for both without timing. Every surface starts and ends a capture
  * here: the report's time zero, replay's timeline, the end at which the link's state is judged.
- * One pass over the chunk columns.
+ * One pass over the chunk columns, once per capture (`captureFact`).
  */
 export function captureSpan(capture: Capture): { startUs: number; endUs: number } {
+  const { startUs, endUs } = captureFact(capture, 'span', spanOf);
+  return { startUs, endUs };
+}
+
+function spanOf(capture: Capture): { startUs: number; endUs: number } {
   const { chunkEnds, chunkTimesUs, byteTimesUs } = capture;
   let start = Infinity;
   let end = -Infinity;

@@ -20,6 +20,7 @@ export {
   type ParsedCapture,
 } from './model.js';
 export { crc32 } from './crc32.js';
+export { captureFact } from './facts.js';
 export {
   CAPTURE_FILE_EXTENSION,
   CAPTURE_FORMAT_VERSION,

@@ -1,0 +1,44 @@
+/**
+ * Facts worked out from a capture's columns (its ports, its span), kept with the capture: the
+ * surfaces that each ask for them (a report and its jobs, a replay's session and its source)
+ * then pay one pass over the chunks, not one each; a day-long capture has eleven million.
+ *
+ * A capture's columns are typed arrays nobody writes once the capture is made. A fact is
+ * worked out again when the capture's chunk columns or events are no longer the ones it was
+ * worked out from (an object spread with new columns is another capture anyway).
+ */
+import type { Capture } from './model.js';
+
+interface Kept {
+  chunkEnds: Uint32Array;
+  chunkTimesUs: Float64Array;
+  chunkPorts: Uint8Array;
+  byteTimesUs: Float64Array | undefined;
+  events: Capture['events'];
+  eventCount: number;
+  facts: Map<string, unknown>;
+}
+
+const kept = new WeakMap<Capture, Kept>();
+
+/** `work(capture)`, worked out once per capture and `name` (see above); the caller copies what it hands out. */
+export function captureFact<T>(capture: Capture, name: string, work: (capture: Capture) => T): T {
+  const { chunkEnds, chunkTimesUs, chunkPorts, byteTimesUs, events } = capture;
+  let k = kept.get(capture);
+  if (
+    k === undefined ||
+    k.chunkEnds !== chunkEnds ||
+    k.chunkTimesUs !== chunkTimesUs ||
+    k.chunkPorts !== chunkPorts ||
+    k.byteTimesUs !== byteTimesUs ||
+    k.events !== events ||
+    k.eventCount !== events.length
+  ) {
+    k = { chunkEnds, chunkTimesUs, chunkPorts, byteTimesUs, events, eventCount: events.length, facts: new Map() };
+    kept.set(capture, k);
+  }
+  if (k.facts.has(name)) return k.facts.get(name) as T;
+  const fact = work(capture);
+  k.facts.set(name, fact);
+  return fact;
+}

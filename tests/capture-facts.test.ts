@@ -1,0 +1,54 @@
+/**
+ * Facts kept with a capture (`captureFact`): its ports and span are worked out once, copied when
+ * handed out, and worked out again when the capture's columns or events are not the ones they
+ * came from.
+ */
+import { describe, expect, it } from 'vitest';
+import { captureSpan } from '../src/analysis/index.js';
+import { captureFact, capturePorts, type Capture } from '../src/capture/index.js';
+
+function capture(ports: number[], times: number[]): Capture {
+  return {
+    kind: 'raw',
+    meta: {},
+    timing: 'per-chunk',
+    bytes: new Uint8Array(ports.length),
+    chunkEnds: Uint32Array.from(ports, (_, i) => i + 1),
+    chunkTimesUs: Float64Array.from(times),
+    chunkPorts: Uint8Array.from(ports),
+    events: [],
+    issues: [],
+  };
+}
+
+describe('facts kept with a capture', () => {
+  it('works a fact out once per capture and name', () => {
+    const c = capture([0, 1], [10, 20]);
+    let work = 0;
+    const count = (): number => ++work;
+    expect([captureFact(c, 'n', count), captureFact(c, 'n', count)]).toEqual([1, 1]);
+    expect(captureFact(c, 'other', count)).toBe(2);
+    expect(captureFact(capture([0, 1], [10, 20]), 'n', count)).toBe(3);
+  });
+
+  it('hands out copies: a caller that changes what it got changes nothing for the next', () => {
+    const c = capture([2, 0, 2], [10, 20, 30]);
+    const ports = capturePorts(c);
+    ports.push(9);
+    expect(capturePorts(c)).toEqual([0, 2]);
+    const span = captureSpan(c);
+    span.startUs = -1;
+    expect(captureSpan(c)).toEqual({ startUs: 10, endUs: 30 });
+  });
+
+  it('works it out again when the events or a column are no longer the ones it came from', () => {
+    const c = capture([0], [100]);
+    expect(captureSpan(c)).toEqual({ startUs: 100, endUs: 100 });
+    (c.events as Capture['events'][number][]).push({ timeUs: 500, port: 0, text: 'port closed', chunkIndex: 1 });
+    expect(captureSpan(c)).toEqual({ startUs: 100, endUs: 500 });
+    const moved = Object.assign(c, { chunkPorts: Uint8Array.from([3]) });
+    expect(capturePorts(moved)).toEqual([3]);
+    const later = Object.assign(c, { chunkTimesUs: Float64Array.from([50]) });
+    expect(captureSpan(later)).toEqual({ startUs: 50, endUs: 500 });
+  });
+});
