@@ -66,7 +66,7 @@ describe('a big capture read on two threads', () => {
     const path = join(dir, name);
     writeFileSync(path, content);
     const { loadCapture } = (await import(resolve(import.meta.dirname, '../dist/cli/input.js'))) as {
-      loadCapture: (file: string, options: object, partsMinBytes?: number) => { capture?: Capture; partsThere?: number; error?: string };
+      loadCapture: (file: string, options: object, partsMinBytes?: number) => { capture?: Capture; bytesThere?: number; partsThere?: number; error?: string };
     };
     return loadCapture(path, {}, 0);
   };
@@ -101,6 +101,8 @@ describe('a big capture read on two threads', () => {
     big.set(bytes.subarray(0, headerLength));
     for (let k = 0; k < copies; k++) big.set(records, headerLength + k * records.length);
     const loaded = await load('big.sscap', big);
+    // The other thread read the file's second half, then took parts.
+    expect(loaded.bytesThere).toBe(big.length - (big.length >> 1));
     expect(loaded.partsThere).toBeGreaterThan(0);
     expect(loaded.partsThere).toBeLessThan(16);
     expect(digest(loaded.capture)).toEqual(digest(readCapture(big, 'big.sscap')));
@@ -122,6 +124,9 @@ describe('a big capture read on two threads', () => {
     expect(content(loaded.capture)).toEqual(content(readCapture(damaged, 'damaged.sscap')));
     const text = await load('notes.txt', new TextEncoder().encode('{"not": "a capture"}\n'));
     expect(text.error).toMatch(/not a Saleae/);
+    // An empty file: nothing for either thread to read.
+    const empty = await load('empty.sscap', new Uint8Array(0));
+    expect(empty.error).toMatch(/empty/);
   });
 });
 

@@ -2,9 +2,9 @@
  * Reading the capture a command names: the file's bytes through `readCapture`, or why not, in
  * the words and exit codes every command uses (2: the file cannot be read, 1: not a capture).
  *
- * A big .sscap (`PARTS_MIN_BYTES` and up) is read on two threads when it is intact: its bytes
- * and columns in shared memory, its records cut into parts (`planParts`) that both threads take
- * in turn, each checking and copying the parts it takes (`readPart`). The capture is the one
+ * A big file (`PARTS_MIN_BYTES` and up) is read on two threads, each half of it by one, into
+ * shared memory. When it is an intact .sscap, its records are then cut into parts (`planParts`)
+ * that both threads take in turn, each checking and copying the parts it takes (`readPart`). The capture is the one
  * `readCapture` makes; a damaged file, or a part the other thread could not read, is read here
  * alone, salvaging as ever.
  */
@@ -22,27 +22,50 @@ import {
   type PartRead,
   type ReadOptions,
 } from '../capture/index.js';
-import type { ReadThreadData, ReadThreadResult } from './read-thread.js';
+import type { ReadThreadData, ReadThreadParts, ReadThreadResult } from './read-thread.js';
 import { secondCore, WaitedWorker } from './waited-worker.js';
 
-/** The capture, and how many of its parts the second thread read (0: read on this thread alone). */
-export type LoadedCapture = { capture: Capture; partsThere: number } | { error: string; exitCode: 1 | 2 };
+/** The capture, and how many of the file's bytes and of its parts the second thread read (0: read on this thread alone). */
+export type LoadedCapture = { capture: Capture; bytesThere: number; partsThere: number } | { error: string; exitCode: 1 | 2 };
 
 /** Files from this size on are read on two threads when they are intact .sscap captures. */
 export const PARTS_MIN_BYTES = 32 << 20;
 
-/** The file's bytes, in shared memory when it is big. @throws what the file system says. */
-function readBytes(file: string, big: number): Uint8Array {
+/** Bytes `[from, to)` of the open file `fd` into `bytes`; how many there were (fewer: the file ended first). */
+function readRange(fd: number, bytes: Uint8Array, from: number, to: number): number {
+  let at = from;
+  for (let n = 1; at < to && n > 0; at += n) n = readSync(fd, bytes, at, to - at, at);
+  return at - from;
+}
+
+/**
+ * The file's bytes (shorter than its size said: what was there), and for a big file on a
+ * machine with a second core, in shared memory, the thread that read its second half while
+ * this one read the first, to read the parts with (`readInParts`). @throws what the file system says.
+ */
+function readBytes(file: string, big: number): { bytes: Uint8Array; bytesThere: number; helper: WaitedWorker<ReadThreadResult> | null } {
   const fd = openSync(file, 'r');
   try {
     const size = fstatSync(fd).size;
-    const bytes = new Uint8Array(size >= big ? new SharedArrayBuffer(size) : new ArrayBuffer(size));
-    for (let at = 0; at < size; ) {
-      const n = readSync(fd, bytes, at, size - at, at);
-      if (n === 0) return bytes.subarray(0, at); // shorter than it said: what was there
-      at += n;
+    if (size < big || !secondCore()) {
+      const bytes = new Uint8Array(size);
+      return { bytes: bytes.subarray(0, readRange(fd, bytes, 0, size)), bytesThere: 0, helper: null };
     }
-    return bytes;
+    const bytes = new Uint8Array(new SharedArrayBuffer(size));
+    const half = size >> 1;
+    const data: ReadThreadData = { file, bytes, from: half, to: size };
+    const helper = new WaitedWorker<ReadThreadResult>(new URL('./read-thread.js', import.meta.url), data);
+    try {
+      const mine = readRange(fd, bytes, 0, half);
+      const there = helper.result(0);
+      // The other thread could not read its half: read it here.
+      const bytesThere = there !== undefined && 'read' in there ? there.read : 0;
+      const theirs = there !== undefined && 'read' in there ? there.read : readRange(fd, bytes, half, size);
+      return { bytes: bytes.subarray(0, mine < half ? mine : half + theirs), bytesThere, helper };
+    } catch (error) {
+      helper.close();
+      throw error;
+    }
   } finally {
     closeSync(fd);
   }
@@ -55,39 +78,38 @@ function readBytes(file: string, big: number): Uint8Array {
  */
 const PARTS = 16;
 
-/** An intact .sscap read on two threads, and how many parts the other read; or null (not one, or not intact: `readCapture` reads it). */
-function readInParts(bytes: Uint8Array): { capture: Capture; partsThere: number } | null {
+/**
+ * An intact .sscap read on two threads (this one and `helper`, which has read the file's second
+ * half and waits for the parts), and how many parts the other read; or null (not one, or not
+ * intact: `readCapture` reads it).
+ */
+function readInParts(bytes: Uint8Array, helper: WaitedWorker<ReadThreadResult>): { capture: Capture; partsThere: number } | null {
   const plan = planParts(bytes, PARTS);
   if (plan === null) return null;
   const { parts } = plan;
   const columns = partColumns(plan, true);
   const taken = new Int32Array(new SharedArrayBuffer(4));
-  const data: ReadThreadData = { bytes, parts, columns, taken };
-  const worker = new WaitedWorker<ReadThreadResult>(new URL('./read-thread.js', import.meta.url), data);
-  try {
-    // Both threads take the next part not taken until none is left; one that is not intact stops both.
-    const reads: (PartRead | undefined)[] = new Array(parts.length);
-    let mine = 0;
-    for (let k = Atomics.add(taken, 0, 1); k < parts.length; k = Atomics.add(taken, 0, 1)) {
-      const read = readPart(bytes, parts[k] as CapturePart, columns);
-      if (!read.intact) {
-        Atomics.store(taken, 0, parts.length);
-        return null;
-      }
-      reads[k] = read;
-      mine++;
+  helper.send({ parts, columns, taken } satisfies ReadThreadParts);
+  // Both threads take the next part not taken until none is left; one that is not intact stops both.
+  const reads: (PartRead | undefined)[] = new Array(parts.length);
+  let mine = 0;
+  for (let k = Atomics.add(taken, 0, 1); k < parts.length; k = Atomics.add(taken, 0, 1)) {
+    const read = readPart(bytes, parts[k] as CapturePart, columns);
+    if (!read.intact) {
+      Atomics.store(taken, 0, parts.length);
+      return null;
     }
-    // Then the other thread's, one result per part it took.
-    for (let i = 0; i < parts.length - mine; i++) {
-      const there = worker.result(i);
-      if (there === undefined || !('ok' in there) || !there.ok.intact) return null;
-      reads[there.k] = there.ok;
-    }
-    const capture = reads.every((r) => r !== undefined) ? assembleParts(plan, columns, reads) : null;
-    return capture === null ? null : { capture, partsThere: parts.length - mine };
-  } finally {
-    worker.close();
+    reads[k] = read;
+    mine++;
   }
+  // Then the other thread's, one result per part it took (after the one for its half of the file).
+  for (let i = 0; i < parts.length - mine; i++) {
+    const there = helper.result(1 + i);
+    if (there === undefined || !('ok' in there) || !there.ok.intact) return null;
+    reads[there.k] = there.ok;
+  }
+  const capture = reads.every((r) => r !== undefined) ? assembleParts(plan, columns, reads) : null;
+  return capture === null ? null : { capture, partsThere: parts.length - mine };
 }
 
 /**
@@ -95,9 +117,9 @@ function readInParts(bytes: Uint8Array): { capture: Capture; partsThere: number 
  * threads (`ReadOptions`). Files of `partsMinBytes` and more are read on two threads.
  */
 export function loadCapture(file: string, options: ReadOptions = {}, partsMinBytes = PARTS_MIN_BYTES): LoadedCapture {
-  let bytes: Uint8Array;
+  let read: ReturnType<typeof readBytes>;
   try {
-    bytes = readBytes(file, partsMinBytes);
+    read = readBytes(file, partsMinBytes);
   } catch (error) {
     const code = (error as NodeJS.ErrnoException).code;
     const why =
@@ -110,11 +132,14 @@ export function loadCapture(file: string, options: ReadOptions = {}, partsMinByt
             : String(error);
     return { error: `cannot read ${file}: ${why}`, exitCode: 2 };
   }
+  const { bytes, bytesThere, helper } = read;
   try {
-    const parts = bytes.length >= partsMinBytes && secondCore() ? readInParts(bytes) : null;
-    return parts ?? { capture: readCapture(bytes, basename(file), options), partsThere: 0 };
+    const parts = helper === null ? null : readInParts(bytes, helper);
+    return { bytesThere, ...(parts ?? { capture: readCapture(bytes, basename(file), options), partsThere: 0 }) };
   } catch (error) {
     if (error instanceof CaptureFormatError) return { error: `${file}: ${error.message}`, exitCode: 1 };
     throw error;
+  } finally {
+    helper?.close();
   }
 }

@@ -1,28 +1,47 @@
 /**
- * The second thread of a big capture's reading (`loadCapture` in input.ts): takes parts of the
- * file's records in turn with the reading thread (the next one not taken, from a shared count),
- * checks and copies each into the shared columns (`readPart`) and posts what it found, until
- * none is left or one is not intact.
+ * The second thread of a big capture's reading (`loadCapture` in input.ts). First it reads the
+ * file's second half into the shared bytes while the reading thread reads the first, and posts
+ * how many bytes it read. Then, when the reading thread sends it the parts of an intact .sscap,
+ * it takes parts in turn with that thread (the next one not taken, from a shared count), checks
+ * and copies each into the shared columns (`readPart`) and posts what it found, until none is
+ * left or one is not intact. A file that is not one is never sent: this thread is stopped.
  */
+import { closeSync, openSync, readSync } from 'node:fs';
 import type { CaptureColumns, CapturePart, PartRead } from '../capture/index.js';
 import { workerSide } from './waited-worker.js';
 
-/** What `loadCapture` hands this thread: the file's bytes, its parts, the columns and the count of parts taken, all shared. */
+/** What `loadCapture` hands this thread when it starts: the file, the shared bytes, and the range of them to read. */
 export interface ReadThreadData {
+  file: string;
   bytes: Uint8Array;
+  from: number;
+  to: number;
+}
+
+/** What `loadCapture` sends it once the file is read: its parts, the columns and the count of parts taken, all shared. */
+export interface ReadThreadParts {
   parts: readonly CapturePart[];
   columns: CaptureColumns;
   /** [0]: the next part to take (Atomics.add); past the last, nothing is left. */
   taken: Int32Array;
 }
 
-/** Part `k`'s reading, or why this thread could not read (the reading thread then reads the file alone). */
-export type ReadThreadResult = { k: number; ok: PartRead } | { error: string };
+/** First the bytes it read (fewer than asked: the file ended first); then part `k`'s reading, one per part; or why it could not. */
+export type ReadThreadResult = { read: number } | { k: number; ok: PartRead } | { error: string };
 
-const { data, post } = workerSide<ReadThreadData>();
+const { data, post, next } = workerSide<ReadThreadData>();
 try {
+  const { file, bytes, from, to } = data;
+  const fd = openSync(file, 'r');
+  let at = from;
+  try {
+    for (let n = 1; at < to && n > 0; at += n) n = readSync(fd, bytes, at, to - at, at);
+  } finally {
+    closeSync(fd);
+  }
+  post({ read: at - from } satisfies ReadThreadResult);
   const { readPart } = await import('../capture/index.js');
-  const { bytes, parts, columns, taken } = data;
+  const { parts, columns, taken } = (await next()) as ReadThreadParts;
   for (let k = Atomics.add(taken, 0, 1); k < parts.length; k = Atomics.add(taken, 0, 1)) {
     const part = parts[k] as CapturePart;
     const ok = readPart(bytes, part, columns);

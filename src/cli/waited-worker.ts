@@ -4,7 +4,8 @@
  * its own and counts it in shared memory; this thread sleeps on the count (`Atomics.wait`) and
  * takes the message off the port (`receiveMessageOnPort`). Results come in the order posted. A
  * worker that ends without posting a result (it failed to load, threw, was stopped) counts its
- * end as well, so that nobody waits for it for ever: the result is then undefined.
+ * end as well, so that nobody waits for it for ever: the result is then undefined. This thread
+ * can also send the worker a message on the same port, which the worker awaits (`next`).
  */
 import { availableParallelism } from 'node:os';
 import { MessageChannel, type MessagePort, receiveMessageOnPort, Worker, workerData } from 'node:worker_threads';
@@ -47,6 +48,11 @@ export class WaitedWorker<Result> {
     return this.#results[i];
   }
 
+  /** Sends the worker a message (its `next()`), without waiting. */
+  send(message: unknown): void {
+    this.#port.postMessage(message);
+  }
+
   /** Stops the worker (whatever it was still doing). */
   close(): void {
     this.#port.close();
@@ -54,8 +60,8 @@ export class WaitedWorker<Result> {
   }
 }
 
-/** In the worker module: its data, and how it posts a result. */
-export function workerSide<Data>(): { data: Data; post: (result: unknown) => void } {
+/** In the worker module: its data, how it posts a result, and the next message `send` sent it. */
+export function workerSide<Data>(): { data: Data; post: (result: unknown) => void; next: () => Promise<unknown> } {
   const { link, ...data } = workerData as Data & { link: Link };
   process.on('exit', () => {
     Atomics.store(link.signal, 1, 1);
@@ -69,5 +75,6 @@ export function workerSide<Data>(): { data: Data; post: (result: unknown) => voi
       Atomics.add(link.signal, 0, 1);
       Atomics.notify(link.signal, 0);
     },
+    next: () => new Promise((resolve) => link.port.once('message', resolve)),
   };
 }
