@@ -3,7 +3,8 @@
  * export replays on its own clock with a timeline, seeking and speeds, and ends frozen at its
  * last recorded time; forcing a resolution that no frame fits says so and counts nothing as
  * link loss; a capture with dropouts and line damage replayed in the page ends with the figures
- * `satscope info` gives for the same file. Needs the built page (`npm run build`) and Debian's
+ * `satscope info` gives for the same file; a paused replay's graphs hold the missed frames its
+ * counters count. Needs the built page (`npm run build`) and Debian's
  * Chromium.
  */
 import { spawnSync } from 'node:child_process';
@@ -249,6 +250,37 @@ describe.skipIf(skip !== null)('seeking in a long capture', () => {
     await expect(page.getByTestId('count-missed').textContent()).resolves.toBe(String(want.missed));
     await expect(page.getByTestId('count-bytes').textContent()).resolves.toBe(String(want.bytes));
     await expect(page.locator('.link dd').nth(1).textContent()).resolves.toBe(`${want.holds} holds · ${want.failsafes} failsafes`);
+    expect(errors).toEqual([]);
+    await page.context().close();
+  });
+});
+
+describe.skipIf(skip !== null)('the graphs and the counters', () => {
+  it('shows in the Lost graph of a paused replay every missed frame the counters count, the newest too', async () => {
+    // An internal remote whose fade counter counts the frames a 40 ms dropout takes.
+    const sim = simulate({ ...preset('dsmx-11ms-2048-internal'), seed: 4, dropouts: [{ atUs: 3e6, durationUs: 40_000 }] }, 20e6);
+    const path = join(dir, 'one-dropout.sscap');
+    writeCapture(path, usbChunks(sim.bytes, sim.timesUs));
+    const { page, errors } = await open('?demo=0');
+    await page.setInputFiles('input[type=file]', path);
+    const missed = page.getByTestId('count-missed');
+    await missed.filter({ hasText: /^[1-9]\d*$/ }).waitFor({ timeout: 15_000 });
+    // Paused at once: the bucket the missed frames are in is still open (under half a second old).
+    await page.getByRole('button', { name: 'Pause' }).click();
+    await page.waitForTimeout(500);
+    const counted = Number(await missed.textContent());
+    // The newest ten buckets of the Lost graph, read through its keyboard cursor's legend.
+    const chart = page.locator('[data-chart="lost"]');
+    await chart.focus();
+    await chart.press('End');
+    let shown = 0;
+    for (let k = 0; k < 10; k++) {
+      const legend = (await chart.locator('.u-legend').textContent()) ?? '';
+      shown += Number(/Lost\s*(\d+) \/100 ms/.exec(legend)?.[1] ?? Number.NaN);
+      await chart.press('ArrowLeft');
+    }
+    expect(counted).toBeGreaterThan(0);
+    expect(shown).toBe(counted);
     expect(errors).toEqual([]);
     await page.context().close();
   });
