@@ -38,7 +38,7 @@ describe('the batcher', () => {
       batcher.schedule();
       clock.advance(1);
     }
-    const batches = of('batch');
+    const batches = of('batches');
     expect(batches.length).toBeLessThanOrEqual(Math.ceil(200 / MIN_BATCH_MS) + 1);
     expect(batches.length).toBeGreaterThanOrEqual(Math.floor(200 / MIN_BATCH_MS) - 1);
     expect(flushes()).toBe(batches.length);
@@ -47,12 +47,12 @@ describe('the batcher', () => {
     source.engine.push(c.bytes, c.timeUs, 0);
     batcher.schedule();
     clock.advance(MIN_BATCH_MS);
-    const after = of('batch');
+    const after = of('batches');
     expect(after.length).toBe(batches.length + 1);
-    expect(after.at(-1)?.batch.counters.bytes).toBe(source.engine.decoder.stats.bytes);
+    expect(after.at(-1)?.batches[0]?.batch.counters.bytes).toBe(source.engine.decoder.stats.bytes);
     // Nothing changed since: no timer waits, nothing more is sent.
     clock.advance(100);
-    expect(of('batch')).toHaveLength(after.length);
+    expect(of('batches')).toHaveLength(after.length);
     expect(clock.pending).toBe(0);
   });
 
@@ -62,7 +62,7 @@ describe('the batcher', () => {
     const c = chunks[0]!;
     source.engine.push(c.bytes, c.timeUs, 0);
     batcher.schedule();
-    expect(of('batch')).toHaveLength(1);
+    expect(of('batches')).toHaveLength(1);
   });
 
   it('ticks every IDLE_TICK_MS while live sources are quiet, and not after stop()', () => {
@@ -92,9 +92,12 @@ describe('the batcher', () => {
     expect(source.engine).not.toBe(a.engine);
     for (const s of [a, b]) s.engine.push(chunks[0]!.bytes, chunks[0]!.timeUs, 0);
     batcher.flush();
-    expect(of('batch').map((m) => [m.source, m.batch.nowUs])).toEqual([
-      [0, 5_000_000],
-      [1, 5_001_000],
+    // Both sources' batches in one message: the page applies them in one task.
+    expect(of('batches').map((m) => m.batches.map((b) => [b.source, b.batch.nowUs]))).toEqual([
+      [
+        [0, 5_000_000],
+        [1, 5_001_000],
+      ],
     ]);
   });
 });

@@ -159,10 +159,10 @@ describe('the dispatcher', () => {
   });
 
   it('gives a source removed while its data is on the way none of it; the others go on', async () => {
-    const { send, worker, clock, posts } = setup();
+    const { send, worker, clock, posts, batches } = setup();
     await send({ type: 'demo-start' });
     clock.advance(200);
-    const batchesOf = (from: number, id: number) => posts.slice(from).filter((p) => p.type === 'batch' && p.source === id).length;
+    const batchesOf = (from: number, id: number) => batches(from).filter((b) => b.source === id).length;
     expect(batchesOf(0, 0)).toBeGreaterThan(5);
     expect(batchesOf(0, 1)).toBeGreaterThan(5);
     // Remote B's next chunk is already generated when its close is handled.

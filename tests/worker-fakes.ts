@@ -1,6 +1,6 @@
 /** A fake clock and host for driving the worker's parts in Node: time moves only when a test says. */
 import type { Clock, Host } from '../src/worker/host.js';
-import type { FromWorker } from '../src/worker/protocol.js';
+import type { Batch, FromWorker } from '../src/worker/protocol.js';
 import type { ReplayClock } from '../src/worker/sources/replay.js';
 
 interface Timer {
@@ -77,7 +77,10 @@ export function fakeHost(clock = new FakeClock()) {
   };
   const of = <T extends FromWorker['type']>(type: T): Extract<FromWorker, { type: T }>[] =>
     posts.filter((p): p is Extract<FromWorker, { type: T }> => p.type === type);
-  return { host, clock, posts, of };
+  /** Every source's batch posted so far, in order (the batcher posts all sources' batches of a flush in one message). */
+  const batches = (from = 0): { source: number; batch: Batch }[] =>
+    posts.slice(from).flatMap((p) => (p.type === 'batches' ? p.batches : []));
+  return { host, clock, posts, of, batches };
 }
 
 /** Wall time for replay: each tick moves it 10 ms; every reading moves it a µs, so slices end. */

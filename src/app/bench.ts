@@ -33,7 +33,7 @@ export function startBenchHooks(worker: Worker): void {
   worker.addEventListener('message', (event: MessageEvent<FromWorker>) => {
     const m = event.data;
     if (m.type === 'reset' && m.source === undefined) bench.resetAtMs = performance.now();
-    else if (m.type === 'batch' && bench.firstBatchAtMs < bench.resetAtMs) bench.firstBatchAtMs = performance.now();
+    else if (m.type === 'batches' && bench.firstBatchAtMs < bench.resetAtMs) bench.firstBatchAtMs = performance.now();
   });
   let version = -1;
   let shown = current();

@@ -172,9 +172,11 @@ function receive(message: FromWorker): void {
       }
       break;
     }
-    case 'batch':
-      liveOf(message.source).apply(message.batch);
-      if (message.source === selected.value) refreshOnFrame();
+    case 'batches':
+      for (const { source, batch } of message.batches) {
+        liveOf(source).apply(batch);
+        if (source === selected.value) refreshOnFrame();
+      }
       break;
     case 'reset':
       if (message.source === undefined) lives.clear();

@@ -1,9 +1,10 @@
 /**
- * The batcher: hands the page what changed in every source, at most every MIN_BATCH_MS however
- * fast bytes come (a display frame is 16.7 ms at 60 Hz), never leaving the last change unsent,
+ * The batcher: hands the page what changed in every source, in one message, at most every
+ * MIN_BATCH_MS however fast bytes come (a display frame is 16.7 ms at 60 Hz), never leaving the last change unsent,
  * and every IDLE_TICK_MS while live sources are quiet, so hold, failsafe and ages advance.
  */
 import type { Clock, Host } from './host.js';
+import type { Batch } from './protocol.js';
 import type { SourceRegistry } from './registry.js';
 
 /** Batches at most this often. */
@@ -34,10 +35,15 @@ export class Batcher {
     this.#clock.cancel(this.#flushTimer);
     this.#flushTimer = undefined;
     this.#lastBatchMs = this.#clock.now();
+    const batches: { source: number; batch: Batch }[] = [];
+    const transfer: ArrayBuffer[] = [];
     for (const s of this.registry.list()) {
       const out = s.engine.batch(this.registry.linkNowUs(s.id));
-      if (out !== null) this.host.post({ type: 'batch', source: s.id, batch: out.batch }, out.transfer);
+      if (out === null) continue;
+      batches.push({ source: s.id, batch: out.batch });
+      transfer.push(...out.transfer);
     }
+    if (batches.length > 0) this.host.post({ type: 'batches', batches }, transfer);
     this.afterFlush();
   }
 

@@ -190,7 +190,8 @@ export interface BindProgress {
 export type FromWorker =
   /** Every source, whenever any of them changes (a handful at most). */
   | { type: 'sources'; sources: SourceStatus[] }
-  | { type: 'batch'; source: number; batch: Batch }
+  /** What changed in each source that changed since the last flush, in one message (one task on the page, all sources at the same moment). */
+  | { type: 'batches'; batches: { source: number; batch: Batch }[] }
   /** A source's decode started over (or all of them when `source` is undefined). */
   | { type: 'reset'; source?: number }
   | { type: 'notice'; level: 'info' | 'warning' | 'error'; title: string; detail: string }
