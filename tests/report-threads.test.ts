@@ -66,7 +66,11 @@ describe('a big capture read on two threads', () => {
     const path = join(dir, name);
     writeFileSync(path, content);
     const { loadCapture } = (await import(resolve(import.meta.dirname, '../dist/cli/input.js'))) as {
-      loadCapture: (file: string, options: object, partsMinBytes?: number) => { capture?: Capture; bytesThere?: number; partsThere?: number; error?: string };
+      loadCapture: (
+        file: string,
+        options: object,
+        partsMinBytes?: number,
+      ) => { capture?: Capture; bytesThere?: number; partsThere?: number; error?: string };
     };
     return loadCapture(path, {}, 0);
   };
