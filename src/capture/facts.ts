@@ -1,6 +1,6 @@
 /**
- * Facts worked out from a capture's columns (its ports, its span), kept with the capture: the
- * surfaces that each ask for them (a report and its jobs, a replay's session and its source)
+ * Facts worked out from a capture's columns (its ports here, its span in the analysis), kept
+ * with the capture: the surfaces that each ask for them (a report and its jobs, a replay's session and its source)
  * then pay one pass over the chunks, not one each; a day-long capture has eleven million.
  *
  * A capture's columns are typed arrays nobody writes once the capture is made. A fact is
@@ -41,4 +41,17 @@ export function captureFact<T>(capture: Capture, name: string, work: (capture: C
   const fact = work(capture);
   k.facts.set(name, fact);
   return fact;
+}
+
+/** The port indices that have at least one data chunk, in increasing order (one pass per capture: `captureFact`). */
+export function capturePorts(capture: Capture): number[] {
+  return captureFact(capture, 'ports', portsOf).slice();
+}
+
+function portsOf(capture: Capture): number[] {
+  const seen = new Uint8Array(256);
+  for (let i = 0; i < capture.chunkPorts.length; i++) seen[capture.chunkPorts[i] ?? 0] = 1;
+  const ports: number[] = [];
+  for (let p = 0; p < 256; p++) if (seen[p] === 1) ports.push(p);
+  return ports;
 }

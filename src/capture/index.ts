@@ -6,7 +6,6 @@
 export {
   CaptureFormatError,
   captureChunks,
-  capturePorts,
   type Capture,
   type CaptureChunk,
   type CaptureEvent,
@@ -20,7 +19,7 @@ export {
   type ParsedCapture,
 } from './model.js';
 export { crc32 } from './crc32.js';
-export { captureFact } from './facts.js';
+export { captureFact, capturePorts } from './facts.js';
 export {
   CAPTURE_FILE_EXTENSION,
   CAPTURE_FORMAT_VERSION,

@@ -2,7 +2,6 @@
  * The in-memory capture model every importer returns and every consumer reads: bytes with their
  * arrival times, chunk by chunk, per port, plus the events and issues found on the way.
  */
-import { captureFact } from './facts.js';
 
 /** A metadata value that is not a list: what the free-form metadata fields may hold. */
 export type MetaScalar = string | number | boolean | null;
@@ -196,17 +195,4 @@ export function* captureChunks(capture: Capture, port?: number): Generator<Captu
     }
     start = end;
   }
-}
-
-/** The port indices that have at least one data chunk, in increasing order (one pass per capture: `captureFact`). */
-export function capturePorts(capture: Capture): number[] {
-  return captureFact(capture, 'ports', portsOf).slice();
-}
-
-function portsOf(capture: Capture): number[] {
-  const seen = new Uint8Array(256);
-  for (let i = 0; i < capture.chunkPorts.length; i++) seen[capture.chunkPorts[i] ?? 0] = 1;
-  const ports: number[] = [];
-  for (let p = 0; p < 256; p++) if (seen[p] === 1) ports.push(p);
-  return ports;
 }
