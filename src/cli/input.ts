@@ -4,9 +4,9 @@
  *
  * A big file (`PARTS_MIN_BYTES` and up) is read on two threads, each half of it by one, into
  * shared memory. When it is an intact .sscap, its records are then cut into parts (`planParts`)
- * that both threads take in turn, each checking and copying the parts it takes (`readPart`). The capture is the one
- * `readCapture` makes; a damaged file, or a part the other thread could not read, is read here
- * alone, salvaging as ever.
+ * that both threads take in turn, each checking and copying the parts it takes (`readPart`).
+ * The capture is the one `readCapture` makes; a damaged file, or a part the other thread could
+ * not read, is read here alone, salvaging as ever.
  */
 import { closeSync, fstatSync, openSync, readSync } from 'node:fs';
 import { basename } from 'node:path';

@@ -1,7 +1,8 @@
 /**
  * The batcher: hands the page what changed in every source, in one message, at most every
- * MIN_BATCH_MS however fast bytes come (a display frame is 16.7 ms at 60 Hz), never leaving the last change unsent,
- * and every IDLE_TICK_MS while live sources are quiet, so hold, failsafe and ages advance.
+ * MIN_BATCH_MS however fast bytes come (a display frame is 16.7 ms at 60 Hz), never leaving the
+ * last change unsent, and every IDLE_TICK_MS while live sources are quiet, so hold, failsafe and
+ * ages advance.
  */
 import type { Clock, Host } from './host.js';
 import type { Batch } from './protocol.js';

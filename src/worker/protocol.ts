@@ -190,7 +190,10 @@ export interface BindProgress {
 export type FromWorker =
   /** Every source, whenever any of them changes (a handful at most). */
   | { type: 'sources'; sources: SourceStatus[] }
-  /** What changed in each source that changed since the last flush, in one message (one task on the page, all sources at the same moment). */
+  /**
+   * What changed in each source that changed since the last flush, in one message: one task on
+   * the page, every source as it was at the same moment.
+   */
   | { type: 'batches'; batches: { source: number; batch: Batch }[] }
   /** A source's decode started over (or all of them when `source` is undefined). */
   | { type: 'reset'; source?: number }

@@ -2,8 +2,9 @@
  * Every remote's fade rate on one x axis, for the Remotes chart: the remotes' buckets share one
  * 100 ms grid on one clock, so the axis is that grid and each remote is a column on it. The
  * columns grow: each redraw takes only the buckets a remote gained since the last one (and its
- * provisional ones again) and writes them in place; nothing is merged, sorted or rebuilt per redraw. A bucket a remote did
- * not send stays null, a gap in its line (nothing is drawn where nothing arrived).
+ * provisional ones again) and writes them in place; nothing is merged, sorted or rebuilt per
+ * redraw. A bucket a remote did not send stays null, a gap in its line (nothing is drawn where
+ * nothing arrived).
  */
 import { BUCKET_US } from '../../../worker/protocol.js';
 import type { SeriesBuffer } from '../../live.js';
