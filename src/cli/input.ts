@@ -8,7 +8,7 @@
  * The capture is the one `readCapture` makes; a damaged file, or a part the other thread could
  * not read, is read here alone, salvaging as ever.
  */
-import { closeSync, fstatSync, openSync, readSync } from 'node:fs';
+import { closeSync, fstatSync, openSync } from 'node:fs';
 import { basename } from 'node:path';
 import {
   assembleParts,
@@ -22,6 +22,7 @@ import {
   type PartRead,
   type ReadOptions,
 } from '../capture/index.js';
+import { readFileRange } from './file-range.js';
 import type { ReadThreadData, ReadThreadParts, ReadThreadResult } from './read-thread.js';
 import { secondCore, WaitedWorker } from './waited-worker.js';
 
@@ -31,17 +32,11 @@ export type LoadedCapture = { capture: Capture; bytesThere: number; partsThere: 
 /** Files from this size on are read on two threads when they are intact .sscap captures. */
 export const PARTS_MIN_BYTES = 32 << 20;
 
-/** Bytes `[from, to)` of the open file `fd` into `bytes`; how many there were (fewer: the file ended first). */
-function readRange(fd: number, bytes: Uint8Array, from: number, to: number): number {
-  let at = from;
-  for (let n = 1; at < to && n > 0; at += n) n = readSync(fd, bytes, at, to - at, at);
-  return at - from;
-}
-
 /**
  * The file's bytes (shorter than its size said: what was there), and for a big file on a
  * machine with a second core, in shared memory, the thread that read its second half while
- * this one read the first, to read the parts with (`readInParts`). @throws what the file system says.
+ * this one read the first, to read the parts with (`readInParts`).
+ * @throws what the file system says
  */
 function readBytes(file: string, big: number): { bytes: Uint8Array; bytesThere: number; helper: WaitedWorker<ReadThreadResult> | null } {
   const fd = openSync(file, 'r');
@@ -49,19 +44,19 @@ function readBytes(file: string, big: number): { bytes: Uint8Array; bytesThere: 
     const size = fstatSync(fd).size;
     if (size < big || !secondCore()) {
       const bytes = new Uint8Array(size);
-      return { bytes: bytes.subarray(0, readRange(fd, bytes, 0, size)), bytesThere: 0, helper: null };
+      return { bytes: bytes.subarray(0, readFileRange(fd, bytes, 0, size)), bytesThere: 0, helper: null };
     }
     const bytes = new Uint8Array(new SharedArrayBuffer(size));
     const half = size >> 1;
     const data: ReadThreadData = { file, bytes, from: half, to: size };
     const helper = new WaitedWorker<ReadThreadResult>(new URL('./read-thread.js', import.meta.url), data);
     try {
-      const mine = readRange(fd, bytes, 0, half);
+      const mine = readFileRange(fd, bytes, 0, half);
       const there = helper.result(0);
+      const readThere = there !== undefined && 'read' in there ? there.read : null;
       // The other thread could not read its half: read it here.
-      const bytesThere = there !== undefined && 'read' in there ? there.read : 0;
-      const theirs = there !== undefined && 'read' in there ? there.read : readRange(fd, bytes, half, size);
-      return { bytes: bytes.subarray(0, mine < half ? mine : half + theirs), bytesThere, helper };
+      const theirs = readThere ?? readFileRange(fd, bytes, half, size);
+      return { bytes: bytes.subarray(0, mine < half ? mine : half + theirs), bytesThere: readThere ?? 0, helper };
     } catch (error) {
       helper.close();
       throw error;

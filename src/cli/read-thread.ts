@@ -6,8 +6,9 @@
  * and copies each into the shared columns (`readPart`) and posts what it found, until none is
  * left or one is not intact. A file that is not one is never sent: this thread is stopped.
  */
-import { closeSync, openSync, readSync } from 'node:fs';
+import { closeSync, openSync } from 'node:fs';
 import type { CaptureColumns, CapturePart, PartRead } from '../capture/index.js';
+import { readFileRange } from './file-range.js';
 import { workerSide } from './waited-worker.js';
 
 /** What `loadCapture` hands this thread when it starts: the file, the shared bytes, and the range of them to read. */
@@ -33,13 +34,13 @@ const { data, post, next } = workerSide<ReadThreadData>();
 try {
   const { file, bytes, from, to } = data;
   const fd = openSync(file, 'r');
-  let at = from;
+  let read: number;
   try {
-    for (let n = 1; at < to && n > 0; at += n) n = readSync(fd, bytes, at, to - at, at);
+    read = readFileRange(fd, bytes, from, to);
   } finally {
     closeSync(fd);
   }
-  post({ read: at - from } satisfies ReadThreadResult);
+  post({ read } satisfies ReadThreadResult);
   const { readPart } = await import('../capture/index.js');
   const { parts, columns, taken } = (await next()) as ReadThreadParts;
   for (let k = Atomics.add(taken, 0, 1); k < parts.length; k = Atomics.add(taken, 0, 1)) {

@@ -100,7 +100,7 @@ export class ReplaySession implements Driver {
         } catch (error) {
           return cannotOpen(`The file could not be read (${String(error)}).`);
         }
-        // An intact file is kept as this worker's half walked it; anything else is read again and parsed.
+        // An intact file is the capture the helper's half kept as it walked; anything else is read again and parsed.
         capture = keptCapture(halves.mine, halves.theirs);
       }
     }

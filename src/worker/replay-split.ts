@@ -8,9 +8,8 @@
  * that does not prove intact is read again and parsed (salvaged) as any other.
  *
  * The halves count only for a capture found intact (or cut off inside its last record, where
- * both halves found the file ending), on the same span, with every
- * checkpoint on the chunk the capture's own order puts it (`checkpointChunks`) and with the
- * capture's chunk and byte counts. A half that fails or disagrees is decoded again from the
+ * both halves found the file ending), on the same span, with every checkpoint on the chunk the
+ * capture's own order puts it (`checkpointChunks`) and with the capture's chunk and byte counts. A half that fails or disagrees is decoded again from the
  * capture, here; the overview and seeks are then exactly the one-worker pass's.
  */
 import type { Capture, ParsedCapture } from '../capture/index.js';

@@ -1,0 +1,12 @@
+/**
+ * A range of a file read into memory, however many reads it takes: both threads of a big
+ * capture's reading (input.ts, read-thread.ts) read their half so.
+ */
+import { readSync } from 'node:fs';
+
+/** Bytes `[from, to)` of the open file `fd` into `bytes` at the same offsets; how many there were (fewer: the file ended first). */
+export function readFileRange(fd: number, bytes: Uint8Array, from: number, to: number): number {
+  let at = from;
+  for (let n = 1; at < to && n > 0; at += n) n = readSync(fd, bytes, at, to - at, at);
+  return at - from;
+}
