@@ -39,6 +39,24 @@ describe('a file arriving in pieces', () => {
     expect(await file.slice(0, 200).arrayBuffer()).toBe(piece.buffer);
   });
 
+  it('reads within one piece as a view of it, across pieces as a copy, and keeps its offsets when a piece read past is transferred away', async () => {
+    const file = new ArrivingFile(bytes.length);
+    const pieces = [bytes.slice(0, 400), bytes.slice(400, 800), bytes.slice(800)];
+    for (const piece of pieces) file.push(piece);
+    const inside = await file.view(100, 300);
+    expect(inside.buffer).toBe(pieces[0]?.buffer);
+    expect(Array.from(inside)).toEqual(Array.from(bytes.subarray(100, 300)));
+    const across = await file.view(350, 450);
+    expect(across.buffer).not.toBe(pieces[0]?.buffer);
+    expect(Array.from(across)).toEqual(Array.from(bytes.subarray(350, 450)));
+    // The first piece goes to another thread while still held here (a read past it may wait for
+    // bytes still to come): its length reads 0 from then on.
+    structuredClone(pieces[0], { transfer: [pieces[0]?.buffer as ArrayBuffer] });
+    expect(pieces[0]?.length).toBe(0);
+    expect(Array.from(await file.view(790, 900))).toEqual(Array.from(bytes.subarray(790, 900)));
+    expect(Array.from(await file.view(850, 1000))).toEqual(Array.from(bytes.subarray(850, 1000)));
+  });
+
   it('fails every read, waiting or to come, and lets go of what it holds, when the file cannot be read', async () => {
     const file = new ArrivingFile(bytes.length);
     file.push(bytes.subarray(0, 100));

@@ -71,7 +71,8 @@ function helperHere(change: (r: FilePassReport) => FilePassReport = (r) => r, tu
     jobs.push(job);
     let stopped = false;
     let t = 0;
-    // What it is fed arrives as in the helper worker: a copy of each piece.
+    // What it is fed arrives as in the helper worker: each piece transferred, so that the worker
+    // can no longer read it (a worker that did would find it empty).
     const file = new ArrivingFile(job.size);
     const paced: SlicedFile = {
       size: file.size,
@@ -100,7 +101,7 @@ function helperHere(change: (r: FilePassReport) => FilePassReport = (r) => r, tu
       feed: (piece) => {
         runs.fed += piece.length;
         runs.mostAhead = Math.max(runs.mostAhead, runs.fed - runs.walkedTo);
-        file.push(piece.slice());
+        file.push(structuredClone(piece, { transfer: [piece.buffer] }));
       },
       fail: (why) => file.fail(new Error(why)),
       stop: () => {

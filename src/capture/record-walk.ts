@@ -32,6 +32,12 @@ const SLICE_BYTES = 16 << 20;
 export interface SlicedFile {
   readonly size: number;
   slice(start: number, end: number): { arrayBuffer(): Promise<ArrayBuffer> };
+  /**
+   * Bytes [start, end) without a copy, where the file holds them in memory already (a file
+   * arriving in pieces): the walk reads through this when it is there. (Not `bytes`: a Blob's
+   * own `bytes()` reads the whole of it.)
+   */
+  view?(start: number, end: number): Promise<Uint8Array>;
 }
 
 /** One data record: its payload is `bytes[start, end)`, recorded at `timeUs` on `port`. */
@@ -78,11 +84,13 @@ export interface WalkOptions {
 export async function walkDataRecords(file: SlicedFile, sink: RecordSink, options: WalkOptions = {}): Promise<WalkedRecords | null> {
   const { goOn = () => true, checked = () => false, eventsChecked = false, runs, sliceBytes = SLICE_BYTES } = options;
   const size = file.size;
-  const read = async (from: number, length: number): Promise<Uint8Array> =>
-    new Uint8Array(await file.slice(from, Math.min(size, from + length)).arrayBuffer());
+  const read = async (from: number, length: number): Promise<Uint8Array> => {
+    const to = Math.min(size, from + length);
+    return file.view === undefined ? new Uint8Array(await file.slice(from, to).arrayBuffer()) : file.view(from, to);
+  };
   // The first read holds the whole header, as long as its fixed part says it is.
   const fixed = await read(0, HEADER_FIXED_SIZE);
-  const metaLength = fixed.length < HEADER_FIXED_SIZE ? 0 : new DataView(fixed.buffer).getUint32(OFF_META_LENGTH, true);
+  const metaLength = fixed.length < HEADER_FIXED_SIZE ? 0 : new DataView(fixed.buffer, fixed.byteOffset).getUint32(OFF_META_LENGTH, true);
   let bytes = await read(0, Math.max(sliceBytes, HEADER_FIXED_SIZE + Math.min(metaLength, MAX_META_BYTES) + CRC_SIZE));
   let view = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
   const issues: Parameters<typeof readHeader>[3] = [];

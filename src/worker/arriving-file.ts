@@ -7,9 +7,11 @@
 import type { SlicedFile } from '../capture/index.js';
 
 export class ArrivingFile implements SlicedFile {
-  /** The pieces not yet read past, in order, and the file offset of the first. */
-  #pieces: Uint8Array[] = [];
-  #firstAt = 0;
+  /**
+   * The pieces not yet read past, in order, each with its file offset. Offsets are kept apart
+   * from the pieces: a piece read past may be transferred away (its length then reads 0).
+   */
+  #pieces: { bytes: Uint8Array; at: number }[] = [];
   #arrived = 0;
   #failed: unknown = null;
   #waiting: (() => void)[] = [];
@@ -19,7 +21,7 @@ export class ArrivingFile implements SlicedFile {
   /** The next bytes of the file (kept, not copied). */
   push(piece: Uint8Array): void {
     if (piece.length === 0) return;
-    this.#pieces.push(piece);
+    this.#pieces.push({ bytes: piece, at: this.#arrived });
     this.#arrived += piece.length;
     this.#wake();
   }
@@ -32,46 +34,56 @@ export class ArrivingFile implements SlicedFile {
     this.#wake();
   }
 
-  slice(start: number, end: number): { arrayBuffer(): Promise<ArrayBuffer> } {
-    return { arrayBuffer: () => this.#read(start, Math.min(end, this.size)) };
-  }
-
   #wake(): void {
     const waiting = this.#waiting;
     this.#waiting = [];
     for (const go of waiting) go();
   }
 
-  /** Bytes [start, end) once they have arrived, copied. Reads go forward: pieces before `start` are let go. */
-  async #read(start: number, end: number): Promise<ArrayBuffer> {
+  slice(start: number, end: number): { arrayBuffer(): Promise<ArrayBuffer> } {
+    return {
+      arrayBuffer: async () => {
+        const bytes = await this.view(start, end, true);
+        return bytes.buffer as ArrayBuffer;
+      },
+    };
+  }
+
+  /**
+   * Bytes [start, end) once they have arrived: a view of the piece that holds them all, a copy
+   * of those of several pieces (or, `own`, a copy unless they are a whole piece that owns its
+   * buffer). Reads go forward: pieces before `start` are let go.
+   */
+  async view(start: number, end: number, own = false): Promise<Uint8Array> {
+    const to = Math.min(end, this.size);
     for (;;) {
       if (this.#failed !== null) throw this.#failed;
-      if (this.#arrived >= end) break;
+      if (this.#arrived >= to) break;
       await new Promise<void>((resolve) => this.#waiting.push(resolve));
     }
-    while (this.#pieces.length > 0 && this.#firstAt + (this.#pieces[0]?.length ?? 0) <= start) {
-      this.#firstAt += this.#pieces.shift()?.length ?? 0;
+    const pieces = this.#pieces;
+    let drop = 0;
+    while (drop < pieces.length && (pieces[drop + 1]?.at ?? this.#arrived) <= start) drop++;
+    if (drop > 0) pieces.splice(0, drop);
+    const first = pieces[0];
+    if (first === undefined || start < first.at) throw new RangeError(`bytes ${start}… were let go: reads go forward`);
+    const from = start - first.at;
+    const length = Math.max(0, to - start);
+    if (from + length <= first.bytes.length) {
+      const whole =
+        from === 0 &&
+        length === first.bytes.length &&
+        first.bytes.byteOffset === 0 &&
+        first.bytes.byteLength === first.bytes.buffer.byteLength;
+      if (!own || whole) return first.bytes.subarray(from, from + length);
     }
-    if (start < this.#firstAt) throw new RangeError(`bytes ${start}… were let go: reads go forward`);
-    // A read of exactly one piece that owns its buffer (one transferred here) is that buffer.
-    const first = this.#pieces[0];
-    if (
-      first !== undefined &&
-      start === this.#firstAt &&
-      end - start === first.length &&
-      first.byteOffset === 0 &&
-      first.byteLength === first.buffer.byteLength
-    )
-      return first.buffer as ArrayBuffer;
-    const out = new Uint8Array(Math.max(0, end - start));
-    let at = this.#firstAt;
-    for (const piece of this.#pieces) {
-      if (at >= end) break;
-      const from = Math.max(start, at);
-      const to = Math.min(end, at + piece.length);
-      if (to > from) out.set(piece.subarray(from - at, to - at), from - start);
-      at += piece.length;
+    const out = new Uint8Array(length);
+    for (const { bytes, at } of pieces) {
+      if (at >= to) break;
+      const a = Math.max(start, at);
+      const b = Math.min(to, at + bytes.length);
+      if (b > a) out.set(bytes.subarray(a - at, b - at), a - start);
     }
-    return out.buffer;
+    return out;
   }
 }

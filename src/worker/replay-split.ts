@@ -263,48 +263,49 @@ function walkedAll(run: HelperRun, capture: Capture): boolean {
 /** Read at a time from the File: its pieces are what the halves of a split pass are fed. */
 const PIECE_BYTES = 16 << 20;
 /**
- * This worker's half walks its pieces this much at a time: the pieces read meanwhile are passed
- * on to the helper between slices, not after a whole piece (the helper waited for them for about
- * a second of the day capture's five).
+ * This worker's half walks its pieces this much at a time: between slices, the pieces it has
+ * walked past go on to the helper, and more are read.
  */
 const HERE_SLICE_BYTES = 1 << 20;
-/** Pieces the helper may be sent ahead of where it has got. */
+/** Pieces read ahead of where either half has got. */
 const AHEAD_PIECES = 3;
-/** Reads of the File under way at once. */
-const READS_AHEAD = 3;
 
 /**
- * `file` read once, a piece at a time (READS_AHEAD reads under way while this worker decodes);
- * each piece is handed to both halves as it arrives: this worker's a copy, the helper's the piece
- * itself (transferred), never more than AHEAD_PIECES ahead of where the helper has got. A read
- * that fails fails both. Nothing is kept here: the helper's half keeps the capture.
+ * `file` read once, a piece at a time, a few pieces ahead of where the halves have got. Each
+ * piece goes to this worker's half as it arrives, and once that half has walked past it, to the
+ * helper's: the piece itself, transferred. Neither copies it (a copy for one half was the whole
+ * file written again here, into memory the system had to map afresh, a piece at a time). The
+ * helper walks a little behind this worker, and it has the longer walk anyway (it keeps the
+ * capture). A read that fails fails both. Nothing is kept here: the helper's half keeps the
+ * capture.
  */
 export async function readInPieces(file: Blob, mine: HelperRun, theirs: HelperRun, pieceBytes = PIECE_BYTES): Promise<void> {
   const size = file.size;
-  // Several reads under way: the browser reads on while this worker decodes its half.
-  const reads: Promise<ArrayBuffer>[] = [];
-  let asked = 0;
-  const askMore = (): void => {
-    while (reads.length < READS_AHEAD && asked < size) {
-      reads.push(file.slice(asked, Math.min(size, asked + pieceBytes)).arrayBuffer());
-      asked = Math.min(size, asked + pieceBytes);
-    }
-  };
+  /** Settles once piece k has gone on to the helper (in order). */
+  const handedOver: Promise<void>[] = [];
   try {
-    askMore();
-    for (let at = 0; at < size; ) {
-      const piece = new Uint8Array(await (reads.shift() as Promise<ArrayBuffer>));
-      askMore();
+    for (let at = 0, k = 0; at < size; k++) {
+      // Never far ahead: what is read waits in memory. A piece goes on once this half has walked
+      // past it, which it can with the next piece read (pieces are longer than its slices and
+      // than any header), and the helper never waits for more than a few pieces.
+      await handedOver[k - AHEAD_PIECES];
+      const piece = new Uint8Array(await file.slice(at, Math.min(size, at + pieceBytes)).arrayBuffer());
       if (piece.length === 0) throw new Error(`the file ended after ${at} of ${size} bytes`);
-      const end = Math.min(size, at + piece.length);
-      mine.feed(piece.slice(0, end - at));
-      // Never more than a few pieces ahead of the helper: they would pile up in its memory.
-      await theirs.reached(at - AHEAD_PIECES * pieceBytes);
-      theirs.feed(piece);
+      const from = at;
+      const end = at + piece.length;
+      mine.feed(piece);
+      handedOver.push(
+        (handedOver.at(-1) ?? Promise.resolve()).then(async () => {
+          // Transferred once nothing here reads it any more; the helper is never far behind.
+          await mine.reached(end);
+          await theirs.reached(from - AHEAD_PIECES * pieceBytes);
+          theirs.feed(piece);
+        }),
+      );
       at = end;
     }
+    await handedOver.at(-1);
   } catch (error) {
-    for (const r of reads) r.catch(() => undefined);
     mine.fail(String(error));
     theirs.fail(String(error));
     throw error;
