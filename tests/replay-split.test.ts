@@ -35,10 +35,13 @@ class Turns {
 /** Reads of a whole file (the file read again to be parsed), counted by slowFile. */
 let wholeReads = 0;
 
-/** `bytes` as a File whose every read waits for a turn. */
-function slowFile(bytes: Uint8Array): Blob {
+/**
+ * `bytes` as a File whose every read waits for a turn: a slice's arrayBuffer(), and each read of
+ * its byte stream (16 kB at most) unless `stream` is false (a browser without one).
+ */
+function slowFile(bytes: Uint8Array, stream = true): Blob {
   const blob = new Blob([bytes.slice()]);
-  const slow = (b: Blob): SlicedFile & { arrayBuffer(): Promise<ArrayBuffer> } => ({
+  const slow = (b: Blob): SlicedFile & { arrayBuffer(): Promise<ArrayBuffer>; stream?: () => ReadableStream } => ({
     size: b.size,
     slice: (start, end) => slow(b.slice(start, end)),
     arrayBuffer: async () => {
@@ -46,6 +49,29 @@ function slowFile(bytes: Uint8Array): Blob {
       await turns.wait();
       return b.arrayBuffer();
     },
+    ...(stream
+      ? {
+          stream: () => {
+            let at = 0;
+            return new ReadableStream({
+              type: 'bytes',
+              async pull(controller) {
+                await turns.wait();
+                const request = controller.byobRequest;
+                const n = Math.min(16 << 10, bytes.length - at, request?.view?.byteLength ?? Number.POSITIVE_INFINITY);
+                if (n <= 0) {
+                  controller.close();
+                  request?.respond(0);
+                } else if (request?.view) {
+                  new Uint8Array(request.view.buffer, request.view.byteOffset, n).set(bytes.subarray(at, at + n));
+                  request.respond(n);
+                } else controller.enqueue(bytes.slice(at, at + n));
+                at += Math.max(0, n);
+              },
+            });
+          },
+        }
+      : {}),
   });
   return slow(blob) as unknown as Blob;
 }
@@ -66,14 +92,14 @@ const turns = new Turns();
 function helperHere(change: (r: FilePassReport) => FilePassReport = (r) => r, turnsPerRead = 0) {
   const jobs: FilePassJob[] = [];
   /** dropped: stopped other than once when done (the pass drops a helper by stopping it). */
-  const runs = { reports: 0, done: false, stops: 0, dropped: false, fed: 0, walkedTo: 0, mostAhead: 0 };
+  const runs = { reports: 0, done: false, stops: 0, dropped: false, fed: 0, walkedTo: 0, mostAhead: 0, givenBack: [] as ArrayBuffer[] };
   const make: PassHelperMaker = (job, onReport) => {
     jobs.push(job);
     let stopped = false;
     let t = 0;
     // What it is fed arrives as in the helper worker: each piece transferred, so that the worker
     // can no longer read it (a worker that did would find it empty).
-    const file = new ArrivingFile(job.size);
+    const file = new ArrivingFile(job.size, true);
     const paced: SlicedFile = {
       size: file.size,
       slice: (start, end) => ({
@@ -90,12 +116,18 @@ function helperHere(change: (r: FilePassReport) => FilePassReport = (r) => r, tu
         if (stopped) return;
         runs.reports++;
         if (r.type === 'done') runs.done = true;
-        if (r.type === 'walked') runs.walkedTo = r.to;
-        onReport(change(r));
+        if (r.type === 'walked') {
+          runs.walkedTo = r.to;
+          // Given back as the helper worker does, transferred: the helper can no longer read them.
+          const spare = structuredClone(r.spare, { transfer: r.spare });
+          runs.givenBack.push(...spare);
+          onReport(change({ ...r, spare }));
+        } else onReport(change(r));
       },
       // 100 ms a read of the clock: a report about every other slice.
       () => (t += 100),
       () => stopped,
+      (to) => file.passed(to),
     );
     return {
       feed: (piece) => {
@@ -115,12 +147,12 @@ function helperHere(change: (r: FilePassReport) => FilePassReport = (r) => r, tu
 }
 
 /** Opens `file` in a worker with `make` as its helper and runs both until the overview is complete. */
-async function openSplit(file: Uint8Array, make: PassHelperMaker | null, previewSizes = PREVIEW) {
+async function openSplit(file: Uint8Array, make: PassHelperMaker | null, previewSizes = PREVIEW, stream = true) {
   const clock = new SlicingClock();
   const fake = fakeHost(clock);
   wholeReads = 0;
   const worker = new Dispatcher(fake.host, { previewSizes, passHelper: make });
-  worker.receive({ type: 'replay-open', name: 'long.sscap', file: slowFile(file) });
+  worker.receive({ type: 'replay-open', name: 'long.sscap', file: slowFile(file, stream) });
   // The helper's turns go on while the file is opened: its half is drawn from before that ends.
   let opened = false;
   const opening = worker.queue.idle().then(() => {
@@ -218,8 +250,13 @@ describe('a long capture decoded on two workers', () => {
     expect(helper.runs.reports).toBeGreaterThan(3);
     // A helper at half the worker's pace is sent no more than a few pieces ahead of where it has
     // got (the file is 3.9 MB, the pieces 16 kB), and the result is the same.
+    // The worker reads each piece into a buffer the helper gave back (its byte stream's reads
+    // take the buffer over): all but the last few, which the file's end leaves unused.
+    expect(helper.runs.givenBack.length).toBeGreaterThan(100);
+    expect(helper.runs.givenBack.filter((b) => b.byteLength > 0).length).toBeLessThanOrEqual(4);
+    // Read a slice at a time (a browser without a byte stream), the result is the same.
     const slow = helperHere(undefined, 2);
-    const paced = await openSplit(FILE, slow.make);
+    const paced = await openSplit(FILE, slow.make, PREVIEW, false);
     expect(slow.runs.dropped).toBe(false);
     expect(slow.runs.mostAhead).toBeGreaterThan(2 * PREVIEW.sliceBytes);
     expect(slow.runs.mostAhead).toBeLessThanOrEqual(5 * PREVIEW.sliceBytes);

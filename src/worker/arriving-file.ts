@@ -15,8 +15,17 @@ export class ArrivingFile implements SlicedFile {
   #arrived = 0;
   #failed: unknown = null;
   #waiting: (() => void)[] = [];
+  /** Pieces read past, each with its end, until `passed` gives them back (`giveBack`). */
+  #readPast: { bytes: Uint8Array; end: number }[] = [];
 
-  constructor(readonly size: number) {}
+  /**
+   * @param giveBack pieces read past are kept for `passed` (the helper hands them back to the
+   *   worker, which reads the file's next pieces into them), not let go
+   */
+  constructor(
+    readonly size: number,
+    readonly giveBack = false,
+  ) {}
 
   /** The next bytes of the file (kept, not copied). */
   push(piece: Uint8Array): void {
@@ -31,7 +40,18 @@ export class ArrivingFile implements SlicedFile {
     this.#failed = error ?? new Error('the file could not be read');
     // Nothing more is read: what is held is let go.
     this.#pieces = [];
+    this.#readPast = [];
     this.#wake();
+  }
+
+  /**
+   * The buffers of the pieces that end at or before `offset`, taken out (a file made to give
+   * them back): whoever walked the file to `offset` holds no view of them any more.
+   */
+  passed(offset: number): ArrayBuffer[] {
+    const out: ArrayBuffer[] = [];
+    while ((this.#readPast[0]?.end ?? Number.POSITIVE_INFINITY) <= offset) out.push(this.#readPast.shift()?.bytes.buffer as ArrayBuffer);
+    return out;
   }
 
   #wake(): void {
@@ -64,7 +84,11 @@ export class ArrivingFile implements SlicedFile {
     const pieces = this.#pieces;
     let drop = 0;
     while (drop < pieces.length && (pieces[drop + 1]?.at ?? this.#arrived) <= start) drop++;
-    if (drop > 0) pieces.splice(0, drop);
+    if (drop > 0) {
+      const gone = pieces.splice(0, drop);
+      if (this.giveBack)
+        gone.forEach(({ bytes }, k) => this.#readPast.push({ bytes, end: gone[k + 1]?.at ?? pieces[0]?.at ?? this.#arrived }));
+    }
     const first = pieces[0];
     if (first === undefined || start < first.at) throw new RangeError(`bytes ${start}… were let go: reads go forward`);
     const from = start - first.at;

@@ -32,8 +32,12 @@ export interface FilePassJob {
 }
 
 export type FilePassReport =
-  /** After each slice: how far into the file the walk has got (the worker sends no more than a few slices ahead of it). */
-  | { type: 'walked'; to: number }
+  /**
+   * After each slice: how far into the file the walk has got (the worker sends no more than a
+   * few pieces ahead of it), and the buffers of the pieces walked past, given back (transferred)
+   * for the worker to read the next pieces into.
+   */
+  | { type: 'walked'; to: number; spare: ArrayBuffer[] }
   | { type: 'progress'; overview: Overview; checkpoints: Checkpoint[] }
   | {
       type: 'done';
@@ -53,7 +57,8 @@ const PROGRESS_MS = 250;
 
 /**
  * Decodes `job` from `file`, reporting as it goes; `stopped` is asked between slices (true: it
- * ends quietly). Never throws: whatever goes wrong is a `failed` report, and the worker decodes
+ * ends quietly); `passed` takes the buffers of the pieces walked past, to give back (a helper's
+ * ArrivingFile). Never throws: whatever goes wrong is a `failed` report, and the worker decodes
  * those ports itself.
  */
 export async function passOverFile(
@@ -62,6 +67,7 @@ export async function passOverFile(
   report: (r: FilePassReport, transfer: Transferable[]) => void,
   now: () => number,
   stopped: () => boolean = () => false,
+  passed: (walkedTo: number) => ArrayBuffer[] = () => [],
 ): Promise<void> {
   try {
     const pass = new ReplayPass(null, job.ports, job.resolution, job.originUs, job.endUs);
@@ -83,7 +89,8 @@ export async function passOverFile(
       if (stopped()) return false;
       // The first slice tells how much of the file is records' payload: room for the rest at that rate.
       kept?.expect(walkedTo, size);
-      report({ type: 'walked', to: walkedTo }, []);
+      const spare = passed(walkedTo);
+      report({ type: 'walked', to: walkedTo, spare }, spare);
       if (now() - lastMs >= PROGRESS_MS) {
         lastMs = now();
         const r = news();
@@ -128,8 +135,10 @@ export function helperReceiver(post: (r: FilePassReport, transfer: Transferable[
   let file: ArrivingFile | null = null;
   return (m) => {
     if ('job' in m) {
-      file = new ArrivingFile(m.job.size);
-      void passOverFile(m.job, file, post, now);
+      // Pieces walked past go back to the worker, to be read into again.
+      const arriving = new ArrivingFile(m.job.size, true);
+      file = arriving;
+      void passOverFile(m.job, arriving, post, now, undefined, (to) => arriving.passed(to));
     } else if ('piece' in m) file?.push(m.piece);
     else file?.fail(new Error(m.failed));
   };

@@ -80,6 +80,8 @@ export class HelperRun {
   /** How far into the file the pass has walked, and the reading waiting for it to walk further. */
   #walkedTo = 0;
   #reader: (() => void) | null = null;
+  /** Buffers of pieces the pass has walked past, given back to be read into again. */
+  readonly #spare: ArrayBuffer[] = [];
 
   /** The pass started on `job`, or null when `make` has none. */
   static start(make: PassHelperMaker, job: FilePassJob): HelperRun | null {
@@ -106,6 +108,7 @@ export class HelperRun {
     if (this.done || this.failed !== null) return;
     if (r.type === 'walked') {
       this.#walkedTo = r.to;
+      this.#spare.push(...r.spare);
       this.#wakeReader();
       return;
     }
@@ -139,6 +142,11 @@ export class HelperRun {
         this.#reader = resolve;
       });
     }
+  }
+
+  /** A buffer of a piece the pass has walked past, given back (the caller takes it over), if there is one. */
+  takeSpare(): ArrayBuffer | undefined {
+    return this.#spare.shift();
   }
 
   /** The file's next piece (kept or transferred: the caller lets go of it). */

@@ -15,6 +15,7 @@
 import type { Capture, ParsedCapture } from '../capture/index.js';
 import type { Clock } from './host.js';
 import { addOverviews } from './overview.js';
+import { PieceReader, type ReadableFile } from './piece-reader.js';
 import type { Overview } from './protocol.js';
 import { HelperRun, type PassHelperMaker, inThisWorker } from './replay-helper.js';
 import { CHECKPOINT_US, type Checkpoint, type OverviewPass, ReplayPass, checkpointDue } from './replay-pass.js';
@@ -223,7 +224,7 @@ export function startSplit(
   });
   // The helper keeps the capture as it walks (the file is not parsed again; the columns are
   // transferred here at the end): this worker's half also reads the file and passes it on.
-  const theirs = HelperRun.start(helper, { ...job(ports.slice(half), []), keep: true });
+  const theirs = HelperRun.start(helper, { ...job(ports.slice(half), []), sliceBytes: sliceBytes ?? PIECE_BYTES, keep: true });
   if (theirs === null) return null;
   // This half also checks records on ports the file's start did not show: ours with a damaged
   // port byte, perhaps. It walks in short slices: between them the pieces read go on to the helper.
@@ -260,8 +261,12 @@ function walkedAll(run: HelperRun, capture: Capture): boolean {
   return run.walked.chunks === capture.chunkEnds.length && run.walked.dataBytes === capture.bytes.length;
 }
 
-/** Read at a time from the File: its pieces are what the halves of a split pass are fed. */
-const PIECE_BYTES = 16 << 20;
+/**
+ * Read at a time from the File: its pieces are what the halves of a split pass are fed, and the
+ * helper's slices. The helper gets a piece only once this worker's half has walked it: short
+ * pieces start it sooner (longer than any header and this half's slices, as readInPieces needs).
+ */
+const PIECE_BYTES = 4 << 20;
 /**
  * This worker's half walks its pieces this much at a time: between slices, the pieces it has
  * walked past go on to the helper, and more are read.
@@ -273,26 +278,27 @@ const AHEAD_PIECES = 3;
 /**
  * `file` read once, a piece at a time, a few pieces ahead of where the halves have got. Each
  * piece goes to this worker's half as it arrives, and once that half has walked past it, to the
- * helper's: the piece itself, transferred. Neither copies it (a copy for one half was the whole
- * file written again here, into memory the system had to map afresh, a piece at a time). The
- * helper walks a little behind this worker, and it has the longer walk anyway (it keeps the
- * capture). A read that fails fails both. Nothing is kept here: the helper's half keeps the
- * capture.
+ * helper's: the piece itself, transferred; the helper gives it back once walked, and the file's
+ * next piece is read into it. Neither half copies a piece, and after the first few no piece is
+ * new memory (a copy for one half, a slice of its own for the other and a new buffer a piece
+ * were each the whole file written into memory the system had to map afresh). The helper walks
+ * a little behind this worker, and it has the longer walk anyway (it keeps the capture). A read
+ * that fails fails both. Nothing is kept here: the helper's half keeps the capture.
  */
-export async function readInPieces(file: Blob, mine: HelperRun, theirs: HelperRun, pieceBytes = PIECE_BYTES): Promise<void> {
-  const size = file.size;
+export async function readInPieces(file: ReadableFile, mine: HelperRun, theirs: HelperRun, pieceBytes = PIECE_BYTES): Promise<void> {
+  const reader = new PieceReader(file, pieceBytes);
   /** Settles once piece k has gone on to the helper (in order). */
   const handedOver: Promise<void>[] = [];
   try {
-    for (let at = 0, k = 0; at < size; k++) {
+    for (let k = 0; ; k++) {
       // Never far ahead: what is read waits in memory. A piece goes on once this half has walked
       // past it, which it can with the next piece read (pieces are longer than its slices and
       // than any header), and the helper never waits for more than a few pieces.
       await handedOver[k - AHEAD_PIECES];
-      const piece = new Uint8Array(await file.slice(at, Math.min(size, at + pieceBytes)).arrayBuffer());
-      if (piece.length === 0) throw new Error(`the file ended after ${at} of ${size} bytes`);
-      const from = at;
-      const end = at + piece.length;
+      const from = reader.at;
+      const piece = await reader.next(theirs.takeSpare());
+      if (piece === null) break;
+      const end = reader.at;
       mine.feed(piece);
       handedOver.push(
         (handedOver.at(-1) ?? Promise.resolve()).then(async () => {
@@ -302,10 +308,10 @@ export async function readInPieces(file: Blob, mine: HelperRun, theirs: HelperRu
           theirs.feed(piece);
         }),
       );
-      at = end;
     }
     await handedOver.at(-1);
   } catch (error) {
+    reader.stop();
     mine.fail(String(error));
     theirs.fail(String(error));
     throw error;
