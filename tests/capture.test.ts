@@ -117,6 +117,30 @@ describe('crc32', () => {
   it('covers only the requested range', () => {
     expect(crc32(ascii('xx123456789yy'), 2, 11)).toBe(0xcbf43926);
   });
+
+  it('agrees with the CRC bit by bit for every length and start, in a view of a larger buffer, with or without a DataView', () => {
+    const bitwise = (b: Uint8Array): number => {
+      let c = 0xffffffff;
+      for (const x of b) {
+        c ^= x;
+        for (let k = 0; k < 8; k++) c = c & 1 ? 0xedb88320 ^ (c >>> 1) : c >>> 1;
+      }
+      return (c ^ 0xffffffff) >>> 0;
+    };
+    const whole = Uint8Array.from({ length: 200 }, (_, i) => (i * 73 + 11) & 0xff);
+    const bytes = whole.subarray(3, 190);
+    const view = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
+    for (let start = 0; start < 8; start++)
+      for (let length = 0; length <= 100; length++) {
+        const want = bitwise(bytes.subarray(start, start + length));
+        expect([start, length, crc32(bytes, start, start + length), crc32(bytes, start, start + length, view)]).toEqual([
+          start,
+          length,
+          want,
+          want,
+        ]);
+      }
+  });
 });
 
 // ---------------------------------------------------------------------------------------------

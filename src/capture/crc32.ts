@@ -29,27 +29,45 @@ function buildCrcTable(): Uint32Array {
   return table;
 }
 
-/** CRC-32 (as zlib computes it) of `bytes[start, end)`, as an unsigned 32-bit number. */
-export function crc32(bytes: Uint8Array, start = 0, end = bytes.length): number {
-  return (crcRun(0xffffffff, bytes, start, end) ^ 0xffffffff) >>> 0;
+/**
+ * CRC-32 (as zlib computes it) of `bytes[start, end)`, as an unsigned 32-bit number. `view`: a
+ * DataView over exactly `bytes`, for callers that check many short records (see crcRun).
+ */
+export function crc32(bytes: Uint8Array, start = 0, end = bytes.length, view?: DataView): number {
+  return (crcRun(0xffffffff, bytes, start, end, view) ^ 0xffffffff) >>> 0;
 }
 
-/** Runs the CRC register `c` (before the final XOR) over `bytes[start, end)`. */
-export function crcRun(c: number, bytes: Uint8Array, start: number, end: number): number {
+/**
+ * Runs the CRC register `c` (before the final XOR) over `bytes[start, end)`. Eight bytes, then
+ * four, are read as little-endian words through `view` (a DataView over exactly `bytes`): half
+ * the time of reading them a byte at a time, on records of a few dozen bytes (measured, node 20).
+ * Without one, a range under 64 bytes is read a byte at a time (making a view costs more).
+ */
+export function crcRun(c: number, bytes: Uint8Array, start: number, end: number, view?: DataView): number {
   // Built on first use rather than at import, so importing the module does no work.
   const t = (crcTable ??= buildCrcTable());
   let i = start;
-  for (; i + 8 <= end; i += 8) {
-    const lo = (c ^ ((bytes[i] ?? 0) | ((bytes[i + 1] ?? 0) << 8) | ((bytes[i + 2] ?? 0) << 16) | ((bytes[i + 3] ?? 0) << 24))) >>> 0;
-    c =
-      (t[1792 + (lo & 0xff)] ?? 0) ^
-      (t[1536 + ((lo >>> 8) & 0xff)] ?? 0) ^
-      (t[1280 + ((lo >>> 16) & 0xff)] ?? 0) ^
-      (t[1024 + (lo >>> 24)] ?? 0) ^
-      (t[768 + (bytes[i + 4] ?? 0)] ?? 0) ^
-      (t[512 + (bytes[i + 5] ?? 0)] ?? 0) ^
-      (t[256 + (bytes[i + 6] ?? 0)] ?? 0) ^
-      (t[bytes[i + 7] ?? 0] ?? 0);
+  // Without a view, one is made only for a range long enough to repay making it.
+  const v = view ?? (end - start >= 64 ? new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength) : undefined);
+  if (v !== undefined) {
+    for (; i + 8 <= end; i += 8) {
+      const lo = (c ^ v.getInt32(i, true)) >>> 0;
+      const hi = v.getUint32(i + 4, true);
+      c =
+        (t[1792 + (lo & 0xff)] ?? 0) ^
+        (t[1536 + ((lo >>> 8) & 0xff)] ?? 0) ^
+        (t[1280 + ((lo >>> 16) & 0xff)] ?? 0) ^
+        (t[1024 + (lo >>> 24)] ?? 0) ^
+        (t[768 + (hi & 0xff)] ?? 0) ^
+        (t[512 + ((hi >>> 8) & 0xff)] ?? 0) ^
+        (t[256 + ((hi >>> 16) & 0xff)] ?? 0) ^
+        (t[hi >>> 24] ?? 0);
+    }
+    if (i + 4 <= end) {
+      const lo = (c ^ v.getInt32(i, true)) >>> 0;
+      c = (t[768 + (lo & 0xff)] ?? 0) ^ (t[512 + ((lo >>> 8) & 0xff)] ?? 0) ^ (t[256 + ((lo >>> 16) & 0xff)] ?? 0) ^ (t[lo >>> 24] ?? 0);
+      i += 4;
+    }
   }
   for (; i < end; i++) c = (t[(c ^ (bytes[i] ?? 0)) & 0xff] ?? 0) ^ (c >>> 8);
   return c;

@@ -153,7 +153,7 @@ export class RecordProbe {
     if (length <= CRC_DIRECT_MAX || length <= this.#directBudget) {
       this.#directBudget -= length;
       this.#work.crcBytes += length;
-      return crc32(this.#bytes, start, end);
+      return crc32(this.#bytes, start, end, this.#view);
     }
     this.#work.crcCombines++;
     // crc(a..b) follows from crc(0..a) and crc(0..b): crc(0..b) = crc(0..a) · x^(8(b−a)) ⊕ crc(a..b).
@@ -166,7 +166,7 @@ export class RecordProbe {
     const k = Math.floor(i / CRC_INDEX_STEP);
     const from = k * CRC_INDEX_STEP;
     this.#work.crcBytes += i - from;
-    return (crcRun((index[k] ?? 0) ^ 0xffffffff, this.#bytes, from, i) ^ 0xffffffff) >>> 0;
+    return (crcRun((index[k] ?? 0) ^ 0xffffffff, this.#bytes, from, i, this.#view) ^ 0xffffffff) >>> 0;
   }
 
   #buildIndex(): Uint32Array {
@@ -174,7 +174,7 @@ export class RecordProbe {
     const index = new Uint32Array(Math.floor(n / CRC_INDEX_STEP) + 1);
     let c = 0xffffffff;
     for (let k = 1; k < index.length; k++) {
-      c = crcRun(c, this.#bytes, (k - 1) * CRC_INDEX_STEP, k * CRC_INDEX_STEP);
+      c = crcRun(c, this.#bytes, (k - 1) * CRC_INDEX_STEP, k * CRC_INDEX_STEP, this.#view);
       index[k] = (c ^ 0xffffffff) >>> 0;
     }
     this.#work.crcBytes += (index.length - 1) * CRC_INDEX_STEP;
@@ -220,7 +220,7 @@ export function readHeader(bytes: Uint8Array, view: DataView, probe: RecordProbe
   if (!magicOk && !(statedFits && (repairedHeaderMatches(bytes, view, stated) || (stated < n && probe.at(stated) > 0)))) {
     throw notCapture(bytes);
   }
-  if (statedFits && crc32(bytes, 0, stated - CRC_SIZE) === view.getUint32(stated - CRC_SIZE, true)) {
+  if (statedFits && crc32(bytes, 0, stated - CRC_SIZE, view) === view.getUint32(stated - CRC_SIZE, true)) {
     if (version !== CAPTURE_FORMAT_VERSION) {
       // An intact header of another version: a format this reader does not know, not damage.
       throw new CaptureFormatError(

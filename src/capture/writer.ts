@@ -59,7 +59,7 @@ function writeRecord(target: Uint8Array, offset: number, type: number, port: num
   target.set(payload, offset + RECORD_HEADER_SIZE);
   const crcEnd = offset + RECORD_HEADER_SIZE + len;
   // The CRC covers type through payload; the sync bytes are checked by matching them.
-  view.setUint32(crcEnd, crc32(target, offset + REC_OFF_TYPE, crcEnd), true);
+  view.setUint32(crcEnd, crc32(target, offset + REC_OFF_TYPE, crcEnd, view), true);
   return RECORD_OVERHEAD + len;
 }
 
