@@ -28,9 +28,13 @@ function file(timed: boolean): Uint8Array {
   return encodeCapture({ baudRate: 115200, source: 'test', ports: [{ name: 'a' }, { name: 'b' }] }, records);
 }
 
-/** The capture a builder keeps from a walk of `bytes`, its room guessed after the first slice when `guess`. */
-async function kept(bytes: Uint8Array, sliceBytes: number | undefined, guess: boolean): Promise<ParsedCapture> {
+/**
+ * The capture a builder keeps from a walk of `bytes`, its room guessed after the first slice when
+ * `guess`, or made before the walk for `reserve` (chunks, data bytes).
+ */
+async function kept(bytes: Uint8Array, sliceBytes: number | undefined, guess: boolean, reserve?: [number, number]): Promise<ParsedCapture> {
   const builder = new CaptureBuilder();
+  if (reserve !== undefined) builder.reserve(...reserve);
   const walked = await walkDataRecords(new Blob([bytes.slice()]), () => {}, {
     checked: () => true,
     eventsChecked: true,
@@ -67,6 +71,14 @@ describe('a capture kept from a walk of its records', () => {
       for (const slice of [7, 333, 4096, undefined])
         for (const guess of [false, true])
           expect({ timed, slice, guess, c: plain(await kept(bytes, slice, guess)) }).toEqual({ timed, slice, guess, c: want });
+      // Room made before the walk: short, exact, or more than enough.
+      const n = want.chunkEnds.length;
+      for (const reserve of [
+        [10, 100],
+        [n, want.bytes.length],
+        [2 * n, 3 * want.bytes.length],
+      ] as [number, number][])
+        expect({ timed, reserve, c: plain(await kept(bytes, 333, true, reserve)) }).toEqual({ timed, reserve, c: want });
     }
   });
 

@@ -266,6 +266,15 @@ describe('a long capture decoded on two workers', () => {
     // The capture played is the one the worker's half kept as it walked: the file is not read again.
     expect([split.wholeReads, paced.wholeReads]).toEqual([0, 0]);
     expectCaptureAsRead(split, FILE);
+    // The helper made room for it before its walk, as much as the file's start promised (3 % more
+    // than its share), and did not grow it on the way.
+    const played = split.worker.replay?.source.capture as Capture;
+    const expected = helper.jobs[0]?.expected ?? { records: 0, dataBytes: 0 };
+    expect(expected.records / played.chunkEnds.length).toBeGreaterThan(1);
+    expect(expected.records / played.chunkEnds.length).toBeLessThan(1.08);
+    expect(expected.dataBytes / played.bytes.length).toBeGreaterThan(1);
+    expect(expected.dataBytes / played.bytes.length).toBeLessThan(1.08);
+    expect(played.bytes.buffer.byteLength / played.bytes.length).toBeLessThan(1.08);
     await expectSeeksExact(split, FILE);
   });
 

@@ -37,6 +37,23 @@ export class CaptureBuilder {
   readonly #events: CaptureEvent[] = [];
 
   /**
+   * Room for `records` chunks of `dataBytes` in all (a guess from the file's start, before any
+   * record is fed), made now and every page of it written once: the system maps a column's
+   * memory where it is first written, and doing that here, while the walk waits for the file,
+   * keeps it off the walk (about 0.2 s of the day capture's 0.4 GB of columns). Instead of
+   * `expect`; growing still covers a guess that falls short.
+   */
+  reserve(records: number, dataBytes: number): void {
+    if (this.#chunks > 0 || !(records > 0 && dataBytes > 0)) return;
+    this.#expected = true;
+    this.#grow(Math.ceil(dataBytes), Math.ceil(records));
+    for (const column of [this.#data, this.#ends, this.#times, this.#ports]) {
+      const step = 4096 / column.BYTES_PER_ELEMENT;
+      for (let i = 0; i < column.length; i += step) column[i] = 0;
+    }
+  }
+
+  /**
    * The records fed so far came from the first `walked` bytes of a file of `size`: room is made
    * at once for the rest at the same rate (and 3 % more), once, so that the columns are not
    * grown and copied on the way. Growing still covers a guess that falls short.

@@ -26,6 +26,8 @@ export interface FilePassJob {
    * (the helper's half), so that the file need not be read and parsed again for playback.
    */
   keep?: boolean | undefined;
+  /** The kept capture's size, guessed from the file's start (`Preview.expected`): its room is made before the walk. */
+  expected?: { records: number; dataBytes: number } | undefined;
   resolution: 'auto' | 1024 | 2048;
   originUs: number;
   endUs: number;
@@ -81,6 +83,7 @@ export async function passOverFile(
     const transfer = (o: Overview): Transferable[] => [o.t.buffer, o.fadeRate.buffer, o.lost.buffer];
     const { ports, alsoChecked, sliceBytes, size } = job;
     const kept = job.keep === true ? new CaptureBuilder() : null;
+    if (job.expected !== undefined) kept?.reserve(job.expected.records, job.expected.dataBytes);
     // Every record decoded here is checked: nothing from a damaged one is ever shown.
     const check = new Uint8Array(256);
     for (const port of [...ports, ...alsoChecked]) check[port] = 1;

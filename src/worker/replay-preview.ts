@@ -22,6 +22,8 @@ export interface Preview {
   /** The first recorded time, and the last (from the file's end). */
   startUs: number;
   endUs: number;
+  /** The whole capture's chunks and data bytes, guessed from the start's (3 % more): room for its columns. */
+  expected: { records: number; dataBytes: number };
 }
 
 /** How much is read (tests read small files): by default PREVIEW_MIN_BYTES, PREVIEW_BYTES and TAIL_BYTES. */
@@ -42,13 +44,14 @@ export async function previewOf(file: SlicedFile, sizes: PreviewSizes = SIZES): 
   if (size < Math.max(minBytes, headBytes + tailBytes)) return null;
   let head: Capture;
   let tail: Capture;
+  let headerLength = 0;
   try {
     const start = new Uint8Array(await file.slice(0, headBytes).arrayBuffer());
     if (!hasCaptureMagic(start)) return null;
     const parsed = parseCapture(start);
     head = parsed;
     // The header as the reader found it, then the file's last bytes: a capture whose first record is cut.
-    const { headerLength } = parsed;
+    ({ headerLength } = parsed);
     const end = new Uint8Array(headerLength + tailBytes);
     end.set(start.subarray(0, headerLength));
     end.set(new Uint8Array(await file.slice(size - tailBytes, size).arrayBuffer()), headerLength);
@@ -61,5 +64,8 @@ export async function previewOf(file: SlicedFile, sizes: PreviewSizes = SIZES): 
   const startUs = captureSpan(head).startUs;
   const endUs = captureSpan(tail).endUs;
   if (!Number.isFinite(startUs) || !Number.isFinite(endUs) || endUs < startUs) return null;
-  return { head, ports: capturePorts(head), startUs, endUs };
+  // The start's share of the file holds its share of the records, give or take.
+  const scale = (1.03 * size) / Math.max(1, headBytes - headerLength);
+  const expected = { records: Math.ceil(head.chunkEnds.length * scale), dataBytes: Math.ceil(head.bytes.length * scale) };
+  return { head, ports: capturePorts(head), startUs, endUs, expected };
 }

@@ -78,7 +78,7 @@ export class ReplaySession implements Driver {
       host.post({ type: 'replay', replay: readingStatus(name, startUs, endUs) });
       const { resolution } = registry;
       const span = { originUs: startUs, endUs, resolution };
-      const halves = startSplit(file, ports, span, parts.passHelper, host.clock, parts.previewSizes?.sliceBytes, () => {
+      const halves = startSplit(file, ports, span, preview.expected, parts.passHelper, host.clock, parts.previewSizes?.sliceBytes, () => {
         // Until the capture is read the overview is drawn from here, after from the replay's slices.
         // Complete once both halves are (every record checked): the parse is not waited for.
         if (session !== null) session.#readOn();

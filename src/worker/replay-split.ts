@@ -205,6 +205,7 @@ export function startSplit(
   file: Blob,
   ports: number[],
   span: { originUs: number; endUs: number; resolution: 'auto' | 1024 | 2048 },
+  expected: { records: number; dataBytes: number } | undefined,
   helper: PassHelperMaker | undefined,
   clock: Clock,
   sliceBytes: number | undefined,
@@ -224,7 +225,7 @@ export function startSplit(
   });
   // The helper keeps the capture as it walks (the file is not parsed again; the columns are
   // transferred here at the end): this worker's half also reads the file and passes it on.
-  const theirs = HelperRun.start(helper, { ...job(ports.slice(half), []), sliceBytes: sliceBytes ?? PIECE_BYTES, keep: true });
+  const theirs = HelperRun.start(helper, { ...job(ports.slice(half), []), sliceBytes: sliceBytes ?? PIECE_BYTES, keep: true, expected });
   if (theirs === null) return null;
   // This half also checks records on ports the file's start did not show: ours with a damaged
   // port byte, perhaps. It walks in short slices: between them the pieces read go on to the helper.
