@@ -5,12 +5,14 @@
  * capture up to the target, as a decode fed every chunk up to there has them.
  */
 import { describe, expect, it } from 'vitest';
-import { capturePorts, readCapture } from '../src/capture/index.js';
+import { capturePorts, encodeCapture, readCapture } from '../src/capture/index.js';
 import { Dispatcher } from '../src/worker/dispatcher.js';
-import { overviewOf } from '../src/worker/overview.js';
+import { addOverviews, overviewOf } from '../src/worker/overview.js';
+import { preset, simulate } from '../src/simulator/index.js';
+import { usbChunks } from './feeds.js';
 import { ReplayPass } from '../src/worker/replay-pass.js';
 import { type PreviewSizes, previewOf } from '../src/worker/replay-preview.js';
-import { captureSpan } from '../src/analysis/index.js';
+import { captureSpan, healthReport } from '../src/analysis/index.js';
 import type { Overview } from '../src/worker/protocol.js';
 import { MINUTE, libraryUpTo, longCapture, longCaptureWithSeed } from './long-capture.js';
 import { FakeClock, ReadingClock, fakeHost } from './worker-fakes.js';
@@ -175,5 +177,43 @@ describe('a long capture in the worker', () => {
     expect(last?.failsafe).toEqual(once.failsafe);
     await send({ type: 'replay-pause' }, { type: 'replay-seek', timeUs: span.startUs + 11 * MINUTE });
     expect({ ...worker.registry.get(0)?.engine.decoder.stats }).toEqual(libraryUpTo(capture, 0, span.startUs + 11 * MINUTE).decoder);
+  });
+
+  it('draws a failsafe still on when the capture ends to its end, read as it goes, in parts or in one go, as the report has it', () => {
+    // The internal remote falls silent 40 s in and never comes back; the external one goes on to the end at 60 s.
+    const a = simulate({ ...preset('dsmx-11ms-2048-internal'), seed: 5, dropouts: [{ atUs: 40e6, durationUs: 100e6 }] }, 60e6);
+    const b = simulate({ ...preset('dsmx-11ms-2048-external'), seed: 6 }, 60e6);
+    const records = [
+      ...usbChunks(a.bytes, a.timesUs).map((c) => ({ type: 'data' as const, bytes: c.bytes, timeUs: c.timeUs, port: 0 })),
+      ...usbChunks(b.bytes, b.timesUs).map((c) => ({ type: 'data' as const, bytes: c.bytes, timeUs: c.timeUs + 3, port: 1 })),
+    ].sort((x, y) => x.timeUs - y.timeUs);
+    const capture = readCapture(encodeCapture({ baudRate: 115200 }, records));
+    const { startUs, endUs } = captureSpan(capture);
+    const [episode, ...others] = healthReport(capture).remotes.flatMap((r) => r.failsafes);
+    expect(others).toEqual([]);
+    expect(episode?.ongoing).toBe(true);
+    const asReported = [{ startUs: (episode?.startUs ?? 0) + startUs, endUs: (episode?.endUs ?? 0) + startUs }];
+    const near = (got: Overview['failsafe']) => got.map((f) => ({ startUs: Math.round(f.startUs / 10), endUs: Math.round(f.endUs / 10) }));
+    expect(near(asReported)[0]?.endUs).toBe(Math.round(endUs / 10));
+    // In one go.
+    expect(near(overviewOf(capture, [0, 1], 'auto').overview.failsafe)).toEqual(near(asReported));
+    // Read as it goes: nothing of it before the reading is past the silence (the overview waits for
+    // the silent port's evidence), then all of it, to the end.
+    const pass = new ReplayPass(capture, [0, 1], 'auto', startUs, endUs);
+    let clock = 0;
+    let steps = 0;
+    for (; !pass.step(1, () => (clock += 1)); steps++) {
+      const o = pass.overview();
+      for (const f of o.failsafe) expect(f.endUs).toBeLessThanOrEqual(o.readUntilUs);
+    }
+    expect(steps).toBeGreaterThan(10);
+    expect(near(pass.overview().failsafe)).toEqual(near(asReported));
+    // Each port decoded apart (a pass split with a helper), and added up.
+    const parts = [0, 1].map((port) => {
+      const part = new ReplayPass(capture, [port], 'auto', startUs, endUs);
+      while (!part.step(1000, () => performance.now()));
+      return part.overview();
+    });
+    expect(near(addOverviews(parts, startUs).failsafe)).toEqual(near(asReported));
   });
 });

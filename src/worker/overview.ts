@@ -4,7 +4,7 @@
  * ports, and the failsafe episodes; also the frame period to pace a capture without timing at.
  * Each port's bytes are decoded once, when the capture opens.
  */
-import { FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US, FRAME_SIZE, systemInfo, type FormatInfo } from '../decoder/index.js';
+import { FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US, FRAME_SIZE, type FormatInfo, type LinkEpisode, systemInfo } from '../decoder/index.js';
 import type { Capture } from '../capture/index.js';
 import { type LinkSeries, captureSpan, decodeCapture } from '../analysis/index.js';
 import type { Overview } from './protocol.js';
@@ -48,7 +48,7 @@ export function overviewOf(
       missed = l.stats.missedFrames;
     });
     all.push(series);
-    for (const e of link.episodes) if (e.kind === 'failsafe') failsafe.push({ startUs: e.startUs, endUs: e.endUs ?? e.startUs });
+    failsafe.push(...failsafeAsRead(failsafesOf(link.episodes), endUs, true));
     if (Number.isNaN(periodUs)) periodUs = periodOf(decoder.format);
   }
   if (Number.isNaN(periodUs)) periodUs = FRAME_PERIOD_11MS_US;
@@ -100,6 +100,29 @@ export function sumOverview(
   return { t, fadeRate: fades, lost, failsafe: inTimeOrder(failsafe), readUntilUs, complete };
 }
 
+/**
+ * The rule for the failsafe episodes an overview draws, one for every surface of it (a decode
+ * in one go, one read as it goes, parts added up): read up to `readUntilUs`, those begun before
+ * it, one still on lasting to there; `complete` (`readUntilUs` is the capture's end), every one,
+ * and one still on when the capture ends lasting to its end, as the report has it (`ongoing`).
+ */
+export function failsafeAsRead(
+  failsafes: Iterable<{ startUs: number; endUs: number | null }>,
+  readUntilUs: number,
+  complete: boolean,
+): Overview['failsafe'] {
+  const out: Overview['failsafe'] = [];
+  for (const e of failsafes)
+    if (complete || e.startUs < readUntilUs)
+      out.push({ startUs: e.startUs, endUs: Math.max(e.startUs, Math.min(e.endUs ?? readUntilUs, readUntilUs)) });
+  return out;
+}
+
+/** The failsafe episodes among a link monitor's episodes. */
+export function failsafesOf(episodes: readonly LinkEpisode[]): LinkEpisode[] {
+  return episodes.filter((e) => e.kind === 'failsafe');
+}
+
 /** Failsafe episodes by start (then end): the same list however the ports were split. */
 function inTimeOrder(failsafe: Overview['failsafe']): Overview['failsafe'] {
   return failsafe.sort((a, b) => a.startUs - b.startUs || a.endUs - b.endUs);
@@ -126,10 +149,10 @@ export function addOverviews(parts: readonly Overview[], originUs: number): Over
       lost[b] = (lost[b] ?? 0) + (p.lost[b] ?? 0);
     }
   }
-  const failsafe: Overview['failsafe'] = [];
-  for (const p of parts)
-    for (const f of p.failsafe)
-      if (complete) failsafe.push(f);
-      else if (f.startUs < readUntilUs) failsafe.push({ startUs: f.startUs, endUs: Math.min(f.endUs, readUntilUs) });
+  const failsafe = failsafeAsRead(
+    parts.flatMap((p) => p.failsafe),
+    readUntilUs,
+    complete,
+  );
   return { t, fadeRate, lost, failsafe: inTimeOrder(failsafe), readUntilUs, complete };
 }

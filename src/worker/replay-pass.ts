@@ -9,7 +9,7 @@
 import { type DecoderCheckpoint, type LinkCheckpoint, type LinkMonitor, SpektrumDecoder } from '../decoder/index.js';
 import type { Capture } from '../capture/index.js';
 import { LinkSeries, monitorWithSeries, timingJitterUs } from '../analysis/index.js';
-import { BIN_US, sumOverview } from './overview.js';
+import { BIN_US, failsafeAsRead, failsafesOf, sumOverview } from './overview.js';
 import type { Overview } from './protocol.js';
 
 /** Capture time between two checkpoints: 1440 of them a day, each a few kilobytes a port. */
@@ -231,12 +231,7 @@ export class ReplayPass implements OverviewPass {
       readUntilUs = Math.max(this.originUs, Math.floor((readUntilUs - this.originUs) / BIN_US - SETTLE_BINS) * BIN_US + this.originUs);
     }
     const bins = this.#done ? undefined : Math.max(0, Math.round((readUntilUs - this.originUs) / BIN_US));
-    const failsafe: Overview['failsafe'] = [];
-    for (const p of this.#ports)
-      for (const e of p.link.episodes)
-        if (e.kind === 'failsafe' && e.startUs < readUntilUs)
-          // One still open where the reading has got to lasts at least that far, not past it.
-          failsafe.push({ startUs: e.startUs, endUs: this.#done ? (e.endUs ?? e.startUs) : Math.min(e.endUs ?? readUntilUs, readUntilUs) });
+    const failsafe = this.#ports.flatMap((p) => failsafeAsRead(failsafesOf(p.link.episodes), readUntilUs, this.#done));
     return sumOverview(
       this.#ports.map((p) => p.series),
       failsafe,
