@@ -21,6 +21,45 @@ async function frameLoop() {
 
 afterEach(() => {
   vi.unstubAllGlobals();
+  vi.useRealTimers();
+});
+
+describe('the frame loop', () => {
+  it('runs every frame while there is news, a few times a second after a second without, and every frame again at once on news', async () => {
+    vi.useFakeTimers({ toFake: ['setTimeout', 'clearTimeout', 'performance'] });
+    vi.resetModules();
+    let queued: FrameRequestCallback[] = [];
+    vi.stubGlobal('requestAnimationFrame', (cb: FrameRequestCallback) => queued.push(cb));
+    const { onFrame, wake } = await import('../src/app/frame-loop.js');
+    let draws = 0;
+    onFrame(() => {
+      draws++;
+    });
+    /** Runs `ms` of time: each animation frame asked for runs after 16 ms, timers as they fall due. */
+    const run = (ms: number) => {
+      for (let t = 0; t < ms; t += 16) {
+        vi.advanceTimersByTime(16);
+        const due = queued;
+        queued = [];
+        for (const cb of due) cb(performance.now());
+      }
+    };
+    run(960);
+    expect(draws).toBeGreaterThanOrEqual(55);
+    // A second with no news: a frame every 250 ms.
+    run(1000);
+    draws = 0;
+    run(1000);
+    expect(draws).toBeGreaterThanOrEqual(3);
+    expect(draws).toBeLessThanOrEqual(5);
+    // News: the next frame runs, not the next idle one.
+    wake();
+    draws = 0;
+    run(32);
+    expect(draws).toBe(2);
+    run(480);
+    expect(draws).toBeGreaterThanOrEqual(30);
+  });
 });
 
 describe('the charts that redraw a few times a second', () => {

@@ -9,9 +9,13 @@ import { App } from './components/App/index.js';
 import { serialUnavailable } from './serial.js';
 import { send, startWorker } from './store.js';
 import { startBenchHooks } from './bench.js';
+import { wake } from './frame-loop.js';
 
 async function main(): Promise<void> {
   const worker = startWorker();
+  // The user's input may change what the views show: they draw every frame again at once.
+  for (const type of ['pointerdown', 'pointermove', 'keydown', 'wheel', 'input', 'resize'])
+    window.addEventListener(type, wake, { passive: true, capture: true });
   const granted = serialUnavailable() === null ? await navigator.serial.getPorts() : [];
   render(<App granted={granted} />, document.getElementById('app') as HTMLElement);
   const params = new URLSearchParams(location.search);

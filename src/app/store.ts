@@ -7,7 +7,7 @@
 import { batch, computed, signal } from '@preact/signals';
 import type { InspectEntry } from '../worker/inspector.js';
 import type { BindProgress, FromWorker, Overview, RecordingStatus, ReplayStatus, SourceStatus, ToWorker } from '../worker/protocol.js';
-import { onFrame } from './frame-loop.js';
+import { onFrame, wake } from './frame-loop.js';
 import { Live } from './live.js';
 import type { DiagnosisStatus } from '../worker/protocol.js';
 
@@ -228,7 +228,10 @@ export function allLives(): ReadonlyMap<number, Live> {
 export function startWorker(): Worker {
   worker = new Worker(new URL('../worker/worker.ts', import.meta.url), { type: 'module', name: 'satscope' });
   // A message's updates (sources and the selection, a replay and its overview…) reach the views as one.
-  worker.addEventListener('message', (event: MessageEvent<FromWorker>) => batch(() => receive(event.data)));
+  worker.addEventListener('message', (event: MessageEvent<FromWorker>) => {
+    wake();
+    batch(() => receive(event.data));
+  });
   worker.addEventListener('error', (event) => notify('error', 'The decoder worker failed', event.message || 'Reload the page.'));
   return worker;
 }
