@@ -31,7 +31,7 @@ export interface PreviewSizes {
   minBytes: number;
   headBytes: number;
   tailBytes: number;
-  /** Then read at a time by the passes that decode it straight from the file (replay-split.ts; default 16 MiB). */
+  /** Then read at a time by the passes that decode it straight from the file (replay-split.ts; default 4 MiB). */
   sliceBytes?: number;
 }
 
