@@ -5,7 +5,7 @@
  * src/ with Rolldown and driven with a fake host whose replay never ticks (its timers for one
  * shot run, so the capture's decode goes on in slices), so only the work of `replay-open` and
  * `replay-seek` is timed: to the first overview sent (of a long capture, that of its first
- * records, before the whole file is read: src/worker/replay-preview.ts); the rest of that decode (the overview complete, the checkpoints); and a
+ * records, before the whole file is read: src/worker/replay/replay-preview.ts); the rest of that decode (the overview complete, the checkpoints); and a
  * seek, from the nearest checkpoint a minute or more before the target. Each file runs in a
  * child of its own (`--expose-gc`): the heap and array buffers the worker holds once the capture
  * is read are measured after a collection, against the file size.
@@ -37,7 +37,7 @@ async function main() {
   await build({
     input: {
       dispatcher: fileURLToPath(new URL('../src/worker/dispatcher.ts', import.meta.url)),
-      'file-pass': fileURLToPath(new URL('../src/worker/replay-file-pass.ts', import.meta.url)),
+      'file-pass': fileURLToPath(new URL('../src/worker/replay/replay-file-pass.ts', import.meta.url)),
       decoder: fileURLToPath(new URL('../src/decoder/index.ts', import.meta.url)),
     },
     platform: 'node',
@@ -130,11 +130,11 @@ function bareDecodeMs(SpektrumDecoder, capture, fromUs, toUs) {
   return performance.now() - started;
 }
 
-/** The replay helper on a thread of its own (the page's is a worker: src/worker/replay-helper-worker.ts). */
+/** The replay helper on a thread of its own (the page's is a worker: src/worker/replay/replay-helper-worker.ts). */
 async function helperThread(bundle) {
   const { parentPort } = await import('node:worker_threads');
   const { helperReceiver } = await import(join(bundle, 'file-pass.mjs'));
-  // As src/worker/replay-helper-worker.ts: its job, then the file's pieces as the worker reads them.
+  // As src/worker/replay/replay-helper-worker.ts: its job, then the file's pieces as the worker reads them.
   const receive = helperReceiver(
     (r, transfer) => parentPort.postMessage(r, transfer),
     () => performance.now(),

@@ -4,7 +4,7 @@
  * reaches every read, and bytes already read past are let go.
  */
 import { describe, expect, it } from 'vitest';
-import { ArrivingFile } from '../src/worker/arriving-file.js';
+import { ArrivingFile } from '../src/worker/replay/arriving-file.js';
 
 const bytes = Uint8Array.from({ length: 1000 }, (_, i) => (i * 7) & 0xff);
 

@@ -4,7 +4,7 @@
  * and a file that ends before its size says so.
  */
 import { describe, expect, it } from 'vitest';
-import { PieceReader, type ReadableFile } from '../src/worker/piece-reader.js';
+import { PieceReader, type ReadableFile } from '../src/worker/replay/piece-reader.js';
 
 const bytes = Uint8Array.from({ length: 100_000 }, (_, i) => (i * 31 + (i >> 8)) & 0xff);
 

@@ -7,11 +7,11 @@
 import { describe, expect, it } from 'vitest';
 import { capturePorts, encodeCapture, readCapture } from '../src/capture/index.js';
 import { Dispatcher } from '../src/worker/dispatcher.js';
-import { addOverviews, overviewOf } from '../src/worker/overview.js';
+import { addOverviews, overviewOf } from '../src/worker/replay/overview.js';
 import { preset, simulate } from '../src/simulator/index.js';
 import { usbChunks } from './feeds.js';
-import { ReplayPass } from '../src/worker/replay-pass.js';
-import { type PreviewSizes, previewOf } from '../src/worker/replay-preview.js';
+import { ReplayPass } from '../src/worker/replay/replay-pass.js';
+import { type PreviewSizes, previewOf } from '../src/worker/replay/replay-preview.js';
 import { captureSpan, healthReport } from '../src/analysis/index.js';
 import type { Overview } from '../src/worker/protocol.js';
 import { MINUTE, libraryUpTo, longCapture, longCaptureWithSeed } from './long-capture.js';

@@ -8,11 +8,11 @@
 import { describe, expect, it } from 'vitest';
 import { type Capture, capturePorts, parseCapture, readCapture, type SlicedFile } from '../src/capture/index.js';
 import { Dispatcher } from '../src/worker/dispatcher.js';
-import { overviewOf } from '../src/worker/overview.js';
+import { overviewOf } from '../src/worker/replay/overview.js';
 import type { Overview } from '../src/worker/protocol.js';
-import { type FilePassJob, type FilePassReport, passOverFile } from '../src/worker/replay-file-pass.js';
-import { ArrivingFile } from '../src/worker/arriving-file.js';
-import type { PassHelperMaker } from '../src/worker/replay-helper.js';
+import { type FilePassJob, type FilePassReport, passOverFile } from '../src/worker/replay/replay-file-pass.js';
+import { ArrivingFile } from '../src/worker/replay/arriving-file.js';
+import type { PassHelperMaker } from '../src/worker/replay/replay-helper.js';
 import { MINUTE, libraryUpTo, longCapture } from './long-capture.js';
 import { ReadingClock, fakeHost } from './worker-fakes.js';
 

@@ -1,7 +1,7 @@
 /**
  * A capture put together from its records as they are walked (record-walk.ts), for a reader
  * that walks the file anyway and would otherwise parse it again: the replay decodes a long
- * capture straight from the file's pieces, and keeps it this way (src/worker/replay-split.ts).
+ * capture straight from the file's pieces, and keeps it this way (src/worker/replay/replay-split.ts).
  * Fed every record of an intact file, each checked, it is the capture `parseCapture` reads:
  * the same columns, events, timing and header. It cannot tell an intact file from a damaged
  * one; whoever feeds it must know (a walk that ended, every CRC checked).

@@ -4,7 +4,7 @@
  * of the records the reader asks for. For a reader that learns elsewhere whether the whole file
  * is intact: the replay decodes a long capture's ports this way in two workers, each checking
  * the records it decodes, one of them keeping the capture (capture-builder.ts), which counts
- * only if both walked to the end (src/worker/replay-split.ts).
+ * only if both walked to the end (src/worker/replay/replay-split.ts).
  */
 import {
   CRC_SIZE,

@@ -288,7 +288,7 @@ describe.skipIf(skip !== null)('the graphs and the counters', () => {
 
 describe.skipIf(skip !== null)('a capture being read', () => {
   // Two hours of two remotes: over 32 MB, so the page shows its span and overview while it reads,
-  // and decodes it on two workers, the helper keeping the capture (src/worker/replay-split.ts).
+  // and decodes it on two workers, the helper keeping the capture (src/worker/replay/replay-split.ts).
   let path = '';
   beforeAll(() => {
     path = join(dir, 'two-hours.sscap');

@@ -2,8 +2,8 @@
  * A replay's growing overview, sent to the page as a long capture is read (replay-session.ts):
  * how often, and never one that reads less far than the last.
  */
-import type { Host } from './host.js';
-import type { Overview } from './protocol.js';
+import type { Host } from '../host.js';
+import type { Overview } from '../protocol.js';
 
 /**
  * The growing overview is sent at most this often, and no more often than a quarter of the time

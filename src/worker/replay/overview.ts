@@ -4,10 +4,17 @@
  * ports, and the failsafe episodes; also the frame period to pace a capture without timing at.
  * Each port's bytes are decoded once, when the capture opens.
  */
-import { FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US, FRAME_SIZE, type FormatInfo, type LinkEpisode, systemInfo } from '../decoder/index.js';
-import type { Capture } from '../capture/index.js';
-import { type LinkSeries, captureSpan, decodeCapture } from '../analysis/index.js';
-import type { Overview } from './protocol.js';
+import {
+  FRAME_PERIOD_11MS_US,
+  FRAME_PERIOD_22MS_US,
+  FRAME_SIZE,
+  type FormatInfo,
+  type LinkEpisode,
+  systemInfo,
+} from '../../decoder/index.js';
+import type { Capture } from '../../capture/index.js';
+import { type LinkSeries, captureSpan, decodeCapture } from '../../analysis/index.js';
+import type { Overview } from '../protocol.js';
 
 /** The overview's bins: one second. */
 export const BIN_US = 1_000_000;

@@ -12,11 +12,11 @@
  * capture's own order puts it (`checkpointChunks`) and with the capture's chunk and byte counts. A half that fails or disagrees is decoded again from the
  * capture, here; the overview and seeks are then exactly the one-worker pass's.
  */
-import type { Capture, ParsedCapture } from '../capture/index.js';
-import type { Clock } from './host.js';
+import type { Capture, ParsedCapture } from '../../capture/index.js';
+import type { Clock } from '../host.js';
 import { addOverviews } from './overview.js';
 import { PieceReader, type ReadableFile } from './piece-reader.js';
-import type { Overview } from './protocol.js';
+import type { Overview } from '../protocol.js';
 import { HelperRun, type PassHelperMaker, inThisWorker } from './replay-helper.js';
 import { CHECKPOINT_US, type Checkpoint, type OverviewPass, ReplayPass, checkpointDue } from './replay-pass.js';
 

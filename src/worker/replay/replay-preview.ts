@@ -5,8 +5,8 @@
  * a record a cut leaves). The start gives the records to decode first; the end gives where the
  * capture ends, so that the page can place the part read on the whole span at once.
  */
-import { type Capture, type SlicedFile, capturePorts, hasCaptureMagic, parseCapture } from '../capture/index.js';
-import { captureSpan } from '../analysis/index.js';
+import { type Capture, type SlicedFile, capturePorts, hasCaptureMagic, parseCapture } from '../../capture/index.js';
+import { captureSpan } from '../../analysis/index.js';
 
 /** A file this large gets a preview: under it, reading it whole is as quick. */
 const PREVIEW_MIN_BYTES = 32 << 20;

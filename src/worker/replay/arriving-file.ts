@@ -4,7 +4,7 @@
  * walk it with walkDataRecords as they would a File. Reading a File again costs as much as the
  * first time (the browser copies it across processes); a piece posted to a helper does not.
  */
-import type { SlicedFile } from '../capture/index.js';
+import type { SlicedFile } from '../../capture/index.js';
 
 export class ArrivingFile implements SlicedFile {
   /**
@@ -87,7 +87,7 @@ export class ArrivingFile implements SlicedFile {
     if (drop > 0) {
       const gone = pieces.splice(0, drop);
       if (this.giveBack)
-        gone.forEach(({ bytes }, k) => this.#readPast.push({ bytes, end: gone[k + 1]?.at ?? pieces[0]?.at ?? this.#arrived }));
+        for (const [k, { bytes }] of gone.entries()) this.#readPast.push({ bytes, end: gone[k + 1]?.at ?? pieces[0]?.at ?? this.#arrived });
     }
     const first = pieces[0];
     if (first === undefined || start < first.at) throw new RangeError(`bytes ${start}… were let go: reads go forward`);

@@ -6,21 +6,21 @@
  * grows, and a seek starts from that decode's nearest checkpoint. Others get their overview at
  * once (overview.ts) and seek with fresh decodes.
  */
-import { CaptureFormatError, capturePorts, readCapture, type Capture } from '../capture/index.js';
-import { FRAME_PERIOD_11MS_US } from '../decoder/index.js';
-import { captureSpan, timingJitterUs } from '../analysis/index.js';
-import type { Batcher } from './batcher.js';
-import type { Diagnosis } from './diagnosis.js';
-import { type Host, notice } from './host.js';
+import { CaptureFormatError, capturePorts, readCapture, type Capture } from '../../capture/index.js';
+import { FRAME_PERIOD_11MS_US } from '../../decoder/index.js';
+import { captureSpan, timingJitterUs } from '../../analysis/index.js';
+import type { Batcher } from '../batcher.js';
+import type { Diagnosis } from '../diagnosis.js';
+import { type Host, notice } from '../host.js';
 import { overviewOf } from './overview.js';
-import type { Overview, ReplayStatus } from './protocol.js';
-import type { Driver, SourceRegistry } from './registry.js';
+import type { Overview, ReplayStatus } from '../protocol.js';
+import type { Driver, SourceRegistry } from '../registry.js';
 import { type Checkpoint, type OverviewPass, ReplayPass } from './replay-pass.js';
 import { type PreviewSizes, previewOf } from './replay-preview.js';
 import type { PassHelperMaker } from './replay-helper.js';
 import { type SplitPass, keptCapture, readInPieces, startSplit } from './replay-split.js';
 import { OverviewSender } from './overview-sender.js';
-import { ReplaySource } from './sources/replay.js';
+import { ReplaySource } from '../sources/replay.js';
 
 /** The position moves every tick; the page needs it a few times a second. */
 const STATUS_MS = 200;

@@ -6,11 +6,11 @@
  * each CHECKPOINT_US of capture time: a seek restores the nearest one and feeds only from there,
  * with the counters, episodes and link state of the whole capture up to the target.
  */
-import { type DecoderCheckpoint, type LinkCheckpoint, type LinkMonitor, SpektrumDecoder } from '../decoder/index.js';
-import type { Capture } from '../capture/index.js';
-import { LinkSeries, monitorWithSeries, timingJitterUs } from '../analysis/index.js';
+import { type DecoderCheckpoint, type LinkCheckpoint, type LinkMonitor, SpektrumDecoder } from '../../decoder/index.js';
+import type { Capture } from '../../capture/index.js';
+import { LinkSeries, monitorWithSeries, timingJitterUs } from '../../analysis/index.js';
 import { BIN_US, failsafeAsRead, failsafesOf, sumOverview } from './overview.js';
-import type { Overview } from './protocol.js';
+import type { Overview } from '../protocol.js';
 
 /** Capture time between two checkpoints: 1440 of them a day, each a few kilobytes a port. */
 export const CHECKPOINT_US = 60e6;

@@ -5,8 +5,8 @@
  * report, then the same at the end with the count of chunks and bytes it walked, which the
  * worker checks against the capture it reads.
  */
-import { CaptureBuilder, type ParsedCapture, type SlicedFile, walkDataRecords } from '../capture/index.js';
-import type { Overview } from './protocol.js';
+import { CaptureBuilder, type ParsedCapture, type SlicedFile, walkDataRecords } from '../../capture/index.js';
+import type { Overview } from '../protocol.js';
 import { ArrivingFile } from './arriving-file.js';
 import { type Checkpoint, ReplayPass } from './replay-pass.js';
 
