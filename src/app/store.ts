@@ -225,11 +225,16 @@ export function allLives(): ReadonlyMap<number, Live> {
   return lives;
 }
 
+/** The worker's messages that change what the frame loop's views draw (their remotes' data). */
+const FRAME_NEWS: ReadonlySet<FromWorker['type']> = new Set(['sources', 'batches', 'reset']);
+
 export function startWorker(): Worker {
   worker = new Worker(new URL('../worker/worker.ts', import.meta.url), { type: 'module', name: 'satscope' });
   // A message's updates (sources and the selection, a replay and its overview…) reach the views as one.
   worker.addEventListener('message', (event: MessageEvent<FromWorker>) => {
-    wake();
+    // What the frame loop draws changed: it draws every frame again (replay's status and
+    // overview, notices and findings are drawn by their components, not by the loop).
+    if (FRAME_NEWS.has(event.data.type)) wake();
     batch(() => receive(event.data));
   });
   worker.addEventListener('error', (event) => notify('error', 'The decoder worker failed', event.message || 'Reload the page.'));
