@@ -1,10 +1,11 @@
 /**
  * One requestAnimationFrame loop for every high-rate view. A renderer is called each frame and
  * decides itself whether anything it shows changed (data version, or a displayed age rolling over).
- * With no news for a while (no remote's data from the worker, no input: a page left open with nothing
- * plugged in, a paused replay, a long capture being read) the loop runs a few times a second
- * instead of every frame: what still moves then (an age, an axis sliding with time) moves at that
- * pace, and an idle page stops costing a frame's work sixty times a second. News wakes it at once.
+ * With no news for a while (no remote's data from the worker, no input: a page left open with
+ * nothing plugged in, a paused replay, a long capture being read) the loop runs a few times a
+ * second instead of every frame: what still moves then (an age, an axis sliding with time) moves
+ * at that pace, and an idle page stops costing a frame's work sixty times a second. News wakes
+ * it at once.
  */
 export type Renderer = (nowMs: number) => void;
 

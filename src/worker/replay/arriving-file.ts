@@ -60,21 +60,27 @@ export class ArrivingFile implements SlicedFile {
     for (const go of waiting) go();
   }
 
+  /** Bytes [start, end) in a buffer of their own: a whole piece that owns its buffer is that buffer, anything else a copy. */
   slice(start: number, end: number): { arrayBuffer(): Promise<ArrayBuffer> } {
     return {
       arrayBuffer: async () => {
-        const bytes = await this.view(start, end, true);
+        const bytes = await this.#read(start, end, true);
         return bytes.buffer as ArrayBuffer;
       },
     };
   }
 
+  /** Bytes [start, end): a view of the piece that holds them all, a copy of those of several. */
+  view(start: number, end: number): Promise<Uint8Array> {
+    return this.#read(start, end, false);
+  }
+
   /**
-   * Bytes [start, end) once they have arrived: a view of the piece that holds them all, a copy
-   * of those of several pieces (or, `own`, a copy unless they are a whole piece that owns its
-   * buffer). Reads go forward: pieces before `start` are let go.
+   * Bytes [start, end) once they have arrived: a view of the piece that holds them all (unless
+   * `own`, a buffer of their own, is asked and they are not a whole piece that owns its buffer),
+   * else a copy. Reads go forward: pieces before `start` are let go.
    */
-  async view(start: number, end: number, own = false): Promise<Uint8Array> {
+  async #read(start: number, end: number, own: boolean): Promise<Uint8Array> {
     const to = Math.min(end, this.size);
     for (;;) {
       if (this.#failed !== null) throw this.#failed;

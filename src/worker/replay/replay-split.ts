@@ -2,15 +2,17 @@
  * A long capture's replay pass on two cores, overview first: as soon as the file's start and end
  * are read, its ports are decoded straight from the file (replay-file-pass.ts) in two halves,
  * the first half in this worker and the later half in a helper worker, and the overview is drawn
- * from both as they go. The file is read once, in pieces handed to both halves as they come
- * (readInPieces); the helper's half keeps the capture as it walks it (`keptCapture`), and hands
- * it over at the end without a copy, so that it plays as soon as both halves are done. A file
- * that does not prove intact is read again and parsed (salvaged) as any other.
+ * from both as they go. The file is read once, a piece at a time, each piece walked by this
+ * worker's half and then by the helper's (readInPieces); the helper's half keeps the capture as
+ * it walks it (`keptCapture`), and hands it over at the end without a copy, so that it plays as
+ * soon as both halves are done. A file that does not prove intact is read again and parsed
+ * (salvaged) as any other.
  *
  * The halves count only for a capture found intact (or cut off inside its last record, where
  * both halves found the file ending), on the same span, with every checkpoint on the chunk the
- * capture's own order puts it (`checkpointChunks`) and with the capture's chunk and byte counts. A half that fails or disagrees is decoded again from the
- * capture, here; the overview and seeks are then exactly the one-worker pass's.
+ * capture's own order puts it (`checkpointChunks`) and with the capture's chunk and byte
+ * counts. A half that fails or disagrees is decoded again from the capture, here; the overview
+ * and seeks are then exactly the one-worker pass's.
  */
 import type { Capture, ParsedCapture } from '../../capture/index.js';
 import type { Clock } from '../host.js';
