@@ -16,7 +16,7 @@ import {
   REC_OFF_TYPE,
 } from './layout.js';
 import type { CaptureEvent, ParsedCapture } from './model.js';
-import type { HeaderResult } from './reader.js';
+import type { HeaderResult } from './header.js';
 import { copyPayload, grown, trimTo } from './records.js';
 import { utf8Decode } from './text.js';
 

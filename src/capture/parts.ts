@@ -9,7 +9,8 @@
  */
 import { RECORD_HEADER_SIZE, RECORD_OVERHEAD, RECORD_TYPE_DATA, REC_OFF_PORT, REC_OFF_TIME, REC_OFF_TYPE } from './layout.js';
 import type { CaptureEvent, CaptureMeta, ParsedCapture } from './model.js';
-import { readHeader, RecordProbe } from './reader.js';
+import { readHeader } from './header.js';
+import { RecordProbe } from './record-probe.js';
 import { copyPayload, plannedSizes } from './records.js';
 import { utf8Decode } from './text.js';
 

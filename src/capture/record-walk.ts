@@ -22,7 +22,8 @@ import {
 } from './layout.js';
 import { crc32 } from './crc32.js';
 import { CaptureFormatError } from './model.js';
-import { type HeaderResult, RecordProbe, readHeader } from './reader.js';
+import { type HeaderResult, readHeader } from './header.js';
+import { RecordProbe } from './record-probe.js';
 import { recordSize } from './records.js';
 
 /** Read at a time: the header (its metadata is at most 1 MiB) and a few hundred thousand records. */

@@ -6,7 +6,8 @@ import { CAPTURE_FILE_EXTENSION, isCaptureMagicPrefix } from './layout.js';
 import { CaptureFormatError } from './model.js';
 import type { Capture } from './model.js';
 import { importRaw } from './raw.js';
-import { looksLikeCaptureMagic, parseCapture, type ReadOptions } from './reader.js';
+import { looksLikeCaptureMagic } from './header.js';
+import { parseCapture, type ReadOptions } from './reader.js';
 import { CR, LF, bomLength, csvColumns, importSaleaeCsv, isBlank, quote } from './saleae.js';
 
 /** How much of a file the text check looks at. */
