@@ -1,7 +1,8 @@
 /**
  * Looking for an intact record at a place in a .sscap file, in time linear in the file however
  * damaged it is: its sync marker, header and CRC (long ranges from an index of prefix CRCs).
- * Shared by the salvaging reader (reader.ts) and the header's repair (header.ts).
+ * The salvaging reader (reader.ts) looks for records with it, and every reader's header repair
+ * (header.ts) with it finds where the records start.
  */
 import { crc32, crcRun, crcShift, mulModPoly } from './crc32.js';
 import {
