@@ -1,11 +1,11 @@
 /**
- * Facts kept with a capture (`captureFact`): its ports and span are worked out once, copied when
+ * Facts kept with a capture (`captureFact`): its ports, their chunk counts and its span are worked out once, copied when
  * handed out, and worked out again when the capture's columns or events are not the ones they
  * came from.
  */
 import { describe, expect, it } from 'vitest';
 import { captureSpan } from '../src/analysis/index.js';
-import { captureFact, capturePorts, type Capture } from '../src/capture/index.js';
+import { captureChunksByPort, captureFact, capturePorts, type Capture } from '../src/capture/index.js';
 
 function capture(ports: number[], times: number[]): Capture {
   return {
@@ -35,6 +35,11 @@ describe('facts kept with a capture', () => {
     const c = capture([2, 0, 2], [10, 20, 30]);
     const ports = capturePorts(c);
     ports.push(9);
+    expect(capturePorts(c)).toEqual([0, 2]);
+    const counts = captureChunksByPort(c);
+    expect([counts.length, counts[0], counts[1], counts[2]]).toEqual([256, 1, 0, 2]);
+    counts[2] = 0;
+    expect(captureChunksByPort(c)[2]).toBe(2);
     expect(capturePorts(c)).toEqual([0, 2]);
     const span = captureSpan(c);
     span.startUs = -1;

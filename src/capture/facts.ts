@@ -45,13 +45,23 @@ export function captureFact<T>(capture: Capture, name: string, work: (capture: C
 
 /** The port indices that have at least one data chunk, in increasing order (one pass per capture: `captureFact`). */
 export function capturePorts(capture: Capture): number[] {
-  return captureFact(capture, 'ports', portsOf).slice();
+  const counts = captureFact(capture, 'port chunks', chunksByPort);
+  const ports: number[] = [];
+  for (let p = 0; p < 256; p++) if ((counts[p] ?? 0) > 0) ports.push(p);
+  return ports;
 }
 
-function portsOf(capture: Capture): number[] {
-  const seen = new Uint8Array(256);
-  for (let i = 0; i < capture.chunkPorts.length; i++) seen[capture.chunkPorts[i] ?? 0] = 1;
-  const ports: number[] = [];
-  for (let p = 0; p < 256; p++) if (seen[p] === 1) ports.push(p);
-  return ports;
+/** How many data chunks each port (0–255) has (the same pass as `capturePorts`). */
+export function captureChunksByPort(capture: Capture): Uint32Array {
+  return captureFact(capture, 'port chunks', chunksByPort).slice();
+}
+
+function chunksByPort(capture: Capture): Uint32Array {
+  const counts = new Uint32Array(256);
+  const chunkPorts = capture.chunkPorts;
+  for (let i = 0; i < chunkPorts.length; i++) {
+    const p = chunkPorts[i] ?? 0;
+    counts[p] = (counts[p] ?? 0) + 1;
+  }
+  return counts;
 }

@@ -33,10 +33,10 @@ export function checkpointChunks(capture: Capture, originUs: number): { chunk: n
   let fed = Number.NEGATIVE_INFINITY;
   for (let i = 0; i < times.length; i++) {
     const t = times[i] ?? Number.NaN;
-    const due = checkpointDue(next, t);
-    if (due !== next) {
+    // Only a chunk at or past the due time can get one (a NaN time never does).
+    if (t >= next) {
       out.push({ chunk: i, fedUntilUs: fed });
-      next = due;
+      next = checkpointDue(next, t);
     }
     if (t > fed) fed = t;
   }
