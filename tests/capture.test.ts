@@ -15,6 +15,7 @@ import {
   readCapture,
 } from '../src/capture/index.js';
 import type { Capture, CaptureMeta, CaptureRecordInput } from '../src/capture/index.js';
+import { crcFollows } from '../src/capture/crc32.js';
 import { concatBytes } from './bytes.js';
 
 // ---------------------------------------------------------------------------------------------
@@ -139,6 +140,25 @@ describe('crc32', () => {
           want,
           want,
         ]);
+      }
+  });
+
+  it('tells whether the CRC stored after a range (as records and headers store it) is the range’s, one wrong bit anywhere apart', () => {
+    const whole = Uint8Array.from({ length: 120 }, (_, i) => (i * 151 + 7) & 0xff);
+    for (let start = 0; start < 8; start++)
+      for (let length = 0; length <= 100; length += 3) {
+        const bytes = whole.slice();
+        const view = new DataView(bytes.buffer);
+        const end = start + length;
+        view.setUint32(end, crc32(bytes, start, end), true);
+        const stored = bytes.slice();
+        expect([start, length, crcFollows(bytes, start, end, view)]).toEqual([start, length, true]);
+        for (const at of [start, end - 1, end, end + 3]) {
+          if (at < start) continue;
+          bytes.set(stored);
+          bytes[at] = (bytes[at] ?? 0) ^ 0x10;
+          expect([start, length, at, crcFollows(bytes, start, end, view)]).toEqual([start, length, at, false]);
+        }
       }
   });
 });

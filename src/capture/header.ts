@@ -5,7 +5,7 @@
  * record walk (record-walk.ts).
  */
 import { utf8Decode } from './text.js';
-import { crc32, crcRun } from './crc32.js';
+import { crcFollows, crcRun } from './crc32.js';
 import {
   CAPTURE_FORMAT_VERSION,
   CRC_SIZE,
@@ -96,7 +96,7 @@ export function readHeader(bytes: Uint8Array, view: DataView, probe: RecordProbe
   if (!magicOk && !(statedFits && (repairedHeaderMatches(bytes, view, stated) || (stated < n && probe.at(stated) > 0)))) {
     throw notCapture(bytes);
   }
-  if (statedFits && crc32(bytes, 0, stated - CRC_SIZE, view) === view.getUint32(stated - CRC_SIZE, true)) {
+  if (statedFits && crcFollows(bytes, 0, stated - CRC_SIZE, view)) {
     if (version !== CAPTURE_FORMAT_VERSION) {
       // An intact header of another version: a format this reader does not know, not damage.
       throw new CaptureFormatError(

@@ -20,7 +20,7 @@ import {
   REC_OFF_TIME,
   REC_OFF_TYPE,
 } from './layout.js';
-import { crc32 } from './crc32.js';
+import { crcFollows } from './crc32.js';
 import { CaptureFormatError } from './model.js';
 import { type HeaderResult, readHeader } from './header.js';
 import { RecordProbe } from './record-probe.js';
@@ -128,7 +128,7 @@ export async function walkDataRecords(file: SlicedFile, sink: RecordSink, option
       const data = bytes[p + REC_OFF_TYPE] === RECORD_TYPE_DATA;
       const port = bytes[p + REC_OFF_PORT] ?? 0;
       const end = p + total - CRC_SIZE;
-      if ((data ? checked(port) : eventsChecked) && crc32(bytes, p + REC_OFF_TYPE, end, view) !== view.getUint32(end, true))
+      if ((data ? checked(port) : eventsChecked) && !crcFollows(bytes, p + REC_OFF_TYPE, end, view))
         throw new CaptureFormatError(`damaged record at offset ${at + p} (its CRC-32 check failed)`);
       if (data) {
         sink(bytes, p + RECORD_HEADER_SIZE, end, view.getFloat64(p + REC_OFF_TIME, true), port);
