@@ -159,6 +159,8 @@ export class SpektrumDecoder {
   #byteTimes: Float64Array | null = null;
   /** What #dateByte dates: a Float64Array slot, so the double is never boxed between calls. */
   readonly #when = new Float64Array(1);
+  /** The time of the chunk pushRange() hands on, likewise. */
+  readonly #pushedAt = new Float64Array(1);
   /** Index in #buf of the first byte not yet decided. */
   #head = 0;
   /** Index in #buf after the last byte pushed. */
@@ -277,24 +279,40 @@ export class SpektrumDecoder {
    * @throws {TypeError} as `push()`, and for a range that is not one of `bytes`.
    */
   pushRange(bytes: Uint8Array, start: number, end: number, time?: number | Float64Array): void {
-    // `=== true` on the hot paths: optimised code tests a boolean field for every kind of falsy value otherwise.
-    if (this.#ended === true) throw new TypeError('push() after end(): call reset() to decode a new stream');
-    if (!(start >= 0 && start <= end && end <= bytes.length && (start | 0) === start && (end | 0) === end))
-      throw new TypeError(`[${start}, ${end}) is not a range of ${bytes.length} bytes`);
-    // push() and this are kept small so that they are inlined into the caller's loop, and the
-    // time is stored here rather than passed on: a double handed from there to a call that is
-    // not inlined, or to `instanceof`, is boxed (a 16-byte heap number every push). See #append.
+    // push() and this are kept this small so that they are inlined into the caller's loop whatever
+    // else is (a compiler's budget for inlining runs out in a long loop, as a capture walk's), and
+    // a chunk time goes on in a typed-array slot: a double handed to a call that is not inlined,
+    // or to `instanceof`, is boxed (a 16-byte heap number every push).
     if (typeof time === 'number') {
-      const i = this.#append(bytes, null, start, end);
-      if (i >= 0) this.#chunkTimes[i] = time;
-      return;
-    }
+      this.#pushedAt[0] = time;
+      this.#pushTimed(bytes, start, end);
+    } else this.#pushOther(bytes, start, end, time);
+  }
+
+  /** pushRange() of a chunk timed #pushedAt[0]. */
+  #pushTimed(bytes: Uint8Array, start: number, end: number): void {
+    this.#checkPush(bytes, start, end);
+    const i = this.#append(bytes, null, start, end);
+    if (i >= 0) this.#chunkTimes[i] = this.#pushedAt[0] ?? Number.NaN;
+  }
+
+  /** pushRange() of a chunk with per-byte times, or none. */
+  #pushOther(bytes: Uint8Array, start: number, end: number, time: Float64Array | undefined): void {
+    this.#checkPush(bytes, start, end);
     const perByte = time instanceof Float64Array;
     if (perByte && time.length !== bytes.length) {
       throw new TypeError(`per-byte times have length ${time.length}, bytes ${bytes.length}`);
     }
     const i = this.#append(bytes, perByte ? time : null, start, end);
-    if (i >= 0) this.#chunkTimes[i] = perByte ? NaN : (time ?? NaN);
+    if (i >= 0) this.#chunkTimes[i] = Number.NaN;
+  }
+
+  /** @throws {TypeError} after `end()`, and for a range that is not one of `bytes` */
+  #checkPush(bytes: Uint8Array, start: number, end: number): void {
+    // `=== true` on the hot paths: optimised code tests a boolean field for every kind of falsy value otherwise.
+    if (this.#ended === true) throw new TypeError('push() after end(): call reset() to decode a new stream');
+    if (!(start >= 0 && start <= end && end <= bytes.length && (start | 0) === start && (end | 0) === end))
+      throw new TypeError(`[${start}, ${end}) is not a range of ${bytes.length} bytes`);
   }
 
   /**
@@ -302,10 +320,8 @@ export class SpektrumDecoder {
    * first and growing it (doubling) only when full, and records the chunk's end. Returns the
    * chunk's index, for the caller to store its time, or -1 for no bytes.
    *
-   * One method, not three: V8 inlines a function into its callers only below 460 bytes of
-   * bytecode, counting what its optimised code has inlined itself. push() must be inlined into
-   * the caller's loop (a double time handed to a call that is not inlined is boxed, 16 bytes a
-   * push), and it stays small enough only while this, its one callee, is never inlined into it.
+   * One method for every kind of chunk, too big ever to be inlined (V8 inlines only below 460
+   * bytes of bytecode): the push paths that call it stay small.
    */
   #append(bytes: Uint8Array, byteTimes: Float64Array | null, start: number, end: number): number {
     const n = end - start;
