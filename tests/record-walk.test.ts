@@ -3,7 +3,7 @@
  * same chunks parseCapture reads, whatever the slice size; a file that is not intact is refused.
  */
 import { describe, expect, it } from 'vitest';
-import { encodeCapture, parseCapture, walkDataRecords } from '../src/capture/index.js';
+import { encodeCapture, parseCapture, recordTimeUs, walkDataRecords } from '../src/capture/index.js';
 
 /** Data records of 1–40 bytes (one of 3000) on three ports, an event every 50, one record far bigger than a slice. */
 function file(): Uint8Array {
@@ -22,7 +22,7 @@ async function walk(bytes: Uint8Array, sliceBytes?: number, checked = true) {
   const got: { bytes: number[]; timeUs: number; port: number }[] = [];
   const walked = await walkDataRecords(
     new Blob([bytes.slice()]),
-    (b, start, end, timeUs, port) => got.push({ bytes: Array.from(b.subarray(start, end)), timeUs, port }),
+    (b, view, start, end, port) => got.push({ bytes: Array.from(b.subarray(start, end)), timeUs: recordTimeUs(view, start), port }),
     { ...(sliceBytes === undefined ? {} : { sliceBytes }), checked: () => checked },
   );
   return { walked, got };

@@ -67,8 +67,10 @@ export function captureSpan(capture: Capture): { startUs: number; endUs: number 
 
 function spanOf(capture: Capture): { startUs: number; endUs: number } {
   const { chunkEnds, chunkTimesUs, byteTimesUs } = capture;
-  let start = Infinity;
-  let end = -Infinity;
+  // The earliest and latest so far, kept in a typed array rather than two locals: Chromium 150
+  // keeps a loop's double locals boxed until the loop is optimised, a heap number a chunk of a
+  // pass that runs once, cold, over eleven million chunks (three times the time, measured).
+  const span = new Float64Array([Infinity, -Infinity]);
   let from = 0;
   for (let i = 0; i < chunkEnds.length; i++) {
     const to = chunkEnds[i] ?? from;
@@ -82,11 +84,13 @@ function spanOf(capture: Capture): { startUs: number; endUs: number } {
         last = chunkTimesUs[i] ?? NaN;
         first = last - (to - from - 1) * BYTE_TIME_US;
       }
-      if (first < start) start = first;
-      if (last > end) end = last;
+      if (first < (span[0] ?? NaN)) span[0] = first;
+      if (last > (span[1] ?? NaN)) span[1] = last;
     }
     from = to;
   }
+  let start = span[0] ?? NaN;
+  let end = span[1] ?? NaN;
   for (const e of capture.events) {
     if (e.timeUs < start) start = e.timeUs;
     if (e.timeUs > end) end = e.timeUs;

@@ -47,6 +47,7 @@ export {
   type SlicedFile,
   type WalkedRecords,
   type WalkOptions,
+  recordTimeUs,
   walkDataRecords,
 } from './record-walk.js';
 export { CaptureBuilder } from './capture-builder.js';

@@ -41,8 +41,18 @@ export interface SlicedFile {
   view?(start: number, end: number): Promise<Uint8Array>;
 }
 
-/** One data record: its payload is `bytes[start, end)`, recorded at `timeUs` on `port`. */
-export type RecordSink = (bytes: Uint8Array, start: number, end: number, timeUs: number, port: number) => void;
+/**
+ * One data record: its payload is `bytes[start, end)` (`view` over `bytes`), recorded on `port` at
+ * `recordTimeUs(view, start)`. The time is read where it is used, not handed over: a double handed
+ * to a call that is not inlined is boxed (a heap number a record), and a walk's loop, with the
+ * decoding inlined into it, runs out of the compiler's budget for inlining (seen in Chromium 150).
+ */
+export type RecordSink = (bytes: Uint8Array, view: DataView, start: number, end: number, port: number) => void;
+
+/** The time (µs) of the data record whose payload starts at `start` of `view` (a RecordSink's). */
+export function recordTimeUs(view: DataView, start: number): number {
+  return view.getFloat64(start - RECORD_HEADER_SIZE + REC_OFF_TIME, true);
+}
 
 /** What a walk to the end found: the data records (the capture's chunks) and their payload bytes, and the header. */
 export interface WalkedRecords {
@@ -131,7 +141,7 @@ export async function walkDataRecords(file: SlicedFile, sink: RecordSink, option
       if ((data ? checked(port) : eventsChecked) && !crcFollows(bytes, p + REC_OFF_TYPE, end, view))
         throw new CaptureFormatError(`damaged record at offset ${at + p} (its CRC-32 check failed)`);
       if (data) {
-        sink(bytes, p + RECORD_HEADER_SIZE, end, view.getFloat64(p + REC_OFF_TIME, true), port);
+        sink(bytes, view, p + RECORD_HEADER_SIZE, end, port);
         chunks++;
         dataBytes += total - RECORD_OVERHEAD;
       }

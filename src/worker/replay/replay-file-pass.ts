@@ -101,7 +101,7 @@ export async function passOverFile(
       }
       return true;
     };
-    const walked = await walkDataRecords(file, (bytes, start, end, timeUs, port) => pass.feed(bytes, start, end, timeUs, port), {
+    const walked = await walkDataRecords(file, (bytes, view, start, end, port) => pass.feedRecord(bytes, view, start, end, port), {
       goOn,
       checked,
       ...(kept === null

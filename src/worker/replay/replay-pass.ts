@@ -7,7 +7,7 @@
  * with the counters, episodes and link state of the whole capture up to the target.
  */
 import { type DecoderCheckpoint, type LinkCheckpoint, type LinkMonitor, SpektrumDecoder } from '../../decoder/index.js';
-import type { Capture } from '../../capture/index.js';
+import { type Capture, recordTimeUs } from '../../capture/index.js';
 import { LinkSeries, monitorWithSeries, timingJitterUs } from '../../analysis/index.js';
 import { BIN_US, failsafeAsRead, failsafesOf, sumOverview } from './overview.js';
 import type { Overview } from '../protocol.js';
@@ -75,6 +75,8 @@ export class ReplayPass implements OverviewPass {
   /** The next chunk of the capture to feed (the count fed so far). */
   #chunk = 0;
   #fedUntilUs = Number.NEGATIVE_INFINITY;
+  /** The time of the chunk being fed (`#feed`). */
+  readonly #at = new Float64Array(1);
   #nextCheckpointUs: number;
   #done = false;
 
@@ -170,12 +172,26 @@ export class ReplayPass implements OverviewPass {
    * here only moves the checkpoints' clock, as in the capture's order it does).
    */
   feed(bytes: Uint8Array, start: number, end: number, atUs: number, port: number): void {
+    this.#at[0] = atUs;
+    this.#feed(bytes, start, end, port);
+  }
+
+  /** `feed()` of a data record of a file as it is walked (a RecordSink): its time is read from `view` here. */
+  feedRecord(bytes: Uint8Array, view: DataView, start: number, end: number, port: number): void {
+    this.#at[0] = recordTimeUs(view, start);
+    this.#feed(bytes, start, end, port);
+  }
+
+  /**
+   * `feed()` at #at[0]. The time goes on in a typed-array slot, not as an argument: a double
+   * handed to a call that is not inlined is boxed, a heap number a chunk, and which calls a
+   * compiler inlines into a walk's loop is its own choice (seen in Chromium 150).
+   */
+  #feed(bytes: Uint8Array, start: number, end: number, port: number): void {
+    const atUs = this.#at[0] ?? Number.NaN;
     if (atUs >= this.#nextCheckpointUs) this.#checkpoint(this.#chunk, atUs);
     const p = this.#byPort[port];
     if (p !== undefined) {
-      // The time goes alone to its call: a double there (not one that may be undefined) gets that
-      // call inlined before the others, where the time would otherwise be boxed, a heap number a
-      // chunk (seen in Chromium 150).
       if (Number.isNaN(atUs)) p.decoder.pushRange(bytes, start, end);
       else p.decoder.pushRange(bytes, start, end, atUs);
       drain(p);

@@ -29,16 +29,16 @@ import { CHECKPOINT_US, type Checkpoint, type OverviewPass, ReplayPass, checkpoi
 export function checkpointChunks(capture: Capture, originUs: number): { chunk: number; fedUntilUs: number }[] {
   const out: { chunk: number; fedUntilUs: number }[] = [];
   const times = capture.chunkTimesUs;
-  let next = originUs + CHECKPOINT_US;
-  let fed = Number.NEGATIVE_INFINITY;
+  // The next due time and the latest arrival, in a typed array (spanOf says why: a cold pass).
+  const at = new Float64Array([originUs + CHECKPOINT_US, Number.NEGATIVE_INFINITY]);
   for (let i = 0; i < times.length; i++) {
     const t = times[i] ?? Number.NaN;
     // Only a chunk at or past the due time can get one (a NaN time never does).
-    if (t >= next) {
-      out.push({ chunk: i, fedUntilUs: fed });
-      next = checkpointDue(next, t);
+    if (t >= (at[0] ?? Number.NaN)) {
+      out.push({ chunk: i, fedUntilUs: at[1] ?? Number.NaN });
+      at[0] = checkpointDue(at[0] ?? Number.NaN, t);
     }
-    if (t > fed) fed = t;
+    if (t > (at[1] ?? Number.NaN)) at[1] = t;
   }
   return out;
 }

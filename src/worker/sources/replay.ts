@@ -78,11 +78,8 @@ class PortChunks {
     let ordered = true;
     if (this.#bytesBefore === undefined && times === undefined) {
       // The common case, read straight from the column: a day's capture has eleven million chunks.
-      for (let k = 1, last = chunkTimesUs[index[0] ?? 0] ?? Number.NaN; k < n && ordered; k++) {
-        const t = chunkTimesUs[index[k] ?? 0] ?? Number.NaN;
-        ordered = t >= last;
-        last = t;
-      }
+      for (let k = 1; k < n && ordered; k++)
+        ordered = (chunkTimesUs[index[k] ?? 0] ?? Number.NaN) >= (chunkTimesUs[index[k - 1] ?? 0] ?? Number.NaN);
     } else {
       for (let k = 1; k < n && ordered; k++) ordered = this.atUs(k) >= this.atUs(k - 1);
     }
