@@ -5,7 +5,7 @@
  */
 import { describe, expect, it } from 'vitest';
 import { captureSpan } from '../src/analysis/index.js';
-import { captureChunksByPort, captureFact, capturePorts, type Capture } from '../src/capture/index.js';
+import { captureChunksByPort, captureFact, capturePorts, captureTimesInOrder, type Capture } from '../src/capture/index.js';
 
 function capture(ports: number[], times: number[]): Capture {
   return {
@@ -44,6 +44,14 @@ describe('facts kept with a capture', () => {
     const span = captureSpan(c);
     span.startUs = -1;
     expect(captureSpan(c)).toEqual({ startUs: 10, endUs: 30 });
+  });
+
+  it('tells whether the chunk times never go back: equal times are in order, a step back or a NaN is not', () => {
+    expect(captureTimesInOrder(capture([0, 1, 0], [10, 10, 20]))).toBe(true);
+    expect(captureTimesInOrder(capture([], []))).toBe(true);
+    expect(captureTimesInOrder(capture([0, 1, 0], [10, 30, 20]))).toBe(false);
+    expect(captureTimesInOrder(capture([0, 1], [Number.NaN, 20]))).toBe(false);
+    expect(captureTimesInOrder(capture([0, 1], [10, Number.NaN]))).toBe(false);
   });
 
   it('works it out again when the events or a column are no longer the ones it came from', () => {

@@ -5,12 +5,13 @@
  * capture up to the target, as a decode fed every chunk up to there has them.
  */
 import { describe, expect, it } from 'vitest';
-import { capturePorts, encodeCapture, readCapture } from '../src/capture/index.js';
+import { type Capture, capturePorts, encodeCapture, readCapture } from '../src/capture/index.js';
 import { Dispatcher } from '../src/worker/dispatcher.js';
 import { addOverviews, overviewOf } from '../src/worker/replay/overview.js';
 import { preset, simulate } from '../src/simulator/index.js';
 import { usbChunks } from './feeds.js';
-import { ReplayPass } from '../src/worker/replay/replay-pass.js';
+import { CHECKPOINT_US, ReplayPass, checkpointDue } from '../src/worker/replay/replay-pass.js';
+import { checkpointChunks } from '../src/worker/replay/replay-split.js';
 import { type PreviewSizes, previewOf } from '../src/worker/replay/replay-preview.js';
 import { captureSpan, healthReport } from '../src/analysis/index.js';
 import type { Overview } from '../src/worker/protocol.js';
@@ -215,5 +216,67 @@ describe('a long capture in the worker', () => {
       return part.overview();
     });
     expect(near(addOverviews(parts, startUs).failsafe)).toEqual(near(asReported));
+  });
+});
+
+describe('where the checkpoints fall in a capture', () => {
+  /** The rule as the replay pass applies it, chunk by chunk: the reference. */
+  function walked(times: number[], originUs: number): { chunk: number; fedUntilUs: number }[] {
+    const out: { chunk: number; fedUntilUs: number }[] = [];
+    let next = originUs + CHECKPOINT_US;
+    let fed = Number.NEGATIVE_INFINITY;
+    times.forEach((t, i) => {
+      const due = checkpointDue(next, t);
+      if (due !== next) {
+        out.push({ chunk: i, fedUntilUs: fed });
+        next = due;
+      }
+      if (t > fed) fed = t;
+    });
+    return out;
+  }
+  const columns = (times: number[]): Capture => ({
+    kind: 'raw',
+    meta: {},
+    timing: 'per-chunk',
+    bytes: new Uint8Array(times.length),
+    chunkEnds: Uint32Array.from(times, (_, i) => i + 1),
+    chunkTimesUs: Float64Array.from(times),
+    chunkPorts: new Uint8Array(times.length),
+    events: [],
+    issues: [],
+  });
+
+  it('finds the chunks the pass’s rule puts them on, by bisection where the times never go back and chunk by chunk where they do', () => {
+    let seed = 7;
+    const random = (): number => {
+      seed = (seed * 48271) % 2147483647;
+      return seed / 2147483647;
+    };
+    let onDue = 0;
+    for (let run = 0; run < 60; run++) {
+      // Chunks 16 ms apart, with runs of equal times, silences of seconds to minutes (several
+      // checkpoints due at once) and, all steps whole 16 ms, chunks right on a due time; in
+      // some runs a step back or a NaN.
+      const times: number[] = [];
+      let t = 1e6;
+      const n = 200 + Math.floor(random() * 30000);
+      for (let i = 0; i < n; i++) {
+        const r = random();
+        t += r < 0.1 ? 0 : r < 0.997 ? 16e3 : Math.floor(random() * 12500) * 16e3;
+        times.push(t);
+      }
+      if (run % 5 === 1) times[n >> 2] = (times[n >> 2] ?? 0) - 30e6;
+      if (run % 7 === 2) times[n >> 3] = Number.NaN;
+      const origin = times[0] ?? 0;
+      const want = walked(times, origin);
+      expect({ run, at: checkpointChunks(columns(times), origin) }).toEqual({ run, at: want });
+      onDue += want.filter(
+        (c) =>
+          (times[c.chunk] ?? 0) === (times[0] ?? 0) + Math.round(((times[c.chunk] ?? 0) - (times[0] ?? 0)) / CHECKPOINT_US) * CHECKPOINT_US,
+      ).length;
+    }
+    // Chunks right on a due time were among them.
+    expect(onDue).toBeGreaterThan(5);
   });
 });

@@ -65,3 +65,19 @@ function chunksByPort(capture: Capture): Uint32Array {
   }
   return counts;
 }
+
+/**
+ * Whether the chunks' recorded times never go back (each at or after the one before it, none
+ * NaN), as recorded captures' do: then the first chunk at or after a time is found by bisection.
+ * One pass per capture (`captureFact`).
+ */
+export function captureTimesInOrder(capture: Capture): boolean {
+  return captureFact(capture, 'times in order', timesInOrder);
+}
+
+function timesInOrder(capture: Capture): boolean {
+  const times = capture.chunkTimesUs;
+  if (times.length > 0 && Number.isNaN(times[0] ?? Number.NaN)) return false;
+  for (let i = 1; i < times.length; i++) if (!((times[i] ?? Number.NaN) >= (times[i - 1] ?? Number.NaN))) return false;
+  return true;
+}

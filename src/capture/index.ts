@@ -19,7 +19,7 @@ export {
   type ParsedCapture,
 } from './model.js';
 export { crc32 } from './crc32.js';
-export { captureChunksByPort, captureFact, capturePorts } from './facts.js';
+export { captureChunksByPort, captureFact, capturePorts, captureTimesInOrder } from './facts.js';
 export {
   CAPTURE_FILE_EXTENSION,
   CAPTURE_FORMAT_VERSION,

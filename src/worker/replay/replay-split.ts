@@ -14,7 +14,7 @@
  * counts. A half that fails or disagrees is decoded again from the capture, here; the overview
  * and seeks are then exactly the one-worker pass's.
  */
-import type { Capture, ParsedCapture } from '../../capture/index.js';
+import { type Capture, type ParsedCapture, captureTimesInOrder } from '../../capture/index.js';
 import type { Clock } from '../host.js';
 import { addOverviews } from './overview.js';
 import { PieceReader, type ReadableFile } from './piece-reader.js';
@@ -29,6 +29,23 @@ import { CHECKPOINT_US, type Checkpoint, type OverviewPass, ReplayPass, checkpoi
 export function checkpointChunks(capture: Capture, originUs: number): { chunk: number; fedUntilUs: number }[] {
   const out: { chunk: number; fedUntilUs: number }[] = [];
   const times = capture.chunkTimesUs;
+  if (captureTimesInOrder(capture)) {
+    // Each is the first chunk at or after the due time, and the latest before it the one before.
+    let next = originUs + CHECKPOINT_US;
+    for (let from = 0; ; ) {
+      let lo = from;
+      let hi = times.length;
+      while (lo < hi) {
+        const mid = (lo + hi) >>> 1;
+        if ((times[mid] ?? Number.NaN) >= next) hi = mid;
+        else lo = mid + 1;
+      }
+      if (lo === times.length) return out;
+      out.push({ chunk: lo, fedUntilUs: lo === 0 ? Number.NEGATIVE_INFINITY : (times[lo - 1] ?? Number.NaN) });
+      next = checkpointDue(next, times[lo] ?? Number.NaN);
+      from = lo + 1;
+    }
+  }
   // The next due time and the latest arrival, in a typed array (spanOf says why: a cold pass).
   const at = new Float64Array([originUs + CHECKPOINT_US, Number.NEGATIVE_INFINITY]);
   for (let i = 0; i < times.length; i++) {
