@@ -1,7 +1,8 @@
 /**
- * Facts worked out from a capture's columns (its ports here, its span in the analysis), kept
- * with the capture: the surfaces that each ask for them (a report and its jobs, a replay's session and its source)
- * then pay one pass over the chunks, not one each; a day-long capture has eleven million.
+ * Facts worked out from a capture's columns (here its ports with their chunk counts, and whether
+ * its times are in order; its span in the analysis), kept with the capture: the surfaces that
+ * each ask for them (a report and its jobs, a replay's session and its source) then pay one pass
+ * over the chunks, not one each; a day-long capture has eleven million.
  *
  * A capture's columns are typed arrays nobody writes once the capture is made. A fact is
  * worked out again when the capture's chunk columns or events are no longer the ones it was

@@ -192,6 +192,7 @@ export class ReplayPass implements OverviewPass {
     if (atUs >= this.#nextCheckpointUs) this.#checkpoint(this.#chunk, atUs);
     const p = this.#byPort[port];
     if (p !== undefined) {
+      // A NaN time is none: the chunk goes in untimed.
       if (Number.isNaN(atUs)) p.decoder.pushRange(bytes, start, end);
       else p.decoder.pushRange(bytes, start, end, atUs);
       drain(p);
