@@ -82,6 +82,21 @@ describe('LinkMonitor: hold and failsafe', () => {
     expect(link.stats.longestGapUs).toBe(2_000_000);
   });
 
+  it('measures the delivery jitter as the widest spread of the last 8 clean windows: an old wide one is forgotten', () => {
+    // Every fifth frame late: by 3 ms for the first 2 s, by 0.5 ms after (windows are 0.5 s).
+    const link = new LinkMonitor();
+    const jitterAt: number[] = [];
+    for (let i = 0; i < 1000; i++) {
+      const t = i * 11_000;
+      link.frame(frame(t + (i % 5 === 2 ? (t < 2_000_000 ? 3000 : 500) : 0)));
+      if (i % 50 === 0) jitterAt.push(link.stats.deliveryJitterUs);
+    }
+    // Read every 0.55 s: from 1.1 s the wide windows count; at 6.6 s the last of them has left
+    // the 8 (a window counts once the next one is closed too), and only the narrow ones count.
+    expect(jitterAt.slice(0, 2)).toEqual([Number.NaN, Number.NaN]);
+    expect(jitterAt.slice(2)).toEqual([...Array(10).fill(3000), ...Array(jitterAt.length - 12).fill(500)]);
+  });
+
   it('waits longer before a hold on a stream whose delivery jitters: the measured jitter is added', () => {
     const jittery = new LinkMonitor();
     const times = usbDelivered(300, 11_000, new Set(), () => 0);
