@@ -153,9 +153,13 @@ export class FrameLedger {
     // punctual frame is only confirmed by the next window, and would pass a period off as
     // lateness: a window's spread counts once the next one has found nothing missing.
     if (k === 0 && Number.isFinite(this.#pendingSpread)) {
-      this.#spreads.push(this.#pendingSpread);
-      if (this.#spreads.length > JITTER_WINDOWS) this.#spreads.shift();
-      this.jitterUs = Math.max(...this.#spreads);
+      const spreads = this.#spreads;
+      spreads.push(this.#pendingSpread);
+      if (spreads.length > JITTER_WINDOWS) spreads.shift();
+      // The widest by hand: Math.max(...spreads) makes an argument list every window.
+      let widest = Number.NEGATIVE_INFINITY;
+      for (let k = 0; k < spreads.length; k++) widest = Math.max(widest, spreads[k] ?? Number.NaN);
+      this.jitterUs = widest;
       this.delayUs = this.#pendingDelay;
     }
     this.#pendingSpread = k === 0 && this.#winFrames > 1 ? this.#winMaxL - this.#winMinL : NaN;
