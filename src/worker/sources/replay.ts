@@ -34,7 +34,7 @@ interface Chunk {
 /**
  * The chunks of one port straight from the capture's columns: an hour of USB batches is 225 000
  * chunks, so they are read by index when fed, never turned into objects up front. The index is
- * the one array of its own a port holds (4 bytes a chunk).
+ * the one array a port adds (4 bytes a chunk): its part of one array for all ports (`portIndexes`).
  */
 class PortChunks {
   readonly length: number;
