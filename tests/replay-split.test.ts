@@ -12,7 +12,8 @@ import { overviewOf } from '../src/worker/replay/overview.js';
 import type { Overview } from '../src/worker/protocol.js';
 import { type FilePassJob, type FilePassReport, passOverFile } from '../src/worker/replay/replay-file-pass.js';
 import { ArrivingFile } from '../src/worker/replay/arriving-file.js';
-import type { PassHelperMaker } from '../src/worker/replay/replay-helper.js';
+import { HelperRun, type PassHelperMaker } from '../src/worker/replay/replay-helper.js';
+import { SplitPass } from '../src/worker/replay/replay-split.js';
 import { MINUTE, libraryUpTo, longCapture } from './long-capture.js';
 import { ReadingClock, fakeHost } from './worker-fakes.js';
 
@@ -355,5 +356,71 @@ describe('a long capture decoded on two workers', () => {
     const alone = await openSplit(FILE, none.make, { ...PREVIEW, minBytes: FILE.length + 1 });
     expect(none.jobs.length).toBe(0);
     expectOverviewsAsOneDecode(alone.overviews, FILE);
+  });
+});
+
+describe('the split pass says its overview is complete without making it', () => {
+  /** An overview of no bins, read to `readUntilUs`, complete or not. */
+  const overview = (complete: boolean): Overview => ({
+    t: new Float64Array(0),
+    fadeRate: new Float32Array(0),
+    lost: new Float32Array(0),
+    failsafe: [],
+    readUntilUs: complete ? 10 * MINUTE : MINUTE,
+    complete,
+  });
+
+  /** Two runs whose reports the test makes, and their pass. */
+  function twoRuns() {
+    const report: ((r: FilePassReport) => void)[] = [];
+    const make: PassHelperMaker = (_job, onReport) => {
+      report.push(onReport);
+      return { feed: () => {}, fail: () => {}, stop: () => {} };
+    };
+    const job = (ports: number[]): FilePassJob => ({
+      size: 1000,
+      ports,
+      alsoChecked: [],
+      resolution: 'auto',
+      originUs: 0,
+      endUs: 10 * MINUTE,
+    });
+    const runs = [HelperRun.start(make, job([0])), HelperRun.start(make, job([1]))].filter((r) => r !== null);
+    const pass = new SplitPass(runs, 'auto', 0, 10 * MINUTE, () => {});
+    const done = (complete: boolean): FilePassReport => ({
+      type: 'done',
+      overview: overview(complete),
+      checkpoints: [],
+      chunks: 0,
+      dataBytes: 0,
+    });
+    return { report, pass, done };
+  }
+
+  it('as overview() judges it, as the runs report', () => {
+    const { report, pass, done } = twoRuns();
+    const seen: boolean[] = [];
+    const check = (): void => {
+      expect(pass.overviewComplete).toBe(pass.overview().complete);
+      seen.push(pass.overviewComplete);
+    };
+    check();
+    report[0]?.({ type: 'progress', overview: overview(false), checkpoints: [] });
+    check();
+    report[0]?.(done(true));
+    check();
+    report[1]?.({ type: 'progress', overview: overview(false), checkpoints: [] });
+    check();
+    report[1]?.(done(true));
+    check();
+    expect(seen).toEqual([false, false, false, false, true]);
+  });
+
+  it('and not when a run that failed leaves its ports to be decoded here', () => {
+    const { report, pass, done } = twoRuns();
+    report[0]?.(done(true));
+    report[1]?.({ type: 'failed', why: 'the helper failed' });
+    expect(pass.overviewComplete).toBe(false);
+    expect(pass.overview().complete).toBe(false);
   });
 });

@@ -82,10 +82,7 @@ export class ReplaySession implements Driver {
         // Until the capture is read the overview is drawn from here, after from the replay's slices.
         // Complete once both halves are (every record checked): the parse is not waited for.
         if (session !== null) session.#readOn();
-        else if (split !== null) {
-          const overview = split.overview();
-          if (overview.complete || sender.due()) sender.offer(overview);
-        }
+        else if (split !== null && (split.overviewComplete || sender.due())) sender.offer(split.overview());
       });
       split = halves?.pass ?? null;
       if (halves === null) {

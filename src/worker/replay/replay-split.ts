@@ -180,6 +180,18 @@ export class SplitPass implements OverviewPass {
     }
   }
 
+  /**
+   * Whether `overview()` would be complete, without making it (adding the halves' overviews up
+   * is a pass over their bins, worth making only when it is sent): as addOverviews judges it,
+   * complete when every part is.
+   */
+  get overviewComplete(): boolean {
+    const parts = this.#runs.length + this.#parts.length;
+    return (
+      parts > 0 && this.#orphans.length === 0 && this.#runs.every((r) => r.overview?.complete === true) && this.#parts.every((p) => p.done)
+    );
+  }
+
   overview(): Overview {
     const parts = [...this.#runs.map((r) => r.overview ?? addOverviews([], this.originUs)), ...this.#parts.map((p) => p.overview())];
     if (this.#orphans.length > 0) parts.push(addOverviews([], this.originUs));
