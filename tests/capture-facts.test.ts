@@ -4,8 +4,16 @@
  * came from.
  */
 import { describe, expect, it } from 'vitest';
-import { captureSpan } from '../src/analysis/index.js';
-import { captureChunksByPort, captureFact, capturePorts, captureTimesInOrder, type Capture } from '../src/capture/index.js';
+import { captureSpan, seedCaptureSpan } from '../src/analysis/index.js';
+import {
+  captureChunksByPort,
+  captureFact,
+  capturePortIndex,
+  capturePorts,
+  captureTimesInOrder,
+  seedCaptureFact,
+  type Capture,
+} from '../src/capture/index.js';
 
 function capture(ports: number[], times: number[]): Capture {
   return {
@@ -52,6 +60,24 @@ describe('facts kept with a capture', () => {
     expect(captureTimesInOrder(capture([0, 1, 0], [10, 30, 20]))).toBe(false);
     expect(captureTimesInOrder(capture([0, 1], [Number.NaN, 20]))).toBe(false);
     expect(captureTimesInOrder(capture([0, 1], [10, Number.NaN]))).toBe(false);
+  });
+
+  it('gives each port its chunk numbers in order, none to a port without chunks', () => {
+    const index = capturePortIndex(capture([2, 0, 2, 255, 0, 2], [1, 2, 3, 4, 5, 6]));
+    expect(index.length).toBe(256);
+    expect([index[0], index[1], index[2], index[255]].map((a) => Array.from(a ?? [9]))).toEqual([[1, 4], [], [0, 2, 5], [3]]);
+  });
+
+  it('keeps a fact seeded from elsewhere instead of working it out, until the capture changes', () => {
+    const c = capture([0], [100]);
+    let work = 0;
+    seedCaptureFact(c, 'n', 42);
+    expect(captureFact(c, 'n', () => ++work)).toBe(42);
+    seedCaptureSpan(c, { startUs: 7, endUs: 8 });
+    expect(captureSpan(c)).toEqual({ startUs: 7, endUs: 8 });
+    const moved = Object.assign(c, { chunkTimesUs: Float64Array.from([50]) });
+    expect([captureFact(moved, 'n', () => ++work), work]).toEqual([1, 1]);
+    expect(captureSpan(moved)).toEqual({ startUs: 50, endUs: 50 });
   });
 
   it('works it out again when the events or a column are no longer the ones it came from', () => {

@@ -5,9 +5,9 @@
  * a long capture.
  */
 import { describe, expect, it } from 'vitest';
-import { decodeCapture, Doctor, type DoctorFinding } from '../src/analysis/index.js';
+import { captureSpan, decodeCapture, Doctor, type DoctorFinding } from '../src/analysis/index.js';
 // Not part of the package's surface: where the scan starts, to check it does leave bytes out.
-import { captureSpan, firstScanned } from '../src/analysis/capture-pass.js';
+import { firstScanned } from '../src/analysis/capture-pass.js';
 import { CaptureWriter, readCapture, type Capture } from '../src/capture/index.js';
 import { crsfStream, ibusStream, preset, receiveAs, simulate, srxl2Stream, srxlV1Stream } from '../src/simulator/index.js';
 import { concatBytes } from './bytes.js';

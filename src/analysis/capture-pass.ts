@@ -9,14 +9,15 @@
  * Chunks are read straight from the capture's columns (no object per chunk), and the capture's
  * span (`captureSpan`) is one pass over its chunk times, taken once by the caller.
  */
-import { captureFact, type Capture, type CaptureEvent, type CaptureTiming } from '../capture/index.js';
-import { BYTE_TIME_US, SpektrumDecoder, USB_CHUNK_JITTER_US, type DecodedFrame, type DecoderOptions } from '../decoder/index.js';
+import type { Capture, CaptureEvent, CaptureTiming } from '../capture/index.js';
+import { SpektrumDecoder, USB_CHUNK_JITTER_US, type DecodedFrame, type DecoderOptions } from '../decoder/index.js';
 import type { LinkMonitor } from '../decoder/index.js';
 import type { Doctor } from './doctor.js';
 import { doctorEvent } from './doctor-events.js';
 import { SCAN_MEMORY, startsCandidate } from './doctor-line.js';
 import { lineWindow } from './doctor-state.js';
 import { LinkSeries, monitorWithSeries } from './series.js';
+import { captureSpan } from './capture-span.js';
 
 export interface DecodeCaptureOptions extends DecoderOptions {
   /** Which serial port of a multi-port capture to decode. Default 0. */
@@ -53,50 +54,6 @@ export function timingJitterUs(timing: CaptureTiming): number {
  * the time of each piece's last byte, so the doctor's own replay (`doctorCapture`) cuts the same.
  */
 export const SLICE_BYTES = 256;
-
-/**
- * The earliest and latest time recorded in a capture on any port (data bytes and events), on
- * the capture's clock, µs; NaN for both without timing. Every surface starts and ends a capture
- * here: the report's time zero, replay's timeline, the end at which the link's state is judged.
- * One pass over the chunk columns, once per capture (`captureFact`).
- */
-export function captureSpan(capture: Capture): { startUs: number; endUs: number } {
-  const { startUs, endUs } = captureFact(capture, 'span', spanOf);
-  return { startUs, endUs };
-}
-
-function spanOf(capture: Capture): { startUs: number; endUs: number } {
-  const { chunkEnds, chunkTimesUs, byteTimesUs } = capture;
-  // The earliest and latest so far, kept in a typed array rather than two locals: Chromium 150
-  // keeps a loop's double locals boxed until the loop is optimised, a heap number a chunk of a
-  // pass that runs once, cold, over eleven million chunks (three times the time, measured).
-  const span = new Float64Array([Infinity, -Infinity]);
-  let from = 0;
-  for (let i = 0; i < chunkEnds.length; i++) {
-    const to = chunkEnds[i] ?? from;
-    if (to > from) {
-      let first: number;
-      let last: number;
-      if (byteTimesUs !== undefined) {
-        first = byteTimesUs[from] ?? NaN;
-        last = byteTimesUs[to - 1] ?? NaN;
-      } else {
-        last = chunkTimesUs[i] ?? NaN;
-        first = last - (to - from - 1) * BYTE_TIME_US;
-      }
-      if (first < (span[0] ?? NaN)) span[0] = first;
-      if (last > (span[1] ?? NaN)) span[1] = last;
-    }
-    from = to;
-  }
-  let start = span[0] ?? NaN;
-  let end = span[1] ?? NaN;
-  for (const e of capture.events) {
-    if (e.timeUs < start) start = e.timeUs;
-    if (e.timeUs > end) end = e.timeUs;
-  }
-  return start <= end ? { startUs: start, endUs: end } : { startUs: NaN, endUs: NaN };
-}
 
 /**
  * Where the doctor's packet scan of `port` must start (a chunk and a byte in it) for the packets

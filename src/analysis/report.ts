@@ -11,7 +11,7 @@
 import type { Capture } from '../capture/index.js';
 import { capturePorts } from '../capture/index.js';
 import { CHANNEL_COUNT, channelName, systemInfo, type LinkEpisode, type Resolution } from '../decoder/index.js';
-import { captureSpan } from './capture-pass.js';
+import { captureSpan } from './capture-span.js';
 import type { Doctor } from './doctor.js';
 import { looksInternal, readPorts } from './resolution-key.js';
 import { decodePort, type PortPass } from './report-port.js';

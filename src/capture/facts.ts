@@ -1,8 +1,10 @@
 /**
- * Facts worked out from a capture's columns (here its ports with their chunk counts, and whether
- * its times are in order; its span in the analysis), kept with the capture: the surfaces that
- * each ask for them (a report and its jobs, a replay's session and its source) then pay one pass
- * over the chunks, not one each; a day-long capture has eleven million.
+ * Facts worked out from a capture's columns (here its ports with their chunk counts, whether its
+ * times are in order and each port's chunk numbers; its span in the analysis), kept with the
+ * capture: the surfaces that each ask for them (a report and its jobs, a replay's session and its
+ * source) then pay one pass over the chunks, not one each; a day-long capture has eleven million.
+ * A reader that walks the capture's records anyway can find them on the way (record-tally.ts)
+ * and seed them (`seedCaptureFact`): then no pass is paid at all.
  *
  * A capture's columns are typed arrays nobody writes once the capture is made. A fact is
  * worked out again when the capture's chunk columns or events are no longer the ones it was
@@ -22,8 +24,13 @@ interface Kept {
 
 const kept = new WeakMap<Capture, Kept>();
 
-/** `work(capture)`, worked out once per capture and `name` (see above); the caller copies what it hands out. */
-export function captureFact<T>(capture: Capture, name: string, work: (capture: Capture) => T): T {
+/** The facts' names (`captureFact`). */
+const PORT_CHUNKS = 'port chunks';
+const TIMES_IN_ORDER = 'times in order';
+const PORT_INDEX = 'port index';
+
+/** The facts kept for `capture`, made afresh when its columns or events are not the ones they came from. */
+function factsOf(capture: Capture): Map<string, unknown> {
   const { chunkEnds, chunkTimesUs, chunkPorts, byteTimesUs, events } = capture;
   let k = kept.get(capture);
   if (
@@ -38,15 +45,31 @@ export function captureFact<T>(capture: Capture, name: string, work: (capture: C
     k = { chunkEnds, chunkTimesUs, chunkPorts, byteTimesUs, events, eventCount: events.length, facts: new Map() };
     kept.set(capture, k);
   }
-  if (k.facts.has(name)) return k.facts.get(name) as T;
+  return k.facts;
+}
+
+/** `work(capture)`, worked out once per capture and `name` (see above); the caller copies what it hands out. */
+export function captureFact<T>(capture: Capture, name: string, work: (capture: Capture) => T): T {
+  const facts = factsOf(capture);
+  if (facts.has(name)) return facts.get(name) as T;
   const fact = work(capture);
-  k.facts.set(name, fact);
+  facts.set(name, fact);
   return fact;
+}
+
+/**
+ * Keeps `fact` as the capture's `name`, worked out elsewhere: as the capture's file was walked
+ * (a long capture's replay, replay-split.ts), so that no pass over its columns repeats it. Who
+ * seeds a fact answers for it being what `captureFact`'s `work` would give (tests hold each
+ * tally to its pass).
+ */
+export function seedCaptureFact<T>(capture: Capture, name: string, fact: T): void {
+  factsOf(capture).set(name, fact);
 }
 
 /** The port indices that have at least one data chunk, in increasing order (one pass per capture: `captureFact`). */
 export function capturePorts(capture: Capture): number[] {
-  const counts = captureFact(capture, 'port chunks', chunksByPort);
+  const counts = captureFact(capture, PORT_CHUNKS, chunksByPort);
   const ports: number[] = [];
   for (let p = 0; p < 256; p++) if ((counts[p] ?? 0) > 0) ports.push(p);
   return ports;
@@ -54,7 +77,7 @@ export function capturePorts(capture: Capture): number[] {
 
 /** How many data chunks each port (0–255) has (the same pass as `capturePorts`). */
 export function captureChunksByPort(capture: Capture): Uint32Array {
-  return captureFact(capture, 'port chunks', chunksByPort).slice();
+  return captureFact(capture, PORT_CHUNKS, chunksByPort).slice();
 }
 
 function chunksByPort(capture: Capture): Uint32Array {
@@ -73,7 +96,7 @@ function chunksByPort(capture: Capture): Uint32Array {
  * One pass per capture (`captureFact`).
  */
 export function captureTimesInOrder(capture: Capture): boolean {
-  return captureFact(capture, 'times in order', timesInOrder);
+  return captureFact(capture, TIMES_IN_ORDER, timesInOrder);
 }
 
 function timesInOrder(capture: Capture): boolean {
@@ -81,4 +104,44 @@ function timesInOrder(capture: Capture): boolean {
   if (times.length > 0 && Number.isNaN(times[0] ?? Number.NaN)) return false;
   for (let i = 1; i < times.length; i++) if (!((times[i] ?? Number.NaN) >= (times[i - 1] ?? Number.NaN))) return false;
   return true;
+}
+
+/**
+ * Each port's chunks (0–255, empty for a port without any): the capture's chunk numbers, in
+ * order. One counting sort over the chunks, once per capture (`captureFact`); the arrays are
+ * views of one array of every chunk, sorted by port, handed out as they are kept: not to be
+ * written (a day-long capture's is 44 MB).
+ */
+export function capturePortIndex(capture: Capture): readonly Uint32Array[] {
+  return captureFact(capture, PORT_INDEX, portIndex);
+}
+
+function portIndex(capture: Capture): Uint32Array[] {
+  const counts = captureFact(capture, PORT_CHUNKS, chunksByPort);
+  const chunkPorts = capture.chunkPorts;
+  const at = new Uint32Array(256);
+  for (let p = 1; p < 256; p++) at[p] = (at[p - 1] ?? 0) + (counts[p - 1] ?? 0);
+  const starts = at.slice();
+  const all = new Uint32Array(chunkPorts.length);
+  for (let i = 0; i < chunkPorts.length; i++) {
+    const p = chunkPorts[i] ?? 0;
+    const k = at[p] ?? 0;
+    all[k] = i;
+    at[p] = k + 1;
+  }
+  return Array.from(starts, (start, p) => all.subarray(start, start + (counts[p] ?? 0)));
+}
+
+/** What a walk of a capture's records found of its chunks (`RecordTally`): the facts above, kept for the capture it reads. */
+export interface ChunkFacts {
+  chunksByPort: Uint32Array;
+  timesInOrder: boolean;
+  portIndex: Uint32Array[];
+}
+
+/** Keeps `facts` as the capture's, found as its records were walked (`seedCaptureFact`). */
+export function seedChunkFacts(capture: Capture, facts: ChunkFacts): void {
+  seedCaptureFact(capture, PORT_CHUNKS, facts.chunksByPort);
+  seedCaptureFact(capture, TIMES_IN_ORDER, facts.timesInOrder);
+  seedCaptureFact(capture, PORT_INDEX, facts.portIndex);
 }

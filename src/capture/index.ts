@@ -19,7 +19,17 @@ export {
   type ParsedCapture,
 } from './model.js';
 export { crc32 } from './crc32.js';
-export { captureChunksByPort, captureFact, capturePorts, captureTimesInOrder } from './facts.js';
+export {
+  type ChunkFacts,
+  captureChunksByPort,
+  captureFact,
+  capturePortIndex,
+  capturePorts,
+  captureTimesInOrder,
+  seedCaptureFact,
+  seedChunkFacts,
+} from './facts.js';
+export { RecordTally, type SpanSink } from './record-tally.js';
 export {
   CAPTURE_FILE_EXTENSION,
   CAPTURE_FORMAT_VERSION,

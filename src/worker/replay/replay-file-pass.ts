@@ -5,7 +5,8 @@
  * report, then the same at the end with the count of chunks and bytes it walked, which the
  * worker checks against the capture it reads.
  */
-import { CaptureBuilder, type ParsedCapture, type SlicedFile, walkDataRecords } from '../../capture/index.js';
+import { CaptureBuilder, type ChunkFacts, type ParsedCapture, RecordTally, type SlicedFile, walkDataRecords } from '../../capture/index.js';
+import { type CaptureSpan, SpanTally } from '../../analysis/index.js';
 import type { Overview } from '../protocol.js';
 import { ArrivingFile } from './arriving-file.js';
 import { type Checkpoint, ReplayPass } from './replay-pass.js';
@@ -26,6 +27,11 @@ export interface FilePassJob {
    * (the helper's half), so that the file need not be read and parsed again for playback.
    */
   keep?: boolean | undefined;
+  /**
+   * The capture's chunk facts and span are found as its records are walked (RecordTally), and
+   * handed over when done: the other half keeps the capture, and they are seeded into it.
+   */
+  tally?: boolean | undefined;
   /** The kept capture's size, guessed from the file's start (`Preview.expected`): its room is made before the walk. */
   expected?: { records: number; dataBytes: number } | undefined;
   resolution: 'auto' | 1024 | 2048;
@@ -51,8 +57,13 @@ export type FilePassReport =
       cutAt?: number | undefined;
       /** Every record walked, for a job that keeps them: the capture, if every record on every port proves intact. */
       kept?: ParsedCapture | undefined;
+      /** What the walk found of the capture's chunks, for a job that tallies them (`tally`). */
+      facts?: WalkedFacts | undefined;
     }
   | { type: 'failed'; why: string };
+
+/** The capture's chunk facts and span, as a file pass found them walking its records. */
+export type WalkedFacts = ChunkFacts & { span: CaptureSpan };
 
 /** A report at most this often: the worker draws the overview about once a second. */
 const PROGRESS_MS = 250;
@@ -83,6 +94,7 @@ export async function passOverFile(
     const transfer = (o: Overview): Transferable[] => [o.t.buffer, o.fadeRate.buffer, o.lost.buffer];
     const { ports, alsoChecked, sliceBytes, size } = job;
     const kept = job.keep === true ? new CaptureBuilder() : null;
+    const tally = job.tally === true ? new RecordTally(new SpanTally()) : null;
     if (job.expected !== undefined) kept?.reserve(job.expected.records, job.expected.dataBytes);
     // Every record decoded here is checked: nothing from a damaged one is ever shown.
     const check = new Uint8Array(256);
@@ -104,11 +116,14 @@ export async function passOverFile(
     const walked = await walkDataRecords(file, (bytes, view, start, end, port) => pass.feedRecord(bytes, view, start, end, port), {
       goOn,
       checked,
-      ...(kept === null
+      ...(kept === null ? {} : { eventsChecked: true }),
+      ...(kept === null && tally === null
         ? {}
         : {
-            eventsChecked: true,
-            runs: (bytes: Uint8Array, view: DataView, from: number, to: number) => kept.records(bytes, view, from, to),
+            runs: (bytes: Uint8Array, view: DataView, from: number, to: number) => {
+              kept?.records(bytes, view, from, to);
+              tally?.records(bytes, view, from, to);
+            },
           }),
       ...(sliceBytes === undefined ? {} : { sliceBytes }),
     });
@@ -121,7 +136,11 @@ export async function passOverFile(
     // The columns go to the worker without a copy (from a helper worker: transferred).
     const columns =
       capture === undefined ? [] : [capture.bytes, capture.chunkEnds, capture.chunkTimesUs, capture.chunkPorts].map((c) => c.buffer);
-    report({ type: 'done', ...r, chunks, dataBytes, cutAt, kept: capture }, [...transfer(r.overview), ...(columns as ArrayBuffer[])]);
+    const facts = tally === null ? undefined : { ...tally.facts(), span: tally.span.span };
+    report({ type: 'done', ...r, chunks, dataBytes, cutAt, kept: capture, facts }, [
+      ...transfer(r.overview),
+      ...(columns as ArrayBuffer[]),
+    ]);
   } catch (error) {
     report({ type: 'failed', why: error instanceof Error ? error.message : String(error) }, []);
   }

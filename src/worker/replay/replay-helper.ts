@@ -7,7 +7,7 @@ import type { ParsedCapture } from '../../capture/index.js';
 import { ArrivingFile } from './arriving-file.js';
 import type { Clock } from '../host.js';
 import type { Overview } from '../protocol.js';
-import { type FilePassJob, type FilePassReport, type HelperMessage, passOverFile } from './replay-file-pass.js';
+import { type FilePassJob, type FilePassReport, type HelperMessage, type WalkedFacts, passOverFile } from './replay-file-pass.js';
 import type { Checkpoint } from './replay-pass.js';
 
 /** A pass at work: `feed` hands it the file's next piece (which it may keep or transfer), `fail` says the file could not be read. */
@@ -70,6 +70,8 @@ export class HelperRun {
   walked: { chunks: number; dataBytes: number; cutAt?: number | undefined } = { chunks: Number.NaN, dataBytes: Number.NaN };
   /** The capture the pass kept from its walk (a job that keeps it, once done; see replay-split.ts for when it counts). */
   kept: ParsedCapture | null = null;
+  /** The capture's chunk facts and span as the pass found them (a job that tallies them, once done). */
+  facts: WalkedFacts | null = null;
   /** Called after each report. */
   onReport: () => void = () => {};
   /** Settles when the pass is done, has failed or was stopped. */
@@ -123,6 +125,7 @@ export class HelperRun {
         this.done = true;
         this.walked = { chunks: r.chunks, dataBytes: r.dataBytes, cutAt: r.cutAt };
         this.kept = r.kept ?? null;
+        this.facts = r.facts ?? null;
         this.stop();
       }
     }

@@ -14,7 +14,8 @@
  * counts. A half that fails or disagrees is decoded again from the capture, here; the overview
  * and seeks are then exactly the one-worker pass's.
  */
-import { type Capture, type ParsedCapture, captureTimesInOrder } from '../../capture/index.js';
+import { type Capture, type ParsedCapture, captureTimesInOrder, seedChunkFacts } from '../../capture/index.js';
+import { seedCaptureSpan } from '../../analysis/index.js';
 import type { Clock } from '../host.js';
 import { addOverviews } from './overview.js';
 import { PieceReader, type ReadableFile } from './piece-reader.js';
@@ -260,12 +261,14 @@ export function startSplit(
   if (theirs === null) return null;
   // This half also checks records on ports the file's start did not show: ours with a damaged
   // port byte, perhaps. It walks in short slices: between them the pieces read go on to the helper.
+  // It also finds the capture's chunk facts and span as it walks (`keptCapture`).
   const mine = HelperRun.start(inThisWorker(clock), {
     ...job(
       ports.slice(0, half),
       [...Array(256).keys()].filter((p) => !ports.includes(p)),
     ),
     sliceBytes: sliceBytes ?? HERE_SLICE_BYTES,
+    tally: true,
   });
   if (mine === null) {
     theirs.stop();
@@ -280,12 +283,18 @@ export function startSplit(
  * on the helper's ports, the helper checking those and the events; so nothing in it is damaged.
  * It must also hold what this worker's half walked (its chunks and bytes; the checkpoints are
  * checked against it next, `adopt`). Null otherwise: the file is then read and parsed (and
- * salvaged) as any other.
+ * salvaged) as any other. The chunk facts and span this worker's half found walking the same
+ * records are seeded into it: the replay plays it with no pass over its columns.
  */
 export function keptCapture(mine: HelperRun, theirs: HelperRun): ParsedCapture | null {
   const kept = theirs.kept;
   if (kept === null || !mine.done || !theirs.done || mine.failed !== null || theirs.failed !== null) return null;
-  return walkedAll(mine, kept) ? kept : null;
+  if (!walkedAll(mine, kept)) return null;
+  if (mine.facts !== null) {
+    seedChunkFacts(kept, mine.facts);
+    seedCaptureSpan(kept, mine.facts.span);
+  }
+  return kept;
 }
 
 /** Whether a run walked every chunk and byte of `capture` (its counts, as it reported them when done). */

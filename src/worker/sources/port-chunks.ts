@@ -3,7 +3,7 @@
  * seek starts, what each chunk holds and when it arrived, recorded or on a paced clock.
  */
 import { BYTE_TIME_US } from '../../decoder/index.js';
-import { captureChunksByPort, captureTimesInOrder, type Capture } from '../../capture/index.js';
+import { captureTimesInOrder, type Capture } from '../../capture/index.js';
 
 /** One chunk's bytes with their times. */
 export interface Chunk {
@@ -17,7 +17,7 @@ export interface Chunk {
 /**
  * The chunks of one port straight from the capture's columns: an hour of USB batches is 225 000
  * chunks, so they are read by index when fed, never turned into objects up front. The index is
- * the one array a port adds (4 bytes a chunk): its part of one array for all ports (`portIndexes`).
+ * the one array a port adds (4 bytes a chunk): the capture's `capturePortIndex`.
  */
 export class PortChunks {
   readonly length: number;
@@ -35,7 +35,7 @@ export class PortChunks {
   readonly #bytesOrdered: boolean;
 
   /**
-   * @param index the capture's chunk number of each of this port's chunks, in order (`portIndexes`)
+   * @param index the capture's chunk number of each of this port's chunks, in order (`capturePortIndex`)
    * @param usPerByte without timing, the pace bytes are played at (µs a byte); NaN with timing
    */
   constructor(
@@ -199,24 +199,4 @@ export class PortChunks {
     if (!this.timed) return (this.bytesBeforeChunk(this.next) + this.nextByte + 1) * this.usPerByte;
     return this.atUs(this.next) - (this.#end(i) - start - 1) * BYTE_TIME_US;
   }
-}
-
-/**
- * Each of `ports`' chunk numbers in the capture, in order: views of one array of the chunks sorted
- * by port (a counting sort on the capture's count of chunks by port), one pass over the chunks.
- */
-export function portIndexes(capture: Capture, ports: readonly number[]): Uint32Array[] {
-  const counts = captureChunksByPort(capture);
-  const chunkPorts = capture.chunkPorts;
-  const at = new Uint32Array(256);
-  for (let p = 1; p < 256; p++) at[p] = (at[p - 1] ?? 0) + (counts[p - 1] ?? 0);
-  const starts = at.slice();
-  const all = new Uint32Array(chunkPorts.length);
-  for (let i = 0; i < chunkPorts.length; i++) {
-    const p = chunkPorts[i] ?? 0;
-    const k = at[p] ?? 0;
-    all[k] = i;
-    at[p] = k + 1;
-  }
-  return ports.map((p) => all.subarray(starts[p] ?? 0, (starts[p] ?? 0) + (counts[p] ?? 0)));
 }

@@ -5,10 +5,10 @@
  * them advance with the one replay clock.
  */
 import { FRAME_PERIOD_11MS_US, FRAME_SIZE } from '../../decoder/index.js';
-import { capturePorts, type Capture } from '../../capture/index.js';
+import { capturePortIndex, capturePorts, type Capture } from '../../capture/index.js';
 import { captureSpan } from '../../analysis/index.js';
 import { BROWSER_CLOCK, type Clock } from '../host.js';
-import { PortChunks, portIndexes } from './port-chunks.js';
+import { PortChunks } from './port-chunks.js';
 
 /** Wall time and ticks, passed in so that tests drive replay with a simulated clock. */
 export type ReplayClock = Pick<Clock, 'now' | 'every' | 'cancel'>;
@@ -70,8 +70,8 @@ export class ReplaySource {
     const span = captureSpan(capture);
     this.recordedTiming = Number.isFinite(span.startUs);
     const usPerByte = this.recordedTiming ? NaN : (options.untimedPeriodUs ?? FRAME_PERIOD_11MS_US) / FRAME_SIZE;
-    const indexes = portIndexes(capture, this.ports);
-    this.#chunks = this.ports.map((p, k) => new PortChunks(capture, p, indexes[k] ?? new Uint32Array(0), usPerByte));
+    const index = capturePortIndex(capture);
+    this.#chunks = this.ports.map((p) => new PortChunks(capture, p, index[p] ?? new Uint32Array(0), usPerByte));
     if (this.recordedTiming) {
       this.startUs = span.startUs;
       this.endUs = span.endUs;
