@@ -6,6 +6,7 @@
  */
 import { describe, expect, it } from 'vitest';
 import { SpanTally, captureSpan } from '../src/analysis/index.js';
+import { BYTE_TIME_US } from '../src/decoder/index.js';
 import {
   RecordTally,
   captureChunksByPort,
@@ -49,17 +50,22 @@ function made(seed: number): Uint8Array {
     if (next(25) === 0) event(next(5) === 0 ? Number.NaN : t + next(3) * 1000);
   }
   if (next(3) === 0) event(t + 9e6);
+  // An empty chunk last, later than any byte: it has no byte, so it is not in the span.
+  if (count > 0 && next(3) === 0)
+    records.push({ type: 'data', bytes: new Uint8Array(0), timeUs: kind === 4 ? Number.NaN : t + 9e6, port: ports[0] ?? 0 });
   return encodeCapture({ baudRate: 115200 }, records);
 }
 
 async function tallied(bytes: Uint8Array, sliceBytes: number | undefined) {
-  const tally = new RecordTally(new SpanTally());
+  const tally = new RecordTally(BYTE_TIME_US);
   await walkDataRecords(new Blob([bytes.slice()]), () => {}, {
     runs: (b, view, from, to) => tally.records(b, view, from, to),
     ...(sliceBytes === undefined ? {} : { sliceBytes }),
   });
-  const { chunksByPort, timesInOrder, portIndex } = tally.facts();
-  return { chunksByPort: Array.from(chunksByPort), timesInOrder, portIndex: portIndex.map((a) => Array.from(a)), span: tally.span.span };
+  const { chunksByPort, timesInOrder, portIndex, firstUs, lastUs } = tally.facts();
+  const span = new SpanTally();
+  span.bytes(firstUs, lastUs);
+  return { chunksByPort: Array.from(chunksByPort), timesInOrder, portIndex: portIndex.map((a) => Array.from(a)), span: span.span };
 }
 
 describe('the chunk facts and span of a capture found as its records are walked', () => {

@@ -2,10 +2,11 @@
  * A capture's span: the earliest and latest time recorded in it on any port (data bytes and
  * events), on the capture's clock, µs. Every surface starts and ends a capture here: the
  * report's time zero, replay's timeline, the end at which the link's state is judged. Worked
- * out once per capture from its columns (`captureSpan`), or as its records are walked
- * (`SpanTally`, a long capture's replay), by the same rule.
+ * out once per capture from its columns (`captureSpan`), or from the earliest and latest
+ * time found as its records are walked (a long capture's replay: the capture's RecordTally),
+ * by the same rule (`SpanTally`).
  */
-import { type Capture, captureFact, seedCaptureFact } from '../capture/index.js';
+import { type Capture, captureFact, chunkFirstByteUs, seedCaptureFact } from '../capture/index.js';
 import { BYTE_TIME_US } from '../decoder/index.js';
 
 export interface CaptureSpan {
@@ -36,7 +37,7 @@ export class SpanTally {
 
   /** A chunk of `count` bytes (at least one) that arrived at `arrivalUs` (chunk timing). */
   chunk(arrivalUs: number, count: number): void {
-    this.bytes(arrivalUs - (count - 1) * BYTE_TIME_US, arrivalUs);
+    this.bytes(chunkFirstByteUs(arrivalUs, count, BYTE_TIME_US), arrivalUs);
   }
 
   /** An event recorded at `timeUs`. */

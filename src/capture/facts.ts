@@ -117,8 +117,11 @@ export function capturePortIndex(capture: Capture): readonly Uint32Array[] {
 }
 
 function portIndex(capture: Capture): Uint32Array[] {
-  const counts = captureFact(capture, PORT_CHUNKS, chunksByPort);
-  const chunkPorts = capture.chunkPorts;
+  return indexByPort(capture.chunkPorts, captureFact(capture, PORT_CHUNKS, chunksByPort));
+}
+
+/** Each port's chunk numbers, from each chunk's port and the counts by port: views of one array of every chunk, sorted by port (a counting sort). */
+export function indexByPort(chunkPorts: Uint8Array, counts: Uint32Array): Uint32Array[] {
   const at = new Uint32Array(256);
   for (let p = 1; p < 256; p++) at[p] = (at[p - 1] ?? 0) + (counts[p - 1] ?? 0);
   const starts = at.slice();

@@ -6,6 +6,7 @@
 export {
   CaptureFormatError,
   captureChunks,
+  chunkFirstByteUs,
   type Capture,
   type CaptureChunk,
   type CaptureEvent,
@@ -29,7 +30,7 @@ export {
   seedCaptureFact,
   seedChunkFacts,
 } from './facts.js';
-export { RecordTally, type SpanSink } from './record-tally.js';
+export { RecordTally } from './record-tally.js';
 export {
   CAPTURE_FILE_EXTENSION,
   CAPTURE_FORMAT_VERSION,

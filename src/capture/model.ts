@@ -196,3 +196,12 @@ export function* captureChunks(capture: Capture, port?: number): Generator<Captu
     start = end;
   }
 }
+
+/**
+ * When the first of a chunk's `count` bytes (at least one) arrived, for a chunk timed by its
+ * last byte's arrival (`chunkTimesUs`), its bytes `byteTimeUs` apart on the line: how every
+ * surface dates a chunk-timed chunk's bytes (the decoder its frames, the span its start).
+ */
+export function chunkFirstByteUs(arrivalUs: number, count: number, byteTimeUs: number): number {
+  return arrivalUs - (count - 1) * byteTimeUs;
+}

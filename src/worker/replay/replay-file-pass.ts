@@ -7,6 +7,7 @@
  */
 import { CaptureBuilder, type ChunkFacts, type ParsedCapture, RecordTally, type SlicedFile, walkDataRecords } from '../../capture/index.js';
 import { type CaptureSpan, SpanTally } from '../../analysis/index.js';
+import { BYTE_TIME_US } from '../../decoder/index.js';
 import type { Overview } from '../protocol.js';
 import { ArrivingFile } from './arriving-file.js';
 import { type Checkpoint, ReplayPass } from './replay-pass.js';
@@ -94,7 +95,7 @@ export async function passOverFile(
     const transfer = (o: Overview): Transferable[] => [o.t.buffer, o.fadeRate.buffer, o.lost.buffer];
     const { ports, alsoChecked, sliceBytes, size } = job;
     const kept = job.keep === true ? new CaptureBuilder() : null;
-    const tally = job.tally === true ? new RecordTally(new SpanTally()) : null;
+    const tally = job.tally === true ? new RecordTally(BYTE_TIME_US) : null;
     if (job.expected !== undefined) kept?.reserve(job.expected.records, job.expected.dataBytes);
     // Every record decoded here is checked: nothing from a damaged one is ever shown.
     const check = new Uint8Array(256);
@@ -136,7 +137,13 @@ export async function passOverFile(
     // The columns go to the worker without a copy (from a helper worker: transferred).
     const columns =
       capture === undefined ? [] : [capture.bytes, capture.chunkEnds, capture.chunkTimesUs, capture.chunkPorts].map((c) => c.buffer);
-    const facts = tally === null ? undefined : { ...tally.facts(), span: tally.span.span };
+    let facts: WalkedFacts | undefined;
+    if (tally !== null) {
+      const { firstUs, lastUs, ...found } = tally.facts();
+      const span = new SpanTally();
+      span.bytes(firstUs, lastUs);
+      facts = { ...found, span: span.span };
+    }
     report({ type: 'done', ...r, chunks, dataBytes, cutAt, kept: capture, facts }, [
       ...transfer(r.overview),
       ...(columns as ArrayBuffer[]),
