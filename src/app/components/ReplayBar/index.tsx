@@ -9,6 +9,7 @@ import { useEffect, useRef } from 'preact/hooks';
 import uPlot from 'uplot';
 import { overview, replay, replayName, replayReading, replaySpanUs, send } from '../../store.js';
 import { chartColors, theme } from '../../theme.js';
+import { overviewColumns } from './columns.js';
 import { readingPercent } from './reading.js';
 import './style.css';
 
@@ -64,14 +65,18 @@ export function ReplayBar() {
   useEffect(() => {
     const el = chart.current;
     if (el === null || o === null) return undefined;
-    const x = Array.from(o.t, (t) => t / 1e6);
+    const width = Math.max(300, el.clientWidth);
+    // A column a device pixel, over the capture's span (or, without one, the bins' own).
+    const first = (o.t[0] ?? 0) / 1e6;
+    const span = toS > fromS ? [fromS, toS] : [first, Math.max(first + 1, (o.t[o.t.length - 1] ?? 0) / 1e6 + 1)];
+    const { x, lost, fadeRate } = overviewColumns(o, Math.ceil(width * (globalThis.devicePixelRatio || 1)), span[0] ?? 0, span[1] ?? 1);
     const bands = o.failsafe;
     const unread = o.complete || !Number.isFinite(o.readUntilUs) ? null : o.readUntilUs / 1e6;
     const c = chartColors(palette);
     const spanned = toS > fromS;
     const plot = new uPlot(
       {
-        width: Math.max(300, el.clientWidth),
+        width,
         height: 56,
         legend: { show: false },
         cursor: { show: false },
@@ -114,7 +119,7 @@ export function ReplayBar() {
           ],
         },
       },
-      [x, Array.from(o.lost), Array.from(o.fadeRate)],
+      [x, lost, fadeRate],
       el,
     );
     return () => plot.destroy();
