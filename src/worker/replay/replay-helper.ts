@@ -18,22 +18,73 @@ export interface PassHandle {
 }
 
 /** Starts a pass on `job`, its reports to `onReport`; null when there is none to start (one core, no workers). */
-export type PassHelperMaker = (job: FilePassJob, onReport: (r: FilePassReport) => void) => PassHandle | null;
+export interface PassHelperMaker {
+  (job: FilePassJob, onReport: (r: FilePassReport) => void): PassHandle | null;
+  /** A long capture starts to open: the helper may start now, to be ready for its job. */
+  prepare?(): void;
+}
+
+const canHelp = (): boolean =>
+  typeof Worker !== 'undefined' && typeof navigator !== 'undefined' && (navigator.hardwareConcurrency ?? 1) >= 2;
+
+/** A helper worker started, and where its reports go from its job on. */
+interface Helper {
+  worker: Worker;
+  /** Its reports go to `onReport` from now on (a failure to start, already seen, too). */
+  listen(onReport: (r: FilePassReport) => void): void;
+}
+
+function newHelper(): Helper {
+  const worker = new Worker(new URL('./replay-helper-worker.ts', import.meta.url), { type: 'module', name: 'satscope-replay-helper' });
+  let to: ((r: FilePassReport) => void) | null = null;
+  // A helper that fails to load before it has a job: said once it has one (its pass then fails).
+  let failed: FilePassReport | null = null;
+  worker.addEventListener('message', (event: MessageEvent<FilePassReport>) => to?.(event.data));
+  worker.addEventListener('error', (event) => {
+    const r: FilePassReport = { type: 'failed', why: event.message || 'the replay helper failed' };
+    if (to === null) failed = r;
+    else to(r);
+  });
+  return {
+    worker,
+    listen: (onReport) => {
+      to = onReport;
+      const r = failed;
+      if (r !== null) queueMicrotask(() => onReport(r));
+    },
+  };
+}
+
+/**
+ * A helper started ahead (`prepare`), waiting for its job. A worker started from this one starts
+ * through this worker's thread, which is busy once the file is read and walked: a helper started
+ * with its job got it 150-350 ms later in most opens of the day capture (timed in the page);
+ * one started as the file's start is read gets it at once. At most one waits, for the next long
+ * capture when this one gives it no job.
+ */
+let waiting: Helper | null = null;
 
 /** The browser's: a module worker, when there is a second core for it. Pieces are transferred. */
-export const WORKER_PASS_HELPER: PassHelperMaker = (job, onReport) => {
-  if (typeof Worker === 'undefined' || typeof navigator === 'undefined' || (navigator.hardwareConcurrency ?? 1) < 2) return null;
-  const helper = new Worker(new URL('./replay-helper-worker.ts', import.meta.url), { type: 'module', name: 'satscope-replay-helper' });
-  helper.addEventListener('message', (event: MessageEvent<FilePassReport>) => onReport(event.data));
-  helper.addEventListener('error', (event) => onReport({ type: 'failed', why: event.message || 'the replay helper failed' }));
-  const send = (m: HelperMessage, transfer: Transferable[] = []): void => helper.postMessage(m, transfer);
-  send({ job });
-  return {
-    feed: (piece) => send({ piece }, [piece.buffer]),
-    fail: (why) => send({ failed: why }),
-    stop: () => helper.terminate(),
-  };
-};
+export const WORKER_PASS_HELPER: PassHelperMaker = Object.assign(
+  (job: FilePassJob, onReport: (r: FilePassReport) => void): PassHandle | null => {
+    if (!canHelp()) return null;
+    const helper = waiting ?? newHelper();
+    waiting = null;
+    helper.listen(onReport);
+    const send = (m: HelperMessage, transfer: Transferable[] = []): void => helper.worker.postMessage(m, transfer);
+    send({ job });
+    return {
+      feed: (piece) => send({ piece }, [piece.buffer]),
+      fail: (why) => send({ failed: why }),
+      stop: () => helper.worker.terminate(),
+    };
+  },
+  {
+    prepare: (): void => {
+      if (canHelp()) waiting ??= newHelper();
+    },
+  },
+);
 
 /** The same pass in this worker, between its other tasks (it awaits each piece of the file). */
 export function inThisWorker(clock: Clock): PassHelperMaker {

@@ -37,11 +37,16 @@ export interface PreviewSizes {
 
 const SIZES: PreviewSizes = { minBytes: PREVIEW_MIN_BYTES, headBytes: PREVIEW_BYTES, tailBytes: TAIL_BYTES };
 
+/** Whether a file of `size` bytes is long enough to get a preview (and a pass split with a helper). */
+export function previewed(size: number, sizes: PreviewSizes = SIZES): boolean {
+  return size >= Math.max(sizes.minBytes, sizes.headBytes + sizes.tailBytes);
+}
+
 /** The preview of `file`, or null when it is not a long .sscap with chunk times whose start and end read. */
 export async function previewOf(file: SlicedFile, sizes: PreviewSizes = SIZES): Promise<Preview | null> {
-  const { minBytes, headBytes, tailBytes } = sizes;
+  const { headBytes, tailBytes } = sizes;
   const size = file.size;
-  if (size < Math.max(minBytes, headBytes + tailBytes)) return null;
+  if (!previewed(size, sizes)) return null;
   let head: Capture;
   let tail: Capture;
   let headerLength = 0;

@@ -16,7 +16,7 @@ import { overviewOf } from './overview.js';
 import type { Overview, ReplayStatus } from '../protocol.js';
 import type { Driver, SourceRegistry } from '../registry.js';
 import { type Checkpoint, type OverviewPass, ReplayPass } from './replay-pass.js';
-import { type PreviewSizes, previewOf } from './replay-preview.js';
+import { type PreviewSizes, previewOf, previewed } from './replay-preview.js';
 import type { PassHelperMaker } from './replay-helper.js';
 import { type SplitPass, keptCapture, readInPieces, startSplit } from './replay-split.js';
 import { OverviewSender } from './overview-sender.js';
@@ -60,6 +60,7 @@ export class ReplaySession implements Driver {
   static async open(name: string, file: Blob, parts: ReplayParts): Promise<ReplaySession | null> {
     const { host, registry, diagnosis } = parts;
     // A long capture: its start decoded and shown on its whole span before all of it is read.
+    if (previewed(file.size, parts.previewSizes)) parts.passHelper?.prepare?.();
     const preview = await previewOf(file, parts.previewSizes);
     const sender = new OverviewSender(host);
     let early: ReplayPass | null = null;
