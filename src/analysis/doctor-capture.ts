@@ -5,7 +5,7 @@
  * Pure: same capture, same findings.
  */
 import { BYTE_TIME_US, LinkMonitor, SpektrumDecoder, USB_CHUNK_JITTER_US, type Resolution } from '../decoder/index.js';
-import { capturePorts, type Capture, type CaptureKind, type CaptureTiming } from '../capture/index.js';
+import { capturePorts, chunkFirstByteUs, type Capture, type CaptureKind, type CaptureTiming } from '../capture/index.js';
 import { Doctor } from './doctor.js';
 import type { DoctorCode, DoctorFinding, Severity } from './doctor-types.js';
 import { doctorEvent } from './doctor-events.js';
@@ -95,7 +95,7 @@ function arrival(capture: Capture): { each: (visit: Visit) => void; bytes: numbe
         // Untimed: as if the bytes came back to back at 115200.
         const t = timed ? chunkTime : to * BYTE_TIME_US;
         // A decoder dates a chunk's frames back from its arrival at 115200: none is earlier than this.
-        const first = t - (to - from - 1) * BYTE_TIME_US;
+        const first = chunkFirstByteUs(t, to - from, BYTE_TIME_US);
         visit(port, t, first, bytes.subarray(from, to), timed ? (Number.isNaN(chunkTime) ? undefined : chunkTime) : t, '');
       }
       from = to;

@@ -198,9 +198,11 @@ export function* captureChunks(capture: Capture, port?: number): Generator<Captu
 }
 
 /**
- * When the first of a chunk's `count` bytes (at least one) arrived, for a chunk timed by its
- * last byte's arrival (`chunkTimesUs`), its bytes `byteTimeUs` apart on the line: how every
- * surface dates a chunk-timed chunk's bytes (the decoder its frames, the span its start).
+ * When the first of a chunk's `count` bytes arrived, for a chunk timed by its last byte's arrival
+ * (`chunkTimesUs`), its bytes `byteTimeUs` apart on the line: as the decoder dates a chunk-timed
+ * chunk's bytes (its own hot path writes it out), the span its start, the doctor its earliest
+ * frame and a replay its next byte. (An empty chunk gets a byte time after its arrival: it has
+ * no byte to date.)
  */
 export function chunkFirstByteUs(arrivalUs: number, count: number, byteTimeUs: number): number {
   return arrivalUs - (count - 1) * byteTimeUs;

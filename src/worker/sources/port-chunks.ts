@@ -3,7 +3,7 @@
  * seek starts, what each chunk holds and when it arrived, recorded or on a paced clock.
  */
 import { BYTE_TIME_US } from '../../decoder/index.js';
-import { captureTimesInOrder, type Capture } from '../../capture/index.js';
+import { captureTimesInOrder, chunkFirstByteUs, type Capture } from '../../capture/index.js';
 
 /** One chunk's bytes with their times. */
 export interface Chunk {
@@ -197,6 +197,6 @@ export class PortChunks {
     const start = this.#start(i);
     if (c.byteTimesUs !== undefined) return c.byteTimesUs[start + this.nextByte] ?? Number.POSITIVE_INFINITY;
     if (!this.timed) return (this.bytesBeforeChunk(this.next) + this.nextByte + 1) * this.usPerByte;
-    return this.atUs(this.next) - (this.#end(i) - start - 1) * BYTE_TIME_US;
+    return chunkFirstByteUs(this.atUs(this.next), this.#end(i) - start, BYTE_TIME_US);
   }
 }

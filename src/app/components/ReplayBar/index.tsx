@@ -68,8 +68,8 @@ export function ReplayBar() {
     const width = Math.max(300, el.clientWidth);
     // A column a device pixel, over the capture's span (or, without one, the bins' own).
     const first = (o.t[0] ?? 0) / 1e6;
-    const span = toS > fromS ? [fromS, toS] : [first, Math.max(first + 1, (o.t[o.t.length - 1] ?? 0) / 1e6 + 1)];
-    const { x, lost, fadeRate } = overviewColumns(o, Math.ceil(width * (globalThis.devicePixelRatio || 1)), span[0] ?? 0, span[1] ?? 1);
+    const [from, to] = toS > fromS ? [fromS, toS] : [first, (o.t[o.t.length - 1] ?? 0) / 1e6 + 1];
+    const { x, lost, fadeRate } = overviewColumns(o, Math.ceil(width * (globalThis.devicePixelRatio || 1)), from, to);
     const bands = o.failsafe;
     const unread = o.complete || !Number.isFinite(o.readUntilUs) ? null : o.readUntilUs / 1e6;
     const c = chartColors(palette);
