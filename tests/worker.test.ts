@@ -344,6 +344,35 @@ describe('a seek', () => {
     });
   }
 
+  it('reads the clock once every 64 chunks it feeds, and hands each chunk the latest reading as when it was fed', () => {
+    const capture = longCapture();
+    const clock = new SimulatedClock();
+    const readings: number[] = [];
+    const now = clock.now.bind(clock);
+    clock.now = () => {
+      readings.push(now());
+      return readings.at(-1)!;
+    };
+    const fedAt: number[] = [];
+    const r = new ReplaySource(
+      capture,
+      (_p, _b, _t, _at, fedAtMs) => fedAt.push(fedAtMs),
+      () => undefined,
+      () => undefined,
+      { clock },
+    );
+    readings.length = 0;
+    r.seek(15 * 60e6);
+    // Ten minutes of both ports at 10 chunks a second; the seek reads the clock as it starts,
+    // every 64 chunks (or ports' ends) it goes through, and once more for where playing resumes.
+    expect(fedAt.length).toBe(12_001);
+    expect(readings.length).toBeGreaterThanOrEqual(2 + Math.floor(fedAt.length / 64));
+    expect(readings.length).toBeLessThanOrEqual(3 + Math.floor(fedAt.length / 64));
+    expect(fedAt[0]).toBe(readings[0]);
+    expect(fedAt.every((t, k) => readings.includes(t) && t >= (fedAt[k - 1] ?? 0))).toBe(true);
+    expect(new Set(fedAt).size).toBe(readings.length - 1);
+  });
+
   it('feeds each port from its first chunk within the ten minutes before the target', () => {
     const capture = longCapture();
     const target = 15 * 60e6;

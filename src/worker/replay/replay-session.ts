@@ -180,7 +180,7 @@ export class ReplaySession implements Driver {
     const { host, registry } = parts;
     this.source = new ReplaySource(
       capture,
-      (port, bytes, time) => registry.get(port)?.engine.push(bytes, time, host.timeOriginMs + host.clock.now()),
+      (port, bytes, time, _atUs, fedAtMs) => registry.get(port)?.engine.push(bytes, time, host.timeOriginMs + fedAtMs),
       () => {
         parts.batcher.flush();
         if (host.clock.now() - this.#lastStatusMs >= STATUS_MS) this.status();

@@ -23,11 +23,21 @@ export interface ReplayOptions {
   untimedPeriodUs?: number;
 }
 
-export type ReplaySink = (port: number, bytes: Uint8Array, time: number | Float64Array | undefined, atUs: number) => void;
+/**
+ * Gets a piece of a port's bytes: its time argument for the decoder, its recorded time, and the
+ * wall time it was fed at (the replay's clock, ms).
+ */
+export type ReplaySink = (port: number, bytes: Uint8Array, time: number | Float64Array | undefined, atUs: number, fedAtMs: number) => void;
 
 const TICK_MS = 10;
 /** Decode for at most this long per tick, then let messages through. */
 const SLICE_MS = 12;
+/**
+ * The clock is read once every this many chunks fed: reading it costs more than a chunk (a
+ * seek feeds a minute or two of every port at once: 13 ms of a first seek's 70 read the clock
+ * for each of its chunks, by the worker's CPU profile).
+ */
+const CLOCK_EVERY_CHUNKS = 64;
 /** The most wall time one tick may move the replay clock by. */
 const MAX_STEP_MS = 100;
 /**
@@ -51,6 +61,8 @@ export class ReplaySource {
   #playing = false;
   #ended = false;
   #lastFedUs = NaN;
+  /** When the chunks being fed were fed: the clock, read once every CLOCK_EVERY_CHUNKS. */
+  #fedAtMs = 0;
   #timer: unknown;
 
   /**
@@ -166,7 +178,7 @@ export class ReplaySource {
 
   #feed(port: number, bytes: Uint8Array, time: number | Float64Array | undefined, atUs: number): void {
     if (Number.isFinite(atUs) && !(atUs <= this.#lastFedUs)) this.#lastFedUs = atUs;
-    this.sink(port, bytes, time, atUs);
+    this.sink(port, bytes, time, atUs, this.#fedAtMs);
   }
 
   /**
@@ -176,9 +188,15 @@ export class ReplaySource {
    */
   #feedUntil(clockUs: number, budgetMs: number): boolean {
     const started = this.#clock.now();
+    this.#fedAtMs = started;
+    let unclocked = 0;
     for (const c of this.#chunks) {
       while (c.next < c.length) {
-        if (budgetMs !== Infinity && this.#clock.now() - started > budgetMs) return false;
+        if (++unclocked === CLOCK_EVERY_CHUNKS) {
+          unclocked = 0;
+          this.#fedAtMs = this.#clock.now();
+          if (budgetMs !== Infinity && this.#fedAtMs - started > budgetMs) return false;
+        }
         const chunk = c.get(c.next);
         if (!c.timed) {
           // The paced clock: byte j of the port is due at (j + 1) × usPerByte; fed untimed.
