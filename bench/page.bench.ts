@@ -36,6 +36,8 @@ const RECORD_SPEED = env('BENCH_RECORD_SPEED', 48);
 const ONLY = (process.env.BENCH_ONLY ?? 'serial,demo,four,record,hour,day,bundle').split(',');
 /** The 24-hour capture bench/day.mjs makes (two remotes at 11 ms, 446 MB). */
 const DAY_FILE = join(tmpdir(), 'satscope-bench-day-v1-24h.sscap');
+/** Times the day capture is opened, each on a new page after the same-run baseline (`twoCoreBaselineMs`). */
+const DAY_RUNS = env('BENCH_DAY_RUNS', 5);
 
 const pct = (xs: number[], p: number) => {
   const s = [...xs].sort((a, b) => a - b);
@@ -213,6 +215,71 @@ function ticks(path: string): number {
   const stat = readFileSync(path, 'utf8');
   const fields = stat.slice(stat.lastIndexOf(')') + 2).split(' ');
   return Number(fields[11]) + Number(fields[12]);
+}
+
+/** CPU time (user + system) of every Chromium process this run started, s: their exited threads too (the replay's helper worker). */
+function chromiumCpuSeconds(): number {
+  let sum = 0;
+  for (const pid of descendants()) {
+    try {
+      if (readFileSync(`/proc/${pid}/cmdline`, 'utf8').includes('chrom')) sum += ticks(`/proc/${pid}/stat`);
+    } catch {
+      // gone meanwhile
+    }
+  }
+  return sum / 100;
+}
+
+/**
+ * The day capture's yardstick, measured just before each open: two workers at once,
+ * each a plain CRC-32 loop (a table, a byte at a time) over 128 MB (a 16 MB buffer eight
+ * times), ms until both are done. The open is bound by what two cores can do, and on a shared
+ * machine that changes from one minute to the next (the same build's open took 3.4 to 6.0 s
+ * within half an hour): an open's time over this one's, in the same minute, is the figure to
+ * compare between runs.
+ */
+async function twoCoreBaselineMs(browser: Browser): Promise<number> {
+  // A blank page of its own: the app's Content-Security-Policy admits no worker from a blob.
+  const page = await browser.newPage();
+  await page.goto('about:blank');
+  const ms = await page.evaluate(async () => {
+    const source = `
+      const table = new Int32Array(256);
+      for (let n = 0; n < 256; n++) {
+        let c = n;
+        for (let k = 0; k < 8; k++) c = c & 1 ? 0xedb88320 ^ (c >>> 1) : c >>> 1;
+        table[n] = c;
+      }
+      const bytes = new Uint8Array(16 << 20);
+      let x = 2463534242;
+      for (let i = 0; i < bytes.length; i++) {
+        x ^= x << 13; x ^= x >>> 17; x ^= x << 5;
+        bytes[i] = x;
+      }
+      onmessage = () => {
+        let c = -1;
+        for (let r = 0; r < 8; r++) for (let i = 0; i < bytes.length; i++) c = table[(c ^ bytes[i]) & 0xff] ^ (c >>> 8);
+        postMessage(c);
+      };
+      postMessage('ready');`;
+    const url = URL.createObjectURL(new Blob([source], { type: 'text/javascript' }));
+    const workers = [new Worker(url), new Worker(url)];
+    const next = (w: Worker) => new Promise<unknown>((resolve) => w.addEventListener('message', (e) => resolve(e.data), { once: true }));
+    const failed = new Promise<never>((_, reject) => {
+      for (const w of workers) w.addEventListener('error', (e) => reject(new Error(`baseline worker: ${e.message}`)));
+    });
+    await Promise.race([Promise.all(workers.map(next)), failed]);
+    const start = performance.now();
+    const done = Promise.all(workers.map(next));
+    for (const w of workers) w.postMessage('go');
+    await Promise.race([done, failed]);
+    const ms = performance.now() - start;
+    for (const w of workers) w.terminate();
+    URL.revokeObjectURL(url);
+    return Math.round(ms);
+  });
+  await page.close();
+  return ms;
 }
 
 function threadTimes(): ThreadTimes | null {
@@ -985,17 +1052,45 @@ it(
       if (ONLY.includes('day')) {
         if (existsSync(DAY_FILE)) {
           const size = statSync(DAY_FILE).size;
-          const page = await newPage();
-          await page.goto(server.url('/?bench&demo=0'));
-          const idle = threadTimes();
-          const open = await openTimes(page, DAY_FILE, 300_000);
+          // Opened DAY_RUNS times, each on a new page right after the baseline; the first seek
+          // (to the middle) follows each open at once. The last page then seeks on, and its
+          // heap is read.
+          type Open = Awaited<ReturnType<typeof openTimes>> & {
+            baselineMs: number;
+            cpuS: number;
+            firstSeek: Awaited<ReturnType<typeof seekTime>>;
+          };
+          const opens: Open[] = [];
+          let page: Page | null = null;
+          let idle: ThreadTimes | null = null;
+          for (let run = 0; run < DAY_RUNS; run++) {
+            await page?.close();
+            page = await newPage();
+            await page.goto(server.url('/?bench&demo=0'));
+            const baselineMs = await twoCoreBaselineMs(browser);
+            idle = threadTimes();
+            const cpu0 = chromiumCpuSeconds();
+            const open = await openTimes(page, DAY_FILE, 300_000);
+            const cpuS = chromiumCpuSeconds() - cpu0;
+            opens.push({ ...open, baselineMs, cpuS, firstSeek: await seekTime(page, 0.5) });
+            await page.waitForTimeout(500);
+          }
+          if (page === null) throw new Error('BENCH_DAY_RUNS must be 1 or more');
+          const open = opens.at(-1) as Open;
           const fractions = [0.5, 0.1, 0.9, 0.99, 0.01, 0.5];
-          const seekParts: { ms: number; workerMs: number; pageMs: number }[] = [];
-          for (const f of fractions) {
+          const seekParts: { ms: number; workerMs: number; pageMs: number }[] = [open.firstSeek];
+          for (const f of fractions.slice(1)) {
             seekParts.push(await seekTime(page, f));
             await page.waitForTimeout(500);
           }
           const seeks = seekParts.map((x) => x.ms);
+          const spread = (xs: number[], digits = 0) => ({
+            median: round(pct(xs, 50), digits),
+            min: round(Math.min(...xs), digits),
+            max: round(Math.max(...xs), digits),
+          });
+          const complete = opens.map((o) => o.completeMs);
+          const firstSeeks = opens.map((o) => o.firstSeek.ms);
           const worker = await WorkerTarget.attach(browser);
           const pageH = await pageHeap(page);
           const workerH = await worker?.heapMB();
@@ -1004,10 +1099,23 @@ it(
           const held = pageH.used + pageH.buffers + (workerH?.used ?? Number.NaN) + (workerH?.buffers ?? Number.NaN);
           results.openDayCapture = {
             fileMB: round(fileMB),
-            openToOverviewMs: open.ms,
-            openToFramesCountedMs: open.countedMs,
-            openToCompleteOverviewMs: open.completeMs,
-            openPartsMs: { pageRead: open.pageReadMs, worker: open.workerMs, draw: open.drawMs },
+            runs: DAY_RUNS,
+            baselineMs: opens.map((o) => o.baselineMs),
+            openToCompleteOverviewMs: complete,
+            openToCompleteOverview: spread(complete),
+            completeOverBaseline: spread(
+              opens.map((o) => o.completeMs / o.baselineMs),
+              2,
+            ),
+            chromiumCpuSecondsWhileOpening: spread(
+              opens.map((o) => o.cpuS),
+              2,
+            ),
+            openToOverviewMs: opens.map((o) => o.ms),
+            openToFramesCountedMs: opens.map((o) => o.countedMs),
+            openPartsMs: opens.map((o) => ({ pageRead: o.pageReadMs, worker: o.workerMs, draw: o.drawMs })),
+            firstSeekMs: firstSeeks,
+            firstSeek: spread(firstSeeks),
             seekFractions: fractions,
             seekMs: seeks,
             seekWorkerMs: seekParts.map((x) => x.workerMs),
