@@ -126,27 +126,11 @@ export async function walkDataRecords(file: SlicedFile, sink: RecordSink, option
   /** A slice to go on with, after the record joined across its start. */
   let queued: { bytes: Uint8Array; at: number; p: number } | null = null;
   let p = headerLength;
-  let chunks = 0;
-  let dataBytes = 0;
+  const count: WalkCount = { chunks: 0, dataBytes: 0 };
   for (;;) {
     const n = bytes.length;
     const run = p;
-    while (p + RECORD_HEADER_SIZE <= n) {
-      const total = recordSize(bytes, view, p);
-      if (total < 0) throw new CaptureFormatError(`no intact record header at offset ${at + p}`);
-      if (p + total > n) break;
-      const data = bytes[p + REC_OFF_TYPE] === RECORD_TYPE_DATA;
-      const port = bytes[p + REC_OFF_PORT] ?? 0;
-      const end = p + total - CRC_SIZE;
-      if ((data ? checked(port) : eventsChecked) && !crcFollows(bytes, p + REC_OFF_TYPE, end, view))
-        throw new CaptureFormatError(`damaged record at offset ${at + p} (its CRC-32 check failed)`);
-      if (data) {
-        sink(bytes, view, p + RECORD_HEADER_SIZE, end, port);
-        chunks++;
-        dataBytes += total - RECORD_OVERHEAD;
-      }
-      p += total;
-    }
+    p = walkRun(bytes, view, p, at, sink, checked, eventsChecked, count);
     if (p > run) runs?.(bytes, view, run, p);
     if (queued !== null) {
       if (p !== n) throw new CaptureFormatError(`no intact record at offset ${at + p}`);
@@ -156,7 +140,7 @@ export async function walkDataRecords(file: SlicedFile, sink: RecordSink, option
       continue;
     }
     if (next === null) {
-      const walked = { chunks, dataBytes, header: { meta, version, headerLength } };
+      const walked = { chunks: count.chunks, dataBytes: count.dataBytes, header: { meta, version, headerLength } };
       return p === n ? walked : { ...walked, cutAt: at + p };
     }
     if (!(await goOn(at + p))) return null;
@@ -189,6 +173,52 @@ export async function walkDataRecords(file: SlicedFile, sink: RecordSink, option
     view = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
     p = 0;
   }
+}
+
+/** The data records walked so far and their payload bytes. */
+interface WalkCount {
+  chunks: number;
+  dataBytes: number;
+}
+
+/**
+ * The whole records of a slice, `bytes` from `from` on (`at`: the slice's file offset), each
+ * checked and handed to `sink` as walkDataRecords says, counted into `count`; returns where the
+ * first record not whole in the slice starts. The walk's hot loop, in a function of its own,
+ * called once a slice: the async walk's code between slices (run for the first time at a
+ * slice's end) threw the loop's optimised code away with it, and it was compiled again, six
+ * times in an open of the day capture. Nothing follows the loop but the return: code after a
+ * loop has not run when the loop is first optimised, and reaching it threw that code away too.
+ */
+function walkRun(
+  bytes: Uint8Array,
+  view: DataView,
+  from: number,
+  at: number,
+  sink: RecordSink,
+  checked: (port: number) => boolean,
+  eventsChecked: boolean,
+  count: WalkCount,
+): number {
+  const n = bytes.length;
+  let p = from;
+  while (p + RECORD_HEADER_SIZE <= n) {
+    const total = recordSize(bytes, view, p);
+    if (total < 0) throw new CaptureFormatError(`no intact record header at offset ${at + p}`);
+    if (p + total > n) return p;
+    const data = bytes[p + REC_OFF_TYPE] === RECORD_TYPE_DATA;
+    const port = bytes[p + REC_OFF_PORT] ?? 0;
+    const end = p + total - CRC_SIZE;
+    if ((data ? checked(port) : eventsChecked) && !crcFollows(bytes, p + REC_OFF_TYPE, end, view))
+      throw new CaptureFormatError(`damaged record at offset ${at + p} (its CRC-32 check failed)`);
+    if (data) {
+      sink(bytes, view, p + RECORD_HEADER_SIZE, end, port);
+      count.chunks++;
+      count.dataBytes += total - RECORD_OVERHEAD;
+    }
+    p += total;
+  }
+  return p;
 }
 
 /**
