@@ -234,8 +234,8 @@ function chromiumCpuSeconds(): number {
  * The day capture's yardstick, measured just before each open: two workers at once,
  * each a plain CRC-32 loop (a table, a byte at a time) over 128 MB (a 16 MB buffer eight
  * times), ms until both are done. The open is bound by what two cores can do, and on a shared
- * machine that changes from one minute to the next (the same build's open took 3.4 to 6.0 s
- * within half an hour): an open's time over this one's, in the same minute, is the figure to
+ * machine that changes from one minute to the next (the same build's open took 3.4 to 6.1 s
+ * within twenty minutes): an open's time over this one's, in the same minute, is the figure to
  * compare between runs.
  */
 async function twoCoreBaselineMs(browser: Browser): Promise<number> {
