@@ -1053,28 +1053,68 @@ it(
         if (existsSync(DAY_FILE)) {
           const size = statSync(DAY_FILE).size;
           // Opened DAY_RUNS times, each on a new page right after the baseline; the first seek
-          // (to the middle) follows each open at once. The last page then seeks on, and its
-          // heap is read.
+          // (to the middle) follows each open at once. The last page is left open (the day's
+          // then seeks on, and its heap is read).
           type Open = Awaited<ReturnType<typeof openTimes>> & {
             baselineMs: number;
             cpuS: number;
             firstSeek: Awaited<ReturnType<typeof seekTime>>;
           };
-          const opens: Open[] = [];
-          let page: Page | null = null;
-          let idle: ThreadTimes | null = null;
-          for (let run = 0; run < DAY_RUNS; run++) {
-            await page?.close();
-            page = await newPage();
-            await page.goto(server.url('/?bench&demo=0'));
-            const baselineMs = await twoCoreBaselineMs(browser);
-            idle = threadTimes();
-            const cpu0 = chromiumCpuSeconds();
-            const open = await openTimes(page, DAY_FILE, 300_000);
-            const cpuS = chromiumCpuSeconds() - cpu0;
-            opens.push({ ...open, baselineMs, cpuS, firstSeek: await seekTime(page, 0.5) });
-            await page.waitForTimeout(500);
+          /** The page of the last open, and the renderer's threads before it. */
+          const last: { page: Page | null; idle: ThreadTimes | null } = { page: null, idle: null };
+          const openRuns = async (file: string): Promise<Open[]> => {
+            const out: Open[] = [];
+            for (let run = 0; run < DAY_RUNS; run++) {
+              await last.page?.close();
+              const page = await newPage();
+              last.page = page;
+              await page.goto(server.url('/?bench&demo=0'));
+              const baselineMs = await twoCoreBaselineMs(browser);
+              last.idle = threadTimes();
+              const cpu0 = chromiumCpuSeconds();
+              const open = await openTimes(page, file, 300_000);
+              const cpuS = chromiumCpuSeconds() - cpu0;
+              out.push({ ...open, baselineMs, cpuS, firstSeek: await seekTime(page, 0.5) });
+              await page.waitForTimeout(500);
+            }
+            return out;
+          };
+          const spread = (xs: number[], digits = 0) => ({
+            median: round(pct(xs, 50), digits),
+            min: round(Math.min(...xs), digits),
+            max: round(Math.max(...xs), digits),
+          });
+          // The cost with the capture's length: bench/day.mjs's 1-minute and 1-hour captures of
+          // the same two remotes (read whole: under the 32 MB a split pass takes), then the day's.
+          const growth: Record<string, unknown>[] = [];
+          const perLength = (name: string, file: string, opens: Open[]) => {
+            const mb = statSync(file).size / (1 << 20);
+            const complete = opens.map((o) => o.completeMs);
+            growth.push({
+              capture: name,
+              fileMB: round(mb, 2),
+              openToCompleteOverviewMs: spread(complete),
+              completeOverBaseline: spread(
+                opens.map((o) => o.completeMs / o.baselineMs),
+                2,
+              ),
+              msPerFileMB: round(pct(complete, 50) / mb, 1),
+              chromiumCpuSecondsPerFileMB: round(
+                pct(
+                  opens.map((o) => o.cpuS),
+                  50,
+                ) / mb,
+                3,
+              ),
+            });
+          };
+          for (const name of ['1m', '1h']) {
+            const file = DAY_FILE.replace('-24h.', `-${name}.`);
+            if (existsSync(file)) perLength(name, file, await openRuns(file));
           }
+          const opens = await openRuns(DAY_FILE);
+          perLength('24h', DAY_FILE, opens);
+          const { page, idle } = last;
           if (page === null) throw new Error('BENCH_DAY_RUNS must be 1 or more');
           const open = opens.at(-1) as Open;
           const fractions = [0.5, 0.1, 0.9, 0.99, 0.01, 0.5];
@@ -1084,11 +1124,6 @@ it(
             await page.waitForTimeout(500);
           }
           const seeks = seekParts.map((x) => x.ms);
-          const spread = (xs: number[], digits = 0) => ({
-            median: round(pct(xs, 50), digits),
-            min: round(Math.min(...xs), digits),
-            max: round(Math.max(...xs), digits),
-          });
           const complete = opens.map((o) => o.completeMs);
           const firstSeeks = opens.map((o) => o.firstSeek.ms);
           const worker = await WorkerTarget.attach(browser);
@@ -1116,6 +1151,7 @@ it(
             openPartsMs: opens.map((o) => ({ pageRead: o.pageReadMs, worker: o.workerMs, draw: o.drawMs })),
             firstSeekMs: firstSeeks,
             firstSeek: spread(firstSeeks),
+            growth,
             seekFractions: fractions,
             seekMs: seeks,
             seekWorkerMs: seekParts.map((x) => x.workerMs),
