@@ -1,11 +1,11 @@
 /**
  * A capture's chunk facts and span found as its records are walked (record-tally.ts, with the
- * analysis's SpanTally), as a long capture's replay finds them: for any capture and any slice
+ * analysis's spanBetween), as a long capture's replay finds them: for any capture and any slice
  * size, what the passes over the columns of the capture the file reads as find. Each port's
  * chunk counts and chunk numbers, whether the times never go back, and the span with its events.
  */
 import { describe, expect, it } from 'vitest';
-import { SpanTally, captureSpan } from '../src/analysis/index.js';
+import { captureSpan, spanBetween } from '../src/analysis/index.js';
 import { BYTE_TIME_US } from '../src/decoder/index.js';
 import {
   RecordTally,
@@ -63,9 +63,12 @@ async function tallied(bytes: Uint8Array, sliceBytes: number | undefined) {
     ...(sliceBytes === undefined ? {} : { sliceBytes }),
   });
   const { chunksByPort, timesInOrder, portIndex, firstUs, lastUs } = tally.facts();
-  const span = new SpanTally();
-  span.bytes(firstUs, lastUs);
-  return { chunksByPort: Array.from(chunksByPort), timesInOrder, portIndex: portIndex.map((a) => Array.from(a)), span: span.span };
+  return {
+    chunksByPort: Array.from(chunksByPort),
+    timesInOrder,
+    portIndex: portIndex.map((a) => Array.from(a)),
+    span: spanBetween(firstUs, lastUs),
+  };
 }
 
 describe('the chunk facts and span of a capture found as its records are walked', () => {

@@ -46,10 +46,16 @@ export class SpanTally {
   }
 
   get span(): CaptureSpan {
-    const start = this.#at[0] ?? NaN;
-    const end = this.#at[1] ?? NaN;
-    return start <= end ? { startUs: start, endUs: end } : { startUs: NaN, endUs: NaN };
+    return spanBetween(this.#at[0] ?? NaN, this.#at[1] ?? NaN);
   }
+}
+
+/**
+ * The span from the earliest to the latest time found (by a SpanTally, or by a walk of the
+ * capture's records, RecordTally): NaN for both when nothing was timed.
+ */
+export function spanBetween(earliestUs: number, latestUs: number): CaptureSpan {
+  return earliestUs <= latestUs ? { startUs: earliestUs, endUs: latestUs } : { startUs: NaN, endUs: NaN };
 }
 
 /** The capture's span, NaN for both without timing: one pass over its chunk columns, once per capture (`captureFact`). */

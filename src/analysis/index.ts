@@ -54,7 +54,7 @@ export {
 } from './doctor-stacks.js';
 export { classifyLine, PacketScanner, PACKET_KINDS, type LineCounts, type LineVerdict, type PacketKind } from './doctor-line.js';
 export { decodeCapture, timingJitterUs, type DecodeCaptureOptions } from './capture-pass.js';
-export { type CaptureSpan, SpanTally, captureSpan, seedCaptureSpan } from './capture-span.js';
+export { type CaptureSpan, SpanTally, captureSpan, seedCaptureSpan, spanBetween } from './capture-span.js';
 export { resolutionKey } from './resolution-key.js';
 export { summarizeCapture, type CaptureSummary, type ChannelSummary } from './summary.js';
 export { LinkSeries, monitorWithSeries } from './series.js';

@@ -4,7 +4,7 @@
  * capture (src/worker/replay/replay-split.ts), seeds them into it and plays at once, where each
  * fact was otherwise one pass over eleven million chunks. Fed every record of the file in order,
  * it finds what those passes find over the capture the file reads as, and the earliest and
- * latest time of any byte or event, the span's makings (the analysis's SpanTally says what they
+ * latest time of any byte or event, the span's makings (the analysis's spanBetween says what they
  * make; the line rate chunks are dated by is the caller's).
  *
  * The walk's loop makes no call a record and keeps each branch's times apart. In Chromium 150,

@@ -6,7 +6,7 @@
  * worker checks against the capture it reads.
  */
 import { CaptureBuilder, type ChunkFacts, type ParsedCapture, RecordTally, type SlicedFile, walkDataRecords } from '../../capture/index.js';
-import { type CaptureSpan, SpanTally } from '../../analysis/index.js';
+import { type CaptureSpan, spanBetween } from '../../analysis/index.js';
 import { BYTE_TIME_US } from '../../decoder/index.js';
 import type { Overview } from '../protocol.js';
 import { ArrivingFile } from './arriving-file.js';
@@ -140,9 +140,7 @@ export async function passOverFile(
     let facts: WalkedFacts | undefined;
     if (tally !== null) {
       const { firstUs, lastUs, ...found } = tally.facts();
-      const span = new SpanTally();
-      span.bytes(firstUs, lastUs);
-      facts = { ...found, span: span.span };
+      facts = { ...found, span: spanBetween(firstUs, lastUs) };
     }
     report({ type: 'done', ...r, chunks, dataBytes, cutAt, kept: capture, facts }, [
       ...transfer(r.overview),

@@ -66,14 +66,13 @@ export function ReplayBar() {
     const el = chart.current;
     if (el === null || o === null) return undefined;
     const width = Math.max(300, el.clientWidth);
+    const spanned = toS > fromS;
     // A column a device pixel, over the capture's span (or, without one, the bins' own).
-    const first = (o.t[0] ?? 0) / 1e6;
-    const [from, to] = toS > fromS ? [fromS, toS] : [first, (o.t[o.t.length - 1] ?? 0) / 1e6 + 1];
+    const [from, to] = spanned ? [fromS, toS] : [(o.t[0] ?? 0) / 1e6, (o.t[o.t.length - 1] ?? 0) / 1e6 + 1];
     const { x, lost, fadeRate } = overviewColumns(o, Math.ceil(width * (globalThis.devicePixelRatio || 1)), from, to);
     const bands = o.failsafe;
     const unread = o.complete || !Number.isFinite(o.readUntilUs) ? null : o.readUntilUs / 1e6;
     const c = chartColors(palette);
-    const spanned = toS > fromS;
     const plot = new uPlot(
       {
         width,
