@@ -83,7 +83,10 @@ export class LinkSeries {
   frame(f: DecodedFrame, link: LinkMonitor): void {
     const t = f.timeUs;
     if (!Number.isFinite(t)) return;
-    const b = this.#bin(t);
+    // A bin the series has, open to frames: #bin's answer without the call (the usual frame; an
+    // origin not known yet is NaN and fails the test).
+    const at = Math.floor((t - this.#origin) / this.binUs);
+    const b = at >= this.#sealed && at < this.#bins ? at : this.#bin(t);
     this.#frames.data[b]! += 1;
     this.#fades.data[b]! += link.lastFades;
     if (f.rssi !== null && f.rssi !== -128) {
