@@ -590,22 +590,30 @@ export class LinkMonitor {
     this.#open = episode;
   }
 
-  /** Period and fade rate with the frame at #lastUs. */
+  /**
+   * Period and fade rate with the frame at #lastUs. The windows' sizes are written out beside
+   * their constants (PERIOD_WINDOW 33, RATE_WINDOW 512) and the rings step without a remainder:
+   * optimised code reads a module's constants with a hole check each time, and a remainder by
+   * a number it does not know is a division (this ran every frame).
+   */
   #measure(fadesDelta: number): void {
     const t = this.#lastUs;
     const s = this.#stats;
     // Period: the span of the last 32 gap-free intervals, which averages out chunk jitter.
     const times = this.#periodTimes;
-    if (this.#periodCount < PERIOD_WINDOW) {
-      if (this.#periodCount === 0) this.#periodOldest = 0;
-      times[this.#periodCount++] = t;
+    const count = this.#periodCount;
+    if (count < 33) {
+      if (count === 0) this.#periodOldest = 0;
+      times[count] = t;
+      this.#periodCount = count + 1;
     } else {
-      times[this.#periodOldest] = t;
-      this.#periodOldest = this.#periodOldest === PERIOD_WINDOW - 1 ? 0 : this.#periodOldest + 1;
+      const oldest = this.#periodOldest;
+      times[oldest] = t;
+      this.#periodOldest = oldest === 32 ? 0 : oldest + 1;
     }
     if (this.#periodCount >= 9) {
       const span = t - (times[this.#periodOldest] ?? NaN);
-      if (!Number.isFinite(this.#systemPeriod) && (!Number.isFinite(s.nominalPeriodUs) || this.#periodCount === PERIOD_WINDOW)) {
+      if (!Number.isFinite(this.#systemPeriod) && (!Number.isFinite(s.nominalPeriodUs) || this.#periodCount === 33)) {
         // Without a system byte: snap the mean interval to 11 or 22 ms, first over 8 intervals,
         // then again over every full window, so a few frames missing early do not stick.
         s.nominalPeriodUs = nominalPeriodOf(span / (this.#periodCount - 1));
@@ -617,13 +625,16 @@ export class LinkMonitor {
     }
     // Fade rate over a window of recent frames.
     const i = this.#rateNext;
-    const prev = this.#rateCount === 0 ? 0 : (this.#rateFades[(i + RATE_WINDOW - 1) % RATE_WINDOW] ?? 0);
-    this.#rateTimes[i] = t;
-    this.#rateFades[i] = prev + fadesDelta;
-    this.#rateNext = (i + 1) % RATE_WINDOW;
-    if (this.#rateCount < RATE_WINDOW) this.#rateCount++;
-    const oldest = this.#rateCount < RATE_WINDOW ? 0 : this.#rateNext;
-    const span = t - (this.#rateTimes[oldest] ?? NaN);
-    s.fadeRate = span > 0 ? (((this.#rateFades[i] ?? 0) - (this.#rateFades[oldest] ?? 0)) / span) * 1e6 : 0;
+    const fades = this.#rateFades;
+    const rateTimes = this.#rateTimes;
+    const prev = this.#rateCount === 0 ? 0 : (fades[i === 0 ? 511 : i - 1] ?? 0);
+    rateTimes[i] = t;
+    fades[i] = prev + fadesDelta;
+    const next = i === 511 ? 0 : i + 1;
+    this.#rateNext = next;
+    if (this.#rateCount < 512) this.#rateCount++;
+    const oldest = this.#rateCount < 512 ? 0 : next;
+    const span = t - (rateTimes[oldest] ?? NaN);
+    s.fadeRate = span > 0 ? (((fades[i] ?? 0) - (fades[oldest] ?? 0)) / span) * 1e6 : 0;
   }
 }
