@@ -567,20 +567,18 @@ describe('.sscap header errors', () => {
   });
 });
 
-describe('.sscap speed', () => {
-  it('parses an hour of 11 ms frames (327 k records of 16 bytes) in well under a second', () => {
+// How fast it parses is measured by the benchmarks (bench:day's `satscope info`), not here.
+describe('.sscap at length', () => {
+  it('parses an hour of 11 ms frames (327 k records of 16 bytes)', () => {
     const frames = 327_273; // 3600 s / 11 ms
     const w = new CaptureWriter({ source: 'simulator' });
     const record = w.data(FRAME, 0);
     const file = new Uint8Array(w.header().length + frames * record.length);
     file.set(w.header());
     for (let i = 0; i < frames; i++) file.set(record, w.header().length + i * record.length);
-    const t0 = performance.now();
     const parsed = parseCapture(file);
-    const elapsed = performance.now() - t0;
     expect(parsed.chunkEnds).toHaveLength(frames);
     expect(parsed.bytes.length).toBe(frames * 16);
-    expect(elapsed).toBeLessThan(800);
   });
 });
 
@@ -634,9 +632,7 @@ describe.skipIf(!px4Present)('Saleae CSV: real PX4 captures (skipped when ../sha
   const load = (name: string): Capture => readCapture(readFileSync(PX4 + name), name);
 
   it('reads dsm_x_data.txt: 1105 bytes, the first at 9 260 826 µs', () => {
-    const t0 = performance.now();
     const capture = load('dsm_x_data.txt');
-    const elapsed = performance.now() - t0;
     expect(capture.kind).toBe('saleae-csv');
     expect(capture.timing).toBe('per-byte');
     expect(capture.bytes).toHaveLength(1105);
@@ -647,7 +643,6 @@ describe.skipIf(!px4Present)('Saleae CSV: real PX4 captures (skipped when ../sha
     expect(capture.issues).toEqual([]);
     expect(capture.chunkEnds).toEqual(Uint32Array.from([1105]));
     expect(capture.chunkTimesUs[0]).toBe(capture.byteTimesUs?.[1104]);
-    expect(elapsed).toBeLessThan(200);
   });
 
   it('reads dsm_x_dx9_data.txt: 7296 bytes', () => {
@@ -657,13 +652,10 @@ describe.skipIf(!px4Present)('Saleae CSV: real PX4 captures (skipped when ../sha
   });
 
   it('reads dsm_x_dx9_px4_binding_data.txt: 7280 bytes starting 3E B2', () => {
-    const t0 = performance.now();
     const capture = load('dsm_x_dx9_px4_binding_data.txt');
-    const elapsed = performance.now() - t0;
     expect(capture.bytes).toHaveLength(7280);
     expect([...capture.bytes.subarray(0, 2)]).toEqual([0x3e, 0xb2]);
     expect(capture.byteTimesUs?.[0]).toBe(3400.8);
-    expect(elapsed).toBeLessThan(200);
   });
 });
 
