@@ -187,8 +187,9 @@ interface WalkCount {
  * first record not whole in the slice starts. The walk's hot loop, in a function of its own,
  * called once a slice: the async walk's code between slices (run for the first time at a
  * slice's end) threw the loop's optimised code away with it, and it was compiled again: nine
- * TurboFan compiles in the two workers of one open of the day capture, four now. Nothing follows the loop but the return: code after a
- * loop has not run when the loop is first optimised, and reaching it threw that code away too.
+ * TurboFan compiles in the two workers of one open of the day capture, four now. Nothing
+ * follows the loop but the return: code after a loop has not run when the loop is first
+ * optimised, and reaching it threw that code away too.
  */
 function walkRun(
   bytes: Uint8Array,
