@@ -33,7 +33,7 @@ export interface FilePassJob {
    * handed over when done: the other half keeps the capture, and they are seeded into it.
    */
   tally?: boolean | undefined;
-  /** The kept capture's size, guessed from the file's start (`Preview.expected`): its room is made before the walk. */
+  /** The capture's size, guessed from the file's start (`Preview.expected`): room for what is kept or tallied is made before the walk. */
   expected?: { records: number; dataBytes: number } | undefined;
   resolution: 'auto' | 1024 | 2048;
   originUs: number;
@@ -96,7 +96,10 @@ export async function passOverFile(
     const { ports, alsoChecked, sliceBytes, size } = job;
     const kept = job.keep === true ? new CaptureBuilder() : null;
     const tally = job.tally === true ? new RecordTally(BYTE_TIME_US) : null;
-    if (job.expected !== undefined) kept?.reserve(job.expected.records, job.expected.dataBytes);
+    if (job.expected !== undefined) {
+      kept?.reserve(job.expected.records, job.expected.dataBytes);
+      tally?.reserve(job.expected.records);
+    }
     // Every record decoded here is checked: nothing from a damaged one is ever shown.
     const check = new Uint8Array(256);
     for (const port of [...ports, ...alsoChecked]) check[port] = 1;

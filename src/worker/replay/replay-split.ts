@@ -269,6 +269,7 @@ export function startSplit(
     ),
     sliceBytes: sliceBytes ?? HERE_SLICE_BYTES,
     tally: true,
+    expected,
   });
   if (mine === null) {
     theirs.stop();
