@@ -9,7 +9,14 @@
 import { existsSync, readFileSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 import { describe, expect, it } from 'vitest';
-import { type DecodedFrame, type DecoderEvent, type DecoderOptions, LinkMonitor, SpektrumDecoder } from '../src/decoder/index.js';
+import {
+  type DecodedFrame,
+  type DecoderEvent,
+  type DecoderOptions,
+  LinkMonitor,
+  type LinkOptions,
+  SpektrumDecoder,
+} from '../src/decoder/index.js';
 import { importSaleaeCsv } from '../src/capture/index.js';
 import { preset, simulate } from '../src/simulator/index.js';
 import { damagedStream, type Feed, feed, type Push } from './lockstep.js';
@@ -27,15 +34,17 @@ interface Pair {
   events: string[];
 }
 
-const LINK_OPTIONS = { jitterUs: 2000, maxEpisodes: 3 } as const;
+const LINK_OPTIONS: LinkOptions = { jitterUs: 2000, maxEpisodes: 3 };
+/** Every episode kept: the checkpoints then share the settled ones (episode-log.ts). */
+const ALL_EPISODES: LinkOptions = { jitterUs: 2000 };
 
-function pair(options: DecoderOptions): Pair {
+function pair(options: DecoderOptions, link = LINK_OPTIONS): Pair {
   const events: string[] = [];
   const asJson = (e: DecoderEvent) => JSON.stringify(e, (_k, v: unknown) => (v instanceof Uint8Array ? Array.from(v) : v));
   const missed: string[] = events;
   return {
     decoder: new SpektrumDecoder({ ...options, onEvent: (e) => events.push(asJson(e)) }),
-    link: new LinkMonitor({ ...LINK_OPTIONS, onMissed: (from, to, n, p) => missed.push(`missed ${from} ${to} ${n} ${p}`) }),
+    link: new LinkMonitor({ ...link, onMissed: (from, to, n, p) => missed.push(`missed ${from} ${to} ${n} ${p}`) }),
     events,
   };
 }
@@ -113,9 +122,16 @@ function* stepsOf(pushes: Iterable<Push>, endUs: number, setAt = -1): Generator<
  * every step must say the same. A second restore from the same checkpoint must too (restoring
  * leaves it as it was).
  */
-function expectRestoredSame(label: string, steps: Step[], options: DecoderOptions, points: number, seed: number): void {
+function expectRestoredSame(
+  label: string,
+  steps: Step[],
+  options: DecoderOptions,
+  points: number,
+  seed: number,
+  link = LINK_OPTIONS,
+): void {
   // next() steps repeat until no frame: expand them as the original ran them.
-  const original = pair(options);
+  const original = pair(options, link);
   const flat: Step[] = [];
   const outs: string[] = [];
   const taken = new Map<number, { decoder: ReturnType<SpektrumDecoder['checkpoint']>; link: ReturnType<LinkMonitor['checkpoint']> }>();
@@ -152,7 +168,7 @@ function expectRestoredSame(label: string, steps: Step[], options: DecoderOption
   const format = JSON.stringify(original.decoder.format);
   for (const [at, cp] of taken) {
     for (let round = 0; round < 2; round++) {
-      const copy = pair(options);
+      const copy = pair(options, link);
       copy.decoder.restore(cp.decoder);
       copy.link.restore(cp.link);
       // Every field the checkpoint holds was put back: a restore line forgotten shows here even
@@ -218,6 +234,72 @@ describe('a decoder and link monitor restored from a checkpoint', () => {
       }
     });
   }
+
+  it('every episode kept (settled ones shared between checkpoints): the same from any point', () => {
+    for (const name of ['dropouts-failsafe', 'dropouts-and-damage']) {
+      const sim = simulate(preset(name));
+      for (const how of FEEDS) {
+        const steps = [...stepsOf(sliced(feed(sim.bytes, sim.timesUs, how)), lastTime(sim.timesUs))];
+        expectRestoredSame(`${name}, ${how}, all episodes`, steps, {}, 40, sim.bytes.length, ALL_EPISODES);
+      }
+    }
+    const { bytes, times } = damagedStream('dsmx-11ms-2048-internal', 41, 8_000_000);
+    const steps = [...stepsOf(feed(bytes, times, 'USB chunks'), lastTime(times))];
+    expectRestoredSame('damaged, all episodes', steps, {}, 60, 9, ALL_EPISODES);
+  });
+
+  it('a day of holds stays linear: settled episodes are shared, never copied into each checkpoint', () => {
+    // 20 minutes with a dropout every 2 s, each tenth a failsafe: more than two blocks of the log.
+    const dropouts = Array.from({ length: 600 }, (_, k) => ({ atUs: 1e6 + k * 2e6, durationUs: k % 10 === 0 ? 1_200_000 : 300_000 }));
+    const sim = simulate({ ...preset('dsm2-22ms-1024-external'), dropouts }, 1_201_000_000);
+    const decoder = new SpektrumDecoder();
+    const link = new LinkMonitor({ jitterUs: 2000 });
+    const taken: { cp: ReturnType<LinkMonitor['checkpoint']>; episodes: string; fed: number }[] = [];
+    let nextUs = 10e6;
+    let fed = 0;
+    for (const push of feed(sim.bytes, sim.timesUs, '64-byte chunks, chunk times')) {
+      const t = push.time as number;
+      if (t >= nextUs) {
+        taken.push({ cp: link.checkpoint(), episodes: JSON.stringify(link.episodes), fed });
+        nextUs += 10e6;
+      }
+      decoder.push(push.bytes, t);
+      for (let f = decoder.next(); f !== undefined; f = decoder.next()) link.frame(f);
+      fed++;
+    }
+    expect(link.episodes.length).toBeGreaterThan(1000);
+    // Each checkpoint copies only the episodes still open to change (at most 64 holds wait to be
+    // judged, and the silence still open), however many came before; full blocks are the same objects.
+    const objects = new Set<object>();
+    for (const { cp } of taken) {
+      expect(cp.graph.episodes.length).toBeLessThanOrEqual(66);
+      for (const block of cp.settled) for (const e of block) objects.add(e);
+    }
+    expect(objects.size).toBeLessThanOrEqual(link.episodes.length);
+    const last = taken.at(-1)!.cp;
+    expect(last.settled.length).toBeGreaterThan(2);
+    expect(taken[taken.length - 2]!.cp.settled[1]).toBe(last.settled[1]);
+    // Restored (also after a structured clone, as a checkpoint crosses workers), a fresh monitor has
+    // the episodes the original had there, and goes on to the same end.
+    const final = JSON.stringify(link.episodes);
+    const pushes = [...feed(sim.bytes, sim.timesUs, '64-byte chunks, chunk times')];
+    for (const k of [3, 40, 77, taken.length - 1]) {
+      const { cp, episodes, fed: at } = taken[k]!;
+      const copy = new LinkMonitor({ jitterUs: 2000 });
+      copy.restore(k % 2 === 0 ? cp : structuredClone(cp));
+      expect(JSON.stringify(copy.episodes), `checkpoint ${k}`).toBe(episodes);
+      expect(JSON.stringify(copy.checkpoint()), `checkpoint ${k} taken again`).toBe(JSON.stringify(cp));
+      const d = new SpektrumDecoder();
+      // The link alone is restored: a fresh decoder fed from a few chunks before gives the same frames from there.
+      let lastUs = copy.lastFrameUs;
+      for (const push of pushes.slice(Math.max(0, at - 4))) {
+        d.push(push.bytes, push.time as number);
+        for (let f = d.next(); f !== undefined; f = d.next()) if (f.timeUs > lastUs) copy.frame(f);
+      }
+      lastUs = Number.NaN;
+      expect(JSON.stringify(copy.episodes), `checkpoint ${k}, fed to the end`).toBe(final);
+    }
+  });
 
   it('damaged streams (lost, stray, repeated bytes, flipped bits): the same from any point', () => {
     for (const [k, name] of ['dsmx-11ms-2048-internal', 'dsm2-22ms-1024-external', 'rssi-spm4649t', 'xplus-8'].entries()) {

@@ -147,6 +147,11 @@ export interface LinkCheckpoint {
   readonly rateFades: Float64Array;
   readonly rateCount: number;
   readonly rateNext: number;
+  /**
+   * The episodes that can no longer change, oldest first, in blocks shared with the monitor's
+   * later checkpoints (episode-log.ts): never written. `graph` holds the episodes after them.
+   */
+  readonly settled: readonly (readonly LinkEpisode[])[];
   readonly graph: Readonly<EpisodeGraph>;
   readonly nextEpisode: number;
   readonly retracted: readonly number[];

@@ -27,6 +27,7 @@
  */
 import { FAILSAFE_TIMEOUT_US, FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US, systemInfo } from './spec.js';
 import type { DecodedFrame } from './types.js';
+import { EpisodeLog } from './episode-log.js';
 import { FrameLedger } from './ledger.js';
 import { copyEpisodes, type LinkCheckpoint } from './checkpoint.js';
 
@@ -162,6 +163,8 @@ export class LinkMonitor {
   #rateCount = 0;
   #rateNext = 0;
   readonly #episodes: LinkEpisode[] = [];
+  /** The episodes that can no longer change, for checkpoints (unless `maxEpisodes`: then they are few). */
+  #log = new EpisodeLog();
   readonly #maxEpisodes: number;
   #nextEpisode = 0;
   #open: LinkEpisode | null = null;
@@ -506,6 +509,8 @@ export class LinkMonitor {
    * fade-rate windows, the ledger, the holds not yet judged and the counters.
    */
   checkpoint(): LinkCheckpoint {
+    // Kept whole otherwise: a monitor that drops old episodes has only a few to copy.
+    const logged = this.#maxEpisodes === Infinity ? this.#log.take(this.#episodes, this.#settled) : null;
     return {
       state: this.#state,
       lastUs: this.#lastUs,
@@ -518,7 +523,13 @@ export class LinkMonitor {
       rateFades: this.#rateFades.slice(),
       rateCount: this.#rateCount,
       rateNext: this.#rateNext,
-      graph: copyEpisodes({ episodes: this.#episodes, open: this.#open, unconfirmed: this.#unconfirmed, burst: this.#burst }),
+      settled: logged?.blocks ?? [],
+      graph: copyEpisodes({
+        episodes: logged?.open ?? this.#episodes,
+        open: this.#open,
+        unconfirmed: this.#unconfirmed,
+        burst: this.#burst,
+      }),
       nextEpisode: this.#nextEpisode,
       retracted: this.#retracted.slice(),
       ledger: this.#ledger.checkpoint(),
@@ -550,8 +561,13 @@ export class LinkMonitor {
     this.#rateNext = cp.rateNext;
     const g = copyEpisodes(cp.graph);
     // Pushed one by one: a long session's thousands of episodes are too many for spread arguments.
+    // The settled ones are copied (the monitor's own are written: redated, ended; the log's never),
+    // and put in order of id with the others.
     this.#episodes.length = 0;
+    for (const block of cp.settled) for (const e of block) this.#episodes.push({ ...e });
     for (const e of g.episodes) this.#episodes.push(e);
+    if (cp.settled.length > 0) this.#episodes.sort((a, b) => a.id - b.id);
+    this.#log = EpisodeLog.of(cp.settled, g.episodes);
     this.#open = g.open;
     this.#unconfirmed.splice(0, this.#unconfirmed.length, ...g.unconfirmed); // at most 64
     this.#burst = g.burst;
@@ -565,6 +581,17 @@ export class LinkMonitor {
     this.#finished = cp.finished;
     Object.assign(this.#stats, cp.stats);
   }
+
+  /**
+   * Whether episode `e` can no longer change: it has ended, no hold waits to be judged by it and
+   * it is not of the silence still open (`#redate` moves those).
+   */
+  readonly #settled = (e: LinkEpisode): boolean =>
+    e.endUs !== null &&
+    e !== this.#open &&
+    !(this.#open !== null && e.lastFrameUs === this.#open.lastFrameUs) &&
+    this.#burst?.episode !== e &&
+    !this.#unconfirmed.some((u) => u.episode === e);
 
   /** Re-dates the episodes counted from `fromUs` to count from the frame at `lastUs`. */
   #redate(fromUs: number, lastUs: number): void {
