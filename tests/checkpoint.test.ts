@@ -291,12 +291,11 @@ describe('a decoder and link monitor restored from a checkpoint', () => {
       expect(JSON.stringify(copy.checkpoint()), `checkpoint ${k} taken again`).toBe(JSON.stringify(cp));
       const d = new SpektrumDecoder();
       // The link alone is restored: a fresh decoder fed from a few chunks before gives the same frames from there.
-      let lastUs = copy.lastFrameUs;
+      const lastUs = copy.lastFrameUs;
       for (const push of pushes.slice(Math.max(0, at - 4))) {
         d.push(push.bytes, push.time as number);
         for (let f = d.next(); f !== undefined; f = d.next()) if (f.timeUs > lastUs) copy.frame(f);
       }
-      lastUs = Number.NaN;
       expect(JSON.stringify(copy.episodes), `checkpoint ${k}, fed to the end`).toBe(final);
     }
   });

@@ -148,8 +148,9 @@ export interface LinkCheckpoint {
   readonly rateCount: number;
   readonly rateNext: number;
   /**
-   * The episodes that can no longer change, oldest first, in blocks shared with the monitor's
-   * later checkpoints (episode-log.ts): never written. `graph` holds the episodes after them.
+   * The episodes that can no longer change, in blocks shared with the monitor's later
+   * checkpoints (episode-log.ts): never written. `graph` holds the others; a restore puts both
+   * back in order of id.
    */
   readonly settled: readonly (readonly LinkEpisode[])[];
   readonly graph: Readonly<EpisodeGraph>;

@@ -583,12 +583,11 @@ export class LinkMonitor {
   }
 
   /**
-   * Whether episode `e` can no longer change: it has ended, no hold waits to be judged by it and
-   * it is not of the silence still open (`#redate` moves those).
+   * Whether episode `e` can no longer change: it has ended (the open one has not), no hold waits
+   * to be judged by it and it is not of the silence still open (`#redate` moves those).
    */
   readonly #settled = (e: LinkEpisode): boolean =>
     e.endUs !== null &&
-    e !== this.#open &&
     !(this.#open !== null && e.lastFrameUs === this.#open.lastFrameUs) &&
     this.#burst?.episode !== e &&
     !this.#unconfirmed.some((u) => u.episode === e);
