@@ -291,6 +291,27 @@ describe.skipIf(skip !== null)('the page on any screen', () => {
     await page.context().close();
   });
 
+  it('closes a menu with Escape from the moment its panel shows, before the next frame', async () => {
+    const { page, errors } = await open({ width: 1280, height: 800 });
+    await demoRunning(page);
+    // All in one task: open, wait only for Preact's render (microtasks), press Escape. A key
+    // listener added after the next animation frame would miss the key, as a busy page did.
+    const result = await page.evaluate(async () => {
+      const button = [...document.querySelectorAll<HTMLButtonElement>('.menu-button')].find((b) => b.textContent?.trim() === 'Settings');
+      if (button === undefined) return 'no Settings button';
+      button.click();
+      const panel = document.getElementById(button.getAttribute('aria-controls') ?? '');
+      for (let i = 0; i < 20 && panel?.hidden !== false; i++) await Promise.resolve();
+      if (panel?.hidden !== false) return 'the panel did not show';
+      document.dispatchEvent(new KeyboardEvent('keydown', { key: 'Escape', bubbles: true }));
+      for (let i = 0; i < 20 && !panel.hidden; i++) await Promise.resolve();
+      return panel.hidden && document.activeElement === button ? 'closed' : 'still open';
+    });
+    expect(result).toBe('closed');
+    expect(errors).toEqual([]);
+    await page.context().close();
+  });
+
   it('selects a remote with the keyboard alone, with visible focus on the way', async () => {
     const { page, errors } = await open({ width: 1280, height: 800 });
     await demoRunning(page);

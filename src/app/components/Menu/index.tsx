@@ -4,7 +4,7 @@
  * Escape closes it and puts focus back on the button; so does a click or focus outside.
  */
 import type { ComponentChildren } from 'preact';
-import { useEffect, useId, useRef, useState } from 'preact/hooks';
+import { useEffect, useId, useLayoutEffect, useRef, useState } from 'preact/hooks';
 import './style.css';
 
 export function Menu({
@@ -29,7 +29,9 @@ export function Menu({
   const root = useRef<HTMLDivElement>(null);
   const button = useRef<HTMLButtonElement>(null);
   const id = useId();
-  useEffect(() => {
+  // A layout effect, so Escape works from the moment the panel shows: a plain effect waits for
+  // the next animation frame, and a key pressed before it (a busy page, a quick hand) was lost.
+  useLayoutEffect(() => {
     if (!open) return undefined;
     const outside = (e: Event) => {
       if (root.current !== null && !root.current.contains(e.target as Node)) setOpen(false);
