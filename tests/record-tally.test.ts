@@ -56,8 +56,9 @@ function made(seed: number): Uint8Array {
   return encodeCapture({ baudRate: 115200 }, records);
 }
 
-async function tallied(bytes: Uint8Array, sliceBytes: number | undefined) {
+async function tallied(bytes: Uint8Array, sliceBytes: number | undefined, reserve?: number) {
   const tally = new RecordTally(BYTE_TIME_US);
+  if (reserve !== undefined) tally.reserve(reserve);
   await walkDataRecords(new Blob([bytes.slice()]), () => {}, {
     runs: (b, view, from, to) => tally.records(b, view, from, to),
     ...(sliceBytes === undefined ? {} : { sliceBytes }),
@@ -101,16 +102,21 @@ describe('the chunk facts and span of a capture found as its records are walked'
     expect(seen.eventOutside).toBeGreaterThan(5);
   });
 
-  it('and of a long recording, each port’s chunk numbers grown as they come', async () => {
+  it('and of a long recording, each port’s chunk numbers grown as they come, with or without a guess of their number', async () => {
     const bytes = longCapture();
     const capture = parseCapture(bytes);
     const index = capturePortIndex(capture);
+    expect(capturePorts(capture).length).toBeGreaterThan(1);
     expect(Math.min(...capturePorts(capture).map((p) => index[p]?.length ?? 0))).toBeGreaterThan(20_000);
-    expect(await tallied(bytes, 1 << 16)).toEqual({
+    const want = {
       chunksByPort: Array.from(captureChunksByPort(capture)),
       timesInOrder: captureTimesInOrder(capture),
       portIndex: index.map((a) => Array.from(a)),
       span: captureSpan(capture),
-    });
+    };
+    // Without a guess of the records, with one that falls short, and with one that is right.
+    const records = capture.chunkEnds.length;
+    for (const reserve of [undefined, records >> 3, records])
+      expect({ reserve, ...(await tallied(bytes, 1 << 16, reserve)) }).toEqual({ reserve, ...want });
   });
 });
