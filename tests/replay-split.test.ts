@@ -331,6 +331,17 @@ describe('a long capture decoded on two workers', () => {
     // Parsed, salvaged: the damaged record is dropped and said to be.
     expect(split.wholeReads).toBe(1);
     expectCaptureAsRead(split, damaged);
+    // The same on the helper's port: the helper finds it, and is dropped.
+    const theirs = FILE.slice();
+    const theirsView = new DataView(theirs.buffer);
+    let q = parseCapture(FILE).headerLength;
+    while (q < theirs.length >> 1 || theirs[q + 2] !== 1 || theirs[q + 3] !== 1) q += 20 + theirsView.getUint32(q + 4, true);
+    theirsView.setFloat64(q + 8, theirsView.getFloat64(q + 8, true) + 5e6, true);
+    const helperPort = helperHere();
+    const caught = await openSplit(theirs, helperPort.make);
+    expect(helperPort.runs.dropped).toBe(true);
+    expectOverviewsAsOneDecode(caught.overviews, theirs);
+    expectCaptureAsRead(caught, theirs);
     // A port byte flipped (port 0 → 1) halfway: the helper's half would take that record for its own.
     const moved = FILE.slice();
     const movedView = new DataView(moved.buffer);
