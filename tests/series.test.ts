@@ -22,17 +22,17 @@ class PlainSums {
   }
 }
 
-/** The series' bins as its readers give them, and its checkpoint's columns, bins `[0, n)`. */
-function read(series: LinkSeries, n: number) {
-  return Array.from({ length: n }, (_, i) => ({
-    i,
-    frames: series.frames(i),
-    fades: series.fades(i),
-    lost: series.lost(i),
-    rssiMean: series.rssiMean(i),
-    rssiMin: series.rssiMin(i),
-    intervalMean: series.intervalMean(i),
-  }));
+const READERS = ['frames', 'fades', 'lost', 'rssiMean', 'rssiMin', 'intervalMean'] as const;
+
+/**
+ * The series' bins as its readers give them, bins `[0, n)`, reader `first` over every bin
+ * before the others (each reader must see what was added since the last read on its own).
+ */
+function read(series: LinkSeries, n: number, first = 0) {
+  const order = [...READERS.slice(first % READERS.length), ...READERS.slice(0, first % READERS.length)];
+  const bins = Array.from({ length: n }, (_, i) => ({ i }) as { i: number } & Record<(typeof READERS)[number], number>);
+  for (const name of order) for (const bin of bins) bin[name] = series[name](bin.i);
+  return bins;
 }
 
 function want(sums: PlainSums, n: number) {
@@ -99,7 +99,7 @@ describe('the binned series of a link', () => {
           reads++;
           const n = series.bins;
           lostSeen = Math.max(lostSeen, ...Array.from({ length: n }, (_, i) => series.lost(i)));
-          expect(read(series, n)).toEqual(want(sums, n));
+          expect(read(series, n, reads)).toEqual(want(sums, n));
           expect(series.checkpoint().columns.map((c) => Array.from(c))).toEqual(wantColumns(sums, n));
         }
       };
@@ -122,35 +122,47 @@ describe('the binned series of a link', () => {
     });
 
   it('restored from a checkpoint taken in the middle of a bin, goes on as the series it was taken from', () => {
-    const sim = simulate(preset('rssi-spm4649t'), 3_000_000);
-    const decoder = new SpektrumDecoder();
-    decoder.push(sim.bytes, sim.timesUs);
-    decoder.end();
-    const frames: DecodedFrame[] = [];
-    for (let f = decoder.next(); f; f = decoder.next()) frames.push({ ...f });
+    // A frame every 11 ms with an RSSI that falls, then rises, in each 250 ms bin, and an interval
+    // that is never a whole number of µs: each bin's minimum and sums depend on both halves.
+    const frames = Array.from(
+      { length: 200 },
+      (_, k) =>
+        ({
+          timeUs: k * 11_000.37,
+          fadesDelta: k % 9 === 0 ? 1 : 0,
+          system: 0xb2,
+          rssi: -40 - Math.abs(11 - (k % 23)) * 3,
+          fades: 0,
+        }) as DecodedFrame,
+    );
     const whole = new LinkSeries(250_000, 0);
     const link = monitorWithSeries({}, whole);
-    const half = frames.length >> 1;
-    let cp: ReturnType<LinkSeries['checkpoint']> | null = null;
-    let linkCp: ReturnType<typeof link.checkpoint> | null = null;
+    const taken = new Map<number, { series: ReturnType<LinkSeries['checkpoint']>; link: ReturnType<LinkMonitor['checkpoint']> }>();
+    const points = [30, 57, 101, 149];
     frames.forEach((f, k) => {
       link.frame(f);
       whole.frame(f, link);
-      if (k === half) {
-        cp = structuredClone(whole.checkpoint());
-        linkCp = structuredClone(link.checkpoint());
-      }
+      if (points.includes(k)) taken.set(k, structuredClone({ series: whole.checkpoint(), link: link.checkpoint() }));
     });
-    expect(whole.binOf(frames[half]?.timeUs ?? 0)).toBe(whole.binOf(frames[half + 1]?.timeUs ?? 0));
-    const resumed = new LinkSeries(250_000, 0);
-    resumed.restore(cp as unknown as ReturnType<LinkSeries['checkpoint']>);
-    const relink = monitorWithSeries({}, resumed);
-    relink.restore(linkCp as unknown as ReturnType<typeof link.checkpoint>);
-    for (const f of frames.slice(half + 1)) {
-      relink.frame(f);
-      resumed.frame(f, relink);
+    const end = whole.checkpoint();
+    const seen = read(whole, whole.bins);
+    for (const k of points) {
+      // Mid-bin: the frame after the checkpoint is in the same bin.
+      expect(whole.binOf(frames[k]?.timeUs ?? 0)).toBe(whole.binOf(frames[k + 1]?.timeUs ?? 0));
+      // Into a new series, and back into the one it was taken from (a seek back).
+      for (const series of [new LinkSeries(250_000, 0), whole]) {
+        const cp = taken.get(k);
+        if (cp === undefined) throw new Error('no checkpoint');
+        series.restore(cp.series);
+        const relink = monitorWithSeries({}, series);
+        relink.restore(cp.link);
+        for (const f of frames.slice(k + 1)) {
+          relink.frame(f);
+          series.frame(f, relink);
+        }
+        expect({ k, cp: series.checkpoint() }).toEqual({ k, cp: end });
+        expect({ k, read: read(series, series.bins, k) }).toEqual({ k, read: seen });
+      }
     }
-    expect(resumed.checkpoint()).toEqual(whole.checkpoint());
-    expect(read(resumed, resumed.bins)).toEqual(read(whole, whole.bins));
   });
 });
