@@ -147,6 +147,23 @@ function helperHere(change: (r: FilePassReport) => FilePassReport = (r) => r, tu
   return { make, jobs, runs };
 }
 
+/** The offset of the first record of `file` from its middle on whose type byte and port `match` says yes. */
+function recordFromMiddle(file: Uint8Array, match: (type: number, port: number) => boolean): number {
+  const view = new DataView(file.buffer, file.byteOffset, file.byteLength);
+  let p = parseCapture(file).headerLength;
+  while (p < file.length >> 1 || !match(file[p + 2] ?? -1, file[p + 3] ?? -1)) p += 20 + view.getUint32(p + 4, true);
+  return p;
+}
+
+/** FILE with its first data record on `port` from the middle on dated 5 s later: its CRC no longer matches. */
+function redated(port: number): Uint8Array {
+  const file = FILE.slice();
+  const view = new DataView(file.buffer);
+  const p = recordFromMiddle(file, (type, on) => type === 1 && on === port);
+  view.setFloat64(p + 8, view.getFloat64(p + 8, true) + 5e6, true);
+  return file;
+}
+
 /** Opens `file` in a worker with `make` as its helper and runs both until the overview is complete. */
 async function openSplit(file: Uint8Array, make: PassHelperMaker | null, previewSizes = PREVIEW, stream = true) {
   const clock = new SlicingClock();
@@ -317,11 +334,7 @@ describe('a long capture decoded on two workers', () => {
   it('does not use the helper for a damaged file, and starts none for a file read whole at once', async () => {
     // Halfway through, the time of a record of port 0 moved 5 s on (its CRC no longer matches):
     // the reader drops that record; decoded, its frames would be a silence that never happened.
-    const damaged = FILE.slice();
-    const view = new DataView(damaged.buffer);
-    let p = parseCapture(FILE).headerLength;
-    while (p < damaged.length >> 1 || damaged[p + 2] !== 1 || damaged[p + 3] !== 0) p += 20 + view.getUint32(p + 4, true);
-    view.setFloat64(p + 8, view.getFloat64(p + 8, true) + 5e6, true);
+    const damaged = redated(0);
     expect(readCapture(damaged, 'long.sscap').issues.length).toBeGreaterThan(0);
     const helper = helperHere();
     const split = await openSplit(damaged, helper.make);
@@ -332,11 +345,7 @@ describe('a long capture decoded on two workers', () => {
     expect(split.wholeReads).toBe(1);
     expectCaptureAsRead(split, damaged);
     // The same on the helper's port: the helper finds it, and is dropped.
-    const theirs = FILE.slice();
-    const theirsView = new DataView(theirs.buffer);
-    let q = parseCapture(FILE).headerLength;
-    while (q < theirs.length >> 1 || theirs[q + 2] !== 1 || theirs[q + 3] !== 1) q += 20 + theirsView.getUint32(q + 4, true);
-    theirsView.setFloat64(q + 8, theirsView.getFloat64(q + 8, true) + 5e6, true);
+    const theirs = redated(1);
     const helperPort = helperHere();
     const caught = await openSplit(theirs, helperPort.make);
     expect(helperPort.runs.dropped).toBe(true);
@@ -344,10 +353,7 @@ describe('a long capture decoded on two workers', () => {
     expectCaptureAsRead(caught, theirs);
     // A port byte flipped (port 0 → 1) halfway: the helper's half would take that record for its own.
     const moved = FILE.slice();
-    const movedView = new DataView(moved.buffer);
-    let at = parseCapture(FILE).headerLength;
-    while (at < moved.length >> 1 || moved[at + 3] !== 0) at += 20 + movedView.getUint32(at + 4, true);
-    moved[at + 3] = 1;
+    moved[recordFromMiddle(moved, (_, port) => port === 0) + 3] = 1;
     const flipped = await openSplit(moved, helperHere().make);
     expectOverviewsAsOneDecode(flipped.overviews, moved);
     expect(flipped.wholeReads).toBe(1);

@@ -9,16 +9,26 @@ import { LinkSeries, monitorWithSeries } from '../src/analysis/index.js';
 import { type DecodedFrame, LinkMonitor, SpektrumDecoder } from '../src/decoder/index.js';
 import { preset, simulate } from '../src/simulator/index.js';
 
+type Sums = { frames: number; fades: number; lost: number; rssi: number[]; intervals: number[] };
+
 /** Each bin's sums, kept by hand: what the series must hold. */
 class PlainSums {
-  readonly bins = new Map<number, { frames: number; fades: number; lost: number; rssi: number[]; intervals: number[] }>();
-  at(b: number) {
-    let bin = this.bins.get(b);
+  readonly #bins = new Map<number, Sums>();
+  /** Bin `b`'s sums, to add to. */
+  at(b: number): Sums {
+    let bin = this.#bins.get(b);
     if (bin === undefined) {
-      bin = { frames: 0, fades: 0, lost: 0, rssi: [], intervals: [] };
-      this.bins.set(b, bin);
+      bin = PlainSums.empty();
+      this.#bins.set(b, bin);
     }
     return bin;
+  }
+  /** Bin `b`'s sums, to read (none added yet: all zero). */
+  of(b: number): Sums {
+    return this.#bins.get(b) ?? PlainSums.empty();
+  }
+  static empty(): Sums {
+    return { frames: 0, fades: 0, lost: 0, rssi: [], intervals: [] };
   }
 }
 
@@ -38,7 +48,7 @@ function read(series: LinkSeries, n: number, first = 0) {
 function want(sums: PlainSums, n: number) {
   const mean = (xs: number[]) => (xs.length === 0 ? Number.NaN : xs.reduce((a, b) => a + b, 0) / xs.length);
   return Array.from({ length: n }, (_, i) => {
-    const bin = sums.bins.get(i) ?? { frames: 0, fades: 0, lost: 0, rssi: [], intervals: [] };
+    const bin = sums.of(i);
     return {
       i,
       frames: bin.frames,
@@ -53,7 +63,7 @@ function want(sums: PlainSums, n: number) {
 
 /** The checkpoint's columns as the plain sums have them: frames, fades, lost, RSSI sum, count and minimum, interval sum and count. */
 function wantColumns(sums: PlainSums, n: number): number[][] {
-  const bins = Array.from({ length: n }, (_, i) => sums.bins.get(i) ?? { frames: 0, fades: 0, lost: 0, rssi: [], intervals: [] });
+  const bins = Array.from({ length: n }, (_, i) => sums.of(i));
   const sum = (xs: number[]) => xs.reduce((a, b) => a + b, 0);
   return [
     bins.map((b) => b.frames),
