@@ -56,7 +56,7 @@ function made(seed: number): Uint8Array {
   return encodeCapture({ baudRate: 115200 }, records);
 }
 
-async function tallied(bytes: Uint8Array, sliceBytes: number | undefined, reserve?: number) {
+async function tallied(bytes: Uint8Array, sliceBytes: number | undefined, reserve?: number[]) {
   const tally = new RecordTally(BYTE_TIME_US);
   if (reserve !== undefined) tally.reserve(reserve);
   await walkDataRecords(new Blob([bytes.slice()]), () => {}, {
@@ -102,7 +102,7 @@ describe('the chunk facts and span of a capture found as its records are walked'
     expect(seen.eventOutside).toBeGreaterThan(5);
   });
 
-  it('and of a long recording, each port’s chunk numbers grown as they come, with or without a guess of their number', async () => {
+  it('and of a long recording, each port’s chunk numbers grown as they come, with or without a guess of how many', async () => {
     const bytes = longCapture();
     const capture = parseCapture(bytes);
     const index = capturePortIndex(capture);
@@ -114,9 +114,18 @@ describe('the chunk facts and span of a capture found as its records are walked'
       portIndex: index.map((a) => Array.from(a)),
       span: captureSpan(capture),
     };
-    // Without a guess of the records, with one that falls short, and with one that is right.
-    const records = capture.chunkEnds.length;
-    for (const reserve of [undefined, records >> 3, records])
-      expect({ reserve, ...(await tallied(bytes, 1 << 16, reserve)) }).toEqual({ reserve, ...want });
+    // Without a guess of each port's chunks, with one that falls short, one that is right, and
+    // ones that miss a port or make room on a port that has none.
+    const counts = want.chunksByPort;
+    const first = capturePorts(capture)[0] ?? 0;
+    const guesses = {
+      none: undefined,
+      short: counts.map((n) => n >> 3),
+      right: counts,
+      onePort: counts.map((n, p) => (p === first ? n : 0)),
+      elsewhere: counts.map((n) => (n > 0 ? 0 : 500)),
+    };
+    for (const [guess, reserve] of Object.entries(guesses))
+      expect({ guess, ...(await tallied(bytes, 1 << 16, reserve)) }).toEqual({ guess, ...want });
   });
 });

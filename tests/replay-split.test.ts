@@ -6,7 +6,7 @@
  * fails, disagrees, or read a damaged file counts for nothing: the worker decodes its ports.
  */
 import { describe, expect, it } from 'vitest';
-import { type Capture, capturePorts, parseCapture, readCapture, type SlicedFile } from '../src/capture/index.js';
+import { type Capture, capturePortIndex, capturePorts, parseCapture, readCapture, type SlicedFile } from '../src/capture/index.js';
 import { Dispatcher } from '../src/worker/dispatcher.js';
 import { overviewOf } from '../src/worker/replay/overview.js';
 import type { Overview } from '../src/worker/protocol.js';
@@ -287,12 +287,20 @@ describe('a long capture decoded on two workers', () => {
     // The helper made room for it before its walk, as much as the file's start promised (3 % more
     // than its share), and did not grow it on the way.
     const played = split.worker.replay?.source.capture as Capture;
-    const expected = helper.jobs[0]?.expected ?? { records: 0, dataBytes: 0 };
+    const expected = helper.jobs[0]?.expected ?? { records: 0, dataBytes: 0, chunksByPort: [] };
     expect(expected.records / played.chunkEnds.length).toBeGreaterThan(1);
     expect(expected.records / played.chunkEnds.length).toBeLessThan(1.08);
     expect(expected.dataBytes / played.bytes.length).toBeGreaterThan(1);
     expect(expected.dataBytes / played.bytes.length).toBeLessThan(1.08);
     expect(played.bytes.buffer.byteLength / played.bytes.length).toBeLessThan(1.08);
+    // So did this worker's half for each port's chunk numbers (the port index it finds).
+    const index = capturePortIndex(played);
+    for (const p of capturePorts(played)) {
+      const room = (index[p]?.buffer.byteLength ?? 0) / 4;
+      expect(room / (index[p]?.length ?? 0)).toBeGreaterThan(1);
+      expect(room / (index[p]?.length ?? 0)).toBeLessThan(1.08);
+      expect(expected.chunksByPort[p]).toBe(room);
+    }
     await expectSeeksExact(split, FILE);
   });
 

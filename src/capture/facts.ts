@@ -108,9 +108,9 @@ function timesInOrder(capture: Capture): boolean {
 
 /**
  * Each port's chunks (0–255, empty for a port without any): the capture's chunk numbers, in
- * order. One counting sort over the chunks, once per capture (`captureFact`); the arrays are
- * views of one array of every chunk, sorted by port, handed out as they are kept: not to be
- * written (a day-long capture's is 44 MB).
+ * order. One counting sort over the chunks, once per capture (`captureFact`), unless a walk of
+ * its records found them (`seedChunkFacts`); the arrays are handed out as they are kept: not to
+ * be written (a day-long capture's are 44 MB).
  */
 export function capturePortIndex(capture: Capture): readonly Uint32Array[] {
   return captureFact(capture, PORT_INDEX, portIndex);
@@ -121,7 +121,7 @@ function portIndex(capture: Capture): Uint32Array[] {
 }
 
 /** Each port's chunk numbers, from each chunk's port and the counts by port: views of one array of every chunk, sorted by port (a counting sort). */
-export function indexByPort(chunkPorts: Uint8Array, counts: Uint32Array): Uint32Array[] {
+function indexByPort(chunkPorts: Uint8Array, counts: Uint32Array): Uint32Array[] {
   const at = new Uint32Array(256);
   for (let p = 1; p < 256; p++) at[p] = (at[p - 1] ?? 0) + (counts[p - 1] ?? 0);
   const starts = at.slice();

@@ -11,6 +11,7 @@ import { BYTE_TIME_US } from '../../decoder/index.js';
 import type { Overview } from '../protocol.js';
 import { ArrivingFile } from './arriving-file.js';
 import { type Checkpoint, ReplayPass } from './replay-pass.js';
+import type { ExpectedSize } from './replay-preview.js';
 
 /** What a half decodes: `ports` of a file of `size` bytes, on the span the worker's pass uses. */
 export interface FilePassJob {
@@ -34,7 +35,7 @@ export interface FilePassJob {
    */
   tally?: boolean | undefined;
   /** The capture's size, guessed from the file's start (`Preview.expected`): room for what is kept or tallied is made before the walk. */
-  expected?: { records: number; dataBytes: number } | undefined;
+  expected?: ExpectedSize | undefined;
   resolution: 'auto' | 1024 | 2048;
   originUs: number;
   endUs: number;
@@ -98,7 +99,7 @@ export async function passOverFile(
     const tally = job.tally === true ? new RecordTally(BYTE_TIME_US) : null;
     if (job.expected !== undefined) {
       kept?.reserve(job.expected.records, job.expected.dataBytes);
-      tally?.reserve(job.expected.records);
+      tally?.reserve(job.expected.chunksByPort);
     }
     // Every record decoded here is checked: nothing from a damaged one is ever shown.
     const check = new Uint8Array(256);

@@ -5,7 +5,7 @@
  * a record a cut leaves). The start gives the records to decode first; the end gives where the
  * capture ends, so that the page can place the part read on the whole span at once.
  */
-import { type Capture, type SlicedFile, capturePorts, hasCaptureMagic, parseCapture } from '../../capture/index.js';
+import { type Capture, type SlicedFile, captureChunksByPort, capturePorts, hasCaptureMagic, parseCapture } from '../../capture/index.js';
 import { captureSpan } from '../../analysis/index.js';
 
 /** A file this large gets a preview: under it, reading it whole is as quick. */
@@ -22,8 +22,15 @@ export interface Preview {
   /** The first recorded time, and the last (from the file's end). */
   startUs: number;
   endUs: number;
-  /** The whole capture's chunks and data bytes, guessed from the start's (3 % more): room for its columns. */
-  expected: { records: number; dataBytes: number };
+  /** The whole capture's size, guessed from the start's: room for its columns. */
+  expected: ExpectedSize;
+}
+
+/** A capture's chunks (in all and of each port, 0–255) and data bytes, guessed from its file's start (3 % more). */
+export interface ExpectedSize {
+  records: number;
+  dataBytes: number;
+  chunksByPort: number[];
 }
 
 /** How much is read (tests read small files): by default PREVIEW_MIN_BYTES, PREVIEW_BYTES and TAIL_BYTES. */
@@ -71,6 +78,10 @@ export async function previewOf(file: SlicedFile, sizes: PreviewSizes = SIZES): 
   if (!Number.isFinite(startUs) || !Number.isFinite(endUs) || endUs < startUs) return null;
   // The start's share of the file holds its share of the records, give or take.
   const scale = (1.03 * size) / Math.max(1, headBytes - headerLength);
-  const expected = { records: Math.ceil(head.chunkEnds.length * scale), dataBytes: Math.ceil(head.bytes.length * scale) };
+  const expected = {
+    records: Math.ceil(head.chunkEnds.length * scale),
+    dataBytes: Math.ceil(head.bytes.length * scale),
+    chunksByPort: Array.from(captureChunksByPort(head), (n) => Math.ceil(n * scale)),
+  };
   return { head, ports: capturePorts(head), startUs, endUs, expected };
 }

@@ -21,6 +21,7 @@ import { addOverviews } from './overview.js';
 import { PieceReader, type ReadableFile } from './piece-reader.js';
 import type { Overview } from '../protocol.js';
 import { HelperRun, type PassHelperMaker, inThisWorker } from './replay-helper.js';
+import type { ExpectedSize } from './replay-preview.js';
 import { CHECKPOINT_US, type Checkpoint, type OverviewPass, ReplayPass, checkpointDue } from './replay-pass.js';
 
 /**
@@ -237,7 +238,7 @@ export function startSplit(
   file: Blob,
   ports: number[],
   span: { originUs: number; endUs: number; resolution: 'auto' | 1024 | 2048 },
-  expected: { records: number; dataBytes: number } | undefined,
+  expected: ExpectedSize | undefined,
   helper: PassHelperMaker | undefined,
   clock: Clock,
   sliceBytes: number | undefined,
