@@ -1,7 +1,8 @@
 /**
  * A File read forward a piece at a time (piece-reader.ts): the pieces are the file's bytes,
- * read into the buffer handed back when there is one, by its byte stream or a slice at a time,
- * and a file that ends before its size says so.
+ * read into the buffer handed back when there is one, by its byte stream or a slice at a time
+ * (also from a read of the stream that never answers on), and a file that ends before its size
+ * says so.
  */
 import { describe, expect, it } from 'vitest';
 import { PieceReader, type ReadableFile } from '../src/worker/replay/piece-reader.js';
@@ -41,6 +42,33 @@ describe('reading a file a piece at a time', () => {
       },
     };
     expect(joined(await readAll(new PieceReader(file, 40_000)))).toEqual(Array.from(bytes));
+  });
+
+  it('reads a slice at a time from a read of the byte stream that never answers, the stream cancelled', async () => {
+    const blob = new Blob([bytes]);
+    const stream = blob.stream();
+    let reads = 0;
+    let cancelled = 0;
+    // The file's own stream, whose third read never answers (as Chromium's sometimes does).
+    const stalling = {
+      getReader: () => {
+        const inner = stream.getReader({ mode: 'byob' });
+        return {
+          read: (view: Uint8Array<ArrayBuffer>) => (++reads === 3 ? new Promise(() => {}) : inner.read(view)),
+          cancel: async () => {
+            cancelled++;
+          },
+        };
+      },
+    } as unknown as ReadableStream<Uint8Array<ArrayBuffer>>;
+    const file: ReadableFile = { size: blob.size, slice: (start, end) => blob.slice(start, end), stream: () => stalling };
+    const reader = new PieceReader(file, 30_000, 20);
+    const pieces = await readAll(reader);
+    expect(joined(pieces)).toEqual(Array.from(bytes));
+    expect(pieces.map((p) => p.length)).toEqual([30_000, 30_000, 30_000, 10_000]);
+    // Given up once, after its wait; not asked again.
+    expect(reads).toBe(3);
+    expect(cancelled).toBe(1);
   });
 
   it('says so when the file ends before its size', async () => {

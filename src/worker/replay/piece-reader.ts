@@ -3,11 +3,21 @@
  * one where there is one: a long capture's pieces go round between the worker and its helper
  * (replay-split.ts), so that reading the file does not map hundreds of megabytes afresh. Reads
  * through the File's byte stream into the given buffer (a BYOB reader) where the browser has
- * one, else a slice at a time into a new buffer.
+ * one, else a slice at a time into a new buffer; and a slice at a time from a read of the stream
+ * that never answers on.
  */
 
 /** What is read: a Blob or File, or a stand-in with the same reads (tests). */
 export type ReadableFile = Pick<Blob, 'size' | 'slice' | 'stream'>;
+
+/**
+ * A read of the byte stream that has brought nothing for this long is given up: the stream is
+ * cancelled and the file read a slice at a time from the piece that stalled. Chromium 156's
+ * stream of a File in a worker sometimes never answers a read: the day capture's open waited
+ * for ever in 3 of 29 opens (at 96, 100 and 285 MB), where reads take 5-200 ms; a slice at a
+ * time never stalled (24 opens). Not seen in a page that only reads the file.
+ */
+export const STALL_MS = 500;
 
 export class PieceReader {
   #at = 0;
@@ -17,6 +27,7 @@ export class PieceReader {
   constructor(
     readonly file: ReadableFile,
     readonly pieceBytes: number,
+    readonly stallMs = STALL_MS,
   ) {
     this.#reader = byobReader(file);
   }
@@ -36,24 +47,31 @@ export class PieceReader {
     const length = Math.min(this.pieceBytes, size - this.#at);
     if (length <= 0) return null;
     const reader = this.#reader;
-    let piece: Uint8Array;
-    if (reader === null) {
+    let piece = reader === null ? null : await this.#readInto(reader, spare, length);
+    if (piece === null) {
+      // No byte stream, or it stalled (given up on: the piece is read again from its start).
+      this.stop();
       piece = new Uint8Array(await this.file.slice(this.#at, this.#at + length).arrayBuffer());
-    } else {
-      let buffer = spare !== undefined && spare.byteLength === this.pieceBytes ? spare : new ArrayBuffer(this.pieceBytes);
-      let filled = 0;
-      while (filled < length) {
-        // Each read takes the buffer over and gives it back with what it read.
-        const { value, done } = await reader.read(new Uint8Array(buffer, filled, length - filled));
-        if (value !== undefined) buffer = value.buffer as ArrayBuffer;
-        if (done || value === undefined) break;
-        filled += value.byteLength;
-      }
-      piece = new Uint8Array(buffer, 0, filled);
     }
     if (piece.length < length) throw new Error(`the file ended after ${this.#at + piece.length} of ${size} bytes`);
     this.#at += piece.length;
     return piece;
+  }
+
+  /** `length` bytes of the stream, in `spare` when it fits (else a new buffer); null when a read stalled. */
+  async #readInto(reader: ReadableStreamBYOBReader, spare: ArrayBuffer | undefined, length: number): Promise<Uint8Array | null> {
+    let buffer = spare !== undefined && spare.byteLength === this.pieceBytes ? spare : new ArrayBuffer(this.pieceBytes);
+    let filled = 0;
+    while (filled < length) {
+      // Each read takes the buffer over and gives it back with what it read.
+      const read = await answered(reader.read(new Uint8Array(buffer, filled, length - filled)), this.stallMs);
+      if (read === null) return null;
+      const { value, done } = read;
+      if (value !== undefined) buffer = value.buffer as ArrayBuffer;
+      if (done || value === undefined) break;
+      filled += value.byteLength;
+    }
+    return new Uint8Array(buffer, 0, filled);
   }
 
   /** Nothing more is read. */
@@ -69,5 +87,18 @@ function byobReader(file: ReadableFile): ReadableStreamBYOBReader | null {
     return file.stream().getReader({ mode: 'byob' });
   } catch {
     return null;
+  }
+}
+
+/** What `read` settles to, or null if it has not within `ms`. */
+async function answered<T>(read: Promise<T>, ms: number): Promise<T | null> {
+  let timer: ReturnType<typeof setTimeout> | undefined;
+  const stalled = new Promise<null>((resolve) => {
+    timer = setTimeout(() => resolve(null), ms);
+  });
+  try {
+    return await Promise.race([read, stalled]);
+  } finally {
+    clearTimeout(timer);
   }
 }
