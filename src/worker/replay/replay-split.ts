@@ -346,16 +346,16 @@ export async function readInPieces(
   /** Settles once piece k has gone on to the helper (in order). */
   const handedOver: Promise<void>[] = [];
   try {
-    for (let k = 0, from = 0; ; k++) {
+    for (let k = 0, at = 0; ; k++) {
       // Never far ahead: what is read waits in memory. A piece goes on once this half has walked
       // past it, which it can with the next piece read (pieces are longer than its slices and
       // than any header), and the helper never waits for more than a few pieces.
       await handedOver[k - AHEAD_PIECES];
       const piece = k === 0 && first !== undefined && first.length > 0 ? first : await reader.next(theirs.takeSpare());
       if (piece === null) break;
-      const start = from;
-      from += piece.length;
-      const end = from;
+      const start = at;
+      at += piece.length;
+      const end = at;
       mine.feed(piece);
       handedOver.push(
         (handedOver.at(-1) ?? Promise.resolve()).then(async () => {
