@@ -15,7 +15,8 @@ const OVERVIEW_EVERY_MS = 1000;
 /**
  * A capture's growing overview sent to the page, as often as OVERVIEW_EVERY_MS says; never one
  * read less far than the last (the halves of a split pass catching up), and nothing after the
- * complete one.
+ * complete one. The first with anything read goes as soon as it is offered: the day capture's
+ * came 1 s after the empty one, which both halves of a split pass make before either has read.
  */
 export class OverviewSender {
   readonly #host: Host;
@@ -37,7 +38,8 @@ export class OverviewSender {
 
   offer(overview: Overview): void {
     if (this.complete || !(overview.complete || overview.readUntilUs > this.#sentUntilUs)) return;
-    this.#lastMs = this.#host.clock.now();
+    // One with nothing read yet (the span alone, hatched) does not hold back the first that has.
+    if (overview.t.length > 0) this.#lastMs = this.#host.clock.now();
     this.#sentUntilUs = overview.readUntilUs;
     this.complete = overview.complete;
     postOverview(this.#host, overview);
