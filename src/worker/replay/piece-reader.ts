@@ -24,15 +24,12 @@ export class PieceReader {
   /** The file's byte stream, read into the buffers given; null: read a slice at a time. */
   #reader: ReadableStreamBYOBReader | null;
 
-  /** Reads `file` from `from` on. */
   constructor(
     readonly file: ReadableFile,
     readonly pieceBytes: number,
-    from = 0,
     readonly stallMs = STALL_MS,
   ) {
-    this.#at = from;
-    this.#reader = byobReader(from === 0 ? file : file.slice(from));
+    this.#reader = byobReader(file);
   }
 
   /** How far the file is read. */
@@ -85,7 +82,7 @@ export class PieceReader {
 }
 
 /** A reader into given buffers of `file`'s byte stream, or null when there is none (a browser without it). */
-function byobReader(file: Pick<Blob, 'stream'>): ReadableStreamBYOBReader | null {
+function byobReader(file: ReadableFile): ReadableStreamBYOBReader | null {
   try {
     return file.stream().getReader({ mode: 'byob' });
   } catch {

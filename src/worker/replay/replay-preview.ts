@@ -10,18 +10,12 @@ import { captureSpan } from '../../analysis/index.js';
 
 /** A file this large gets a preview: under it, reading it whole is as quick. */
 const PREVIEW_MIN_BYTES = 32 << 20;
-/**
- * The start read first: some 12 minutes of two remotes at 11 ms, and a split pass's first piece
- * (replay-split.ts's size: it is not read again). Reading and parsing 8 MB, as before, kept both
- * halves waiting longer: 83-180 ms into the day capture's open against 69-123.
- */
-const PREVIEW_BYTES = 4 << 20;
+/** The start read first: some 25 minutes of two remotes at 11 ms. */
+const PREVIEW_BYTES = 8 << 20;
 /** The end read for the last recorded time. */
 const TAIL_BYTES = 64 << 10;
 
 export interface Preview {
-  /** The file's first bytes, as read: a split pass walks them first (its first piece, taken over). */
-  start: Uint8Array;
   /** The capture's first records. */
   head: Capture;
   ports: number[];
@@ -63,9 +57,8 @@ export async function previewOf(file: SlicedFile, sizes: PreviewSizes = SIZES): 
   let head: Capture;
   let tail: Capture;
   let headerLength = 0;
-  let start: Uint8Array;
   try {
-    start = new Uint8Array(await file.slice(0, headBytes).arrayBuffer());
+    const start = new Uint8Array(await file.slice(0, headBytes).arrayBuffer());
     if (!hasCaptureMagic(start)) return null;
     const parsed = parseCapture(start);
     head = parsed;
@@ -90,5 +83,5 @@ export async function previewOf(file: SlicedFile, sizes: PreviewSizes = SIZES): 
     dataBytes: Math.ceil(head.bytes.length * scale),
     chunksByPort: Array.from(captureChunksByPort(head), (n) => Math.ceil(n * scale)),
   };
-  return { start, head, ports: capturePorts(head), startUs, endUs, expected };
+  return { head, ports: capturePorts(head), startUs, endUs, expected };
 }

@@ -93,7 +93,7 @@ export class ReplaySession implements Driver {
       } else {
         try {
           // Read once, piece by piece, each piece to both halves as it comes: the overview first.
-          await readInPieces(file, halves.mine, halves.theirs, parts.previewSizes?.sliceBytes, preview.start);
+          await readInPieces(file, halves.mine, halves.theirs, parts.previewSizes?.sliceBytes);
           await Promise.all([halves.mine.ended, halves.theirs.ended]);
         } catch (error) {
           return cannotOpen(`The file could not be read (${String(error)}).`);

@@ -332,36 +332,28 @@ export const AHEAD_PIECES = 6;
  * new memory (a copy for one half, a slice of its own for the other and a new buffer a piece
  * were each the whole file written into memory the system had to map afresh). The helper walks
  * a little behind this worker, and it has the longer walk anyway (it keeps the capture). A read
- * that fails fails both. Nothing is kept here: the helper's half keeps the capture. `first`,
- * the file's first bytes already read (the preview's), is the first piece (taken over).
+ * that fails fails both. Nothing is kept here: the helper's half keeps the capture.
  */
-export async function readInPieces(
-  file: ReadableFile,
-  mine: HelperRun,
-  theirs: HelperRun,
-  pieceBytes = PIECE_BYTES,
-  first?: Uint8Array,
-): Promise<void> {
-  const reader = new PieceReader(file, pieceBytes, first?.length ?? 0);
+export async function readInPieces(file: ReadableFile, mine: HelperRun, theirs: HelperRun, pieceBytes = PIECE_BYTES): Promise<void> {
+  const reader = new PieceReader(file, pieceBytes);
   /** Settles once piece k has gone on to the helper (in order). */
   const handedOver: Promise<void>[] = [];
   try {
-    for (let k = 0, at = 0; ; k++) {
+    for (let k = 0; ; k++) {
       // Never far ahead: what is read waits in memory. A piece goes on once this half has walked
       // past it, which it can with the next piece read (pieces are longer than its slices and
       // than any header), and the helper never waits for more than a few pieces.
       await handedOver[k - AHEAD_PIECES];
-      const piece = k === 0 && first !== undefined && first.length > 0 ? first : await reader.next(theirs.takeSpare());
+      const from = reader.at;
+      const piece = await reader.next(theirs.takeSpare());
       if (piece === null) break;
-      const start = at;
-      at += piece.length;
-      const end = at;
+      const end = reader.at;
       mine.feed(piece);
       handedOver.push(
         (handedOver.at(-1) ?? Promise.resolve()).then(async () => {
           // Transferred once nothing here reads it any more; the helper is never far behind.
           await mine.reached(end);
-          await theirs.reached(start - AHEAD_PIECES * pieceBytes);
+          await theirs.reached(from - AHEAD_PIECES * pieceBytes);
           theirs.feed(piece);
         }),
       );
