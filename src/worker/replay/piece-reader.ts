@@ -17,7 +17,7 @@ export type ReadableFile = Pick<Blob, 'size' | 'slice' | 'stream'>;
  * for ever in 3 of 29 opens (at 96, 100 and 285 MB), where reads take 5-200 ms; a slice at a
  * time never stalled (24 opens). Not seen in a page that only reads the file.
  */
-export const STALL_MS = 500;
+const STALL_MS = 500;
 
 export class PieceReader {
   #at = 0;
@@ -49,8 +49,8 @@ export class PieceReader {
     const reader = this.#reader;
     let piece = reader === null ? null : await this.#readInto(reader, spare, length);
     if (piece === null) {
-      // No byte stream, or it stalled (given up on: the piece is read again from its start).
-      this.stop();
+      // No byte stream, or it stalled: given up on (cancelled), the piece read again from its start.
+      if (reader !== null) this.stop();
       piece = new Uint8Array(await this.file.slice(this.#at, this.#at + length).arrayBuffer());
     }
     if (piece.length < length) throw new Error(`the file ended after ${this.#at + piece.length} of ${size} bytes`);
