@@ -15,6 +15,7 @@
 import type { ChunkFacts } from './facts.js';
 import { RECORD_OVERHEAD, RECORD_TYPE_DATA, REC_OFF_LENGTH, REC_OFF_PORT, REC_OFF_TIME, REC_OFF_TYPE } from './layout.js';
 import { chunkFirstByteUs } from './model.js';
+import { primeRuns } from './prime-runs.js';
 
 /** Room for this many of a port's chunks at first when none was guessed, then grown by half as needed (4 bytes a chunk). */
 const FIRST_ROOM = 1 << 10;
@@ -34,7 +35,9 @@ export class RecordTally {
   #inOrder = true;
 
   /** @param byteTimeUs how far apart a chunk's bytes arrived, for dating its first byte (the line rate's byte time) */
-  constructor(readonly byteTimeUs: number) {}
+  constructor(readonly byteTimeUs: number) {
+    primeRuns((bytes, view, from, to) => this.records(bytes, view, from, to));
+  }
 
   /**
    * Room for `chunksByPort[p]` chunks of each port at once (a guess from the file's start, before

@@ -4,8 +4,10 @@
  * as the worker reads them.
  */
 /// <reference lib="webworker" />
+import { detachEarly } from '../detach-early.js';
 import { type HelperMessage, helperReceiver } from './replay-file-pass.js';
 
+detachEarly();
 const scope = self as unknown as DedicatedWorkerGlobalScope;
 const receive = helperReceiver(
   (r, transfer) => scope.postMessage(r, transfer),
