@@ -256,6 +256,11 @@ export class SpektrumDecoder {
     this.#options = { resolution, remote, headerMode };
     this.#fixedBy = options.resolutionFrom === 'internal-remote' ? 'internal-remote' : 'user';
     this.#onEvent = options.onEvent;
+    // Written again, not only declared: a field written once the engine takes as constant, and
+    // end() writing it then threw away the compiled decode (Chromium 156, the end of a long
+    // capture's pass: #nextFast, #checkPush, the record walk's loop), which its first seek then
+    // ran cold.
+    this.#ended = false;
   }
 
   /**
