@@ -375,8 +375,8 @@ function multiPortCapture(path: string, scenarios: Scenario[], seconds: number):
  */
 async function armOpenTimer(page: Page): Promise<void> {
   await page.evaluate(() => {
-    const w = window as unknown as { __open: { start: number; plotted: number; counted: number; complete: number } };
-    w.__open = { start: 0, plotted: 0, counted: 0, complete: 0 };
+    const w = window as unknown as { __open: { start: number; plotted: number; withData: number; counted: number; complete: number } };
+    w.__open = { start: 0, plotted: 0, withData: 0, counted: 0, complete: 0 };
     document.querySelector('input[type=file]')?.addEventListener(
       'change',
       () => {
@@ -391,7 +391,12 @@ async function armOpenTimer(page: Page): Promise<void> {
         w.__open.plotted = performance.now();
       // A page without a growing overview (BENCH_APP_DIR of an older build) is complete at once.
       const o = document.querySelector('section.replay .overview');
-      if (w.__open.counted > 0 && o?.querySelector('canvas') && o.getAttribute('data-complete') !== 'false') {
+      const drawnComplete = o?.querySelector('canvas') && o.getAttribute('data-complete') !== 'false';
+      // The first overview drawn is the span alone, hatched: the first with anything read says more than 0 %.
+      const reading = document.querySelector('[data-testid="replay-reading"]')?.textContent ?? '';
+      if (w.__open.withData === 0 && (drawnComplete || (/^Reading the capture: /.test(reading) && !reading.endsWith(': 0 %'))))
+        w.__open.withData = performance.now();
+      if (w.__open.counted > 0 && drawnComplete) {
         w.__open.complete = performance.now();
         obs.disconnect();
       }
@@ -414,19 +419,29 @@ async function openTimes(
   page: Page,
   file: string,
   timeoutMs: number,
-): Promise<{ ms: number; countedMs: number; completeMs: number; pageReadMs: number; workerMs: number; drawMs: number }> {
+): Promise<{
+  ms: number;
+  withDataMs: number;
+  countedMs: number;
+  completeMs: number;
+  pageReadMs: number;
+  workerMs: number;
+  drawMs: number;
+}> {
   await armOpenTimer(page);
   await page.setInputFiles('input[type=file]', file);
   await page.waitForFunction(() => (window as unknown as { __open: { complete: number } }).__open.complete > 0, undefined, {
     timeout: timeoutMs,
   });
   return page.evaluate(() => {
-    const o = (window as unknown as { __open: { start: number; plotted: number; counted: number; complete: number } }).__open;
+    const o = (window as unknown as { __open: { start: number; plotted: number; withData: number; counted: number; complete: number } })
+      .__open;
     const mark = (name: string) => performance.getEntriesByName(name).at(-1)?.startTime ?? Number.NaN;
     const read = mark('satscope:capture-read');
     const received = mark('satscope:overview-received');
     return {
       ms: Math.round(o.plotted - o.start),
+      withDataMs: Math.round(o.withData - o.start),
       countedMs: Math.round(o.counted - o.start),
       completeMs: Math.round(o.complete - o.start),
       pageReadMs: Math.round(read - o.start),
@@ -1147,6 +1162,7 @@ it(
               2,
             ),
             openToOverviewMs: opens.map((o) => o.ms),
+            openToOverviewWithDataMs: opens.map((o) => o.withDataMs),
             openToFramesCountedMs: opens.map((o) => o.countedMs),
             openPartsMs: opens.map((o) => ({ pageRead: o.pageReadMs, worker: o.workerMs, draw: o.drawMs })),
             firstSeekMs: firstSeeks,
