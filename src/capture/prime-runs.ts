@@ -5,8 +5,8 @@
  *
  * That first run is a whole piece of the file (4 MB, about 140,000 records), and the engine
  * compiles the loop while the run is still in it (on-stack replacement). The stores after the
- * loop have never run with type feedback kept (V8 keeps a function's only from about its ninth
- * call), so the compiled code leaves at them. Chromium 156 kept that compiled loop and left it
+ * loop have no type feedback yet (V8 gives a function somewhere to keep it only from about its
+ * ninth call), so the compiled code leaves at them. Chromium 156 kept that compiled loop and left it
  * there at the end of every later run: 14 to 169 times an open of the day capture
  * (--trace-deopt), each run starting again in the interpreter. Run empty first, the stores have
  * their feedback when the loop is compiled, and the code stays.
