@@ -10,6 +10,7 @@ import { join, resolve } from 'node:path';
 import { pathToFileURL } from 'node:url';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { preset, simulate } from '../src/simulator/index.js';
+import { CLI_TIMEOUT_MS } from './cli-timeout.js';
 
 const cli = resolve(import.meta.dirname, '../dist/cli/main.js');
 let dir = '';
@@ -75,7 +76,11 @@ describe('satscope decode into a pipe', () => {
     const full = openSync('/dev/full', 'w');
     try {
       for (const command of ['decode', 'info']) {
-        const r = spawnSync(process.execPath, [cli, command, big], { stdio: ['ignore', full, 'pipe'], encoding: 'utf8' });
+        const r = spawnSync(process.execPath, [cli, command, big], {
+          stdio: ['ignore', full, 'pipe'],
+          encoding: 'utf8',
+          timeout: CLI_TIMEOUT_MS,
+        });
         expect(r.status, command).toBe(1);
         expect(r.stderr, command).toBe('satscope: cannot write the output: ENOSPC\n');
       }
@@ -91,7 +96,7 @@ describe('satscope decode into a pipe', () => {
         '-c',
         `("${process.execPath}" "${join(dir, 'peak.mjs')}" decode "${big}" 2>"${dir}/err"; echo $? >"${dir}/rc") | head -n 3; cat "${dir}/rc" "${dir}/err"`,
       ],
-      { encoding: 'utf8' },
+      { encoding: 'utf8', timeout: CLI_TIMEOUT_MS },
     );
     const out = r.stdout.split('\n');
     expect(out.slice(0, 3).every((l) => l.startsWith('{"t": null, "remote": "internal"'))).toBe(true);

@@ -12,6 +12,7 @@ import { summarizeCapture } from '../src/analysis/index.js';
 import { preset, simulate } from '../src/simulator/index.js';
 import { concatBytes } from './bytes.js';
 import { usbChunks } from './feeds.js';
+import { CLI_TIMEOUT_MS } from './cli-timeout.js';
 
 const cli = resolve(import.meta.dirname, '../dist/cli/main.js');
 let dir = '';
@@ -19,7 +20,7 @@ const sim = simulate({ ...preset('dropouts-failsafe'), seed: 3 }, 4_000_000, { t
 const intact = sim.truth!.frames.filter((f) => f.damage === null);
 
 function satscope(...args: string[]) {
-  const r = spawnSync(process.execPath, [cli, ...args], { encoding: 'utf8' });
+  const r = spawnSync(process.execPath, [cli, ...args], { encoding: 'utf8', timeout: CLI_TIMEOUT_MS });
   return { code: r.status, out: r.stdout, err: r.stderr };
 }
 
@@ -162,7 +163,11 @@ describe('satscope decode', () => {
   it('takes FILE after --, also a FILE whose name starts with -', () => {
     const plain = satscope('decode', join(dir, 'run.bin')).out;
     expect(satscope('decode', '--', join(dir, 'run.bin'))).toMatchObject({ code: 0, out: plain });
-    const dashed = spawnSync(process.execPath, [cli, 'decode', '--format', 'csv', '--', '-dash.bin'], { cwd: dir, encoding: 'utf8' });
+    const dashed = spawnSync(process.execPath, [cli, 'decode', '--format', 'csv', '--', '-dash.bin'], {
+      cwd: dir,
+      encoding: 'utf8',
+      timeout: CLI_TIMEOUT_MS,
+    });
     expect(dashed.status).toBe(0);
     expect(dashed.stdout.trim().split('\n')).toHaveLength(intact.length + 1);
   });

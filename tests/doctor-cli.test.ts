@@ -13,6 +13,7 @@ import { CaptureWriter } from '../src/capture/index.js';
 import { ibusStream, preset, receiveAs, simulate } from '../src/simulator/index.js';
 import { concatBytes } from './bytes.js';
 import { usbChunks } from './feeds.js';
+import { CLI_TIMEOUT_MS } from './cli-timeout.js';
 
 const SECOND = 1_000_000;
 let dir = '';
@@ -99,7 +100,7 @@ describe('satscope doctor', () => {
 
   it('runs as `satscope doctor` from the built command line', () => {
     const cli = resolve(import.meta.dirname, '../dist/cli/main.js');
-    const r = spawnSync(process.execPath, [cli, 'doctor', join(dir, 'ibus.sscap')], { encoding: 'utf8' });
+    const r = spawnSync(process.execPath, [cli, 'doctor', join(dir, 'ibus.sscap')], { encoding: 'utf8', timeout: CLI_TIMEOUT_MS });
     expect(r.stderr).toBe('');
     expect(r.status).toBe(1);
     expect(r.stdout).toMatch(/this is FlySky IBUS/);

@@ -29,6 +29,7 @@ import {
 } from '../src/analysis/index.js';
 import { encodeServo2048, preset, simulate, type Scenario, type SimChunk } from '../src/simulator/index.js';
 import { perByteCapture } from './feeds.js';
+import { CLI_TIMEOUT_MS } from './cli-timeout.js';
 
 // ---------------------------------------------------------------------------------------------
 // Captures from the simulator
@@ -612,7 +613,7 @@ describe.skipIf(!px4Present)('healthReport on the real PX4 captures', () => {
 
 const cli = resolve(import.meta.dirname, '../dist/cli/main.js');
 function satscope(...args: string[]) {
-  const r = spawnSync(process.execPath, [cli, ...args], { encoding: 'utf8' });
+  const r = spawnSync(process.execPath, [cli, ...args], { encoding: 'utf8', timeout: CLI_TIMEOUT_MS });
   return { code: r.status, out: r.stdout, err: r.stderr };
 }
 
