@@ -6,13 +6,12 @@
 import { spawn, spawnSync } from 'node:child_process';
 import { closeSync, existsSync, mkdtempSync, openSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
-import { join, resolve } from 'node:path';
+import { join } from 'node:path';
 import { pathToFileURL } from 'node:url';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { preset, simulate } from '../src/simulator/index.js';
-import { CLI_TIMEOUT_MS } from './cli-timeout.js';
+import { CLI as cli, CLI_TIMEOUT_MS } from './built-cli.js';
 
-const cli = resolve(import.meta.dirname, '../dist/cli/main.js');
 let dir = '';
 let big = '';
 /** Tiles of a simulated minute, back to back: a continuous stream of whole frames. */

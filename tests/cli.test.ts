@@ -2,27 +2,20 @@
  * The satscope command, run as a user would (node dist/cli/main.js), on captures of each kind
  * made from the simulator. Needs `npm run build:lib` first (`npm test` does it).
  */
-import { spawnSync } from 'node:child_process';
 import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
-import { join, resolve } from 'node:path';
+import { join } from 'node:path';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { CaptureWriter, readCapture } from '../src/capture/index.js';
 import { summarizeCapture } from '../src/analysis/index.js';
 import { preset, simulate } from '../src/simulator/index.js';
 import { concatBytes } from './bytes.js';
 import { usbChunks } from './feeds.js';
-import { CLI_TIMEOUT_MS } from './cli-timeout.js';
+import { satscope, satscopeWith } from './built-cli.js';
 
-const cli = resolve(import.meta.dirname, '../dist/cli/main.js');
 let dir = '';
 const sim = simulate({ ...preset('dropouts-failsafe'), seed: 3 }, 4_000_000, { truth: true });
 const intact = sim.truth!.frames.filter((f) => f.damage === null);
-
-function satscope(...args: string[]) {
-  const r = spawnSync(process.execPath, [cli, ...args], { encoding: 'utf8', timeout: CLI_TIMEOUT_MS });
-  return { code: r.status, out: r.stdout, err: r.stderr };
-}
 
 beforeAll(() => {
   dir = mkdtempSync(join(tmpdir(), 'satscope-cli-'));
@@ -163,13 +156,9 @@ describe('satscope decode', () => {
   it('takes FILE after --, also a FILE whose name starts with -', () => {
     const plain = satscope('decode', join(dir, 'run.bin')).out;
     expect(satscope('decode', '--', join(dir, 'run.bin'))).toMatchObject({ code: 0, out: plain });
-    const dashed = spawnSync(process.execPath, [cli, 'decode', '--format', 'csv', '--', '-dash.bin'], {
-      cwd: dir,
-      encoding: 'utf8',
-      timeout: CLI_TIMEOUT_MS,
-    });
-    expect(dashed.status).toBe(0);
-    expect(dashed.stdout.trim().split('\n')).toHaveLength(intact.length + 1);
+    const dashed = satscopeWith({ cwd: dir }, 'decode', '--format', 'csv', '--', '-dash.bin');
+    expect(dashed.code).toBe(0);
+    expect(dashed.out.trim().split('\n')).toHaveLength(intact.length + 1);
   });
 
   it('refuses options a command does not take, missing and repeated values, with exit code 2', () => {

@@ -3,17 +3,16 @@
  * and the line model, called in-process and, once, as a user would (node dist/cli/main.js;
  * needs `npm run build:lib` first, as tests/cli.test.ts does).
  */
-import { spawnSync } from 'node:child_process';
 import { mkdtempSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
-import { join, resolve } from 'node:path';
+import { join } from 'node:path';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { doctorCommand } from '../src/cli/doctor.js';
 import { CaptureWriter } from '../src/capture/index.js';
 import { ibusStream, preset, receiveAs, simulate } from '../src/simulator/index.js';
 import { concatBytes } from './bytes.js';
 import { usbChunks } from './feeds.js';
-import { CLI_TIMEOUT_MS } from './cli-timeout.js';
+import { satscope } from './built-cli.js';
 
 const SECOND = 1_000_000;
 let dir = '';
@@ -99,10 +98,9 @@ describe('satscope doctor', () => {
   });
 
   it('runs as `satscope doctor` from the built command line', () => {
-    const cli = resolve(import.meta.dirname, '../dist/cli/main.js');
-    const r = spawnSync(process.execPath, [cli, 'doctor', join(dir, 'ibus.sscap')], { encoding: 'utf8', timeout: CLI_TIMEOUT_MS });
-    expect(r.stderr).toBe('');
-    expect(r.status).toBe(1);
-    expect(r.stdout).toMatch(/this is FlySky IBUS/);
+    const r = satscope('doctor', join(dir, 'ibus.sscap'));
+    expect(r.err).toBe('');
+    expect(r.code).toBe(1);
+    expect(r.out).toMatch(/this is FlySky IBUS/);
   });
 });

@@ -3,7 +3,6 @@
  * from the simulator, checked against its ground truth; and on the real PX4 captures when they
  * are beside the repository. The CLI tests need `npm run build:lib` first (`npm test` does it).
  */
-import { spawnSync } from 'node:child_process';
 import { existsSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
@@ -29,7 +28,7 @@ import {
 } from '../src/analysis/index.js';
 import { encodeServo2048, preset, simulate, type Scenario, type SimChunk } from '../src/simulator/index.js';
 import { perByteCapture } from './feeds.js';
-import { CLI_TIMEOUT_MS } from './cli-timeout.js';
+import { satscope } from './built-cli.js';
 
 // ---------------------------------------------------------------------------------------------
 // Captures from the simulator
@@ -610,12 +609,6 @@ describe.skipIf(!px4Present)('healthReport on the real PX4 captures', () => {
 // ---------------------------------------------------------------------------------------------
 // satscope report
 // ---------------------------------------------------------------------------------------------
-
-const cli = resolve(import.meta.dirname, '../dist/cli/main.js');
-function satscope(...args: string[]) {
-  const r = spawnSync(process.execPath, [cli, ...args], { encoding: 'utf8', timeout: CLI_TIMEOUT_MS });
-  return { code: r.status, out: r.stdout, err: r.stderr };
-}
 
 describe('satscope report', () => {
   let dir = '';
