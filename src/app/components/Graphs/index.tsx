@@ -93,6 +93,9 @@ export function Graphs({ windowUs }: { windowUs: Signal<number> }) {
     const sync = uPlot.sync('satscope');
     const list = specs(rssi);
     const width = () => Math.max(200, el.clientWidth - 4);
+    // Measured once for all the panes: read after each one is appended, it laid the page out
+    // again each time (33 ms when a capture opens). The observer below follows any change.
+    const first = width();
     const panes = list.map((spec) => {
       const box = document.createElement('div');
       box.className = 'chart';
@@ -100,7 +103,7 @@ export function Graphs({ windowUs }: { windowUs: Signal<number> }) {
       box.setAttribute('aria-label', `${spec.title} over time: hover, or the arrow keys, for the values`);
       box.dataset.chart = spec.key;
       el.append(box);
-      return { key: spec.key, box, chart: makeChart(box, spec, width(), sync) };
+      return { key: spec.key, box, chart: makeChart(box, spec, first, sync) };
     });
     const charts = panes.map((p) => p.chart);
     const cursors = panes.map((p) => keyboardCursor(p.chart, p.box));
