@@ -10,6 +10,7 @@ import { join } from 'node:path';
 import { pathToFileURL } from 'node:url';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { preset, simulate } from '../src/simulator/index.js';
+import { COMMAND_NODE_FLAGS } from '../src/cli/relaunch.js';
 import { CLI as cli, CLI_TIMEOUT_MS } from './built-cli.js';
 
 let dir = '';
@@ -28,7 +29,8 @@ beforeAll(() => {
   for (let t = 0; t < TILES; t++) bytes.set(minute.bytes, t * minute.bytes.length);
   big = join(dir, 'big.bin');
   writeFileSync(big, bytes);
-  // Runs the CLI and, as it exits, reports its peak resident memory on stderr.
+  // Runs the CLI and, as it exits, reports its peak resident memory on stderr: in this process,
+  // started with the command's Node options (else it would start another Node to run in).
   writeFileSync(
     join(dir, 'peak.mjs'),
     `import { writeSync } from 'node:fs';\n` +
@@ -43,7 +45,9 @@ const sleep = (ms: number): Promise<void> => new Promise((r) => setTimeout(r, ms
 
 describe('satscope decode into a pipe', () => {
   it('keeps its memory flat when the reader is slow, and still delivers every frame', async () => {
-    const child = spawn(process.execPath, [join(dir, 'peak.mjs'), 'decode', big], { stdio: ['ignore', 'pipe', 'pipe'] });
+    const child = spawn(process.execPath, [...COMMAND_NODE_FLAGS, join(dir, 'peak.mjs'), 'decode', big], {
+      stdio: ['ignore', 'pipe', 'pipe'],
+    });
     let err = '';
     child.stderr.setEncoding('utf8').on('data', (s: string) => (err += s));
     const exited = new Promise<number | null>((r) => child.on('close', (code) => r(code)));
@@ -93,7 +97,7 @@ describe('satscope decode into a pipe', () => {
       'sh',
       [
         '-c',
-        `("${process.execPath}" "${join(dir, 'peak.mjs')}" decode "${big}" 2>"${dir}/err"; echo $? >"${dir}/rc") | head -n 3; cat "${dir}/rc" "${dir}/err"`,
+        `("${process.execPath}" ${COMMAND_NODE_FLAGS.join(' ')} "${join(dir, 'peak.mjs')}" decode "${big}" 2>"${dir}/err"; echo $? >"${dir}/rc") | head -n 3; cat "${dir}/rc" "${dir}/err"`,
       ],
       { encoding: 'utf8', timeout: CLI_TIMEOUT_MS },
     );
