@@ -27,10 +27,14 @@ beforeAll(() => {
 
 afterAll(() => rmSync(dir, { recursive: true, force: true }));
 
-/** The command line of each child of process `pid`. */
-function childrenOf(pid: number): string[][] {
-  const ids = readFileSync(`/proc/${pid}/task/${pid}/children`, 'utf8').trim().split(/\s+/).filter(Boolean);
-  return ids.map((id) => readFileSync(`/proc/${id}/cmdline`, 'utf8').split('\0').filter(Boolean));
+/** The children of process `pid`. */
+function childrenOf(pid: number): number[] {
+  return readFileSync(`/proc/${pid}/task/${pid}/children`, 'utf8').trim().split(/\s+/).filter(Boolean).map(Number);
+}
+
+/** The command line of process `pid`, word by word. */
+function commandLine(pid: number): string[] {
+  return readFileSync(`/proc/${pid}/cmdline`, 'utf8').split('\0').filter(Boolean);
 }
 
 /** Whether process `pid` is still running (not gone, not a zombie). */
@@ -39,7 +43,7 @@ function running(pid: number): boolean {
   return !/\) [ZX] /.test(readFileSync(`/proc/${pid}/stat`, 'utf8'));
 }
 
-describe.skipIf(!existsSync('/proc/self/task'))('the satscope executable', () => {
+describe.skipIf(!existsSync(`/proc/${process.pid}/task/${process.pid}/children`))('the satscope executable', () => {
   it('runs the command in a Node started with the command options, and a SIGTERM stops both', async () => {
     const satscope = spawn(process.execPath, [CLI, 'decode', file], { stdio: ['ignore', 'pipe', 'pipe'] });
     // Nobody reads: the command waits on the full pipe, still running.
@@ -47,16 +51,16 @@ describe.skipIf(!existsSync('/proc/self/task'))('the satscope executable', () =>
     const ended = new Promise<{ code: number | null; signal: string | null }>((r) =>
       satscope.on('exit', (code, signal) => r({ code, signal })),
     );
-    let children: string[][] = [];
+    let children: number[] = [];
     for (let i = 0; i < 100 && children.length === 0; i++) {
       await new Promise((r) => setTimeout(r, 50));
       children = childrenOf(satscope.pid!);
     }
     expect(children).toHaveLength(1);
-    const [command] = children as [string[]];
+    const childPid = children[0]!;
+    const command = commandLine(childPid);
     expect(command.slice(1, 1 + COMMAND_NODE_FLAGS.length)).toEqual(COMMAND_NODE_FLAGS);
     expect(command.slice(-3)).toEqual([CLI, 'decode', file]);
-    const childPid = Number(readFileSync(`/proc/${satscope.pid}/task/${satscope.pid}/children`, 'utf8').trim());
     expect(running(childPid)).toBe(true);
     // What the command wrote, to its end: once satscope has ended, Node reads its pipe on.
     let lines = 0;
@@ -67,6 +71,8 @@ describe.skipIf(!existsSync('/proc/self/task'))('the satscope executable', () =>
     satscope.kill('SIGTERM');
     expect(await ended).toEqual({ code: null, signal: 'SIGTERM' });
     await closed;
+    // Its pipe closes as it exits: a moment before it is gone.
+    for (let i = 0; i < 40 && running(childPid); i++) await new Promise((r) => setTimeout(r, 50));
     expect(running(childPid)).toBe(false);
     // Stopped where the pipe held it: not one of the twenty minutes' hundred thousand frames more.
     expect(lines).toBeLessThan(2_000);
