@@ -10,7 +10,7 @@ import { join } from 'node:path';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { COMMAND_NODE_FLAGS } from '../src/cli/relaunch.js';
 import { preset, simulate } from '../src/simulator/index.js';
-import { CLI, CLI_TIMEOUT_MS } from './built-cli.js';
+import { CLI, CLI_TIMEOUT_MS, satscope } from './built-cli.js';
 
 let dir = '';
 let file = '';
@@ -90,8 +90,8 @@ describe.skipIf(!existsSync(`/proc/${process.pid}/task/${process.pid}/children`)
         .every((l) => l.startsWith('{"t": null, "remote": "internal"')),
     ).toBe(true);
     expect(r.stderr).toBe('exit 0\n');
-    const missing = spawnSync(process.execPath, [CLI, 'info', join(dir, 'no-such.bin')], { encoding: 'utf8', timeout: CLI_TIMEOUT_MS });
-    expect(missing.status).toBe(2);
-    expect(missing.stderr).toMatch(/^satscope: .*no-such\.bin/);
+    const missing = satscope('info', join(dir, 'no-such.bin'));
+    expect(missing.code).toBe(2);
+    expect(missing.err).toMatch(/^satscope: .*no-such\.bin/);
   });
 });

@@ -11,7 +11,7 @@ import { pathToFileURL } from 'node:url';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { preset, simulate } from '../src/simulator/index.js';
 import { COMMAND_NODE_FLAGS } from '../src/cli/relaunch.js';
-import { CLI as cli, CLI_TIMEOUT_MS } from './built-cli.js';
+import { CLI as cli, CLI_TIMEOUT_MS, satscopeWith } from './built-cli.js';
 
 let dir = '';
 let big = '';
@@ -79,13 +79,9 @@ describe('satscope decode into a pipe', () => {
     const full = openSync('/dev/full', 'w');
     try {
       for (const command of ['decode', 'info']) {
-        const r = spawnSync(process.execPath, [cli, command, big], {
-          stdio: ['ignore', full, 'pipe'],
-          encoding: 'utf8',
-          timeout: CLI_TIMEOUT_MS,
-        });
-        expect(r.status, command).toBe(1);
-        expect(r.stderr, command).toBe('satscope: cannot write the output: ENOSPC\n');
+        const r = satscopeWith({ stdio: ['ignore', full, 'pipe'] }, command, big);
+        expect(r.code, command).toBe(1);
+        expect(r.err, command).toBe('satscope: cannot write the output: ENOSPC\n');
       }
     } finally {
       closeSync(full);

@@ -12,6 +12,7 @@ import { SpektrumDecoder } from '../decoder/index.js';
 import { reportHtml, summarizeCapture } from '../analysis/index.js';
 import { threadedReport } from './report-threads.js';
 import { parseCommandLine, UsageError, type Args } from './args.js';
+import { fileProblem } from './file-problem.js';
 import { loadCapture } from './input.js';
 import { formatJsonLine, formatCsvHeader, formatCsvLine, formatReportVerdict, formatSummary } from './format.js';
 import { TextOutput } from './output.js';
@@ -172,16 +173,7 @@ async function report(capture: Capture, args: Args, out: TextOutput): Promise<nu
     try {
       writeFileSync(args.out, text);
     } catch (error) {
-      const code = (error as NodeJS.ErrnoException).code;
-      const why =
-        code === 'ENOENT'
-          ? 'no such directory'
-          : code === 'EISDIR'
-            ? 'it is a directory'
-            : code === 'EACCES'
-              ? 'permission denied'
-              : String(error);
-      process.stderr.write(`satscope: cannot write ${args.out}: ${why}\n`);
+      process.stderr.write(`satscope: cannot write ${args.out}: ${fileProblem(error, 'no such directory')}\n`);
       return Promise.resolve(2);
     }
     out.text(`${formatReportVerdict(r, args.out)}\n`);

@@ -23,6 +23,7 @@ import {
   type ReadOptions,
 } from '../capture/index.js';
 import { readFileRange } from './file-range.js';
+import { fileProblem } from './file-problem.js';
 import type { ReadThreadData, ReadThreadParts, ReadThreadResult } from './read-thread.js';
 import { secondCore, WaitedWorker } from './waited-worker.js';
 
@@ -116,16 +117,7 @@ export function loadCapture(file: string, options: ReadOptions = {}, partsMinByt
   try {
     read = readBytes(file, partsMinBytes);
   } catch (error) {
-    const code = (error as NodeJS.ErrnoException).code;
-    const why =
-      code === 'ENOENT'
-        ? 'no such file'
-        : code === 'EISDIR'
-          ? 'it is a directory'
-          : code === 'EACCES'
-            ? 'permission denied'
-            : String(error);
-    return { error: `cannot read ${file}: ${why}`, exitCode: 2 };
+    return { error: `cannot read ${file}: ${fileProblem(error, 'no such file')}`, exitCode: 2 };
   }
   const { bytes, bytesThere, helper } = read;
   try {
