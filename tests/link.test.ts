@@ -273,6 +273,72 @@ describe('LinkMonitor: period and bounds', () => {
     expect(link.stats.periodUs).toBeCloseTo(11_000, 0);
   });
 
+  it('reads the same period and fade rate whenever they are read, through gaps, system changes, untimed frames, interrupts and restores', () => {
+    // `every` is read after each frame (as if worked out at every frame); `sometimes` only now
+    // and then, so what it works out when read must be what every frame would have left.
+    const every = new LinkMonitor();
+    let sometimes = new LinkMonitor();
+    let seed = 11;
+    const rand = () => {
+      seed = (seed * 48271) % 2147483647;
+      return seed / 2147483647;
+    };
+    /** A monitor fed frames of its own and never read: what it owes must not outlive a restore. */
+    const used = () => {
+      const m = new LinkMonitor();
+      for (let k = 0; k < 20; k++) m.frame(frame(k * 22_000, 1, 0xa2));
+      return m;
+    };
+    let t = 1e6;
+    let system: number | null = 0xb2;
+    const seen = { reads: 0, gaps: 0, changes: 0, restores: 0 };
+    let sinceGap = Number.POSITIVE_INFINITY;
+    for (let i = 0; i < 40_000; i++) {
+      // Now and then the system changes (11 ms, 22 ms, none), on a frame with no time half the
+      // time (an untimed capture's): then no window moves, and what is owed is still the old one.
+      let untimed = rand() < 0.003;
+      if (rand() < 0.003) {
+        system = system === 0xb2 ? 0xa2 : system === 0xa2 ? null : 0xb2;
+        untimed ||= rand() < 0.5;
+        seen.changes++;
+      }
+      const period = system === 0xa2 ? 22_000 : 11_000;
+      sinceGap++;
+      if (rand() < 0.004) {
+        t += 5 * period; // a gap that empties the period window
+        seen.gaps++;
+        sinceGap = 0;
+      } else t += period + (rand() - 0.5) * 2_000;
+      const f = frame(untimed ? Number.NaN : t, rand() < 0.05 ? 1 + Math.floor(rand() * 3) : 0, system, system === null ? null : i & 0xff);
+      if (rand() < 0.001) {
+        every.interrupt(t);
+        sometimes.interrupt(t);
+      }
+      every.frame(f);
+      sometimes.frame(f);
+      const want = every.stats;
+      const pick = (s: typeof want) => ({ periodUs: s.periodUs, fadeRate: s.fadeRate, nominalPeriodUs: s.nominalPeriodUs });
+      if (rand() < 0.05) {
+        seen.reads++;
+        expect(pick(sometimes.stats)).toEqual(pick(want));
+      }
+      // Restored into a monitor that owes figures of its own, it is the monitor it was taken
+      // from, read at once (a window just emptied by a gap most of all) and fed on.
+      if (rand() < 0.002 || (sinceGap < 8 && rand() < 0.2)) {
+        const moved = used();
+        moved.restore(sometimes.checkpoint());
+        expect(moved.stats).toEqual(want);
+        sometimes = moved;
+        seen.restores++;
+      }
+    }
+    expect(seen.reads).toBeGreaterThan(1_000);
+    expect(seen.gaps).toBeGreaterThan(100);
+    expect(seen.changes).toBeGreaterThan(100);
+    expect(seen.restores).toBeGreaterThan(100);
+    expect(sometimes.stats).toEqual(every.stats);
+  });
+
   it('keeps at most maxEpisodes episodes while the counts go on', () => {
     const link = new LinkMonitor({ maxEpisodes: 10 });
     let t = 0;

@@ -162,6 +162,14 @@ export class LinkMonitor {
   readonly #rateFades = new Float64Array(RATE_WINDOW);
   #rateCount = 0;
   #rateNext = 0;
+  /**
+   * `periodUs` and `fadeRate` are owed to the stats: #measure keeps only the windows, and they
+   * are worked out from them when the stats are read (#settleStats), not at every frame (a division
+   * and a rounding a frame, 3 % of opening a day-long capture). Settled before anything but
+   * #measure changes a window or the nominal period, so they read as if worked out every frame.
+   */
+  #periodOwed = false;
+  #rateOwed = false;
   readonly #episodes: LinkEpisode[] = [];
   /** The episodes that can no longer change, for checkpoints (unless `maxEpisodes`: then they are few). */
   #log = new EpisodeLog();
@@ -229,8 +237,9 @@ export class LinkMonitor {
     return this.#state;
   }
 
-  /** Live counters (the same object each time). */
+  /** Live counters (the same object each time; read it again after more frames). */
   get stats(): Readonly<LinkStats> {
+    this.#settleStats();
     return this.#stats;
   }
 
@@ -277,6 +286,7 @@ export class LinkMonitor {
     if (frame.system !== null && frame.system !== this.#systemByte) {
       const info = systemInfo(frame.system);
       if (info) {
+        this.#settleStats(); // the period owed is the one measured with the nominal period before
         this.#systemByte = frame.system;
         this.#systemPeriod = info.periodMs === 11 ? FRAME_PERIOD_11MS_US : FRAME_PERIOD_22MS_US;
         s.nominalPeriodUs = this.#systemPeriod;
@@ -308,7 +318,10 @@ export class LinkMonitor {
         if (gap > s.longestGapUs) s.longestGapUs = gap;
         const p = s.nominalPeriodUs;
         if (Number.isFinite(p) && isFrameInterval(gap, p, this.jitterUs)) this.#lastInterval = gap;
-        if (gap > 3 * (Number.isFinite(p) ? p : FRAME_PERIOD_22MS_US)) this.#periodCount = 0;
+        if (gap > 3 * (Number.isFinite(p) ? p : FRAME_PERIOD_22MS_US)) {
+          this.#settleStats(); // the period owed is that of the window about to be emptied
+          this.#periodCount = 0;
+        }
       }
       this.#lastUs = t;
       this.#measure(fades); // at #lastUs: a double handed to a call that is not inlined is boxed, 16 bytes a frame
@@ -502,6 +515,7 @@ export class LinkMonitor {
       this.#open = null;
     }
     this.#lastUs = NaN;
+    this.#settleStats();
     this.#periodCount = 0;
     this.#ledger.reset();
     this.#state = 'waiting';
@@ -512,6 +526,7 @@ export class LinkMonitor {
    * fade-rate windows, the ledger, the holds not yet judged and the counters.
    */
   checkpoint(): LinkCheckpoint {
+    this.#settleStats();
     // Kept whole otherwise: a monitor that drops old episodes has only a few to copy.
     const logged = this.#maxEpisodes === Infinity ? this.#log.take(this.#episodes, this.#settled) : null;
     return {
@@ -583,6 +598,9 @@ export class LinkMonitor {
     this.#lastInterval = cp.lastInterval;
     this.#finished = cp.finished;
     Object.assign(this.#stats, cp.stats);
+    // Its stats were settled when it was taken.
+    this.#periodOwed = false;
+    this.#rateOwed = false;
   }
 
   /**
@@ -620,12 +638,13 @@ export class LinkMonitor {
   }
 
   /**
-   * Period and fade rate with the frame at #lastUs. The rings step by comparison, not by a
-   * remainder (twice a frame: about 4 ns a frame less in a Chromium micro-harness, near its noise).
+   * The period and fade-rate windows take the frame at #lastUs (and, without a system byte, the
+   * nominal period is snapped, which the frame's own rules read); the figures are owed
+   * (#settleStats). The rings step by comparison, not by a remainder (twice a frame: about 4 ns
+   * a frame less in a Chromium micro-harness, near its noise).
    */
   #measure(fadesDelta: number): void {
     const t = this.#lastUs;
-    const s = this.#stats;
     // Period: the span of the last 32 gap-free intervals, which averages out chunk jitter.
     const times = this.#periodTimes;
     const count = this.#periodCount;
@@ -639,29 +658,49 @@ export class LinkMonitor {
       this.#periodOldest = oldest === PERIOD_WINDOW - 1 ? 0 : oldest + 1;
     }
     if (this.#periodCount >= 9) {
-      const span = t - (times[this.#periodOldest] ?? NaN);
+      const s = this.#stats;
       if (!Number.isFinite(this.#systemPeriod) && (!Number.isFinite(s.nominalPeriodUs) || this.#periodCount === PERIOD_WINDOW)) {
         // Without a system byte: snap the mean interval to 11 or 22 ms, first over 8 intervals,
         // then again over every full window, so a few frames missing early do not stick.
-        s.nominalPeriodUs = nominalPeriodOf(span / (this.#periodCount - 1));
+        s.nominalPeriodUs = nominalPeriodOf((t - (times[this.#periodOldest] ?? NaN)) / (this.#periodCount - 1));
       }
-      // Whole periods in the span (a missed frame makes one interval two periods long), so a
-      // short gap does not bias the measurement and chunk-time jitter averages out.
-      const periods = Math.max(1, Math.round(span / s.nominalPeriodUs));
-      s.periodUs = span / periods;
+      this.#periodOwed = true;
     }
     // Fade rate over a window of recent frames.
     const i = this.#rateNext;
     const fades = this.#rateFades;
-    const rateTimes = this.#rateTimes;
     const prev = this.#rateCount === 0 ? 0 : (fades[i === 0 ? RATE_WINDOW - 1 : i - 1] ?? 0);
-    rateTimes[i] = t;
+    this.#rateTimes[i] = t;
     fades[i] = prev + fadesDelta;
-    const next = i === RATE_WINDOW - 1 ? 0 : i + 1;
-    this.#rateNext = next;
+    this.#rateNext = i === RATE_WINDOW - 1 ? 0 : i + 1;
     if (this.#rateCount < RATE_WINDOW) this.#rateCount++;
-    const oldest = this.#rateCount < RATE_WINDOW ? 0 : next;
-    const span = t - (rateTimes[oldest] ?? NaN);
-    s.fadeRate = span > 0 ? (((fades[i] ?? 0) - (fades[oldest] ?? 0)) / span) * 1e6 : 0;
+    this.#rateOwed = true;
+  }
+
+  /**
+   * Works out what #measure left owed, from its windows as the last frame left them: the period
+   * (whole periods in the span, so a missed frame, one interval two periods long, does not bias
+   * it, and chunk-time jitter averages out) and the fade rate.
+   */
+  #settleStats(): void {
+    const s = this.#stats;
+    if (this.#periodOwed === true) {
+      this.#periodOwed = false;
+      const times = this.#periodTimes;
+      const oldest = this.#periodOldest;
+      const newest = this.#periodCount < PERIOD_WINDOW ? this.#periodCount - 1 : oldest === 0 ? PERIOD_WINDOW - 1 : oldest - 1;
+      const span = (times[newest] ?? NaN) - (times[oldest] ?? NaN);
+      const periods = Math.max(1, Math.round(span / s.nominalPeriodUs));
+      s.periodUs = span / periods;
+    }
+    if (this.#rateOwed === true) {
+      this.#rateOwed = false;
+      const next = this.#rateNext;
+      const i = next === 0 ? RATE_WINDOW - 1 : next - 1;
+      const oldest = this.#rateCount < RATE_WINDOW ? 0 : next;
+      const fades = this.#rateFades;
+      const span = (this.#rateTimes[i] ?? NaN) - (this.#rateTimes[oldest] ?? NaN);
+      s.fadeRate = span > 0 ? (((fades[i] ?? 0) - (fades[oldest] ?? 0)) / span) * 1e6 : 0;
+    }
   }
 }
