@@ -10,8 +10,6 @@ const CRC32_POLY = 0xedb88320;
  * bytes, so eight bytes take eight lookups and no loop-carried shift per byte (about three times
  * the speed of one table on records of a few dozen bytes).
  */
-let crcTable: Uint32Array | undefined;
-
 function buildCrcTable(): Uint32Array {
   const table = new Uint32Array(8 * 256);
   for (let n = 0; n < 256; n++) {
@@ -28,6 +26,13 @@ function buildCrcTable(): Uint32Array {
   }
   return table;
 }
+
+/**
+ * Built as the module loads (2048 entries, some microseconds), not on first use: a table read
+ * through a `let` that may still be unset is loaded and tested at every call, and that made a
+ * record's check 40 ns instead of 33 in Node. Pure, for bundlers that drop an unused module.
+ */
+const crcTable = /* @__PURE__ */ buildCrcTable();
 
 /**
  * CRC-32 (as zlib computes it) of `bytes[start, end)`, as an unsigned 32-bit number. `view`: a
@@ -65,8 +70,7 @@ const register = new Int32Array(1);
  * one, a range under 64 bytes is read a byte at a time (making a view costs more).
  */
 function run(from: number, bytes: Uint8Array, start: number, end: number, view?: DataView): void {
-  // Built on first use rather than at import, so importing the module does no work.
-  const t = (crcTable ??= buildCrcTable());
+  const t = crcTable;
   // A 32-bit integer from the start: a register that began as the argument (a tagged value) would
   // be boxed on every turn of the loop in Chromium once it leaves the small integers (±2^30), a
   // new heap number a record and about three times the time (measured in Chromium 150).
