@@ -153,7 +153,6 @@ describe('crc32', () => {
     // The reference, a bit at a time, with the running register kept for each prefix.
     const prefix = new Uint32Array(bytes.length + 1);
     let c = 0xffffffff;
-    prefix[0] = 0;
     bytes.forEach((x, i) => {
       c ^= x;
       for (let k = 0; k < 8; k++) c = c & 1 ? 0xedb88320 ^ (c >>> 1) : c >>> 1;

@@ -47,12 +47,14 @@ export function overviewOf(
   for (const port of ports) {
     let missed = 0;
     const { link, series, decoder } = decodeCapture(capture, { resolution, port, binUs: BIN_US, originUs, endUs }, (f, l) => {
+      // Read only where it is used: reading the stats works out what the monitor owes (link.ts).
       if (untimed) {
+        const now = l.stats.missedFrames;
         marks.offset.push(f.offset);
         marks.fades.push(l.lastFades);
-        marks.missed.push(l.stats.missedFrames - missed);
+        marks.missed.push(now - missed);
+        missed = now;
       }
-      missed = l.stats.missedFrames;
     });
     all.push(series);
     failsafe.push(...failsafeAsRead(failsafesOf(link.episodes), endUs, true));
