@@ -14,7 +14,7 @@ import type uPlot from 'uplot';
 import { chartColors } from './theme.js';
 
 /** Round steps for the time axis, s. */
-const TIME_STEPS = [1, 2, 5, 10, 15, 30, 60, 120, 300, 600];
+const TIME_STEPS = [0.1, 0.2, 0.5, 1, 2, 5, 10, 15, 30, 60, 120, 300, 600];
 const LONGEST_STEP = 600;
 /** Wanted space between two time labels, px. */
 const TIME_LABEL_PX = 64;

@@ -57,6 +57,9 @@ export interface ChartColors {
   lost: string;
   failsafeBand: string;
   remotes: string[];
+  /** The channel traces, one a lane (cycled), and the glitch marks over them. */
+  traces: string[];
+  glitch: string;
 }
 
 const DARK: ChartColors = {
@@ -69,6 +72,8 @@ const DARK: ChartColors = {
   lost: '#ff6b6b',
   failsafeBand: 'rgba(255,60,60,0.25)',
   remotes: ['#4fd1a5', '#f0b429', '#7cc4ff', '#ff8fab', '#c3a6ff'],
+  traces: ['#7cc4ff', '#4fd1a5', '#f0b429', '#c3a6ff'],
+  glitch: '#ff4d4f',
 };
 
 const LIGHT: ChartColors = {
@@ -81,6 +86,8 @@ const LIGHT: ChartColors = {
   lost: '#d1343a',
   failsafeBand: 'rgba(209,52,58,0.16)',
   remotes: ['#0a7d5a', '#b7791f', '#1f6fd1', '#c2185b', '#7048e8'],
+  traces: ['#1f6fd1', '#0a7d5a', '#a0660f', '#7048e8'],
+  glitch: '#d1343a',
 };
 
 export function chartColors(t: Theme = theme.value): ChartColors {

@@ -19,6 +19,7 @@ import { Remotes } from '../Remotes/index.js';
 import { ReplayBar } from '../ReplayBar/index.js';
 import { SystemBadge } from '../SystemBadge/index.js';
 import { Toolbar } from '../Toolbar/index.js';
+import { Traces } from '../Traces/index.js';
 import './style.css';
 
 const BindPanel = lazy(() => import('../Bind/index.js').then((m) => m.BindPanel));
@@ -130,6 +131,9 @@ export function App({ granted }: { granted: SerialPort[] }) {
             ) : null}
             <div class="panel p-graphs">
               <Graphs windowUs={windowUs} />
+            </div>
+            <div class="panel p-traces">
+              <Traces windowUs={windowUs} />
             </div>
             <div class="panel p-inspector">
               <InspectorPanel />
