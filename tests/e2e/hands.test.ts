@@ -141,3 +141,135 @@ describe.skipIf(skip !== null)('channel traces', () => {
     await page.context().close();
   });
 });
+
+describe.skipIf(skip !== null)('a phone at 390 px', () => {
+  it('shows the link state and every channel bar on the first screen, the rest folded until tapped', async () => {
+    const { page, errors } = await open({ width: 390, height: 844 });
+    await page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor({ timeout: 10_000 });
+    await page.waitForTimeout(1000);
+    const box = async (selector: string) => {
+      const b = await page.locator(selector).first().boundingBox();
+      if (b === null) throw new Error(`${selector} is not shown`);
+      return b;
+    };
+    const link = await box('[data-testid="link-state"]');
+    const bars = await box('.p-channels');
+    console.log(
+      `390 × 844: link state at ${Math.round(link.y)} px, channel bars ${Math.round(bars.y)}–${Math.round(bars.y + bars.height)} px`,
+    );
+    expect(link.y + link.height).toBeLessThan(844);
+    expect(bars.y).toBeLessThan(844);
+    // All twelve, not only the first.
+    expect(bars.y + bars.height).toBeLessThanOrEqual(844);
+    // The rest is folded: its disclosure shows, its content does not.
+    for (const name of ['diagnosis', 'remotes', 'graphs', 'traces', 'system', 'counters']) {
+      await expect(page.locator(`.p-${name} .fold-toggle`).getAttribute('aria-expanded')).resolves.toBe('false');
+      await expect(page.locator(`.p-${name} .fold-body`).isVisible()).resolves.toBe(false);
+    }
+    await page.locator('.p-graphs .fold-toggle').click();
+    await expect(page.locator('.p-graphs .fold-toggle').getAttribute('aria-expanded')).resolves.toBe('true');
+    await page.locator('.graphs canvas').first().waitFor();
+    // The charts take the panel's width once shown (they were made while it was folded).
+    await expect
+      .poll(() =>
+        page
+          .locator('.graphs .chart')
+          .first()
+          .evaluate((e) => e.getBoundingClientRect().width),
+      )
+      .toBeGreaterThan(300);
+    // The worst finding under the link state opens the folded diagnosis and goes there.
+    await page.getByTestId('top-finding').click();
+    await expect(page.locator('.p-diagnosis .fold-toggle').getAttribute('aria-expanded')).resolves.toBe('true');
+    await expect(page.locator('.p-diagnosis .fold-body').isVisible()).resolves.toBe(true);
+    expect(errors).toEqual([]);
+    await page.context().close();
+  });
+
+  it('gives every control a touch target of 40 px or more, replay speed and window included', async () => {
+    const { page, errors } = await open({ width: 390, height: 844, query: '?demo=0' });
+    await replayed(page, spiky);
+    for (const name of ['graphs', 'traces', 'diagnosis', 'counters', 'system']) await page.locator(`.p-${name} .fold-toggle`).click();
+    await page.getByRole('button', { name: 'Inspect frames…' }).click();
+    await page.locator('.insp-table').waitFor();
+    const small = await page.$$eval('button, select, [role="radio"], input[type="range"]', (els) =>
+      els
+        .filter((e) => (e as HTMLElement).offsetParent !== null)
+        .map((e) => ({ what: `${e.tagName.toLowerCase()} ${e.textContent?.trim() ?? ''}`, h: e.getBoundingClientRect().height }))
+        .filter((x) => x.h < 40),
+    );
+    expect(small).toEqual([]);
+    expect(await page.getByRole('radio', { name: '4×' }).count()).toBe(1);
+    expect(await page.getByRole('radio', { name: '1 s' }).count()).toBe(1);
+    expect(errors).toEqual([]);
+    await page.context().close();
+  });
+
+  it('shows the inspector readable: each row its bytes wrapped whole in their groups, then its values', async () => {
+    const { page, errors } = await open({ width: 390, height: 844 });
+    await page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor({ timeout: 10_000 });
+    await page.getByRole('button', { name: 'Inspect frames…' }).click();
+    await page.locator('.insp-body .row.frame').first().waitFor();
+    await page.waitForTimeout(600);
+    const rows = await page.$$eval('.insp-body .row.frame', (els) =>
+      els.slice(-20).map((row) => {
+        const scroll = row.closest('.insp-scroll')?.getBoundingClientRect();
+        const groups = [...row.querySelectorAll('.g')].map((g) => g.getBoundingClientRect());
+        return {
+          height: row.getBoundingClientRect().height,
+          groups: groups.length,
+          // Every byte group inside the visible box, none cut off at its right edge.
+          inside: groups.every((g) => scroll !== undefined && g.right <= scroll.right && g.left >= scroll.left),
+        };
+      }),
+    );
+    expect(rows.length).toBeGreaterThan(5);
+    for (const r of rows) {
+      expect(r.groups).toBeGreaterThanOrEqual(8);
+      expect(r.inside).toBe(true);
+      expect(r.height).toBeLessThan(200);
+    }
+    const widths = await page.evaluate(() => [document.documentElement.scrollWidth, document.documentElement.clientWidth]);
+    expect(widths[0]).toBe(widths[1]);
+    expect(errors).toEqual([]);
+    await page.context().close();
+  });
+});
+
+const SIZES = [
+  { name: '390', width: 390, height: 844 },
+  { name: '1280', width: 1280, height: 800 },
+  { name: '1920', width: 1920, height: 1080 },
+] as const;
+const OUT = '/tmp/shots-pageB';
+
+describe.skipIf(skip !== null)('screenshots', () => {
+  it('of the live demo, a replay, the inspector and the traces at 390, 1280 and 1920 px, light and dark', async () => {
+    mkdirSync(OUT, { recursive: true });
+    for (const size of SIZES) {
+      for (const scheme of ['light', 'dark'] as const) {
+        const demo = await open({ width: size.width, height: size.height, scheme });
+        await demo.page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor({ timeout: 10_000 });
+        await demo.page.waitForTimeout(3000);
+        await demo.page.screenshot({ path: join(OUT, `demo-first-screen-${size.name}-${scheme}.png`) });
+        await demo.page.screenshot({ path: join(OUT, `demo-${size.name}-${scheme}.png`), fullPage: true });
+        if (size.width < 600) {
+          await demo.page.locator('.p-traces .fold-toggle').click();
+          await demo.page.locator('.traces canvas').waitFor();
+          await demo.page.waitForTimeout(500);
+        }
+        await demo.page.locator('.traces').screenshot({ path: join(OUT, `traces-${size.name}-${scheme}.png`) });
+        await demo.page.getByRole('button', { name: 'Inspect frames…' }).click();
+        await demo.page.locator('.insp-table').waitFor();
+        await demo.page.waitForTimeout(600);
+        await demo.page.locator('.p-inspector').screenshot({ path: join(OUT, `inspector-${size.name}-${scheme}.png`) });
+        await demo.page.context().close();
+        const rep = await open({ width: size.width, height: size.height, scheme, query: '?demo=0' });
+        await replayed(rep.page, spiky);
+        await rep.page.waitForTimeout(500);
+        await rep.page.screenshot({ path: join(OUT, `replay-${size.name}-${scheme}.png`), fullPage: true });
+        await rep.page.context().close();
+      }
+    }
+  }, 240_000);
+});

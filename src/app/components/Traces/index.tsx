@@ -75,7 +75,23 @@ function makeChart(el: HTMLElement, channels: readonly number[], width: number, 
           value: (_u: uPlot, v: number | null) => (v === null || !Number.isFinite(v) ? '—' : `${Math.round(laneUs(v, k, lanes))} µs`),
         })),
       ],
-      hooks: { draw: [marks] },
+      hooks: {
+        // Every other lane shaded, so that a line near its lane's edge is read in its own lane.
+        drawClear: [
+          (u: uPlot) => {
+            const ctx = u.ctx;
+            ctx.save();
+            ctx.fillStyle = c.lane;
+            for (let k = 1; k < lanes; k += 2) {
+              const top = u.valToPos(lanes - k, 'y', true);
+              const bottom = u.valToPos(lanes - 1 - k, 'y', true);
+              ctx.fillRect(u.bbox.left, top, u.bbox.width, bottom - top);
+            }
+            ctx.restore();
+          },
+        ],
+        draw: [marks],
+      },
     }),
     [[], ...channels.map(() => [])],
     el,
@@ -224,6 +240,7 @@ export function Traces({ windowUs }: { windowUs: Signal<number> }) {
       if (count.current !== null) {
         const inView = b.indexAt(span[1] + 1e-6) - b.indexAt(span[0]);
         setText(count.current, inView === 0 ? '' : glitches === 1 ? '1 glitch in view' : `${glitches} glitches in view`);
+        count.current.classList.toggle('found', glitches > 0);
       }
     });
     return () => {
