@@ -169,7 +169,10 @@ export interface ReplayStatus {
  * (each message the whole of it so far) while the capture is decoded, then once complete.
  */
 export interface Overview {
+  /** Each bin's start, µs (the capture's clock; without timing, where in the file). */
   t: Float64Array;
+  /** The bins' width, µs: narrower for a short capture (overviewBinUs), so what is drawn keeps its proportions. */
+  binUs: number;
   fadeRate: Float32Array;
   lost: Float32Array;
   failsafe: { startUs: number; endUs: number }[];

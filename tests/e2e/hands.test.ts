@@ -23,6 +23,9 @@ let dir = '';
 /** A capture with three one-frame glitches, a short dropout and a failsafe. */
 let spiky = '';
 let spikyGlitches = 0;
+/** A 0.74 s capture with one 66 ms hold, and a clean one as short. */
+let shortHold = '';
+let shortClean = '';
 
 /** `sim` with channel slot 0 of each frame in `frames` pushed 600 steps away, for that frame only. */
 function withSpikes(sim: SimChunk, frames: number[]): SimChunk {
@@ -48,6 +51,12 @@ beforeAll(async () => {
   spikyGlitches = healthReport(perByteCapture(sim)).remotes[0]?.glitches.count ?? -1;
   spiky = join(dir, 'spiky.sscap');
   writeCapture(spiky, usbChunks(sim.bytes, sim.timesUs));
+  const hold = simulate({ ...preset('dsmx-11ms-2048-internal'), dropouts: [{ atUs: 300_000, durationUs: 66_000 }] }, 740_000);
+  shortHold = join(dir, 'short-hold.sscap');
+  writeCapture(shortHold, usbChunks(hold.bytes, hold.timesUs));
+  const clean = simulate(preset('dsmx-11ms-2048-internal'), 740_000);
+  shortClean = join(dir, 'short-clean.sscap');
+  writeCapture(shortClean, usbChunks(clean.bytes, clean.timesUs));
 });
 
 afterAll(async () => {
@@ -231,6 +240,66 @@ describe.skipIf(skip !== null)('a phone at 390 px', () => {
     }
     const widths = await page.evaluate(() => [document.documentElement.scrollWidth, document.documentElement.clientWidth]);
     expect(widths[0]).toBe(widths[1]);
+    expect(errors).toEqual([]);
+    await page.context().close();
+  });
+});
+
+/** The replay timeline's canvas read back: the plot's columns with a lost-frame bar, and whether its time axis is drawn. */
+async function timeline(page: Page): Promise<{ width: number; lostColumns: number; axisPixels: number }> {
+  return page.$eval('.replay .overview canvas', (c) => {
+    const canvas = c as HTMLCanvasElement;
+    const ctx = canvas.getContext('2d');
+    if (ctx === null) return { width: 0, lostColumns: 0, axisPixels: 0 };
+    const { width, height } = canvas;
+    const d = ctx.getImageData(0, 0, width, height).data;
+    const px = (x: number, y: number) => d.slice((y * width + x) * 4, (y * width + x) * 4 + 4);
+    // Red bars: red well above green and blue, and opaque.
+    const red = (x: number, y: number) => {
+      const [r = 0, g = 0, b = 0, a = 0] = px(x, y);
+      return a > 100 && r > 150 && r > g + 60 && r > b + 60;
+    };
+    const axisTop = Math.round(height * (56 / 78));
+    let lostColumns = 0;
+    for (let x = 0; x < width; x++) {
+      let hit = false;
+      for (let y = 0; y < axisTop && !hit; y++) hit = red(x, y);
+      if (hit) lostColumns++;
+    }
+    let axisPixels = 0;
+    for (let y = axisTop; y < height; y++) for (let x = 0; x < width; x++) if ((px(x, y)[3] ?? 0) > 100) axisPixels++;
+    return { width, lostColumns, axisPixels };
+  });
+}
+
+describe.skipIf(skip !== null)('a short capture', () => {
+  it('draws a 66 ms hold of a 0.74 s capture as long as it was, on a time axis, in the 1 s window', async () => {
+    const { page, errors } = await open({ query: '?demo=0' });
+    await replayed(page, shortHold);
+    await page.locator('.replay .overview canvas').waitFor();
+    await page.waitForTimeout(300);
+    const t = await timeline(page);
+    console.log(`0.74 s capture, 66 ms hold: lost-frame bars over ${t.lostColumns} of ${t.width} px; axis ${t.axisPixels} px`);
+    // 66 ms of 740 is 9 % of the width: drawn in 10 ms bins, between 5 % and 15 %, never half of it.
+    expect(t.lostColumns).toBeGreaterThan(0.05 * t.width);
+    expect(t.lostColumns).toBeLessThan(0.15 * t.width);
+    expect(t.axisPixels).toBeGreaterThan(100);
+    await expect(page.getByRole('radio', { name: '1 s' }).getAttribute('aria-checked')).resolves.toBe('true');
+    await page.locator('section.replay').screenshot({ path: join(SHOTS, 'hands-short-hold-timeline-1280-dark.png') });
+    expect(errors).toEqual([]);
+    await page.context().close();
+  });
+
+  it('gives a clean short capture a time axis and no lost-frame bar', async () => {
+    const { page, errors } = await open({ query: '?demo=0' });
+    await replayed(page, shortClean);
+    await page.locator('.replay .overview canvas').waitFor();
+    await page.waitForTimeout(300);
+    const t = await timeline(page);
+    expect(t.lostColumns).toBe(0);
+    expect(t.axisPixels).toBeGreaterThan(100);
+    await expect(page.getByRole('radio', { name: '1 s' }).getAttribute('aria-checked')).resolves.toBe('true');
+    await page.locator('section.replay').screenshot({ path: join(SHOTS, 'hands-short-clean-timeline-1280-dark.png') });
     expect(errors).toEqual([]);
     await page.context().close();
   });
