@@ -204,47 +204,61 @@ export function traceView(
   const lanes = channels.length;
   const x: number[] = [];
   const ys: (number | null)[][] = channels.map(() => []);
+  const t = b.t;
+  const us = b.us;
+  const gap = b.gap;
+  // Each lane's channel, and the height of 903 µs and of a µs in it (laneY, worked out once).
+  const ch = Int32Array.from(channels);
+  const zero = new Float64Array(lanes);
+  const slope = laneY(PULSE_MIN_US + 1, 0, 1) - laneY(PULSE_MIN_US, 0, 1);
+  for (let k = 0; k < lanes; k++) zero[k] = laneY(PULSE_MIN_US, k, lanes);
+  const height = (k: number, v: number): number | null => (Number.isNaN(v) ? null : (zero[k] as number) + (v - PULSE_MIN_US) * slope);
+  const empty = (at: number) => {
+    x.push(at / 1e6);
+    for (let k = 0; k < lanes; k++) (ys[k] as (number | null)[]).push(null);
+  };
   // From the frame before the window (the line enters it from the left) to the last in it.
   const from = Math.max(0, b.indexAt(startUs) - 1);
   const to = b.indexAt(endUs + 1e-6);
-  const push = (tUs: number, value: (lane: number) => number) => {
-    x.push(tUs / 1e6);
-    for (let k = 0; k < lanes; k++) {
-      const v = value(k);
-      ys[k]?.push(Number.isNaN(v) ? null : laneY(v, k, lanes));
-    }
-  };
-  const none = () => Number.NaN;
-  const at = (i: number) => (k: number) => b.us[i * CHANNEL_COUNT + (channels[k] ?? 0)] ?? Number.NaN;
   if (to - from <= 2 * columns) {
     for (let i = from; i < to; i++) {
       // A point with no value between the frames on either side of a break.
-      if (b.gap[i] === 1 && x.length > 0) push(((b.t[i - 1] ?? 0) + (b.t[i] ?? 0)) / 2, none);
-      push(b.t[i] ?? 0, at(i));
+      if (gap[i] === 1 && x.length > 0) empty(((t[i - 1] as number) + (t[i] as number)) / 2);
+      x.push((t[i] as number) / 1e6);
+      const row = i * CHANNEL_COUNT;
+      for (let k = 0; k < lanes; k++) (ys[k] as (number | null)[]).push(height(k, us[row + (ch[k] as number)] as number));
     }
-  } else {
-    const per = (endUs - startUs) / columns;
-    const lo = new Float64Array(lanes);
-    const hi = new Float64Array(lanes);
-    let i = from;
-    while (i < to) {
-      const column = Math.floor(((b.t[i] ?? 0) - startUs) / per);
-      const colStart = startUs + column * per;
-      if (b.gap[i] === 1 && x.length > 0) push(colStart, none);
-      lo.fill(Number.POSITIVE_INFINITY);
-      hi.fill(Number.NEGATIVE_INFINITY);
-      let first = true;
-      for (; i < to && Math.floor(((b.t[i] ?? 0) - startUs) / per) === column && (first || b.gap[i] !== 1); i++) {
-        first = false;
-        for (let k = 0; k < lanes; k++) {
-          const v = b.us[i * CHANNEL_COUNT + (channels[k] ?? 0)] ?? Number.NaN;
-          if (v < (lo[k] ?? 0)) lo[k] = v;
-          if (v > (hi[k] ?? 0)) hi[k] = v;
-        }
+    return [x, ...ys];
+  }
+  const per = (endUs - startUs) / columns;
+  const lo = new Float64Array(lanes);
+  const hi = new Float64Array(lanes);
+  let i = from;
+  while (i < to) {
+    const column = Math.floor(((t[i] as number) - startUs) / per);
+    const colStart = startUs + column * per;
+    const colEnd = colStart + per;
+    if (gap[i] === 1 && x.length > 0) empty(colStart);
+    lo.fill(Number.POSITIVE_INFINITY);
+    hi.fill(Number.NEGATIVE_INFINITY);
+    // The frames of this column, up to a break (the line stops there, and starts again after it);
+    // the first always, so that every pass moves on.
+    const first = i;
+    for (; i < to && (i === first || ((t[i] as number) < colEnd && gap[i] !== 1)); i++) {
+      const row = i * CHANNEL_COUNT;
+      for (let k = 0; k < lanes; k++) {
+        const v = us[row + (ch[k] as number)] as number;
+        if (v < (lo[k] as number)) lo[k] = v;
+        if (v > (hi[k] as number)) hi[k] = v;
       }
-      const fin = (v: number) => (Number.isFinite(v) ? v : Number.NaN);
-      push(colStart, (k) => fin(lo[k] ?? Number.NaN));
-      push(colStart + per / 2, (k) => fin(hi[k] ?? Number.NaN));
+    }
+    x.push(colStart / 1e6, (colStart + per / 2) / 1e6);
+    for (let k = 0; k < lanes; k++) {
+      const y = ys[k] as (number | null)[];
+      const l = lo[k] as number;
+      const h = hi[k] as number;
+      // A lane with no value in the column (none since a break): no point.
+      y.push(l === Number.POSITIVE_INFINITY ? null : height(k, l), h === Number.NEGATIVE_INFINITY ? null : height(k, h));
     }
   }
   return [x, ...ys];
