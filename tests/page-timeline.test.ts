@@ -9,9 +9,9 @@ import { BIN_US, overviewBinUs } from '../src/worker/replay/overview.js';
 
 describe('the replay timeline', () => {
   it('bins a capture in the narrowest round width that keeps it to 2000 bins, a second at most', () => {
-    expect(overviewBinUs(740_000)).toBe(10_000);
-    expect(overviewBinUs(20e6)).toBe(10_000);
-    expect(overviewBinUs(30e6)).toBe(20_000);
+    expect(overviewBinUs(740_000)).toBe(20_000);
+    expect(overviewBinUs(40e6)).toBe(20_000);
+    expect(overviewBinUs(41e6)).toBe(50_000);
     expect(overviewBinUs(600e6)).toBe(500_000);
     expect(overviewBinUs(86_400e6)).toBe(BIN_US);
     expect(overviewBinUs(Number.NaN)).toBe(BIN_US);

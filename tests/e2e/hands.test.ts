@@ -280,7 +280,7 @@ describe.skipIf(skip !== null)('a short capture', () => {
     await page.waitForTimeout(300);
     const t = await timeline(page);
     console.log(`0.74 s capture, 66 ms hold: lost-frame bars over ${t.lostColumns} of ${t.width} px; axis ${t.axisPixels} px`);
-    // 66 ms of 740 is 9 % of the width: drawn in 10 ms bins, between 5 % and 15 %, never half of it.
+    // 66 ms of 740 is 9 % of the width: drawn in 20 ms bins, between 5 % and 15 %, never half of it.
     expect(t.lostColumns).toBeGreaterThan(0.05 * t.width);
     expect(t.lostColumns).toBeLessThan(0.15 * t.width);
     expect(t.axisPixels).toBeGreaterThan(100);

@@ -18,15 +18,18 @@ import type { Overview } from '../protocol.js';
 
 /** The overview's widest bins: one second (a long capture's). */
 export const BIN_US = 1_000_000;
-/** The bin widths an overview takes, µs: round ones, from 10 ms to BIN_US. */
-const BIN_WIDTHS_US = [10_000, 20_000, 50_000, 100_000, 200_000, 500_000, BIN_US];
+/**
+ * The bin widths an overview takes, µs: round ones, from 20 ms (a frame or two of an 11 ms
+ * system is due in each, so a run of lost frames is a run of bars, not a comb) to BIN_US.
+ */
+const BIN_WIDTHS_US = [20_000, 50_000, 100_000, 200_000, 500_000, BIN_US];
 /** Bins at most across a capture: two a pixel of a timeline about a thousand pixels wide. */
 const MOST_BINS = 2000;
 
 /**
  * The bins of a capture `spanUs` long: the narrowest round width that keeps it to MOST_BINS, so
  * that a short capture's timeline draws a hold or a lost frame as long as it was (a 0.74 s
- * capture in 10 ms bins, not in one bin of a second that the whole timeline would stand for);
+ * capture in 20 ms bins, not in one bin of a second that the whole timeline would stand for);
  * BIN_US for a long capture, and for one whose span is unknown.
  */
 export function overviewBinUs(spanUs: number): number {

@@ -127,6 +127,13 @@ export function ReplayBar() {
                 const top = u.valToPos(n, 'lost', true);
                 ctx.fillRect(a, top, w, base - top);
               }
+              // Each failsafe's extent also as a line along the top, seen over the lost frames' bars.
+              ctx.fillStyle = c.lost;
+              for (const b of bands) {
+                const a = u.valToPos(b.startUs / 1e6, 'x', true);
+                const z = u.valToPos(b.endUs / 1e6, 'x', true);
+                ctx.fillRect(a, u.bbox.top, Math.max(MIN_MARK_PX * devicePixelRatio, z - a), 3 * devicePixelRatio);
+              }
               if (unread !== null) {
                 // Not read yet: hatched, so that it never reads as a clean stretch of link.
                 const a = u.valToPos(unread, 'x', true);
