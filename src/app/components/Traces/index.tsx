@@ -5,7 +5,7 @@
  * and in replay. Glitches (a value that jumps and comes back, the health report's rule) are
  * marked where they happened. The user picks the channels; by default, every channel 0–11 the
  * remote sends. Drawn from the remote's trace columns (traces.ts) once per animation frame when
- * something changed, or five times a second as the window slides.
+ * something changed, or five times a second as the window slides, and only while on screen.
  */
 import { type Signal, signal, useSignal } from '@preact/signals';
 import { useEffect, useRef } from 'preact/hooks';
@@ -14,7 +14,7 @@ import { SPIKE_MIN_JUMP_PERCENT, SPIKE_RETURN_PERCENT } from '../../../analysis/
 import { CHANNEL_COUNT, channelName } from '../../../decoder/index.js';
 import { layeredChart } from '../../axes-layer.js';
 import { agoAxis, hoverCursor, keyboardCursor, legendTime, showNewest } from '../../axes.js';
-import { chartTurn, onFrame } from '../../frame-loop.js';
+import { chartTurn, onFrame, wake } from '../../frame-loop.js';
 import type { Live } from '../../live.js';
 import { current } from '../../store.js';
 import { setText } from '../../text.js';
@@ -212,7 +212,19 @@ export function Traces({ windowUs }: { windowUs: Signal<number> }) {
     let drawn: Live | undefined;
     let version = -1;
     let drawnAt = 0;
+    // Drawn only while on screen: below the fold, or folded away on a phone, it costs nothing
+    // (it is drawn at once when scrolled to).
+    let onScreen = false;
+    const seen = new IntersectionObserver((entries) => {
+      onScreen = entries.some((e) => e.isIntersecting);
+      if (onScreen) {
+        drawn = undefined;
+        wake();
+      }
+    });
+    seen.observe(box);
     const stop = onFrame((nowMs) => {
+      if (!onScreen) return;
       live = current();
       const b = live.traces;
       if (live === drawn && b.version === version && nowMs - drawnAt < 200) return;
@@ -245,6 +257,7 @@ export function Traces({ windowUs }: { windowUs: Signal<number> }) {
     });
     return () => {
       stop();
+      seen.disconnect();
       resize.disconnect();
       keys();
       chart.destroy();
