@@ -5,7 +5,7 @@
  * its timeline with a time axis and the graphs' window fitted to it. Screenshots at 390, 1280
  * and 1920 px in both themes. Needs the built page (`npm run build`) and Debian's Chromium.
  */
-import { mkdirSync, mkdtempSync, rmSync } from 'node:fs';
+import { mkdirSync, mkdtempSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import type { Page } from 'playwright-core';
@@ -146,6 +146,20 @@ describe.skipIf(skip !== null)('channel traces', () => {
     await expect.poll(() => page.getByTestId('glitch-count').textContent()).toBe(`${spikyGlitches} glitches in view`);
     mkdirSync(SHOTS, { recursive: true });
     await page.locator('.traces').screenshot({ path: join(SHOTS, 'hands-traces-glitches-1280-dark.png') });
+    expect(errors).toEqual([]);
+    await page.context().close();
+  });
+
+  it('says a capture without timing has no time axis for traces, and draws no empty lanes', async () => {
+    const raw = join(dir, 'untimed.bin');
+    writeFileSync(raw, simulate(preset('dsmx-11ms-2048-internal'), 2_000_000).bytes);
+    const { page, errors } = await open({ query: '?demo=0' });
+    await replayed(page, raw);
+    await page.locator('.traces').scrollIntoViewIfNeeded();
+    await expect.poll(() => page.locator('.trace-note').textContent()).toMatch(/no times/);
+    await expect(page.locator('.traces [data-chart="traces"]').isVisible()).resolves.toBe(false);
+    // The channels it sent are still offered.
+    await expect(page.locator('.trace-picker').getByRole('button', { name: /^0\b/ }).getAttribute('aria-pressed')).resolves.toBe('true');
     expect(errors).toEqual([]);
     await page.context().close();
   });

@@ -81,10 +81,14 @@ export function overviewOf(
   if (Number.isNaN(periodUs)) periodUs = FRAME_PERIOD_11MS_US;
   if (untimed) {
     const usPerByte = periodUs / FRAME_SIZE;
-    const binOf = (offset: number): number => Math.floor(((offset + FRAME_SIZE) * usPerByte) / BIN_US);
+    // The paced clock's span: where the last frame ends (a loop: a long file has millions of frames).
+    let lastOffset = 0;
+    for (const offset of marks.offset) if (offset > lastOffset) lastOffset = offset;
+    const binUs = overviewBinUs((lastOffset + FRAME_SIZE) * usPerByte);
+    const binOf = (offset: number): number => Math.floor(((offset + FRAME_SIZE) * usPerByte) / binUs);
     let bins = 0;
     for (const offset of marks.offset) bins = Math.max(bins, binOf(offset) + 1);
-    const t = Float64Array.from({ length: bins }, (_, b) => b * BIN_US);
+    const t = Float64Array.from({ length: bins }, (_, b) => b * binUs);
     const fades = new Float32Array(bins);
     const lost = new Float32Array(bins);
     marks.offset.forEach((offset, k) => {
@@ -92,7 +96,7 @@ export function overviewOf(
       fades[b] = (fades[b] ?? 0) + (marks.fades[k] ?? 0);
       lost[b] = (lost[b] ?? 0) + (marks.missed[k] ?? 0);
     });
-    return { overview: { t, binUs: BIN_US, fadeRate: fades, lost, failsafe: [], readUntilUs: Number.NaN, complete: true }, periodUs };
+    return { overview: { t, binUs, fadeRate: fades, lost, failsafe: [], readUntilUs: Number.NaN, complete: true }, periodUs };
   }
   return { overview: sumOverview(all, failsafe, undefined, endUs, true), periodUs };
 }

@@ -179,11 +179,14 @@ export function Traces({ windowUs }: { windowUs: Signal<number> }) {
   const lanes = picked.value ?? seenIds(seen.value, NORMAL);
   const key = lanes.join(',');
 
-  // What the remote has sent, followed as it changes (a new remote, a reset, an X-Plus channel).
+  // What the remote has sent, followed as it changes (a new remote, a reset, an X-Plus channel);
+  // with or without times (frames without any still have channels, shown as lanes with a note).
   useEffect(
     () =>
       onFrame(() => {
-        const s = current().traces.seen;
+        const seenUs = current().seenUs;
+        let s = 0;
+        for (let id = 0; id < CHANNEL_COUNT; id++) if (!Number.isNaN(seenUs[id] ?? Number.NaN)) s |= 1 << id;
         if (s !== seen.peek()) seen.value = s;
       }),
     [],
@@ -236,6 +239,8 @@ export function Traces({ windowUs }: { windowUs: Signal<number> }) {
       const untimed = b.length === 0 && live.counters.frames > 0;
       if (note.current !== null)
         setText(note.current, untimed ? 'These frames carry no times (a capture without timing): traces need a time axis.' : '');
+      // Without times, no empty lanes that would read as channels that sent nothing.
+      if (box.hidden !== untimed) box.hidden = untimed;
       if (!Number.isFinite(endUs)) {
         chart.setData([[], ...lanes.map(() => [])]);
         if (count.current !== null) setText(count.current, '');
