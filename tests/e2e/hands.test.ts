@@ -337,9 +337,11 @@ describe.skipIf(skip !== null)('screenshots', () => {
         await demo.page.screenshot({ path: join(OUT, `demo-first-screen-${size.name}-${scheme}.png`) });
         await demo.page.screenshot({ path: join(OUT, `demo-${size.name}-${scheme}.png`), fullPage: true });
         if (size.width < 600) {
+          await demo.page.locator('.p-graphs .fold-toggle').click();
           await demo.page.locator('.p-traces .fold-toggle').click();
           await demo.page.locator('.traces canvas').waitFor();
           await demo.page.waitForTimeout(500);
+          await demo.page.screenshot({ path: join(OUT, `demo-unfolded-${size.name}-${scheme}.png`), fullPage: true });
         }
         await demo.page.locator('.traces').screenshot({ path: join(OUT, `traces-${size.name}-${scheme}.png`) });
         await demo.page.getByRole('button', { name: 'Inspect frames…' }).click();
