@@ -12,6 +12,7 @@ import { fakeHost } from './worker-fakes.js';
 function overview(bins: number, complete = false): Overview {
   return {
     t: Float64Array.from({ length: bins }, (_, i) => i * 1e6),
+    binUs: 1e6,
     fadeRate: new Float32Array(bins),
     lost: new Float32Array(bins),
     failsafe: [],

@@ -16,6 +16,7 @@ function overview(n: number, fromS = 1000, seed = 1): Overview {
   };
   return {
     t: Float64Array.from({ length: n }, (_, b) => (fromS + b) * 1e6),
+    binUs: 1e6,
     lost: Float32Array.from({ length: n }, () => (next(50) === 0 ? next(90) : 0)),
     fadeRate: Float32Array.from({ length: n }, () => (next(30) === 0 ? Number.NaN : next(7) === 0 ? next(40) / 4 : 0)),
     failsafe: [],

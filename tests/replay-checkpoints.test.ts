@@ -54,7 +54,7 @@ describe('a long capture in the worker', () => {
       // It grows, and only up to where every port has been read.
       expect(o.readUntilUs).toBeGreaterThanOrEqual(before);
       before = o.readUntilUs;
-      expect(o.t.length).toBeLessThanOrEqual(Math.round((o.readUntilUs - (once.t[0] ?? 0)) / 1e6));
+      expect(o.t.length).toBeLessThanOrEqual(Math.round((o.readUntilUs - (once.t[0] ?? 0)) / o.binUs));
       for (let b = 0; b < o.t.length; b++) {
         expect(o.t[b]).toBe(once.t[b]);
         expect([b, o.fadeRate[b], o.lost[b]]).toEqual([b, once.fadeRate[b], once.lost[b]]);

@@ -222,7 +222,7 @@ function expectOverviewsAsOneDecode(overviews: Overview[], file: Uint8Array): vo
     expect(o.readUntilUs).toBeGreaterThan(before);
     before = o.readUntilUs;
     // Every bin before readUntilUs drawn, none after it (the bins are whole seconds from the start).
-    expect(o.readUntilUs).toBe((once.t[0] ?? 0) + o.t.length * 1e6);
+    expect(o.readUntilUs).toBe((once.t[0] ?? 0) + o.t.length * o.binUs);
     for (let b = 0; b < o.t.length; b++)
       expect([b, o.t[b], o.fadeRate[b], o.lost[b]]).toEqual([b, once.t[b], once.fadeRate[b], once.lost[b]]);
     // The failsafes the whole decode has, as far as they are read.
@@ -388,6 +388,7 @@ describe('the split pass says its overview is complete without making it', () =>
   /** An overview of no bins, read to `readUntilUs`, complete or not. */
   const overview = (complete: boolean): Overview => ({
     t: new Float64Array(0),
+    binUs: 1e6,
     fadeRate: new Float32Array(0),
     lost: new Float32Array(0),
     failsafe: [],

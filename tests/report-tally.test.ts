@@ -11,6 +11,7 @@ import { decodeCapture, healthReport, REPORT_THRESHOLDS, SPIKE_MIN_JUMP_PERCENT 
 import { importRaw, type Capture } from '../src/capture/index.js';
 import { channelName, channelResolution, servoToMicros, servoToPercent } from '../src/decoder/index.js';
 import { Prng, preset, simulate, type SimChunk } from '../src/simulator/index.js';
+import { SpikeFinder } from '../src/analysis/spikes.js';
 import { perByteCapture } from './feeds.js';
 
 const SECOND = 1_000_000;
@@ -163,6 +164,28 @@ describe("the report tally on the spike rule's edges", () => {
       // The streams do sit on the edges: spikes found, and jumps of 25 % or more that are none.
       expect(plain.glitches.length).toBeGreaterThan(20);
       expect(plain.turnedDown).toBeGreaterThan(plain.glitches.length);
+    });
+    it(`${name}: the page's SpikeFinder, fed frame by frame, finds every glitch the report lists, timed and untimed`, () => {
+      for (const capture of [perByteCapture(sim), importRaw(sim.bytes)]) {
+        const found: { channel: number; frameIndex: number; beforeUs: number; spikeUs: number; afterUs: number }[] = [];
+        const finder = new SpikeFinder();
+        decodeCapture(capture, {}, (f) =>
+          finder.frame(f, (s) =>
+            found.push({ channel: s.channel, frameIndex: s.frameIndex, beforeUs: s.beforeUs, spikeUs: s.spikeUs, afterUs: s.afterUs }),
+          ),
+        );
+        const r = healthReport(capture).remotes[0];
+        expect(found.length).toBe(r?.glitches.count);
+        expect(found.length).toBeGreaterThan(20);
+        const listed = r?.glitches.listed.map((g) => ({
+          channel: g.channel,
+          frameIndex: g.frameIndex,
+          beforeUs: g.beforeUs,
+          spikeUs: g.spikeUs,
+          afterUs: g.afterUs,
+        }));
+        expect(found.slice(0, listed?.length)).toEqual(listed);
+      }
     });
     it(`${name}: the same without timing (the window in frames)`, () => {
       const r = healthReport(importRaw(sim.bytes)).remotes[0];

@@ -3,9 +3,11 @@
  * often bytes come, the last change always delivered, idle ticks while live sources are quiet.
  */
 import { describe, expect, it } from 'vitest';
+import { SpektrumDecoder } from '../src/decoder/index.js';
 import { preset, simulate } from '../src/simulator/index.js';
 import { Batcher, IDLE_TICK_MS, MIN_BATCH_MS } from '../src/worker/batcher.js';
 import { Diagnosis } from '../src/worker/diagnosis.js';
+import type { FromWorker } from '../src/worker/protocol.js';
 import { SourceRegistry } from '../src/worker/registry.js';
 import { usbChunks } from './feeds.js';
 import { fakeHost } from './worker-fakes.js';
@@ -54,6 +56,44 @@ describe('the batcher', () => {
     clock.advance(100);
     expect(of('batches')).toHaveLength(after.length);
     expect(clock.pending).toBe(0);
+  });
+
+  it("hands every frame's channel traces in the flush's one message, their arrays transferred, none twice", () => {
+    const { clock, registry, source, chunks, host } = setup();
+    const sent: { message: FromWorker; transfer: Transferable[] }[] = [];
+    const batcher = new Batcher({ ...host, post: (message, transfer = []) => sent.push({ message, transfer }) }, registry, () => undefined);
+    for (let k = 0; k < 300; k++) {
+      const c = chunks[k]!;
+      source.engine.push(c.bytes, c.timeUs, 0);
+      batcher.schedule();
+      clock.advance(1);
+    }
+    clock.advance(MIN_BATCH_MS);
+    const times: number[] = [];
+    for (const { message, transfer } of sent) {
+      if (message.type !== 'batches') continue;
+      for (const { batch } of message.batches) {
+        times.push(...batch.traces.t);
+        for (const a of [
+          batch.traces.t,
+          batch.traces.us,
+          batch.traces.gap,
+          batch.traces.spikes.t,
+          batch.traces.spikes.channel,
+          batch.traces.spikes.us,
+        ])
+          expect(transfer).toContain(a.buffer);
+      }
+      expect(new Set(transfer).size).toBe(transfer.length);
+    }
+    // Every frame decoded, once, in order: what a decoder fed the same bytes gives.
+    const decoder = new SpektrumDecoder();
+    for (const c of chunks.slice(0, 300)) decoder.push(c.bytes, c.timeUs);
+    const want: number[] = [];
+    for (let f = decoder.next(); f !== undefined; f = decoder.next()) want.push(f.timeUs);
+    expect(want.length).toBeGreaterThan(100);
+    expect(times).toEqual(want);
+    expect(sent.length).toBeLessThan(300 / MIN_BATCH_MS + 2);
   });
 
   it('flushes at once when the last batch is old enough', () => {

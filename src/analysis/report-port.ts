@@ -20,14 +20,8 @@ import {
 } from '../decoder/index.js';
 import { decodeCapture } from './capture-pass.js';
 import type { Doctor } from './doctor.js';
-import {
-  MAX_LISTED_GLITCHES,
-  REPORT_BIN_US,
-  SPIKE_MIN_JUMP_PERCENT,
-  SPIKE_RETURN_PERCENT,
-  SPIKE_WINDOW_FRAMES,
-  SPIKE_WINDOW_US,
-} from './report-thresholds.js';
+import { MAX_LISTED_GLITCHES, REPORT_BIN_US, SPIKE_MIN_JUMP_PERCENT } from './report-thresholds.js';
+import { isSpike } from './spikes.js';
 import { r1 } from './report-text.js';
 import type { ReportGlitch, ReportPeriodStats } from './report-types.js';
 
@@ -379,7 +373,7 @@ class PortTally {
 
   /**
    * Channel `id`'s candidate B, right after A and now left for C (% travel `p`, µs `u`) by at
-   * least SPIKE_MIN_JUMP_PERCENT: a spike when C is back near A, on the same side, in the window.
+   * least SPIKE_MIN_JUMP_PERCENT: a spike when the rule (`isSpike`) says so.
    */
   #spike(id: number, p: number, u: number): void {
     const t = this.#frame[0] as number;
@@ -388,12 +382,7 @@ class PortTally {
     const o = id * CH_STRIDE;
     const pA = ch[o + CH_PCT_A] as number;
     const pB = ch[o + CH_PCT_B] as number;
-    const atA = ch[o + CH_AT_A] as number;
-    const up = pB - pA;
-    const down = pB - p;
-    const span =
-      Number.isFinite(t) && Number.isFinite(atA) ? t - atA <= SPIKE_WINDOW_US : index - (ch[o + CH_IDX_A] as number) <= SPIKE_WINDOW_FRAMES;
-    if (!(span && Math.sign(up) === Math.sign(down) && Math.abs(p - pA) <= SPIKE_RETURN_PERCENT)) return;
+    if (!isSpike(pA, pB, p, ch[o + CH_AT_A] as number, t, ch[o + CH_IDX_A] as number, index)) return;
     this.glitchCount++;
     const frameIndex = ch[o + CH_IDX_B] as number;
     if (frameIndex !== this.#lastGlitchFrame) this.glitchFrames++;
@@ -408,7 +397,7 @@ class PortTally {
         beforeUs: ch[o + CH_US_A] as number,
         spikeUs: ch[o + CH_US_B] as number,
         afterUs: u,
-        jumpPercent: r1(up),
+        jumpPercent: r1(pB - pA),
       });
     }
   }

@@ -14,10 +14,56 @@ import type uPlot from 'uplot';
 import { chartColors } from './theme.js';
 
 /** Round steps for the time axis, s. */
-const TIME_STEPS = [1, 2, 5, 10, 15, 30, 60, 120, 300, 600];
+const TIME_STEPS = [0.1, 0.2, 0.5, 1, 2, 5, 10, 15, 30, 60, 120, 300, 600];
 const LONGEST_STEP = 600;
 /** Wanted space between two time labels, px. */
 const TIME_LABEL_PX = 64;
+
+/** Round steps for a whole capture's time axis, s: those of the graphs, then up to a day. */
+const ELAPSED_STEPS = [...TIME_STEPS, 900, 1800, 3600, 7200, 10_800, 21_600, 43_200, 86_400];
+
+/**
+ * Time since a capture's start as a label in steps of `step` s: in seconds on an axis stepping
+ * below 10 s ("0.25 s", "12 s"), else as a clock ("1:30", "2:05:00").
+ */
+export function elapsedLabel(seconds: number, step: number): string {
+  const s = Math.max(0, seconds);
+  if (step < 10) return `${s.toFixed(decimals(step))} s`;
+  const whole = Math.round(s);
+  const h = Math.floor(whole / 3600);
+  const m = Math.floor((whole % 3600) / 60);
+  const sec = String(whole % 60).padStart(2, '0');
+  return h > 0 ? `${h}:${String(m).padStart(2, '0')}:${sec}` : `${m}:${sec}`;
+}
+
+/**
+ * The time axis of a whole capture (the replay's timeline): time since `startS` (the capture's
+ * start, s of its clock) in round steps counted from there, about one label per TIME_LABEL_PX.
+ */
+export function elapsedAxis(startS: number): uPlot.Axis {
+  const c = chartColors();
+  const stepFor = (u: uPlot, min: number, max: number) => {
+    const most = Math.max(2, Math.floor(u.bbox.width / devicePixelRatio / TIME_LABEL_PX));
+    return ELAPSED_STEPS.find((s) => (max - min) / s <= most) ?? (ELAPSED_STEPS.at(-1) as number);
+  };
+  return {
+    stroke: c.axis,
+    grid: { show: false },
+    ticks: { stroke: c.grid, width: 1, size: 4 },
+    size: 22,
+    gap: 2,
+    splits: (u, _axis, min, max) => {
+      const step = stepFor(u, min, max);
+      const out: number[] = [];
+      for (let k = Math.ceil((min - startS) / step - 1e-9); startS + k * step <= max + 1e-9; k++) out.push(startS + k * step);
+      return out;
+    },
+    values: (_u, splits) => {
+      const step = stepOf(splits);
+      return splits.map((v) => elapsedLabel(v - startS, step));
+    },
+  };
+}
 
 /** Seconds before now as a label: "now", "−20 s", or "−2 min" on an axis stepping in minutes. */
 export function agoLabel(seconds: number, step = 1): string {

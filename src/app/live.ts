@@ -5,6 +5,7 @@
  */
 import { CHANNEL_COUNT } from '../decoder/index.js';
 import type { Batch } from '../worker/protocol.js';
+import { TraceBuffer } from './traces.js';
 
 /** Episodes are kept as long as the longest graph window (10 min). */
 const EPISODE_KEEP_US = 600e6;
@@ -105,6 +106,8 @@ export class Live {
   readonly positions = new Uint16Array(CHANNEL_COUNT);
   readonly seenUs = new Float64Array(CHANNEL_COUNT).fill(NaN);
   readonly series = new SeriesBuffer();
+  /** Every frame's channel values and the glitches, for the channel traces. */
+  readonly traces = new TraceBuffer();
   readonly episodes = new Map<number, Episode>();
   link: Batch['link'] | null = null;
   counters: Batch['counters'] = { bytes: 0, frames: 0, resyncs: 0, discardedBytes: 0, badFrames: 0, emptySlots: 0, vtxFrames: 0 };
@@ -131,6 +134,7 @@ export class Live {
     this.ended = batch.ended;
     this.mismatch = batch.mismatch;
     this.series.append(batch.series);
+    this.traces.append(batch.traces);
     for (const e of batch.episodes) this.episodes.set(e.id, { kind: e.kind, startUs: e.startUs, endUs: e.endUs });
     for (const id of batch.retracted) this.episodes.delete(id);
     // Nothing shows episodes older than the longest window: a long session must not pile them up.
@@ -145,6 +149,7 @@ export class Live {
     this.positions.fill(0);
     this.seenUs.fill(NaN);
     this.series.clear();
+    this.traces.clear();
     this.episodes.clear();
     this.link = null;
     this.counters = { bytes: 0, frames: 0, resyncs: 0, discardedBytes: 0, badFrames: 0, emptySlots: 0, vtxFrames: 0 };

@@ -57,6 +57,11 @@ export interface ChartColors {
   lost: string;
   failsafeBand: string;
   remotes: string[];
+  /** The channel traces, one a lane (cycled), and the glitch marks over them. */
+  traces: string[];
+  glitch: string;
+  /** The shade of every other lane of the traces. */
+  lane: string;
 }
 
 const DARK: ChartColors = {
@@ -69,6 +74,9 @@ const DARK: ChartColors = {
   lost: '#ff6b6b',
   failsafeBand: 'rgba(255,60,60,0.25)',
   remotes: ['#4fd1a5', '#f0b429', '#7cc4ff', '#ff8fab', '#c3a6ff'],
+  traces: ['#7cc4ff', '#4fd1a5', '#f0b429', '#c3a6ff'],
+  glitch: '#ff4d4f',
+  lane: 'rgba(140,160,190,0.07)',
 };
 
 const LIGHT: ChartColors = {
@@ -81,6 +89,9 @@ const LIGHT: ChartColors = {
   lost: '#d1343a',
   failsafeBand: 'rgba(209,52,58,0.16)',
   remotes: ['#0a7d5a', '#b7791f', '#1f6fd1', '#c2185b', '#7048e8'],
+  traces: ['#1f6fd1', '#0a7d5a', '#a0660f', '#7048e8'],
+  glitch: '#d1343a',
+  lane: 'rgba(60,80,110,0.05)',
 };
 
 export function chartColors(t: Theme = theme.value): ChartColors {

@@ -17,6 +17,7 @@ import {
 } from '../decoder/index.js';
 import { LinkSeries } from '../analysis/index.js';
 import { InspectorLog } from './inspector.js';
+import { TraceLog } from './traces.js';
 import { BUCKET_US, type Batch } from './protocol.js';
 
 export interface EngineOptions {
@@ -51,6 +52,8 @@ export class Engine {
   tap: EngineTap | null = null;
   readonly link: LinkMonitor;
   readonly series = new LinkSeries(BUCKET_US);
+  /** Every frame's channel values and the glitches found, for the page's channel traces. */
+  readonly traces = new TraceLog();
   readonly #positions = new Uint16Array(CHANNEL_COUNT);
   readonly #seenUs = new Float64Array(CHANNEL_COUNT).fill(NaN);
   #frames = 0;
@@ -176,6 +179,7 @@ export class Engine {
       this.#currentUs = t;
       this.link.frame(f);
       this.series.frame(f, this.link);
+      this.traces.frame(f, this.link.holdAfterUs);
       this.#frames++;
       this.tap?.frame(f);
       for (let i = 0; i < f.count; i++) {
@@ -306,6 +310,7 @@ export class Engine {
       series,
       episodes,
       retracted,
+      traces: this.traces.take(),
     };
     this.#frames = 0;
     return {
@@ -318,6 +323,7 @@ export class Engine {
         series.rssi.buffer,
         series.periodMs.buffer,
         series.lost.buffer,
+        ...TraceLog.transfer(batch.traces),
       ] as ArrayBuffer[],
     };
   }

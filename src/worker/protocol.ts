@@ -127,6 +127,8 @@ export interface Batch {
   episodes: { id: number; kind: 'hold' | 'failsafe'; startUs: number; endUs: number | null }[];
   /** Ids of holds withdrawn: a silence the frames after it showed was the adapter holding bytes back. */
   retracted: number[];
+  /** Every timed frame's channel values since the last batch, and the glitches found (the channel traces). */
+  traces: TraceBatch;
 }
 
 export interface RecordingStatus {
@@ -167,7 +169,10 @@ export interface ReplayStatus {
  * (each message the whole of it so far) while the capture is decoded, then once complete.
  */
 export interface Overview {
+  /** Each bin's start, µs (the capture's clock; without timing, where in the file). */
   t: Float64Array;
+  /** The bins' width, µs: narrower for a short capture (overviewBinUs), so what is drawn keeps its proportions. */
+  binUs: number;
   fadeRate: Float32Array;
   lost: Float32Array;
   failsafe: { startUs: number; endUs: number }[];
@@ -216,4 +221,20 @@ export interface DiagnosisStatus {
   probeable: number[];
   /** A listen at another speed under way. */
   probing: { source: number; baudRate: number } | null;
+}
+
+// The channel traces (src/worker/traces.ts, src/app/traces.ts).
+
+/**
+ * Timed frames decoded since the last batch, as columns: `t` each frame's time (µs), `us` its
+ * channel values in µs, CHANNEL_COUNT a frame (NaN: a channel the frame did not carry), `gap` 1
+ * where a silence the link monitor would call a hold came before the frame (or frames were
+ * dropped before it), and the glitches found (the library's spike rule): each spike's time, its
+ * channel and its wrong value in µs.
+ */
+export interface TraceBatch {
+  t: Float64Array;
+  us: Float32Array;
+  gap: Uint8Array;
+  spikes: { t: Float64Array; channel: Uint8Array; us: Float32Array };
 }

@@ -232,6 +232,8 @@ describe.skipIf(skip !== null)('the Diagnosis panel in replay, on a phone and a 
           await page.locator('section.replay').waitFor();
           await page.getByRole('radio', { name: 'max' }).click();
           await page.locator('[data-testid="source-status"]', { hasText: '(end)' }).waitFor({ timeout: 20_000 });
+          // On a phone the panel is folded under the channel bars until tapped.
+          if (width < 600) await page.locator('.p-diagnosis .fold-toggle').click();
           await page.locator(`.diagnosis .finding[data-code="${code}"]`).waitFor({ timeout: 5000 });
           // The panel hears at most 4× a second: let the last word of the replay arrive.
           await page.waitForTimeout(600);

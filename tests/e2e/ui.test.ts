@@ -135,7 +135,8 @@ async function axe(page: Page, label: string): Promise<string[]> {
 
 async function demoRunning(page: Page): Promise<void> {
   await page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor({ timeout: 10_000 });
-  await page.locator('.remotes .state-chip', { hasText: 'live' }).nth(1).waitFor({ timeout: 10_000 });
+  // Attached: on a phone the remotes' panel is folded away.
+  await page.locator('.remotes .state-chip', { hasText: 'live' }).nth(1).waitFor({ state: 'attached', timeout: 10_000 });
 }
 
 async function replayed(page: Page, path: string): Promise<void> {
@@ -234,7 +235,8 @@ describe.skipIf(skip !== null)('the page on any screen', () => {
     // The raw and % columns went first.
     await expect(page.locator('.channel-list .bar .raw').first().isVisible()).resolves.toBe(false);
     await expect(page.locator('.channel-list .bar .pct').first().isVisible()).resolves.toBe(false);
-    // State chips are not clipped ("HOL"): their text fits.
+    // State chips are not clipped ("HOL"): their text fits (the remotes' panel unfolded).
+    await page.locator('.p-remotes .fold-toggle').click();
     const chips = await page.$$eval('.state-chip', (els) => els.map((e) => e.scrollWidth - e.clientWidth));
     for (const c of chips) expect(c).toBeLessThanOrEqual(0);
     // The inspector's table scrolls inside its panel.

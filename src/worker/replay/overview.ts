@@ -16,8 +16,25 @@ import type { Capture } from '../../capture/index.js';
 import { type LinkSeries, captureSpan, decodeCapture } from '../../analysis/index.js';
 import type { Overview } from '../protocol.js';
 
-/** The overview's bins: one second. */
+/** The overview's widest bins: one second (a long capture's). */
 export const BIN_US = 1_000_000;
+/**
+ * The bin widths an overview takes, µs: round ones, from 20 ms (a frame or two of an 11 ms
+ * system is due in each, so a run of lost frames is a run of bars, not a comb) to BIN_US.
+ */
+const BIN_WIDTHS_US = [20_000, 50_000, 100_000, 200_000, 500_000, BIN_US];
+/** Bins at most across a capture: two a pixel of a timeline about a thousand pixels wide. */
+const MOST_BINS = 2000;
+
+/**
+ * The bins of a capture `spanUs` long: the narrowest round width that keeps it to MOST_BINS, so
+ * that a short capture's timeline draws a hold or a lost frame as long as it was (a 0.74 s
+ * capture in 20 ms bins, not in one bin of a second that the whole timeline would stand for);
+ * BIN_US for a long capture, and for one whose span is unknown.
+ */
+export function overviewBinUs(spanUs: number): number {
+  return BIN_WIDTHS_US.find((w) => spanUs / w <= MOST_BINS) ?? BIN_US;
+}
 
 /** The frame period a decoder's format implies (its system byte, or 1024 resolution: 22 ms), NaN when it implies none. */
 function periodOf(format: FormatInfo): number {
@@ -44,9 +61,10 @@ export function overviewOf(
   const marks: { offset: number[]; fades: number[]; missed: number[] } = { offset: [], fades: [], missed: [] };
   // One walk of the chunks for where the capture starts and ends, not one per port.
   const { startUs: originUs, endUs } = captureSpan(capture);
+  const binUs = overviewBinUs(endUs - originUs);
   for (const port of ports) {
     let missed = 0;
-    const { link, series, decoder } = decodeCapture(capture, { resolution, port, binUs: BIN_US, originUs, endUs }, (f, l) => {
+    const { link, series, decoder } = decodeCapture(capture, { resolution, port, binUs, originUs, endUs }, (f, l) => {
       // Read only where it is used: reading the stats works out what the monitor owes (link.ts).
       if (untimed) {
         const now = l.stats.missedFrames;
@@ -63,10 +81,14 @@ export function overviewOf(
   if (Number.isNaN(periodUs)) periodUs = FRAME_PERIOD_11MS_US;
   if (untimed) {
     const usPerByte = periodUs / FRAME_SIZE;
-    const binOf = (offset: number): number => Math.floor(((offset + FRAME_SIZE) * usPerByte) / BIN_US);
+    // The paced clock's span: where the last frame ends (a loop: a long file has millions of frames).
+    let lastOffset = 0;
+    for (const offset of marks.offset) if (offset > lastOffset) lastOffset = offset;
+    const binUs = overviewBinUs((lastOffset + FRAME_SIZE) * usPerByte);
+    const binOf = (offset: number): number => Math.floor(((offset + FRAME_SIZE) * usPerByte) / binUs);
     let bins = 0;
     for (const offset of marks.offset) bins = Math.max(bins, binOf(offset) + 1);
-    const t = Float64Array.from({ length: bins }, (_, b) => b * BIN_US);
+    const t = Float64Array.from({ length: bins }, (_, b) => b * binUs);
     const fades = new Float32Array(bins);
     const lost = new Float32Array(bins);
     marks.offset.forEach((offset, k) => {
@@ -74,7 +96,7 @@ export function overviewOf(
       fades[b] = (fades[b] ?? 0) + (marks.fades[k] ?? 0);
       lost[b] = (lost[b] ?? 0) + (marks.missed[k] ?? 0);
     });
-    return { overview: { t, fadeRate: fades, lost, failsafe: [], readUntilUs: Number.NaN, complete: true }, periodUs };
+    return { overview: { t, binUs, fadeRate: fades, lost, failsafe: [], readUntilUs: Number.NaN, complete: true }, periodUs };
   }
   return { overview: sumOverview(all, failsafe, undefined, endUs, true), periodUs };
 }
@@ -92,10 +114,11 @@ export function sumOverview(
 ): Overview {
   const n = bins ?? Math.max(0, ...all.map((x) => x.bins));
   const origin = all[0]?.originUs ?? Number.NaN;
+  const binUs = all[0]?.binUs ?? BIN_US;
   const t = new Float64Array(Number.isNaN(origin) ? 0 : n);
   const fades = new Float32Array(t.length);
   const lost = new Float32Array(t.length);
-  for (let b = 0; b < t.length; b++) t[b] = origin + b * BIN_US;
+  for (let b = 0; b < t.length; b++) t[b] = origin + b * binUs;
   // Port by port, each over every bin: with the ports' short loop inside the bins' one, optimised
   // code entered in the middle of it left it at every bin (a deoptimisation each, 14 000 in one
   // open of the day capture, Chromium 150's --trace-deopt). The sums are whole counts, exact in
@@ -106,7 +129,7 @@ export function sumOverview(
       lost[b] = (lost[b] ?? 0) + x.lost(b);
     }
   }
-  return { t, fadeRate: fades, lost, failsafe: inTimeOrder(failsafe), readUntilUs, complete };
+  return { t, binUs, fadeRate: fades, lost, failsafe: inTimeOrder(failsafe), readUntilUs, complete };
 }
 
 /**
@@ -163,5 +186,5 @@ export function addOverviews(parts: readonly Overview[], originUs: number): Over
     readUntilUs,
     complete,
   );
-  return { t, fadeRate, lost, failsafe: inTimeOrder(failsafe), readUntilUs, complete };
+  return { t, binUs: parts[0]?.binUs ?? BIN_US, fadeRate, lost, failsafe: inTimeOrder(failsafe), readUntilUs, complete };
 }

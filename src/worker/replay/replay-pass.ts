@@ -9,7 +9,7 @@
 import { type DecoderCheckpoint, type LinkCheckpoint, type LinkMonitor, SpektrumDecoder } from '../../decoder/index.js';
 import { type Capture, recordTimeUs } from '../../capture/index.js';
 import { LinkSeries, monitorWithSeries, timingJitterUs } from '../../analysis/index.js';
-import { BIN_US, failsafeAsRead, failsafesOf, sumOverview } from './overview.js';
+import { failsafeAsRead, failsafesOf, overviewBinUs, sumOverview } from './overview.js';
 import type { Overview } from '../protocol.js';
 
 /** Capture time between two checkpoints: 1440 of them a day, each a few kilobytes a port. */
@@ -30,7 +30,7 @@ export function checkpointDue(nextUs: number, atUs: number): number {
  * How far behind the slowest port's last frame the overview is drawn while the pass runs: frames
  * found missing are confirmed over ledger windows (0.5 s) and placed where they were due.
  */
-const SETTLE_BINS = 2;
+const SETTLE_US = 2_000_000;
 
 interface PortPass {
   port: number;
@@ -70,6 +70,8 @@ export class ReplayPass implements OverviewPass {
   #capture: Capture | null;
   #prefix: boolean;
   readonly #ports: PortPass[];
+  /** The overview's bin width (overviewBinUs: a short capture's are narrow). */
+  readonly #binUs: number;
   /** Each port's decode by port number (0–255), undefined for the ports not decoded here. */
   readonly #byPort: (PortPass | undefined)[] = [];
   /** The next chunk of the capture to feed (the count fed so far). */
@@ -96,8 +98,9 @@ export class ReplayPass implements OverviewPass {
   ) {
     this.#capture = capture;
     this.#prefix = prefix;
+    this.#binUs = overviewBinUs(endUs - originUs);
     this.#ports = ports.map((port) => {
-      const series = new LinkSeries(BIN_US, originUs);
+      const series = new LinkSeries(this.#binUs, originUs);
       return {
         port,
         decoder: new SpektrumDecoder({ resolution }),
@@ -251,9 +254,10 @@ export class ReplayPass implements OverviewPass {
         const last = p.link.lastFrameUs;
         if (Number.isFinite(last) && last < readUntilUs) readUntilUs = last;
       }
-      readUntilUs = Math.max(this.originUs, Math.floor((readUntilUs - this.originUs) / BIN_US - SETTLE_BINS) * BIN_US + this.originUs);
+      const bin = this.#binUs;
+      readUntilUs = Math.max(this.originUs, Math.floor((readUntilUs - this.originUs - SETTLE_US) / bin) * bin + this.originUs);
     }
-    const bins = this.#done ? undefined : Math.max(0, Math.round((readUntilUs - this.originUs) / BIN_US));
+    const bins = this.#done ? undefined : Math.max(0, Math.round((readUntilUs - this.originUs) / this.#binUs));
     const failsafe = this.#ports.flatMap((p) => failsafeAsRead(failsafesOf(p.link.episodes), readUntilUs, this.#done));
     return sumOverview(
       this.#ports.map((p) => p.series),

@@ -7,11 +7,12 @@ import { computed, signal } from '@preact/signals';
 import { useEffect, useState } from 'preact/hooks';
 import { lazy } from '../../lazy.js';
 import { openCapture } from '../../open-file.js';
-import { replayName, replaySpanUs, sources, status, xplusSeen } from '../../store.js';
+import { diagnosis, replayName, replaySpanUs, sources, status, xplusSeen } from '../../store.js';
 import { ChannelBars } from '../ChannelBars/index.js';
 import { Counters } from '../Counters/index.js';
 import { DiagnosisPanel } from '../Diagnosis/index.js';
 import { EmptyState } from '../EmptyState/index.js';
+import { Fold } from '../Fold/index.js';
 import { Graphs, WINDOWS } from '../Graphs/index.js';
 import { LinkPanel } from '../LinkPanel/index.js';
 import { Notices } from '../Notices/index.js';
@@ -19,6 +20,7 @@ import { Remotes } from '../Remotes/index.js';
 import { ReplayBar } from '../ReplayBar/index.js';
 import { SystemBadge } from '../SystemBadge/index.js';
 import { Toolbar } from '../Toolbar/index.js';
+import { Traces } from '../Traces/index.js';
 import './style.css';
 
 const BindPanel = lazy(() => import('../Bind/index.js').then((m) => m.BindPanel));
@@ -30,6 +32,11 @@ const XPLUS = [12, 13, 14, 15, 16, 17, 18, 19];
 const windowUs = signal(60e6);
 /** The channel panel's title names the remote shown when there are several (a signal bound to the text). */
 const channelsTitle = computed(() => (sources.value.length > 1 ? `Channels — remote ${status.value.label}` : 'Channels'));
+/** What the folded diagnosis says on a phone: how many findings (nothing before the doctor spoke). */
+const findingsHint = computed(() => {
+  const n = diagnosis.value?.findings.length;
+  return n === undefined ? undefined : n === 1 ? '1 finding' : `${n} findings`;
+});
 /** Whether the bind panel is open. */
 export const binding = signal(false);
 
@@ -95,28 +102,30 @@ export function App({ granted }: { granted: SerialPort[] }) {
         </main>
       ) : (
         <main class="grid">
-          {/* On a phone both columns dissolve into one, ordered by what matters first (style.css). */}
+          {/* On a phone both columns dissolve into one, ordered by what matters first, the rest folded (style.css). */}
           <aside class="side">
             <div class="panel p-link">
               <LinkPanel windowUs={windowUs} />
             </div>
-            <div class="panel p-system">
+            <Fold name="system" title="System">
               <h2>System</h2>
               <SystemBadge />
-            </div>
-            <div class="panel p-counters">
+            </Fold>
+            <Fold name="counters" title="Counters">
               <h2>Counters</h2>
               <Counters />
-            </div>
+            </Fold>
           </aside>
           <div class="main">
-            <div class="panel p-diagnosis" id="diagnosis">
-              <DiagnosisPanel />
-            </div>
-            {sources.value.length > 1 ? (
-              <div class="panel p-remotes">
-                <Remotes windowUs={windowUs} />
+            <Fold name="diagnosis" title="Diagnosis" hint={findingsHint.value} anchor="diagnosis">
+              <div id="diagnosis">
+                <DiagnosisPanel />
               </div>
+            </Fold>
+            {sources.value.length > 1 ? (
+              <Fold name="remotes" title="Remotes side by side" hint={`${sources.value.length} remotes`}>
+                <Remotes windowUs={windowUs} />
+              </Fold>
             ) : null}
             <div class="panel p-channels">
               <h2>{channelsTitle}</h2>
@@ -128,9 +137,12 @@ export function App({ granted }: { granted: SerialPort[] }) {
                 <ChannelBars ids={XPLUS} label="X-Plus channels" />
               </div>
             ) : null}
-            <div class="panel p-graphs">
+            <Fold name="graphs" title="Link over time">
               <Graphs windowUs={windowUs} />
-            </div>
+            </Fold>
+            <Fold name="traces" title="Channels over time">
+              <Traces windowUs={windowUs} />
+            </Fold>
             <div class="panel p-inspector">
               <InspectorPanel />
             </div>

@@ -27,7 +27,9 @@ import {
 import { chartColors, theme } from '../../theme.js';
 import './style.css';
 
+/** The windows offered, shortest first (the first that holds a capture is chosen for it). */
 export const WINDOWS = [
+  [1e6, '1 s'],
   [10e6, '10 s'],
   [60e6, '1 min'],
   [600e6, '10 min'],

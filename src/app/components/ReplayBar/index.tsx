@@ -8,10 +8,16 @@ import { computed, useComputed, useSignal } from '@preact/signals';
 import { useEffect, useRef } from 'preact/hooks';
 import uPlot from 'uplot';
 import { overview, replay, replayName, replayReading, replaySpanUs, send } from '../../store.js';
+import { elapsedAxis } from '../../axes.js';
 import { chartColors, theme } from '../../theme.js';
 import { overviewColumns } from './columns.js';
 import { readingPercent } from './reading.js';
 import './style.css';
+
+/** The timeline's height, px: the plot and its time axis. */
+const TIMELINE_PX = 78;
+/** The narrowest a failsafe band is drawn, px: a short one is still seen. */
+const MIN_MARK_PX = 2;
 
 const SPEEDS = [
   [1, '1×'],
@@ -68,35 +74,65 @@ export function ReplayBar() {
     const width = Math.max(300, el.clientWidth);
     const spanned = toS > fromS;
     // A column a device pixel, over the capture's span (or, without one, the bins' own).
-    const [from, to] = spanned ? [fromS, toS] : [(o.t[0] ?? 0) / 1e6, (o.t[o.t.length - 1] ?? 0) / 1e6 + 1];
-    const { x, lost, fadeRate } = overviewColumns(o, Math.ceil(width * (globalThis.devicePixelRatio || 1)), from, to);
+    const [from, to] = spanned ? [fromS, toS] : [(o.t[0] ?? 0) / 1e6, (o.t[o.t.length - 1] ?? 0) / 1e6 + o.binUs / 1e6];
+    const columns = Math.ceil(width * (globalThis.devicePixelRatio || 1));
+    const { x, lost, fadeRate } = overviewColumns(o, columns, from, to);
+    const binS = o.binUs / 1e6;
+    const columnS = (to - from) / columns;
     const bands = o.failsafe;
     const unread = o.complete || !Number.isFinite(o.readUntilUs) ? null : o.readUntilUs / 1e6;
     const c = chartColors(palette);
     const plot = new uPlot(
       {
         width,
-        height: 56,
+        height: TIMELINE_PX,
         legend: { show: false },
         cursor: { show: false },
-        axes: [{ show: false }, { show: false }],
-        scales: { x: spanned ? { time: false, range: () => [fromS, toS] } : { time: false } },
+        // Time since the capture's start; the values need no axis (the graphs below have them).
+        axes: [spanned ? elapsedAxis(from) : { show: false }, { show: false }],
+        scales: {
+          x: { time: false, range: () => [from, to] },
+          lost: { range: (_u, _min, max) => [0, Math.max(1, max)] },
+        },
         series: [
           {},
-          { stroke: c.lost, fill: `${c.lost}66`, paths: uPlot.paths.bars?.({ size: [1, Infinity] }), points: { show: false } },
+          // In the scale only: drawn below, each bar as wide as the time it counts.
+          { scale: 'lost', paths: () => null, points: { show: false } },
           { stroke: c.fades, width: 1, points: { show: false } },
         ],
         hooks: {
           drawClear: [
             (u) => {
-              // Failsafe episodes as red bands behind the series.
               const ctx = u.ctx;
               ctx.save();
+              // Failsafe episodes as red bands behind the series, as long as they lasted (at
+              // least MIN_MARK_PX, so that a short one is still seen).
               ctx.fillStyle = c.failsafeBand;
               for (const b of bands) {
                 const a = u.valToPos(b.startUs / 1e6, 'x', true);
                 const z = u.valToPos(b.endUs / 1e6, 'x', true);
-                ctx.fillRect(a, u.bbox.top, Math.max(2, z - a), u.bbox.height);
+                ctx.fillRect(a, u.bbox.top, Math.max(MIN_MARK_PX * devicePixelRatio, z - a), u.bbox.height);
+              }
+              // Lost frames: each column's bar spans the bins it counts (a bin, or a device pixel
+              // where bins are narrower), never wider: a 66 ms hold is a 66 ms bar.
+              ctx.fillStyle = `${c.lost}aa`;
+              const base = u.valToPos(0, 'lost', true);
+              for (let i = 0; i < x.length; i++) {
+                const n = lost[i] ?? 0;
+                if (!(n > 0)) continue;
+                const t = x[i] ?? 0;
+                const end = Math.min(t + Math.max(binS, columnS), x[i + 1] ?? to, to);
+                const a = u.valToPos(t, 'x', true);
+                const w = Math.max(devicePixelRatio, u.valToPos(end, 'x', true) - a);
+                const top = u.valToPos(n, 'lost', true);
+                ctx.fillRect(a, top, w, base - top);
+              }
+              // Each failsafe's extent also as a line along the top, seen over the lost frames' bars.
+              ctx.fillStyle = c.lost;
+              for (const b of bands) {
+                const a = u.valToPos(b.startUs / 1e6, 'x', true);
+                const z = u.valToPos(b.endUs / 1e6, 'x', true);
+                ctx.fillRect(a, u.bbox.top, Math.max(MIN_MARK_PX * devicePixelRatio, z - a), 3 * devicePixelRatio);
               }
               if (unread !== null) {
                 // Not read yet: hatched, so that it never reads as a clean stretch of link.
@@ -180,6 +216,9 @@ export function ReplayBar() {
         data-complete={o === null ? undefined : String(o.complete)}
         title={readUntil.value === null ? undefined : 'Hatched: not read yet. Seeking goes as far as the capture has been read.'}
       />
+      <p class="overview-key muted" aria-hidden="true">
+        <span class="key lost" /> frames lost <span class="key fades" /> fades <span class="key failsafe" /> failsafe
+      </p>
       <input
         type="range"
         class="seek"
