@@ -196,7 +196,9 @@ export class Dispatcher {
   async #startDemo(): Promise<void> {
     const { registry } = this;
     await registry.closeAll();
-    const demo = new DemoSource(this.host.clock, this.sink);
+    const demo = new DemoSource(this.host.clock, this.sink, (atUs) => {
+      for (const s of registry.list()) if (s.kind === 'demo') s.engine.interrupt(atUs);
+    });
     await registry.use(demo);
     for (let i = 0; i < demo.remotes; i++) {
       const s = registry.add('demo', i, i === 0 ? 'Demo remote (internal, DSMX 11 ms)' : 'Demo remote (external)', USB_CHUNK_JITTER_US);

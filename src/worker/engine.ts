@@ -92,6 +92,8 @@ export class Engine {
   readonly #pushTimes = new Array<Float64Array | undefined>(PUSHES_KEPT).fill(undefined);
   /** Pushes so far. */
   #pushCount = 0;
+  /** Where the source stopped sending for a reason not the link's (`interrupt()`), NaN when not. */
+  #interruptUs = Number.NaN;
   /** Whether the resolution is forced (only then can it match no frame). */
   #forced: boolean;
 
@@ -136,6 +138,15 @@ export class Engine {
   }
 
   /**
+   * The source stopped sending at `atUs` for a reason that is not the link (the demo's
+   * simulation paused over a stall): nothing is counted for the time until its next frame. The
+   * link is told when that frame comes, after the frames the decoder still holds from before.
+   */
+  interrupt(atUs: number): void {
+    this.#interruptUs = atUs;
+  }
+
+  /**
    * Forces (or frees) the resolution at source time `nowUs`. The frames may stop until the
    * decoder finds them again: that is the user's doing, not the link's, so the link monitor
    * counts nothing for the time in between (no hold, failsafe or missed frame).
@@ -174,6 +185,10 @@ export class Engine {
       this.inspector.onFrame(f);
       const t = f.timeUs;
       this.#currentUs = t;
+      if (t > this.#interruptUs) {
+        this.link.interrupt(this.#interruptUs);
+        this.#interruptUs = Number.NaN;
+      }
       this.link.frame(f);
       this.series.frame(f, this.link);
       this.#frames++;
