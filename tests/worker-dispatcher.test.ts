@@ -37,6 +37,10 @@ class FakePort {
       },
     });
   }
+  /** Bytes arrive on the line. */
+  receive(bytes: Uint8Array): void {
+    this.#line?.enqueue(bytes);
+  }
   /** The device goes away: reading fails as WebSerial's does. */
   unplug(): void {
     const gone = new Error('The device has been lost.');
@@ -155,6 +159,47 @@ describe('the dispatcher', () => {
     clock.advance(5000);
     await worker.queue.idle();
     expect(port.opens).toBe(2);
+    await send({ type: 'close-all' });
+  });
+
+  it('counts no hold, failsafe or missed frame for the time an unplugged adapter is away', async () => {
+    const port = new FakePort();
+    let plugged = true;
+    const { send, worker, clock, batches } = setup(async () => (plugged ? (port as unknown as SerialPort) : undefined));
+    await send({ type: 'serial-open', port: { index: 0, usbVendorId: 0x0403, usbProductId: 0x6001 } });
+    // A second of frames at their pace, then the adapter goes.
+    const sim = simulate({ ...preset('dsmx-11ms-2048-internal'), seed: 5 }, 1_000_000);
+    for (let i = 0; i < sim.bytes.length; i += 16) {
+      port.receive(sim.bytes.slice(i, i + 16));
+      await new Promise((r) => setTimeout(r, 0));
+      clock.advance(11);
+    }
+    plugged = false;
+    port.unplug();
+    await new Promise((r) => setTimeout(r, 0));
+    clock.advance(3000);
+    await worker.queue.idle();
+    worker.batcher.flush();
+    const last = batches()
+      .filter((b) => b.source === 0)
+      .at(-1)?.batch;
+    expect(last?.counters.frames).toBeGreaterThan(80);
+    expect(last?.link).toMatchObject({ holds: 0, failsafes: 0, missedFrames: 0, state: 'waiting' });
+    // Back, and frames again: still nothing counted for the time away.
+    plugged = true;
+    clock.advance(1000);
+    await worker.queue.idle();
+    expect(worker.registry.get(0)?.state).toBe('reading');
+    for (let i = 0; i < 160; i += 16) {
+      port.receive(sim.bytes.slice(i, i + 16));
+      await new Promise((r) => setTimeout(r, 0));
+      clock.advance(11);
+    }
+    worker.batcher.flush();
+    const back = batches()
+      .filter((b) => b.source === 0)
+      .at(-1)?.batch;
+    expect(back?.link).toMatchObject({ holds: 0, failsafes: 0, missedFrames: 0, state: 'live' });
     await send({ type: 'close-all' });
   });
 

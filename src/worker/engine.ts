@@ -138,12 +138,15 @@ export class Engine {
   }
 
   /**
-   * The source stopped sending at `atUs` for a reason that is not the link (the demo's
-   * simulation paused over a stall): nothing is counted for the time until its next frame. The
-   * link is told when that frame comes, after the frames the decoder still holds from before.
+   * The source stopped sending at `atUs` for a reason that is not the link (its port was lost,
+   * the demo's simulation paused over a stall): no hold, failsafe or missed frame is counted
+   * from there to its next frame. The link stops being judged now, and is told again at the
+   * first frame after `atUs`, once the frames the decoder still held from before are counted.
    */
   interrupt(atUs: number): void {
+    this.link.interrupt(atUs);
     this.#interruptUs = atUs;
+    this.#changed = true;
   }
 
   /**

@@ -127,16 +127,28 @@ describe.skipIf(skip !== null)('the page', () => {
         input.dispatchEvent(new Event('change', { bubbles: true }));
       }, us);
     };
+    // Paused, the panel says so, and what the link was doing at that point of the capture.
     await seek(failsafeGap.lastFrameUs! + 200_000);
-    await page.getByTestId('link-state').filter({ hasText: 'Hold' }).waitFor();
+    await page.getByTestId('link-hint').filter({ hasText: 'there the link was in hold' }).waitFor();
+    await expect(page.getByTestId('link-state').textContent()).resolves.toBe('Paused');
     await shot(page, 'hold');
     await seek(failsafeGap.lastFrameUs! + 1_200_000);
-    await page.getByTestId('link-state').filter({ hasText: 'Failsafe' }).waitFor();
+    await page.getByTestId('link-hint').filter({ hasText: 'there the link was in failsafe' }).waitFor();
+    await expect(page.getByTestId('link-state').textContent()).resolves.toBe('Paused');
     await shot(page, 'failsafe');
+    // Playing, the state at the replay position, named as the capture's.
     await page.getByRole('button', { name: 'Play' }).click();
+    await page
+      .getByTestId('link-hint')
+      .filter({ hasText: /^Replay at \d:\d\d\.\d: / })
+      .waitFor();
     await playToEnd(page);
-    await page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor();
-    await expect(page.locator('.link dd').nth(1).textContent()).resolves.toMatch(/2 holds · 1 failsafes/);
+    await page.getByTestId('link-state').filter({ hasText: 'Ended' }).waitFor();
+    await page
+      .getByTestId('link-hint')
+      .filter({ hasText: /^Replay ended at 0:03\.\d: there the link was live\.$/ })
+      .waitFor();
+    await expect(page.locator('.link dd').nth(1).textContent()).resolves.toBe('2 holds · 1 failsafe');
     // The health report of the capture, as a page and as JSON.
     const html = page.waitForEvent('download');
     await page.getByRole('button', { name: 'Report', exact: true }).click();
