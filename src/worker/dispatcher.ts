@@ -129,7 +129,7 @@ export class Dispatcher {
       case 'export': {
         const result = await recorder.export(message.recording, message.what);
         if (typeof result === 'string') notice(host, 'warning', 'Nothing to export', result);
-        else host.post({ type: 'export-ready', name: result.name, mime: 'application/octet-stream', data: result.data }, [result.data]);
+        else for (const { name, data } of result) host.post({ type: 'export-ready', name, mime: 'application/octet-stream', data }, [data]);
         break;
       }
       case 'inspect': {

@@ -241,7 +241,9 @@ export function Toolbar({ granted, onBind }: { granted: SerialPort[]; onBind(): 
                   >
                     raw .bin
                   </button>
-                  <p class="hint">Only the bytes, without times: for other tools.</p>
+                  <p class="hint">
+                    Only the bytes, without times, for other tools: one file per port, as a raw file cannot say which port a byte came from.
+                  </p>
                 </>
               )}
             </Menu>
