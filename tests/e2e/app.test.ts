@@ -7,10 +7,10 @@
 import { existsSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import type { Page } from 'playwright-core';
+import type { Download, Page } from 'playwright-core';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { channelName } from '../../src/decoder/index.js';
-import { CaptureWriter, capturePorts, parseCapture, readCapture } from '../../src/capture/index.js';
+import { CaptureWriter, captureChunks, capturePorts, parseCapture, readCapture } from '../../src/capture/index.js';
 import { decodeCapture, summarizeCapture } from '../../src/analysis/index.js';
 import { preset, simulate } from '../../src/simulator/index.js';
 import {
@@ -188,6 +188,27 @@ describe.skipIf(skip !== null)('the page', () => {
     expect(capturePorts(capture)).toEqual([0, 1]);
     expect(summarizeCapture(capture, { port: 1 }).format.remote).toBe('external');
     expect(capture.meta.ports?.map((p) => p.name)).toEqual(['A', 'B']);
+    // Raw .bin: one file per port, each exactly that remote's bytes, decoding with nothing discarded.
+    const raws: Download[] = [];
+    page.on('download', (d) => raws.push(d));
+    await page.getByRole('button', { name: 'Other export formats' }).click();
+    await page.getByRole('button', { name: 'raw .bin' }).click();
+    await expect.poll(() => raws.length, { timeout: 5000 }).toBe(2);
+    await page.waitForTimeout(300);
+    expect(raws.length).toBe(2);
+    expect(raws.map((d) => d.suggestedFilename())).toEqual([expect.stringMatching(/-port0\.bin$/), expect.stringMatching(/-port1\.bin$/)]);
+    for (const [port, d] of raws.entries()) {
+      const path = join(dir, `recorded-${port}.bin`);
+      await d.saveAs(path);
+      const raw = readCapture(new Uint8Array(readFileSync(path)), path);
+      const want = [...captureChunks(capture, port)].flatMap((c) => [...c.bytes]);
+      expect(Buffer.from(raw.bytes).equals(Buffer.from(want))).toBe(true);
+      const alone = summarizeCapture(raw);
+      expect(alone.decoder.discardedBytes).toBe(0);
+      expect(alone.decoder.frames).toBe(summarizeCapture(capture, { port }).decoder.frames);
+      expect(alone.format.remote).toBe(port === 0 ? 'internal' : 'external');
+    }
+    page.removeAllListeners('download');
     // A report on the live session's recording, made off the reading worker.
     const reportDownload = page.waitForEvent('download');
     await page.getByRole('button', { name: 'Report', exact: true }).click();
