@@ -5,10 +5,11 @@
  * gives it the browser's.
  */
 import { USB_CHUNK_JITTER_US } from '../decoder/index.js';
-import type { Capture } from '../capture/index.js';
+import { parseCapture, type Capture } from '../capture/index.js';
 import { Batcher } from './batcher.js';
 import { bind } from './binding.js';
 import { Diagnosis } from './diagnosis.js';
+import { framesFile } from './frames-export.js';
 import { type Host, notice, nowUs } from './host.js';
 import { type LiveSink, liveSink } from './live.js';
 import type { PortIdentity, ToWorker } from './protocol.js';
@@ -154,6 +155,9 @@ export class Dispatcher {
         );
         break;
       }
+      case 'export-frames':
+        await this.#exportFrames(message);
+        break;
       case 'diagnosis-confirm':
         await this.#confirm(message);
         break;
@@ -191,6 +195,29 @@ export class Dispatcher {
         throw new Error(`unknown message ${JSON.stringify(never)}`);
       }
     }
+  }
+
+  /** A remote's decoded frames, from the capture replayed or the live session's recording. */
+  async #exportFrames(m: Extract<ToWorker, { type: 'export-frames' }>): Promise<void> {
+    const replay = this.replay;
+    let capture: Capture | null = replay?.source.capture ?? null;
+    if (replay === undefined) {
+      const bytes = await this.recorder.current();
+      capture = bytes === null ? null : parseCapture(bytes);
+    }
+    if (capture === null) {
+      notice(this.host, 'warning', 'No frames to export', 'Record the live session (● Record) or open a capture first.');
+      return;
+    }
+    const { data, frames } = framesFile(capture, { ...m, port: m.source, resolution: this.registry.resolution });
+    if (frames === 0) {
+      notice(this.host, 'warning', 'No frames to export', 'No frame of this remote was decoded in that span.');
+      return;
+    }
+    const label = this.registry.get(m.source)?.label ?? `port${m.source}`;
+    const base = `${(replay?.name ?? 'satscope-live').replace(/\.[^.]+$/, '') || 'satscope'}-${label}`.replace(/[^\w.-]+/g, '-');
+    const mime = m.format === 'csv' ? 'text/csv' : 'application/x-ndjson';
+    this.host.post({ type: 'export-ready', name: `${base}.frames.${m.format}`, mime, data }, [data]);
   }
 
   async #startDemo(): Promise<void> {

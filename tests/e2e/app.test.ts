@@ -4,6 +4,7 @@
  * files, CSP, no third-party requests, and offline use. Screenshots of each state go to
  * test-results/screenshots/.
  */
+import { spawnSync } from 'node:child_process';
 import { existsSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
@@ -11,7 +12,7 @@ import type { Download, Page } from 'playwright-core';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { channelName } from '../../src/decoder/index.js';
 import { CaptureWriter, captureChunks, capturePorts, parseCapture, readCapture } from '../../src/capture/index.js';
-import { decodeCapture, summarizeCapture } from '../../src/analysis/index.js';
+import { captureSpan, decodeCapture, summarizeCapture } from '../../src/analysis/index.js';
 import { preset, simulate } from '../../src/simulator/index.js';
 import {
   SHARED_CAPTURES,
@@ -24,6 +25,7 @@ import {
   writeCapture,
   type AppSession,
 } from './app-fixture.js';
+import { CLI } from '../built-cli.js';
 
 const skip = browserUnavailable();
 if (skip !== null) console.warn(`skipping the page tests: ${skip}`);
@@ -287,6 +289,36 @@ describe.skipIf(skip !== null)('the page', () => {
     await expect(page.getByTestId('resolution').textContent()).resolves.toMatch(/2048 from the internal remote/);
     await page.waitForTimeout(500);
     await shot(page, 'remotes-replay');
+
+    // Remote R's decoded frames, the whole capture and then 1-2 s of it, are the lines
+    // `satscope decode` prints for that port.
+    const cli = (format: string) =>
+      spawnSync(process.execPath, [CLI, 'decode', path, '--format', format, '--port', '1'], { encoding: 'utf8' }).stdout;
+    const exportFrames = async (button: string, from = '', to = ''): Promise<string> => {
+      await page.getByRole('button', { name: 'Report', exact: true }).click();
+      await page.getByRole('group', { name: 'Decoded frames of remote R' }).waitFor();
+      await page.getByRole('textbox', { name: 'from' }).fill(from);
+      await page.getByRole('textbox', { name: 'to' }).fill(to);
+      if (from !== '') await shot(page, 'frames-export');
+      const download = page.waitForEvent('download');
+      await page.getByRole('button', { name: button }).click();
+      const d = await download;
+      expect(d.suggestedFilename()).toMatch(/^two-R\.frames\.(csv|jsonl)$/);
+      const saved = join(dir, d.suggestedFilename());
+      await d.saveAs(saved);
+      return readFileSync(saved, 'utf8');
+    };
+    const csv = cli('csv');
+    expect(csv.split('\n').length).toBeGreaterThan(200);
+    await expect(exportFrames('Frames as CSV')).resolves.toBe(csv);
+    const start = captureSpan(capture).startUs;
+    const inSpan = (line: string) => {
+      const t = (JSON.parse(line) as { t: number }).t * 1e6 - start;
+      return t >= 1e6 && t <= 2e6;
+    };
+    const want = cli('jsonl').trimEnd().split('\n').filter(inSpan);
+    expect(want.length).toBeGreaterThan(80);
+    await expect(exportFrames('Frames as JSONL', '1', '2')).resolves.toBe(`${want.join('\n')}\n`);
     expect(errors).toEqual([]);
     await page.context().close();
   });

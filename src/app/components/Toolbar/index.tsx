@@ -11,6 +11,7 @@ import { recording, replayName, resolutionOverride, send, sources } from '../../
 import { chooseCapture, openCapture, setCaptureInput } from '../../open-file.js';
 import { setTheme, theme, themeChoice } from '../../theme.js';
 import { Menu } from '../Menu/index.js';
+import { FramesExport } from './frames-export.js';
 import './style.css';
 
 function size(bytes: number): string {
@@ -258,7 +259,7 @@ export function Toolbar({ granted, onBind }: { granted: SerialPort[]; onBind(): 
           disabled={!canReport}
           title={
             canReport
-              ? 'One-page link-quality report of the capture being replayed, or of what was recorded live'
+              ? 'One-page link-quality report, or the decoded frames, of the capture being replayed or of what was recorded live'
               : 'Open a capture or record first: a report covers one of them'
           }
         >
@@ -282,6 +283,7 @@ export function Toolbar({ granted, onBind }: { granted: SerialPort[]; onBind(): 
               >
                 Report as data (JSON)
               </button>
+              <FramesExport close={close} />
             </>
           )}
         </Menu>
