@@ -113,6 +113,8 @@ export class Live {
   ended = false;
   /** While a forced resolution matches no frame: the resolution the stream looks like. */
   mismatch: 1024 | 2048 | null = null;
+  /** Each channel's frames, lowest, highest and last µs, as `satscope info` counts them (null: none yet). */
+  channels: Batch['channels'] | null = null;
   /** Source clock at the last batch, and when (performance.now()) it arrived. */
   #clockUs = NaN;
   #clockAtMs = 0;
@@ -130,6 +132,7 @@ export class Live {
     this.resolution = batch.resolution;
     this.ended = batch.ended;
     this.mismatch = batch.mismatch;
+    this.channels = batch.channels;
     this.series.append(batch.series);
     for (const e of batch.episodes) this.episodes.set(e.id, { kind: e.kind, startUs: e.startUs, endUs: e.endUs });
     for (const id of batch.retracted) this.episodes.delete(id);
@@ -151,6 +154,7 @@ export class Live {
     this.resolution = null;
     this.ended = false;
     this.mismatch = null;
+    this.channels = null;
     this.#clockUs = NaN;
     this.version++;
   }

@@ -16,6 +16,7 @@ import {
   type Resolution,
 } from '../decoder/index.js';
 import { LinkSeries } from '../analysis/index.js';
+import { ChannelRanges } from '../analysis/summary.js';
 import { InspectorLog } from './inspector.js';
 import { BUCKET_US, type Batch } from './protocol.js';
 
@@ -51,6 +52,10 @@ export class Engine {
   tap: EngineTap | null = null;
   readonly link: LinkMonitor;
   readonly series = new LinkSeries(BUCKET_US);
+  /** Each channel's frames and lowest, highest and last pulse width, as `satscope info` counts them. */
+  #ranges = new ChannelRanges();
+  /** Where the ranges start: NaN from the stream's start, else the checkpoint a seek restored. */
+  #rangesSinceUs = Number.NaN;
   readonly #positions = new Uint16Array(CHANNEL_COUNT);
   readonly #seenUs = new Float64Array(CHANNEL_COUNT).fill(NaN);
   #frames = 0;
@@ -117,6 +122,8 @@ export class Engine {
   restore(decoder: DecoderCheckpoint, link: LinkCheckpoint): void {
     this.decoder.restore(decoder);
     this.link.restore(link);
+    this.#ranges = new ChannelRanges();
+    this.#rangesSinceUs = this.link.lastFrameUs;
     this.#forced = decoder.resolutionOption !== 'auto';
     // Frames found missing from here on are placed from the checkpoint's last frame.
     this.#currentUs = this.link.lastFrameUs;
@@ -194,6 +201,7 @@ export class Engine {
       }
       this.link.frame(f);
       this.series.frame(f, this.link);
+      this.#ranges.frame(f);
       this.#frames++;
       this.tap?.frame(f);
       for (let i = 0; i < f.count; i++) {
@@ -324,11 +332,23 @@ export class Engine {
       series,
       episodes,
       retracted,
+      channels: {
+        frames: this.#ranges.frames.slice(),
+        minUs: this.#ranges.min.slice(),
+        maxUs: this.#ranges.max.slice(),
+        lastUs: this.#ranges.last.slice(),
+        sinceUs: this.#rangesSinceUs,
+      },
     };
     this.#frames = 0;
+    const c = batch.channels;
     return {
       batch,
       transfer: [
+        c.frames.buffer,
+        c.minUs.buffer,
+        c.maxUs.buffer,
+        c.lastUs.buffer,
         batch.positions.buffer,
         batch.seenUs.buffer,
         series.t.buffer,

@@ -134,6 +134,13 @@ export interface Batch {
   episodes: { id: number; kind: 'hold' | 'failsafe'; startUs: number; endUs: number | null }[];
   /** Ids of holds withdrawn: a silence the frames after it showed was the adapter holding bytes back. */
   retracted: number[];
+  // What `satscope info` prints per channel, over the frames this decode saw.
+  /**
+   * Each channel's frames, lowest, highest and last pulse width (µs), by channel id, as
+   * `ChannelRanges` counts them; `sinceUs`: NaN when they cover the stream from its start, else
+   * the time they start from (a replay's seek restores the decode there).
+   */
+  channels: { frames: Uint32Array; minUs: Float64Array; maxUs: Float64Array; lastUs: Float64Array; sinceUs: number };
 }
 
 export interface RecordingStatus {

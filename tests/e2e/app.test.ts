@@ -289,6 +289,18 @@ describe.skipIf(skip !== null)('the page', () => {
     await expect(page.getByTestId('resolution').textContent()).resolves.toMatch(/2048 from the internal remote/);
     await page.waitForTimeout(500);
     await shot(page, 'remotes-replay');
+    // Min / max / last per channel: what satscope info prints for that port.
+    await page.getByText('Min / max / last per channel').first().click();
+    const table = page.getByTestId('channel-ranges').first();
+    const ranges = expectB.channels
+      .filter((c) => c.id < 12)
+      .map((c) => [c.name, String(c.frames), `${c.minUs} µs`, `${c.maxUs} µs`, `${c.lastUs} µs`]);
+    await expect
+      .poll(() => table.locator('tbody tr').evaluateAll((rows) => rows.map((r) => [...r.children].map((c) => c.textContent ?? ''))), {
+        timeout: 3000,
+      })
+      .toEqual(ranges);
+    await page.getByText('Every frame so far.').first().waitFor();
 
     // Remote R's decoded frames, the whole capture and then 1-2 s of it, are the lines
     // `satscope decode` prints for that port.
