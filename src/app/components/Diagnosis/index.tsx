@@ -11,6 +11,7 @@ import { computed, signal } from '@preact/signals';
 import { useState } from 'preact/hooks';
 import type { DoctorFinding, FlightStack } from '../../../analysis/index.js';
 import { diagnosis, replayReading, send, sources } from '../../store.js';
+import { plural } from '../../../analysis/report-text.js';
 import { splitFindings } from './current.js';
 import './style.css';
 
@@ -179,7 +180,7 @@ export function DiagnosisPanel() {
     if (paste === null) return;
     const ok = await copy(`${paste.lines.join('\n')}\n`);
     copied.value = ok
-      ? `Copied ${paste.lines.length} ${which} lines (${paste.from.title}).`
+      ? `Copied ${plural(paste.lines.length, `${which} line`)} (${paste.from.title}).`
       : 'The browser did not allow copying: select the lines below instead.';
   };
   return (
