@@ -130,6 +130,18 @@ describe.skipIf(skip !== null)('the page parts', () => {
         await page.getByRole('button', { name: 'Play' }).click();
         await page.getByTestId('link-state').filter({ hasText: 'Ended' }).waitFor({ timeout: 20_000 });
         await expect(page.getByTestId('link-hint').textContent()).resolves.toMatch(/^Replay ended at 0:03\.\d: there the link was live\.$/);
+        // Min / max / last open, and the frames export in the Report menu, fit the width.
+        await page.getByText('Min / max / last per channel').first().click();
+        await page.getByTestId('channel-ranges').first().locator('tbody tr').first().filter({ hasText: 'µs' }).waitFor();
+        await page.getByRole('button', { name: 'Report', exact: true }).click();
+        await page.getByRole('group', { name: 'Decoded frames of remote A' }).waitFor();
+        await expect(page.evaluate(() => document.documentElement.scrollWidth)).resolves.toBeLessThanOrEqual(width);
+        const pop = await page.locator('.menu-pop:not([hidden])').boundingBox();
+        expect(pop?.x).toBeGreaterThanOrEqual(0);
+        expect((pop?.x ?? 0) + (pop?.width ?? 0)).toBeLessThanOrEqual(width);
+        const table = await page.getByTestId('channel-ranges').first().evaluate((t) => t.getBoundingClientRect().right);
+        const box = await page.locator('section.channels').first().evaluate((c) => c.getBoundingClientRect().right);
+        expect(table).toBeLessThanOrEqual(box + 1);
         await shot(page, `parts-${width}-${theme}-ended`);
         expect(errors).toEqual([]);
         await page.context().close();
