@@ -139,8 +139,14 @@ describe.skipIf(skip !== null)('the page parts', () => {
         const pop = await page.locator('.menu-pop:not([hidden])').boundingBox();
         expect(pop?.x).toBeGreaterThanOrEqual(0);
         expect((pop?.x ?? 0) + (pop?.width ?? 0)).toBeLessThanOrEqual(width);
-        const table = await page.getByTestId('channel-ranges').first().evaluate((t) => t.getBoundingClientRect().right);
-        const box = await page.locator('section.channels').first().evaluate((c) => c.getBoundingClientRect().right);
+        const table = await page
+          .getByTestId('channel-ranges')
+          .first()
+          .evaluate((t) => t.getBoundingClientRect().right);
+        const box = await page
+          .locator('section.channels')
+          .first()
+          .evaluate((c) => c.getBoundingClientRect().right);
         expect(table).toBeLessThanOrEqual(box + 1);
         await shot(page, `parts-${width}-${theme}-ended`);
         expect(errors).toEqual([]);
