@@ -27,8 +27,8 @@ const USAGE = `Usage:
 FILE is a SatScope capture (.sscap), a raw byte dump (.bin) or a Saleae async-serial CSV export
 (after --, a FILE may start with -). decode prints one line per frame as it decodes; info prints
 a summary (system, remote, resolution and why, frames, channels, fades, frame period, gaps,
-failsafe episodes), or with --json the same summary as JSON. --port picks the serial port of a
-capture that holds several (default 0). report makes a link-health report of every port (fades
+failsafe episodes) of every port, or with --json the summary of one as JSON. --port picks the
+serial port of a capture that holds several (default 0; info prints them all). report makes a link-health report of every port (fades
 per minute, lost frames, holds, failsafe episodes, frame-period jitter, channels, glitches, with
 graphs) as one self-contained HTML page on stdout, or in the file --out names (then the findings
 go to stdout); --json gives the same report as JSON.
@@ -64,6 +64,7 @@ async function main(argv: string[]): Promise<number> {
   const { capture } = loaded;
   for (const issue of capture.issues) process.stderr.write(`satscope: ${args.file}: ${issue.message}\n`);
   if (args.command === 'report') return report(capture, args, out);
+  if (args.command === 'info' && !args.json && args.port === null && capturePorts(capture).length > 1) return infoAll(capture, args, out);
   const port = args.port ?? 0;
   const noData = portProblem(capture, args.port);
   if (noData !== null) {
@@ -76,6 +77,14 @@ async function main(argv: string[]): Promise<number> {
     return finish(out, summary.decoder.frames > 0 ? 0 : 1);
   }
   return decode(capture, args, port, out);
+}
+
+/** `satscope info` of a capture with several ports and none chosen: each port's summary in turn. */
+function infoAll(capture: Capture, args: Args, out: TextOutput): Promise<number> {
+  const ports = capturePorts(capture);
+  const blocks = ports.map((port) => summarizeCapture(capture, { resolution: args.resolution, port }));
+  out.text(`${blocks.map((s) => formatSummary(s, basename(args.file), ports)).join('\n\n')}\n`);
+  return finish(out, blocks.some((s) => s.decoder.frames > 0) ? 0 : 1);
 }
 
 /** Why the port asked for (or port 0) cannot be decoded, naming the ports that have data; null when it can. */

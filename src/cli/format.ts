@@ -1,6 +1,8 @@
 /** Text forms of frames and summaries for the CLI. */
 import type { HealthReport, ReportFinding } from '../analysis/index.js';
 import type { CaptureSummary } from '../analysis/index.js';
+import { plural } from '../analysis/report-text.js';
+import type { CaptureTiming } from '../capture/index.js';
 import { systemInfo } from '../decoder/spec.js';
 
 // One frame a line, as `satscope decode` prints it: the library's, which the page's export uses too.
@@ -9,14 +11,29 @@ export { formatCsvHeader, formatCsvLine, formatJsonLine } from '../analysis/fram
 const ms = (us: number): string => `${(us / 1000).toFixed(us < 100_000 ? 2 : 0)} ms`;
 const hex = (v: number): string => `0x${v.toString(16).toUpperCase().padStart(2, '0')}`;
 
-/** The human summary `satscope info` prints. */
-export function formatSummary(s: CaptureSummary, name: string): string {
+/** A capture's timing in words: "a time per chunk", "no times". */
+export const TIMING_WORDS: Record<CaptureTiming, string> = {
+  'per-byte': 'a time per byte',
+  'per-chunk': 'a time per chunk',
+  none: 'no times',
+};
+
+/**
+ * The human summary `satscope info` prints of one port. `ports` lists every port of the capture
+ * with data, so that a summary of one of several says which one it is and names the others.
+ */
+export function formatSummary(s: CaptureSummary, name: string, ports: readonly number[] = [s.port]): string {
   const lines: string[] = [];
   const add = (label: string, value: string): void => {
     lines.push(`${label.padEnd(14)}${value}`);
   };
   const timed = s.timing !== 'none';
-  add('File', `${name} (${s.kind}, ${s.bytes} bytes on port ${s.port}, timing ${s.timing})`);
+  add('File', `${name} (${s.kind}, ${TIMING_WORDS[s.timing]})`);
+  const others = ports.filter((p) => p !== s.port);
+  add(
+    'Port',
+    `${s.port}, ${plural(s.bytes, 'byte')}${others.length === 0 ? '' : ` (the capture also has ${others.length === 1 ? 'port' : 'ports'} ${others.join(', ')})`}`,
+  );
   if (timed && Number.isFinite(s.durationUs)) add('Duration', `${(s.durationUs / 1e6).toFixed(3)} s`);
   const f = s.format;
   if (!f.locked && s.decoder.frames === 0) {
@@ -37,10 +54,10 @@ export function formatSummary(s: CaptureSummary, name: string): string {
   const d = s.decoder;
   add(
     'Frames',
-    `${d.frames} (${d.discardedBytes} bytes discarded, ${d.resyncs} resyncs, ${d.badFrames} bad frames, ${d.emptySlots} empty slots${d.vtxFrames ? `, ${d.vtxFrames} VTX frames` : ''})`,
+    `${d.frames} (${plural(d.discardedBytes, 'byte')} discarded, ${plural(d.resyncs, 'resync')}, ${plural(d.badFrames, 'bad frame')}, ${plural(d.emptySlots, 'empty slot')}${d.vtxFrames ? `, ${plural(d.vtxFrames, 'VTX frame')}` : ''})`,
   );
-  if (s.formatChanges > 0) add('', `the format changed ${s.formatChanges} time(s) during the capture`);
-  add('Channels', s.channels.length === 0 ? 'none' : '');
+  if (s.formatChanges > 0) add('', `the format changed ${plural(s.formatChanges, 'time')} during the capture`);
+  add('Channels', s.channels.length === 0 ? 'none' : `${s.channels.length} (frames carrying each, lowest–highest, last)`);
   for (const c of s.channels)
     lines.push(
       `  ${String(c.id).padStart(2)} ${c.name.padEnd(9)} ${String(c.frames).padStart(7)} frames  ${c.minUs}–${c.maxUs} µs  last ${c.lastUs} µs`,
@@ -54,8 +71,8 @@ export function formatSummary(s: CaptureSummary, name: string): string {
       'Frame period',
       Number.isFinite(l.periodUs) ? `${ms(l.periodUs)} measured (${ms(l.nominalPeriodUs)} nominal)` : 'too few frames to measure',
     );
-    add('Gaps', `${l.missedFrames} missed frames, longest gap ${ms(l.longestGapUs)}`);
-    add('Failsafe', `${l.holds} holds, ${l.failsafes} failsafes`);
+    add('Gaps', `${plural(l.missedFrames, 'missed frame')}, longest gap ${ms(l.longestGapUs)}`);
+    add('Failsafe', `${plural(l.holds, 'hold')}, ${plural(l.failsafes, 'failsafe')}`);
     for (const e of s.episodes) {
       const end = e.endUs === null ? 'to the end' : `until ${(e.endUs / 1e6).toFixed(3)} s`;
       lines.push(`  ${e.kind.padEnd(8)} from ${(e.startUs / 1e6).toFixed(3)} s ${end}`);
