@@ -5,11 +5,10 @@
  * gives it the browser's.
  */
 import { USB_CHUNK_JITTER_US } from '../decoder/index.js';
-import { parseCapture, type Capture } from '../capture/index.js';
+import type { Capture } from '../capture/index.js';
 import { Batcher } from './batcher.js';
 import { bind } from './binding.js';
 import { Diagnosis } from './diagnosis.js';
-import { framesFile } from './frames-export.js';
 import { type Host, notice, nowUs } from './host.js';
 import { type LiveSink, liveSink } from './live.js';
 import type { PortIdentity, ToWorker } from './protocol.js';
@@ -20,6 +19,7 @@ import { ReplaySession } from './replay/replay-session.js';
 import type { PreviewSizes } from './replay/replay-preview.js';
 import { type PassHelperMaker, WORKER_PASS_HELPER } from './replay/replay-helper.js';
 import { type ReportMaker, WORKER_REPORT_MAKER, report } from './report.js';
+import type { ReportRequest } from './report-worker.js';
 import { setResolution, shareResolution, tellMismatch } from './resolution.js';
 import { DemoSource } from './sources/demo.js';
 import { SerialPorts } from './sources/serial-ports.js';
@@ -197,27 +197,42 @@ export class Dispatcher {
     }
   }
 
-  /** A remote's decoded frames, from the capture replayed or the live session's recording. */
+  /**
+   * A remote's decoded frames, from the capture replayed or the live session's recording, made
+   * by the report helper (a long capture's take seconds; the ports are read meanwhile).
+   */
   async #exportFrames(m: Extract<ToWorker, { type: 'export-frames' }>): Promise<void> {
     const replay = this.replay;
-    let capture: Capture | null = replay?.source.capture ?? null;
-    if (replay === undefined) {
+    let of: ReportRequest['of'] | null = null;
+    let transfer: Transferable[] = [];
+    if (replay !== undefined) of = { capture: replay.source.capture };
+    else {
       const bytes = await this.recorder.current();
-      capture = bytes === null ? null : parseCapture(bytes);
+      if (bytes !== null) {
+        const copy = bytes.slice();
+        of = { bytes: copy };
+        transfer = [copy.buffer];
+      }
     }
-    if (capture === null) {
+    if (of === null) {
       notice(this.host, 'warning', 'No frames to export', 'Record the live session (● Record) or open a capture first.');
       return;
     }
-    const { data, frames } = framesFile(capture, { ...m, port: m.source, resolution: this.registry.resolution });
-    if (frames === 0) {
+    const name = replay?.name ?? 'satscope-live';
+    const frames = { port: m.source, format: m.format, fromUs: m.fromUs, toUs: m.toUs };
+    const reply = await this.#makeReport({ of, name, format: 'json', resolution: this.registry.resolution, frames }, transfer);
+    if (reply.error !== undefined) {
+      notice(this.host, 'error', 'The frames could not be exported', reply.error);
+      return;
+    }
+    if (reply.frames === 0) {
       notice(this.host, 'warning', 'No frames to export', 'No frame of this remote was decoded in that span.');
       return;
     }
     const label = this.registry.get(m.source)?.label ?? `port${m.source}`;
-    const base = `${(replay?.name ?? 'satscope-live').replace(/\.[^.]+$/, '') || 'satscope'}-${label}`.replace(/[^\w.-]+/g, '-');
+    const base = `${name.replace(/\.[^.]+$/, '') || 'satscope'}-${label}`.replace(/[^\w.-]+/g, '-');
     const mime = m.format === 'csv' ? 'text/csv' : 'application/x-ndjson';
-    this.host.post({ type: 'export-ready', name: `${base}.frames.${m.format}`, mime, data }, [data]);
+    this.host.post({ type: 'export-ready', name: `${base}.frames.${m.format}`, mime, data: reply.data }, [reply.data]);
   }
 
   async #startDemo(): Promise<void> {
