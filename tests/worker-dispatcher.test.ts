@@ -3,9 +3,10 @@
  * ports, commands through its queue in order, sources closed while their data is on the way.
  */
 import { describe, expect, it } from 'vitest';
-import { encodeCapture } from '../src/capture/index.js';
+import { encodeCapture, parseCapture } from '../src/capture/index.js';
 import { preset, simulate } from '../src/simulator/index.js';
 import { Dispatcher } from '../src/worker/dispatcher.js';
+import { framesFile } from '../src/worker/frames-export.js';
 import type { ToWorker } from '../src/worker/protocol.js';
 import type { ReportRequest } from '../src/worker/report-worker.js';
 import { usbChunks } from './feeds.js';
@@ -37,6 +38,10 @@ class FakePort {
       },
     });
   }
+  /** Bytes arrive on the line. */
+  receive(bytes: Uint8Array): void {
+    this.#line?.enqueue(bytes);
+  }
   /** The device goes away: reading fails as WebSerial's does. */
   unplug(): void {
     const gone = new Error('The device has been lost.');
@@ -63,6 +68,11 @@ function setup(findPort?: () => Promise<SerialPort | undefined>) {
     findPort,
     makeReport: async (request) => {
       reports.push(request);
+      // Frames are made as the helper makes them; a report is a stand-in.
+      if (request.frames !== undefined && 'capture' in request.of) {
+        const file = framesFile(request.of.capture, { ...request.frames, resolution: request.resolution });
+        return { data: file.data, frames: file.frames };
+      }
       return { data: new TextEncoder().encode('report').buffer as ArrayBuffer };
     },
   });
@@ -95,6 +105,24 @@ describe('the dispatcher', () => {
       [0, 'A', 'paused', 'replay'],
       [1, 'Tail', 'paused', 'replay'],
     ]);
+  });
+
+  it("exports a replayed remote's decoded frames through the helper, named after the capture and the remote", async () => {
+    const { send, of, reports } = setup();
+    const data = twoPortCapture();
+    await send({ type: 'replay-open', name: 'two.sscap', file: new Blob([data]) }, { type: 'replay-pause' });
+    await send({ type: 'export-frames', source: 1, format: 'jsonl', fromUs: null, toUs: null });
+    expect(reports.at(-1)?.frames).toEqual({ port: 1, format: 'jsonl', fromUs: null, toUs: null });
+    const file = of('export-ready').at(-1);
+    expect(file?.name).toBe('two-B.frames.jsonl');
+    const want = framesFile(parseCapture(new Uint8Array(data)), { port: 1, format: 'jsonl', fromUs: null, toUs: null, resolution: 'auto' });
+    expect(new TextDecoder().decode(file?.data)).toBe(new TextDecoder().decode(want.data));
+    expect(want.frames).toBeGreaterThan(250);
+    // A span with no frame: said, and nothing saved.
+    const before = of('export-ready').length;
+    await send({ type: 'export-frames', source: 1, format: 'csv', fromUs: 0, toUs: 1 });
+    expect(of('export-ready').length).toBe(before);
+    expect(of('notice').at(-1)?.title).toBe('No frames to export');
   });
 
   it('tells the user of a command that failed, and goes on with the next', async () => {
@@ -155,6 +183,47 @@ describe('the dispatcher', () => {
     clock.advance(5000);
     await worker.queue.idle();
     expect(port.opens).toBe(2);
+    await send({ type: 'close-all' });
+  });
+
+  it('counts no hold, failsafe or missed frame for the time an unplugged adapter is away', async () => {
+    const port = new FakePort();
+    let plugged = true;
+    const { send, worker, clock, batches } = setup(async () => (plugged ? (port as unknown as SerialPort) : undefined));
+    await send({ type: 'serial-open', port: { index: 0, usbVendorId: 0x0403, usbProductId: 0x6001 } });
+    // A second of frames at their pace, then the adapter goes.
+    const sim = simulate({ ...preset('dsmx-11ms-2048-internal'), seed: 5 }, 1_000_000);
+    for (let i = 0; i < sim.bytes.length; i += 16) {
+      port.receive(sim.bytes.slice(i, i + 16));
+      await new Promise((r) => setTimeout(r, 0));
+      clock.advance(11);
+    }
+    plugged = false;
+    port.unplug();
+    await new Promise((r) => setTimeout(r, 0));
+    clock.advance(3000);
+    await worker.queue.idle();
+    worker.batcher.flush();
+    const last = batches()
+      .filter((b) => b.source === 0)
+      .at(-1)?.batch;
+    expect(last?.counters.frames).toBeGreaterThan(80);
+    expect(last?.link).toMatchObject({ holds: 0, failsafes: 0, missedFrames: 0, state: 'waiting' });
+    // Back, and frames again: still nothing counted for the time away.
+    plugged = true;
+    clock.advance(1000);
+    await worker.queue.idle();
+    expect(worker.registry.get(0)?.state).toBe('reading');
+    for (let i = 0; i < 160; i += 16) {
+      port.receive(sim.bytes.slice(i, i + 16));
+      await new Promise((r) => setTimeout(r, 0));
+      clock.advance(11);
+    }
+    worker.batcher.flush();
+    const back = batches()
+      .filter((b) => b.source === 0)
+      .at(-1)?.batch;
+    expect(back?.link).toMatchObject({ holds: 0, failsafes: 0, missedFrames: 0, state: 'live' });
     await send({ type: 'close-all' });
   });
 

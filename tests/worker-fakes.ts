@@ -54,6 +54,17 @@ export class FakeClock implements Clock {
     }
     this.#now = end;
   }
+
+  /**
+   * Moves time on by `ms` with the thread starved: no timer runs on the way, and each one due
+   * runs once at the end, late, as a browser's timers do after a long task.
+   */
+  stall(ms: number): void {
+    const end = this.#now + ms;
+    for (const t of this.#timers.values()) if (t.at < end) t.at = end;
+    this.#now = end;
+    this.advance(0);
+  }
 }
 
 /** A clock that moves 10 ms each time it is read, so the capture's decode goes in slices. */

@@ -57,6 +57,7 @@ export { decodeCapture, timingJitterUs, type DecodeCaptureOptions } from './capt
 export { type CaptureSpan, SpanTally, captureSpan, seedCaptureSpan, spanBetween } from './capture-span.js';
 export { resolutionKey } from './resolution-key.js';
 export { summarizeCapture, type CaptureSummary, type ChannelSummary } from './summary.js';
+export { formatCsvHeader, formatCsvLine, formatJsonLine } from './frame-text.js';
 export { LinkSeries, monitorWithSeries } from './series.js';
 export { healthReport, type ReadingsElsewhere } from './report.js';
 export { formatClock, formatDuration } from './report-text.js';

@@ -34,8 +34,11 @@ export interface CaptureSummary {
   issues: readonly CaptureIssue[];
 }
 
-/** Each channel's frames and pulse widths (µs), frame by frame; fields, not a closure over mutable locals, for the per-frame loop. */
-class ChannelRanges {
+/**
+ * Each channel's frames and pulse widths (µs), frame by frame; fields, not a closure over mutable
+ * locals, for the per-frame loop. `satscope info` prints them, and the page shows them live.
+ */
+export class ChannelRanges {
   readonly frames = new Uint32Array(CHANNEL_COUNT);
   readonly min = new Float64Array(CHANNEL_COUNT).fill(Infinity);
   readonly max = new Float64Array(CHANNEL_COUNT).fill(-Infinity);

@@ -116,6 +116,8 @@ export class Live {
   ended = false;
   /** While a forced resolution matches no frame: the resolution the stream looks like. */
   mismatch: 1024 | 2048 | null = null;
+  /** Each channel's frames, lowest, highest and last µs, as `satscope info` counts them (null: none yet). */
+  channels: Batch['channels'] | null = null;
   /** Source clock at the last batch, and when (performance.now()) it arrived. */
   #clockUs = NaN;
   #clockAtMs = 0;
@@ -133,6 +135,7 @@ export class Live {
     this.resolution = batch.resolution;
     this.ended = batch.ended;
     this.mismatch = batch.mismatch;
+    this.channels = batch.channels;
     this.series.append(batch.series);
     this.traces.append(batch.traces);
     for (const e of batch.episodes) this.episodes.set(e.id, { kind: e.kind, startUs: e.startUs, endUs: e.endUs });
@@ -156,6 +159,7 @@ export class Live {
     this.resolution = null;
     this.ended = false;
     this.mismatch = null;
+    this.channels = null;
     this.#clockUs = NaN;
     this.version++;
   }

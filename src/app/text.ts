@@ -20,3 +20,8 @@ export function setText(el: Node, text: string): void {
     if (el.firstChild === null) el.appendChild((el.ownerDocument ?? document).createTextNode(''));
   }
 }
+
+/** A fade rate as the page words it everywhere: per minute, as the link monitor's rate (per second) times 60. */
+export function fadesPerMinute(perSecond: number): string {
+  return Number.isFinite(perSecond) ? `${(perSecond * 60).toFixed(0)}/min` : '—';
+}

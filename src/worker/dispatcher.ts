@@ -19,6 +19,7 @@ import { ReplaySession } from './replay/replay-session.js';
 import type { PreviewSizes } from './replay/replay-preview.js';
 import { type PassHelperMaker, WORKER_PASS_HELPER } from './replay/replay-helper.js';
 import { type ReportMaker, WORKER_REPORT_MAKER, report } from './report.js';
+import type { ReportRequest } from './report-worker.js';
 import { setResolution, shareResolution, tellMismatch } from './resolution.js';
 import { DemoSource } from './sources/demo.js';
 import { SerialPorts } from './sources/serial-ports.js';
@@ -129,7 +130,7 @@ export class Dispatcher {
       case 'export': {
         const result = await recorder.export(message.recording, message.what);
         if (typeof result === 'string') notice(host, 'warning', 'Nothing to export', result);
-        else host.post({ type: 'export-ready', name: result.name, mime: 'application/octet-stream', data: result.data }, [result.data]);
+        else for (const { name, data } of result) host.post({ type: 'export-ready', name, mime: 'application/octet-stream', data }, [data]);
         break;
       }
       case 'inspect': {
@@ -154,6 +155,9 @@ export class Dispatcher {
         );
         break;
       }
+      case 'export-frames':
+        await this.#exportFrames(message);
+        break;
       case 'diagnosis-confirm':
         await this.#confirm(message);
         break;
@@ -193,10 +197,50 @@ export class Dispatcher {
     }
   }
 
+  /**
+   * A remote's decoded frames, from the capture replayed or the live session's recording, made
+   * by the report helper (a long capture's take seconds; the ports are read meanwhile).
+   */
+  async #exportFrames(m: Extract<ToWorker, { type: 'export-frames' }>): Promise<void> {
+    const replay = this.replay;
+    let of: ReportRequest['of'] | null = null;
+    let transfer: Transferable[] = [];
+    if (replay !== undefined) of = { capture: replay.source.capture };
+    else {
+      const bytes = await this.recorder.current();
+      if (bytes !== null) {
+        const copy = bytes.slice();
+        of = { bytes: copy };
+        transfer = [copy.buffer];
+      }
+    }
+    if (of === null) {
+      notice(this.host, 'warning', 'No frames to export', 'Record the live session (● Record) or open a capture first.');
+      return;
+    }
+    const name = replay?.name ?? 'satscope-live';
+    const frames = { port: m.source, format: m.format, fromUs: m.fromUs, toUs: m.toUs };
+    const reply = await this.#makeReport({ of, name, format: 'json', resolution: this.registry.resolution, frames }, transfer);
+    if (reply.error !== undefined) {
+      notice(this.host, 'error', 'The frames could not be exported', reply.error);
+      return;
+    }
+    if (reply.frames === 0) {
+      notice(this.host, 'warning', 'No frames to export', 'No frame of this remote was decoded in that span.');
+      return;
+    }
+    const label = this.registry.get(m.source)?.label ?? `port${m.source}`;
+    const base = `${name.replace(/\.[^.]+$/, '') || 'satscope'}-${label}`.replace(/[^\w.-]+/g, '-');
+    const mime = m.format === 'csv' ? 'text/csv' : 'application/x-ndjson';
+    this.host.post({ type: 'export-ready', name: `${base}.frames.${m.format}`, mime, data: reply.data }, [reply.data]);
+  }
+
   async #startDemo(): Promise<void> {
     const { registry } = this;
     await registry.closeAll();
-    const demo = new DemoSource(this.host.clock, this.sink);
+    const demo = new DemoSource(this.host.clock, this.sink, (atUs) => {
+      for (const s of registry.list()) if (s.kind === 'demo') s.engine.interrupt(atUs);
+    });
     await registry.use(demo);
     for (let i = 0; i < demo.remotes; i++) {
       const s = registry.add('demo', i, i === 0 ? 'Demo remote (internal, DSMX 11 ms)' : 'Demo remote (external)', USB_CHUNK_JITTER_US);

@@ -16,6 +16,7 @@ import {
   type Resolution,
 } from '../decoder/index.js';
 import { LinkSeries } from '../analysis/index.js';
+import { ChannelRanges } from '../analysis/summary.js';
 import { InspectorLog } from './inspector.js';
 import { TraceLog } from './traces.js';
 import { BUCKET_US, type Batch } from './protocol.js';
@@ -54,6 +55,10 @@ export class Engine {
   readonly series = new LinkSeries(BUCKET_US);
   /** Every frame's channel values and the glitches found, for the page's channel traces. */
   readonly traces = new TraceLog();
+  /** Each channel's frames and lowest, highest and last pulse width, as `satscope info` counts them. */
+  #ranges = new ChannelRanges();
+  /** Where the ranges start: NaN from the stream's start, else the checkpoint a seek restored. */
+  #rangesSinceUs = Number.NaN;
   readonly #positions = new Uint16Array(CHANNEL_COUNT);
   readonly #seenUs = new Float64Array(CHANNEL_COUNT).fill(NaN);
   #frames = 0;
@@ -95,6 +100,8 @@ export class Engine {
   readonly #pushTimes = new Array<Float64Array | undefined>(PUSHES_KEPT).fill(undefined);
   /** Pushes so far. */
   #pushCount = 0;
+  /** Where the source stopped sending for a reason not the link's (`interrupt()`), NaN when not. */
+  #interruptUs = Number.NaN;
   /** Whether the resolution is forced (only then can it match no frame). */
   #forced: boolean;
 
@@ -118,6 +125,8 @@ export class Engine {
   restore(decoder: DecoderCheckpoint, link: LinkCheckpoint): void {
     this.decoder.restore(decoder);
     this.link.restore(link);
+    this.#ranges = new ChannelRanges();
+    this.#rangesSinceUs = this.link.lastFrameUs;
     this.#forced = decoder.resolutionOption !== 'auto';
     // Frames found missing from here on are placed from the checkpoint's last frame.
     this.#currentUs = this.link.lastFrameUs;
@@ -135,6 +144,18 @@ export class Engine {
     this.#endUs = endUs;
     this.#currentUs = Number.isFinite(endUs) ? endUs : this.#currentUs;
     if (this.#mismatch === null) this.link.finish(endUs);
+    this.#changed = true;
+  }
+
+  /**
+   * The source stopped sending at `atUs` for a reason that is not the link (its port was lost,
+   * the demo's simulation paused over a stall): no hold, failsafe or missed frame is counted
+   * from there to its next frame. The link stops being judged now, and is told again at the
+   * first frame after `atUs`, once the frames the decoder still held from before are counted.
+   */
+  interrupt(atUs: number): void {
+    this.link.interrupt(atUs);
+    this.#interruptUs = atUs;
     this.#changed = true;
   }
 
@@ -177,9 +198,14 @@ export class Engine {
       this.inspector.onFrame(f);
       const t = f.timeUs;
       this.#currentUs = t;
+      if (t > this.#interruptUs) {
+        this.link.interrupt(this.#interruptUs);
+        this.#interruptUs = Number.NaN;
+      }
       this.link.frame(f);
       this.series.frame(f, this.link);
       this.traces.frame(f, this.link.holdAfterUs);
+      this.#ranges.frame(f);
       this.#frames++;
       this.tap?.frame(f);
       for (let i = 0; i < f.count; i++) {
@@ -311,11 +337,23 @@ export class Engine {
       episodes,
       retracted,
       traces: this.traces.take(),
+      channels: {
+        frames: this.#ranges.frames.slice(),
+        minUs: this.#ranges.min.slice(),
+        maxUs: this.#ranges.max.slice(),
+        lastUs: this.#ranges.last.slice(),
+        sinceUs: this.#rangesSinceUs,
+      },
     };
     this.#frames = 0;
+    const c = batch.channels;
     return {
       batch,
       transfer: [
+        c.frames.buffer,
+        c.minUs.buffer,
+        c.maxUs.buffer,
+        c.lastUs.buffer,
         batch.positions.buffer,
         batch.seenUs.buffer,
         series.t.buffer,

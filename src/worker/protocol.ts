@@ -47,7 +47,14 @@ export type ToWorker =
   | { type: 'replay-seek'; timeUs: number }
   | { type: 'set-resolution'; resolution: 'auto' | 1024 | 2048 }
   /** Listen briefly at a finding's other line setting to confirm it, then return to 115200. */
-  | { type: 'diagnosis-confirm'; source: number; probe: ConfirmProbe };
+  | { type: 'diagnosis-confirm'; source: number; probe: ConfirmProbe }
+  // Exports of what the page shows.
+  /**
+   * One remote's decoded frames (of the capture being replayed, or of the live session's
+   * recording) as `satscope decode` writes them; `fromUs`/`toUs` on the capture's clock, null
+   * for its start or end.
+   */
+  | { type: 'export-frames'; source: number; format: 'csv' | 'jsonl'; fromUs: number | null; toUs: number | null };
 
 /** Low-rate state of one source (one remote), sent when it changes. */
 export interface SourceStatus {
@@ -129,6 +136,13 @@ export interface Batch {
   retracted: number[];
   /** Every timed frame's channel values since the last batch, and the glitches found (the channel traces). */
   traces: TraceBatch;
+  // What `satscope info` prints per channel, over the frames this decode saw.
+  /**
+   * Each channel's frames, lowest, highest and last pulse width (µs), by channel id, as
+   * `ChannelRanges` counts them; `sinceUs`: NaN when they cover the stream from its start, else
+   * the time they start from (a replay's seek restores the decode there).
+   */
+  channels: { frames: Uint32Array; minUs: Float64Array; maxUs: Float64Array; lastUs: Float64Array; sinceUs: number };
 }
 
 export interface RecordingStatus {

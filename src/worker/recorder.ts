@@ -5,7 +5,7 @@
  * carries a CRC, so an unfinished file is simply a capture that ends early: a marker file names
  * the recording in progress, and on the next start it is offered back.
  */
-import { CaptureWriter, parseCapture, type CaptureMeta } from '../capture/index.js';
+import { CaptureWriter, captureChunks, capturePorts, parseCapture, type Capture, type CaptureMeta } from '../capture/index.js';
 import type { RecordingStatus } from './protocol.js';
 
 const DIR = 'recordings';
@@ -62,6 +62,22 @@ async function pruneFinished(dir: FileSystemDirectoryHandle, unfinished: readonl
   }
   names.sort();
   for (const name of names.slice(0, Math.max(0, names.length - KEEP_FINISHED))) await dir.removeEntry(name).catch(() => undefined);
+}
+
+/** A capture's raw bytes, one file per port (`base.bin`, or `base-port0.bin`… with several ports). */
+export function rawFiles(capture: Capture, base: string): { name: string; data: ArrayBuffer }[] {
+  const ports = capturePorts(capture);
+  if (ports.length <= 1) return [{ name: `${base}.bin`, data: capture.bytes.slice().buffer }];
+  return ports.map((port) => {
+    const parts = Array.from(captureChunks(capture, port), (c) => c.bytes);
+    const out = new Uint8Array(parts.reduce((n, b) => n + b.length, 0));
+    let at = 0;
+    for (const b of parts) {
+      out.set(b, at);
+      at += b.length;
+    }
+    return { name: `${base}-port${port}.bin`, data: out.buffer };
+  });
 }
 
 export class Recorder {
@@ -222,17 +238,18 @@ export class Recorder {
   }
 
   /**
-   * The bytes of the last (or recovered) recording: the .sscap file itself, or the raw serial
-   * bytes alone (every intact record's data, in order).
+   * The last (or recovered) recording: the .sscap file itself, or the raw serial bytes alone,
+   * one file per port (every intact record's data of that port, in order). A raw file has no
+   * room to say which port a byte came from, so two ports' bytes in one would interleave into
+   * a stream no decoder can read.
    */
-  async export(which: 'last' | 'recovered', what: 'sscap' | 'raw'): Promise<{ name: string; data: ArrayBuffer } | string> {
+  async export(which: 'last' | 'recovered', what: 'sscap' | 'raw'): Promise<{ name: string; data: ArrayBuffer }[] | string> {
     const name = which === 'last' ? this.#last : (this.#recovered?.name ?? null);
     if (name === null || this.#dir === undefined) return which === 'last' ? 'Nothing recorded yet.' : 'No unfinished recording.';
     const file = await (await this.#dir.getFileHandle(name)).getFile();
     const data = await file.arrayBuffer();
-    if (what === 'sscap') return { name, data };
-    const capture = parseCapture(new Uint8Array(data));
-    return { name: name.replace(/\.sscap$/, '.bin'), data: capture.bytes.slice().buffer };
+    if (what === 'sscap') return [{ name, data }];
+    return rawFiles(parseCapture(new Uint8Array(data)), name.replace(/\.sscap$/, ''));
   }
 
   /**

@@ -1,10 +1,12 @@
 /**
- * A short-lived worker that makes one health report (diagnosedHealthReport, reportHtml), so the
- * worker reading the ports never stalls on it.
+ * A short-lived worker that makes one health report (diagnosedHealthReport, reportHtml), or one
+ * remote's decoded frames as `satscope decode` writes them (frames-export.ts), so the worker
+ * reading the ports never stalls on it (a long capture's frames take seconds).
  */
 /// <reference lib="webworker" />
 import { type Capture, readCapture } from '../capture/index.js';
 import { diagnosedHealthReport, reportHtml } from '../analysis/index.js';
+import { type FramesExport, framesFile } from './frames-export.js';
 
 export interface ReportRequest {
   /** A capture file's bytes (the live session's recording), or a capture already read (the one being replayed). */
@@ -12,16 +14,25 @@ export interface ReportRequest {
   name: string;
   format: 'html' | 'json';
   resolution: 'auto' | 1024 | 2048;
+  /** Instead of the report: these decoded frames (`format` is then unused). */
+  frames?: Omit<FramesExport, 'resolution'>;
 }
 
-export type ReportReply = { data: ArrayBuffer; error?: undefined } | { error: string; data?: undefined };
+/** The file made; with `frames` asked for, how many it holds. */
+export type ReportReply = { data: ArrayBuffer; frames?: number; error?: undefined } | { error: string; data?: undefined };
 
 const scope = self as unknown as DedicatedWorkerGlobalScope;
 
 scope.addEventListener('message', (event: MessageEvent<ReportRequest>) => {
-  const { of, name, format, resolution } = event.data;
+  const { of, name, format, resolution, frames } = event.data;
   try {
     const capture = 'capture' in of ? of.capture : readCapture(of.bytes, name);
+    if (frames !== undefined) {
+      const file = framesFile(capture, { ...frames, resolution });
+      const reply: ReportReply = { data: file.data, frames: file.frames };
+      scope.postMessage(reply, [file.data]);
+      return;
+    }
     const report = diagnosedHealthReport(capture, { resolution, name });
     const text = format === 'html' ? reportHtml(report) : `${JSON.stringify(report, null, 2)}\n`;
     const data = new TextEncoder().encode(text).buffer as ArrayBuffer;

@@ -4,14 +4,15 @@
  * files, CSP, no third-party requests, and offline use. Screenshots of each state go to
  * test-results/screenshots/.
  */
+import { spawnSync } from 'node:child_process';
 import { existsSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import type { Page } from 'playwright-core';
+import type { Download, Page } from 'playwright-core';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { channelName } from '../../src/decoder/index.js';
-import { CaptureWriter, capturePorts, parseCapture, readCapture } from '../../src/capture/index.js';
-import { decodeCapture, summarizeCapture } from '../../src/analysis/index.js';
+import { CaptureWriter, captureChunks, capturePorts, parseCapture, readCapture } from '../../src/capture/index.js';
+import { captureSpan, decodeCapture, summarizeCapture } from '../../src/analysis/index.js';
 import { preset, simulate } from '../../src/simulator/index.js';
 import {
   SHARED_CAPTURES,
@@ -24,6 +25,7 @@ import {
   writeCapture,
   type AppSession,
 } from './app-fixture.js';
+import { CLI } from '../built-cli.js';
 
 const skip = browserUnavailable();
 if (skip !== null) console.warn(`skipping the page tests: ${skip}`);
@@ -127,16 +129,28 @@ describe.skipIf(skip !== null)('the page', () => {
         input.dispatchEvent(new Event('change', { bubbles: true }));
       }, us);
     };
+    // Paused, the panel says so, and what the link was doing at that point of the capture.
     await seek(failsafeGap.lastFrameUs! + 200_000);
-    await page.getByTestId('link-state').filter({ hasText: 'Hold' }).waitFor();
+    await page.getByTestId('link-hint').filter({ hasText: 'there the link was in hold' }).waitFor();
+    await expect(page.getByTestId('link-state').textContent()).resolves.toBe('Paused');
     await shot(page, 'hold');
     await seek(failsafeGap.lastFrameUs! + 1_200_000);
-    await page.getByTestId('link-state').filter({ hasText: 'Failsafe' }).waitFor();
+    await page.getByTestId('link-hint').filter({ hasText: 'there the link was in failsafe' }).waitFor();
+    await expect(page.getByTestId('link-state').textContent()).resolves.toBe('Paused');
     await shot(page, 'failsafe');
+    // Playing, the state at the replay position, named as the capture's.
     await page.getByRole('button', { name: 'Play' }).click();
+    await page
+      .getByTestId('link-hint')
+      .filter({ hasText: /^Replay at \d:\d\d\.\d: / })
+      .waitFor();
     await playToEnd(page);
-    await page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor();
-    await expect(page.locator('.link dd').nth(1).textContent()).resolves.toMatch(/2 holds · 1 failsafes/);
+    await page.getByTestId('link-state').filter({ hasText: 'Ended' }).waitFor();
+    await page
+      .getByTestId('link-hint')
+      .filter({ hasText: /^Replay ended at 0:03\.\d: there the link was live\.$/ })
+      .waitFor();
+    await expect(page.locator('.link dd').nth(1).textContent()).resolves.toBe('2 holds · 1 failsafe');
     // The health report of the capture, as a page and as JSON.
     const html = page.waitForEvent('download');
     await page.getByRole('button', { name: 'Report', exact: true }).click();
@@ -176,6 +190,27 @@ describe.skipIf(skip !== null)('the page', () => {
     expect(capturePorts(capture)).toEqual([0, 1]);
     expect(summarizeCapture(capture, { port: 1 }).format.remote).toBe('external');
     expect(capture.meta.ports?.map((p) => p.name)).toEqual(['A', 'B']);
+    // Raw .bin: one file per port, each exactly that remote's bytes, decoding with nothing discarded.
+    const raws: Download[] = [];
+    page.on('download', (d) => raws.push(d));
+    await page.getByRole('button', { name: 'Other export formats' }).click();
+    await page.getByRole('button', { name: 'raw .bin' }).click();
+    await expect.poll(() => raws.length, { timeout: 5000 }).toBe(2);
+    await page.waitForTimeout(300);
+    expect(raws.length).toBe(2);
+    expect(raws.map((d) => d.suggestedFilename())).toEqual([expect.stringMatching(/-port0\.bin$/), expect.stringMatching(/-port1\.bin$/)]);
+    for (const [port, d] of raws.entries()) {
+      const path = join(dir, `recorded-${port}.bin`);
+      await d.saveAs(path);
+      const raw = readCapture(new Uint8Array(readFileSync(path)), path);
+      const want = [...captureChunks(capture, port)].flatMap((c) => [...c.bytes]);
+      expect(Buffer.from(raw.bytes).equals(Buffer.from(want))).toBe(true);
+      const alone = summarizeCapture(raw);
+      expect(alone.decoder.discardedBytes).toBe(0);
+      expect(alone.decoder.frames).toBe(summarizeCapture(capture, { port }).decoder.frames);
+      expect(alone.format.remote).toBe(port === 0 ? 'internal' : 'external');
+    }
+    page.removeAllListeners('download');
     // A report on the live session's recording, made off the reading worker.
     const reportDownload = page.waitForEvent('download');
     await page.getByRole('button', { name: 'Report', exact: true }).click();
@@ -254,6 +289,48 @@ describe.skipIf(skip !== null)('the page', () => {
     await expect(page.getByTestId('resolution').textContent()).resolves.toMatch(/2048 from the internal remote/);
     await page.waitForTimeout(500);
     await shot(page, 'remotes-replay');
+    // Min / max / last per channel: what satscope info prints for that port.
+    await page.getByText('Min / max / last per channel').first().click();
+    const table = page.getByTestId('channel-ranges').first();
+    const ranges = expectB.channels
+      .filter((c) => c.id < 12)
+      .map((c) => [c.name, String(c.frames), `${c.minUs} µs`, `${c.maxUs} µs`, `${c.lastUs} µs`]);
+    await expect
+      .poll(() => table.locator('tbody tr').evaluateAll((rows) => rows.map((r) => [...r.children].map((c) => c.textContent ?? ''))), {
+        timeout: 3000,
+      })
+      .toEqual(ranges);
+    await page.getByText('Every frame so far.').first().waitFor();
+
+    // Remote R's decoded frames, the whole capture and then 1-2 s of it, are the lines
+    // `satscope decode` prints for that port.
+    const cli = (format: string) =>
+      spawnSync(process.execPath, [CLI, 'decode', path, '--format', format, '--port', '1'], { encoding: 'utf8' }).stdout;
+    const exportFrames = async (button: string, from = '', to = ''): Promise<string> => {
+      await page.getByRole('button', { name: 'Report', exact: true }).click();
+      await page.getByRole('group', { name: 'Decoded frames of remote R' }).waitFor();
+      await page.getByRole('textbox', { name: 'from' }).fill(from);
+      await page.getByRole('textbox', { name: 'to' }).fill(to);
+      if (from !== '') await shot(page, 'frames-export');
+      const download = page.waitForEvent('download');
+      await page.getByRole('button', { name: button }).click();
+      const d = await download;
+      expect(d.suggestedFilename()).toMatch(/^two-R\.frames\.(csv|jsonl)$/);
+      const saved = join(dir, d.suggestedFilename());
+      await d.saveAs(saved);
+      return readFileSync(saved, 'utf8');
+    };
+    const csv = cli('csv');
+    expect(csv.split('\n').length).toBeGreaterThan(200);
+    await expect(exportFrames('Frames as CSV')).resolves.toBe(csv);
+    const start = captureSpan(capture).startUs;
+    const inSpan = (line: string) => {
+      const t = (JSON.parse(line) as { t: number }).t * 1e6 - start;
+      return t >= 1e6 && t <= 2e6;
+    };
+    const want = cli('jsonl').trimEnd().split('\n').filter(inSpan);
+    expect(want.length).toBeGreaterThan(80);
+    await expect(exportFrames('Frames as JSONL', '1', '2')).resolves.toBe(`${want.join('\n')}\n`);
     expect(errors).toEqual([]);
     await page.context().close();
   });

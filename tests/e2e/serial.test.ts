@@ -94,11 +94,18 @@ describe.skipIf(skip !== null)('a receiver on a serial port', () => {
     await expect(page.locator('.link dd').nth(1).textContent()).resolves.toMatch(/^[01] holds? · 0 failsafes$/);
     await shot(page, 'serial-live');
 
-    // Unplug: the page says so, holds, then fails safe; the recording goes on and keeps every byte.
+    // Unplug: the page says the port is lost (not a failsafe: no frame can arrive, so the link's
+    // state is unknown), and what the doctor said of it is no longer the link now; the recording
+    // goes on and keeps every byte.
     await fake.hangup();
     await page.getByRole('alert').filter({ hasText: 'unplugged' }).waitFor();
-    await linkState(page, 'Failsafe', 5000);
+    await linkState(page, 'Port lost', 5000);
+    await expect(page.getByTestId('link-hint').textContent()).resolves.toMatch(/^Remote A's adapter is gone/);
     await expect(page.getByTestId('source-status').textContent()).resolves.toMatch(/device lost/);
+    await page.waitForTimeout(1500);
+    await expect(page.getByTestId('link-state').textContent()).resolves.toBe('Port lost');
+    await expect(page.getByTestId('top-finding').count()).resolves.toBe(0);
+    await expect(page.getByTestId('findings').count()).resolves.toBe(0);
     await shot(page, 'serial-unplugged');
 
     // Plug back in: picked up again with no prompt; the rest of the capture arrives.

@@ -79,6 +79,11 @@ async function replayTime(page: Page): Promise<[number, number]> {
   return [Number(m[1]) * 60 + Number(m[2]), Number(m[3]) * 60 + Number(m[4])];
 }
 
+/** The link panel's episode counts, as the page words them ("1 hold · 0 failsafes"). */
+function episodesText(holds: number, failsafes: number): string {
+  return `${holds} ${holds === 1 ? 'hold' : 'holds'} · ${failsafes} ${failsafes === 1 ? 'failsafe' : 'failsafes'}`;
+}
+
 describe.skipIf(skip !== null)('honest states', () => {
   it('replays a Saleae export on its own clock: a timeline, 1×, seeking, full speed, and an end frozen at the last recorded time', async () => {
     const path = saleaeFile();
@@ -114,10 +119,9 @@ describe.skipIf(skip !== null)('honest states', () => {
     const [end, span2] = await replayTime(page);
     expect(end).toBe(span2);
     const state = await page.getByTestId('link-state').textContent();
-    expect(state).toBe('Live');
-    await expect(page.locator('.link dd').nth(1).textContent()).resolves.toBe(
-      `${summary.link.holds} holds · ${summary.link.failsafes} failsafes`,
-    );
+    expect(state).toBe('Ended');
+    await expect(page.getByTestId('link-hint').textContent()).resolves.toMatch(/: there the link was live\.$/);
+    await expect(page.locator('.link dd').nth(1).textContent()).resolves.toBe(episodesText(summary.link.holds, summary.link.failsafes));
     await expect(page.getByTestId('count-missed').textContent()).resolves.toBe(String(summary.link.missedFrames));
     await shot(page, 'replay-ended');
     // The wall clock moving on changes nothing.
@@ -197,7 +201,7 @@ describe.skipIf(skip !== null)('honest states', () => {
       expect(shown).toEqual({
         frames: String(summary.decoder.frames),
         missed: String(summary.link.missedFrames),
-        episodes: `${summary.link.holds} holds · ${summary.link.failsafes} failsafes`,
+        episodes: episodesText(summary.link.holds, summary.link.failsafes),
         resolution: `${summary.format.resolution ?? '?'}${resolutionSource(summary.format.resolutionReason)}`,
       });
       expect(errors).toEqual([]);
@@ -249,7 +253,7 @@ describe.skipIf(skip !== null)('seeking in a long capture', () => {
       .waitFor({ timeout: 5000 });
     await expect(page.getByTestId('count-missed').textContent()).resolves.toBe(String(want.missed));
     await expect(page.getByTestId('count-bytes').textContent()).resolves.toBe(String(want.bytes));
-    await expect(page.locator('.link dd').nth(1).textContent()).resolves.toBe(`${want.holds} holds · ${want.failsafes} failsafes`);
+    await expect(page.locator('.link dd').nth(1).textContent()).resolves.toBe(episodesText(want.holds, want.failsafes));
     expect(errors).toEqual([]);
     await page.context().close();
   });

@@ -6,6 +6,7 @@
  * grows, and a seek starts from that decode's nearest checkpoint. Others get their overview at
  * once (overview.ts) and seek with fresh decodes.
  */
+import { plural } from '../../analysis/report-text.js';
 import { CaptureFormatError, capturePorts, readCapture, type Capture } from '../../capture/index.js';
 import { FRAME_PERIOD_11MS_US } from '../../decoder/index.js';
 import { captureSpan, timingJitterUs } from '../../analysis/index.js';
@@ -121,7 +122,7 @@ export class ReplaySession implements Driver {
       notice(
         host,
         'warning',
-        `${name}: ${capture.issues.length} damaged part(s) skipped`,
+        `${name}: ${plural(capture.issues.length, 'damaged part')} skipped`,
         `${capture.issues[0]?.message ?? ''} Every intact record is kept.`,
       );
     }

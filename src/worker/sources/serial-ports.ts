@@ -114,6 +114,8 @@ export class SerialPorts implements Driver {
       lost: () => {
         if (registry.get(id) !== source) return;
         recorder.event('device lost', now(), id);
+        // No frame can arrive: the silence from here on is the adapter's, not the link's.
+        source.engine.interrupt(now());
         diagnosis.close(id);
         registry.setState(source, 'lost');
         notice(

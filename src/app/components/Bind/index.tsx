@@ -7,13 +7,20 @@
  * (preview.ts): pulses for that adapter's chip, or for the common chips, saying so. Tables
  * scroll inside the panel on a phone.
  */
-import { useMemo, useState } from 'preact/hooks';
+import { useEffect, useMemo, useState } from 'preact/hooks';
 import { BIND_MODES, type PowerLine, type PowerPolarity } from '../../../bind/index.js';
-import wiring from '../../../bind/wiring.svg';
+import wiringSvg from '../../../bind/wiring.svg?raw';
+import wiringDoc from '../../../../docs/bind-wiring.md?raw';
 import { identify, pickPort, portLabel, serialUnavailable } from '../../serial.js';
 import { bindLog, notify, send } from '../../store.js';
 import { bindPreview, plainStep, sincePowerOn } from './preview.js';
 import './style.css';
+
+/**
+ * The wiring diagram drawn inline, so it takes the page's theme (Bind/style.css colours it): its
+ * own style element, dark, is for the docs, and the page's CSP refuses inline styles anyway.
+ */
+const WIRING = wiringSvg.replace(/<style>[\s\S]*?<\/style>/, '').replace(/<!--[\s\S]*?-->/g, '');
 
 const hex = (v: number) => `0x${v.toString(16).toUpperCase().padStart(2, '0')}`;
 
@@ -21,6 +28,15 @@ const hex = (v: number) => `0x${v.toString(16).toUpperCase().padStart(2, '0')}`;
 const ANOTHER = -1;
 
 export function BindPanel({ granted, onClose }: { granted: SerialPort[]; onClose(): void }) {
+  // Escape closes the panel, unless it is closing a menu (the menu's own Escape) or a select.
+  useEffect(() => {
+    const key = (e: KeyboardEvent) => {
+      if (e.key !== 'Escape' || e.defaultPrevented || document.querySelector('.menu-pop:not([hidden])') !== null) return;
+      onClose();
+    };
+    document.addEventListener('keydown', key);
+    return () => document.removeEventListener('keydown', key);
+  }, [onClose]);
   const [pulses, setPulses] = useState(9);
   const [powerLine, setPowerLine] = useState<PowerLine>('rts');
   const [polarity, setPolarity] = useState<PowerPolarity>('asserted');
@@ -210,11 +226,16 @@ export function BindPanel({ granted, onClose }: { granted: SerialPort[]; onClose
           ) : null}
         </div>
         <figure class="wiring">
-          <img
-            src={wiring}
-            alt="Wiring: adapter TX through a diode and 470 Ω to the satellite's DATA, RX straight to DATA, RTS or DTR switching the satellite's 3.3 V through a P-MOSFET, grounds joined."
-          />
-          <figcaption>Wiring for binding (details in docs/bind-wiring.md). Use a 3.3 V adapter.</figcaption>
+          {/* The project's own diagram, bundled at build time: no outside markup. */}
+          <div class="wiring-scroll" tabIndex={0} role="region" aria-label="Wiring diagram" dangerouslySetInnerHTML={{ __html: WIRING }} />
+          <figcaption>
+            Wiring for binding. Use a 3.3 V adapter. The wiring and the timeline in detail are in the guide below (docs/bind-wiring.md in
+            the source).
+          </figcaption>
+          <details class="guide">
+            <summary>Guide: binding wiring and timeline</summary>
+            <pre data-testid="bind-guide">{wiringDoc}</pre>
+          </details>
         </figure>
       </div>
     </section>

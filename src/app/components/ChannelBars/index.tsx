@@ -4,13 +4,15 @@
  * once per animation frame when they change (no virtual DOM on the 91 Hz path). A channel that
  * stops arriving greys out and shows its age. A scale row names the marks (−100 %, 0, +100 %
  * at 1102, 1500 and 1898 µs). On a narrow screen the raw and % columns go first and the age
- * moves into the track, so the bar itself always keeps its room.
+ * moves into the track, so the bar itself always keeps its room. Under them, folded, each
+ * channel's min / max / last as `satscope info` prints them.
  */
 import { useEffect, useRef } from 'preact/hooks';
 import { channelName, channelResolution, PULSE_MAX_US, PULSE_MIN_US, servoToMicros, servoToPercent } from '../../../decoder/index.js';
 import { onFrame } from '../../frame-loop.js';
 import { current } from '../../store.js';
 import { setText } from '../../text.js';
+import { ChannelRanges } from './ranges.js';
 import './style.css';
 
 /** A channel is stale when it has not come for this long (a few frame pairs). */
@@ -138,6 +140,7 @@ export function ChannelBars({ ids, label }: { ids: number[]; label: string }) {
           </div>
         ))}
       </div>
+      <ChannelRanges ids={ids} />
     </section>
   );
 }

@@ -8,7 +8,7 @@ import { useEffect, useRef } from 'preact/hooks';
 import { onFrame } from '../../frame-loop.js';
 import type { Live } from '../../live.js';
 import { current } from '../../store.js';
-import { setText } from '../../text.js';
+import { fadesPerMinute, setText } from '../../text.js';
 import './style.css';
 
 type Key = 'frames' | 'bytes' | 'resyncs' | 'discarded' | 'bad' | 'empty' | 'vtx' | 'fades' | 'missed' | 'period' | 'rssi';
@@ -32,7 +32,12 @@ const ROWS: readonly (readonly [Key, string, string, boolean])[] = [
     false,
   ],
   ['vtx', 'VTX frames', 'Frames carrying video-transmitter control instead of the last two channels (Spektrum VTX).', false],
-  ['fades', 'Fades', 'Frames the receiver missed on the radio side (its own count); a rising rate means a weak or blocked antenna.', false],
+  [
+    'fades',
+    'Fades',
+    'Frames the receiver missed on the radio side (its own count), and their rate per minute now; a rising rate means a weak or blocked antenna.',
+    false,
+  ],
   ['missed', 'Missed frames', 'Frames that should have arrived on the serial line and did not.', true],
   ['period', 'Frame period', 'Time between frames as measured.', false],
   ['rssi', 'RSSI', 'Signal strength the receiver reports (SPM4649T).', false],
@@ -69,7 +74,7 @@ export function Counters() {
         // Shown only where they occur.
         empty: c.emptySlots ? String(c.emptySlots) : null,
         vtx: c.vtxFrames ? String(c.vtxFrames) : null,
-        fades: l === null ? '—' : `${l.fades} (${l.fadeRate.toFixed(1)}/s)`,
+        fades: l === null ? '—' : `${l.fades} (${fadesPerMinute(l.fadeRate)})`,
         missed: l === null ? '—' : String(l.missedFrames),
         period: l === null || !Number.isFinite(l.periodUs) ? '—' : `${(l.periodUs / 1000).toFixed(2)} ms`,
         rssi: l === null || !Number.isFinite(l.rssi) ? '—' : `${l.rssi} dBm`,

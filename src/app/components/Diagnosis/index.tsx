@@ -4,12 +4,15 @@
  * stack's settings. A finding appears once its evidence suffices and goes when it no longer
  * holds; in replay, the findings at the replay position. "Copy settings" puts the chosen flight
  * stack's CLI lines on the clipboard. `TopFinding` is the worst one in one line, for under the
- * link state.
+ * link state. Findings about ports that are gone (unplugged) are listed apart, as what was seen
+ * before the loss, never as the link now.
  */
-import { signal } from '@preact/signals';
+import { computed, signal } from '@preact/signals';
 import { useState } from 'preact/hooks';
 import type { DoctorFinding, FlightStack } from '../../../analysis/index.js';
 import { diagnosis, replayReading, send, sources } from '../../store.js';
+import { plural } from '../../../analysis/report-text.js';
+import { splitFindings } from './current.js';
 import './style.css';
 
 const STACKS: readonly FlightStack[] = ['Betaflight', 'iNav', 'ArduPilot', 'PX4'];
@@ -32,6 +35,16 @@ const copied = signal('');
 
 const keyOf = (f: DoctorFinding): string => `${f.code}:${f.ports.join(',')}`;
 
+/** Ports whose adapter is gone: what the doctor last said of them is not the link now. */
+const lostPorts = computed(() => sources.value.filter((s) => s.kind === 'serial' && s.state === 'lost').map((s) => s.id));
+/** The findings about the link now, and those about ports lost since. */
+const split = computed(() => splitFindings(diagnosis.value?.findings ?? [], lostPorts.value));
+/** "remote A", "remotes A and B": the lost ports' labels. */
+const lostNames = computed(() => {
+  const labels = sources.value.filter((s) => lostPorts.value.includes(s.id)).map((s) => s.label);
+  return labels.length === 1 ? `remote ${labels[0]}` : `remotes ${labels.slice(0, -1).join(', ')} and ${labels.at(-1)}`;
+});
+
 /** The lines to paste for `which`: from the worst finding that has some for it. */
 function settingsFor(findings: readonly DoctorFinding[], which: FlightStack): { lines: string[]; from: DoctorFinding } | null {
   for (const f of findings) {
@@ -51,7 +64,7 @@ async function copy(text: string): Promise<boolean> {
 }
 
 export function TopFinding() {
-  const top = diagnosis.value?.findings[0];
+  const top = split.value.current[0];
   if (top === undefined) return null;
   return (
     <a class={`top-finding sev-${top.severity}`} href="#diagnosis" title={top.title} data-testid="top-finding">
@@ -135,7 +148,7 @@ function Finding({ f, open, onToggle }: { f: DoctorFinding; open: boolean; onTog
 
 export function DiagnosisPanel() {
   const d = diagnosis.value;
-  const findings = d?.findings ?? [];
+  const { current: findings, before } = split.value;
   // Which findings the user opened or closed. The worst starts open when it is a problem (then
   // there is little else to look at); warnings and advice stay one line each, so on a phone
   // the channel bars are not pushed far down.
@@ -143,6 +156,19 @@ export function DiagnosisPanel() {
   const opened = (f: DoctorFinding, i: number): boolean => toggled[keyOf(f)] ?? (i === 0 && f.severity === 'problem');
   const which = stack.value;
   const paste = settingsFor(findings, which);
+  const item = (f: DoctorFinding, i: number) => {
+    const key = keyOf(f);
+    return (
+      <Finding
+        key={key}
+        f={f}
+        open={opened(f, i)}
+        onToggle={(open) => {
+          if (opened(f, i) !== open) setToggled({ ...toggled, [key]: open });
+        }}
+      />
+    );
+  };
   const empty = replayReading.value
     ? 'Reading the capture: findings appear once it plays.'
     : d === null || (d.mode === 'live' && sources.value.length === 0)
@@ -154,7 +180,7 @@ export function DiagnosisPanel() {
     if (paste === null) return;
     const ok = await copy(`${paste.lines.join('\n')}\n`);
     copied.value = ok
-      ? `Copied ${paste.lines.length} ${which} lines (${paste.from.title}).`
+      ? `Copied ${plural(paste.lines.length, `${which} line`)} (${paste.from.title}).`
       : 'The browser did not allow copying: select the lines below instead.';
   };
   return (
@@ -199,25 +225,23 @@ export function DiagnosisPanel() {
       </p>
       {findings.length === 0 ? (
         <p class="none" data-testid="diagnosis-none">
-          {empty}
+          {before.length === 0
+            ? empty
+            : sources.value.every((s) => lostPorts.value.includes(s.id))
+              ? 'No port is read now: nothing can be said about the link.'
+              : 'Nothing wrong found on the ports still read.'}
         </p>
       ) : (
         <ul class="findings" data-testid="findings">
-          {findings.map((f, i) => {
-            const key = keyOf(f);
-            return (
-              <Finding
-                key={key}
-                f={f}
-                open={opened(f, i)}
-                onToggle={(open) => {
-                  if (opened(f, i) !== open) setToggled({ ...toggled, [key]: open });
-                }}
-              />
-            );
-          })}
+          {findings.map(item)}
         </ul>
       )}
+      {before.length > 0 ? (
+        <div class="before" data-testid="findings-before">
+          <h3>Before {lostNames.value}'s adapter was lost: not the link now</h3>
+          <ul class="findings">{before.map((f, i) => item(f, i + findings.length))}</ul>
+        </div>
+      ) : null}
     </section>
   );
 }

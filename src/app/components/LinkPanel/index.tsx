@@ -7,19 +7,13 @@ import { computed, type Signal } from '@preact/signals';
 import { useEffect, useRef } from 'preact/hooks';
 import { onFrame } from '../../frame-loop.js';
 import type { Live } from '../../live.js';
-import { current, linkEnded, linkMismatch, linkState, replayReading, resolutionOverride, status } from '../../store.js';
+import { current, linkEnded, linkMismatch, linkState, replay, replayReading, resolutionOverride, status } from '../../store.js';
 import { setText } from '../../text.js';
 import { drawEpisodes } from '../../timeline.js';
 import { TopFinding } from '../Diagnosis/index.js';
+import { linkView } from './view.js';
+import { plural } from '../../../analysis/report-text.js';
 import './style.css';
-
-const LABEL = { waiting: 'Waiting', live: 'Live', hold: 'Hold', failsafe: 'Failsafe' } as const;
-const HINT = {
-  waiting: 'No frame yet. Nothing for long? Check RX on the grey DATA wire and that the satellite is bound.',
-  live: 'Frames arriving',
-  hold: 'Frames missing: last values held',
-  failsafe: 'No frame for 1 s: failsafe',
-} as const;
 
 function ago(us: number): string {
   if (!Number.isFinite(us)) return '—';
@@ -29,23 +23,24 @@ function ago(us: number): string {
 
 // The state, its hint and the panel's colour as signals bound to the DOM: a Live/Hold flip
 // changes two texts and a class, and re-renders nothing.
-const sectionClass = computed(() => `link ${linkState.value}`);
-// A capture being read has no link yet, and a replayed port no frame yet: that is said, not a
-// receiver's "waiting" with its wiring hint.
-const label = computed(() => (replayReading.value ? 'Reading' : LABEL[linkState.value]));
-// A replay at its end keeps its last state, frozen, and says it ended; a forced resolution
-// that matches no frame is not link loss.
-const hint = computed(() =>
-  replayReading.value
-    ? 'Reading the capture: its link state shows once the whole file is read and it plays.'
-    : linkEnded.value
-      ? 'Replay ended: the state at the end of the capture'
-      : linkMismatch.value !== null
-        ? `Forced ${resolutionOverride.value}: no frame matches; the stream looks like ${linkMismatch.value}`
-        : linkState.value === 'waiting' && status.value.kind === 'replay'
-          ? 'No frame yet at this point of the capture.'
-          : HINT[linkState.value],
-);
+const view = computed(() => {
+  const s = status.value;
+  const r = replay.value;
+  return linkView({
+    state: linkState.value,
+    kind: s.kind,
+    sourceState: s.state,
+    remote: s.label,
+    reading: replayReading.value,
+    positionUs: r === null ? Number.NaN : r.positionUs - r.startUs,
+    ended: linkEnded.value,
+    mismatch: linkMismatch.value,
+    forced: resolutionOverride.value,
+  });
+});
+const sectionClass = computed(() => `link ${view.value.key}`);
+const label = computed(() => view.value.label);
+const hint = computed(() => view.value.hint);
 
 export function LinkPanel({ windowUs }: { windowUs: Signal<number> }) {
   const since = useRef<HTMLSpanElement>(null);
@@ -66,7 +61,7 @@ export function LinkPanel({ windowUs }: { windowUs: Signal<number> }) {
         shown = text;
       }
       // The counts change with the batch that changed them, as the counters beside them do.
-      const episodes = l === null ? 'none' : `${l.holds} holds · ${l.failsafes} failsafes`;
+      const episodes = l === null ? 'none' : `${plural(l.holds, 'hold')} · ${plural(l.failsafes, 'failsafe')}`;
       if (episodes !== shownEpisodes && counts.current !== null) {
         setText(counts.current, episodes);
         shownEpisodes = episodes;
@@ -82,7 +77,7 @@ export function LinkPanel({ windowUs }: { windowUs: Signal<number> }) {
         'aria-label',
         parts.length === 0
           ? 'No hold or failsafe in this window'
-          : `${parts.filter((p) => p === 'failsafe').length} failsafe and ${parts.filter((p) => p === 'hold').length} hold episodes in this window`,
+          : `${plural(parts.filter((p) => p === 'failsafe').length, 'failsafe')} and ${plural(parts.filter((p) => p === 'hold').length, 'hold')} in this window`,
       );
     });
   }, [windowUs]);

@@ -28,6 +28,7 @@ export function Menu({
   const [open, setOpen] = useState(false);
   const root = useRef<HTMLDivElement>(null);
   const button = useRef<HTMLButtonElement>(null);
+  const pop = useRef<HTMLDivElement>(null);
   const id = useId();
   // A layout effect, so Escape works from the moment the panel shows: a plain effect waits for
   // the next animation frame, and a key pressed before it (a busy page, a quick hand) was lost.
@@ -49,6 +50,16 @@ export function Menu({
       document.removeEventListener('focusin', outside);
       document.removeEventListener('keydown', key);
     };
+  }, [open]);
+  // On a narrow screen a panel lined up with its button can run past the viewport's edge (the
+  // Report menu's, on a phone): it is moved back inside, 8 px from the edge, before it paints.
+  useLayoutEffect(() => {
+    const el = pop.current;
+    if (!open || el === null) return;
+    el.style.translate = '';
+    const r = el.getBoundingClientRect();
+    const shift = r.left < 8 ? 8 - r.left : r.right > innerWidth - 8 ? Math.max(8 - r.left, innerWidth - 8 - r.right) : 0;
+    if (shift !== 0) el.style.translate = `${shift}px 0`;
   }, [open]);
   useEffect(() => {
     if (disabled) setOpen(false);
@@ -72,7 +83,7 @@ export function Menu({
         {label}
         <span class="caret" aria-hidden="true" />
       </button>
-      <div id={id} class={`menu-pop ${align}`} hidden={!open}>
+      <div id={id} ref={pop} class={`menu-pop ${align}`} hidden={!open}>
         {open ? children(close) : null}
       </div>
     </div>

@@ -10,7 +10,9 @@ import type { SourceStatus } from '../../../worker/protocol.js';
 import { recording, replayName, resolutionOverride, send, sources } from '../../store.js';
 import { chooseCapture, openCapture, setCaptureInput } from '../../open-file.js';
 import { setTheme, theme, themeChoice } from '../../theme.js';
+import { plural } from '../../../analysis/report-text.js';
 import { Menu } from '../Menu/index.js';
+import { FramesExport } from './frames-export.js';
 import './style.css';
 
 function size(bytes: number): string {
@@ -22,21 +24,46 @@ function duration(us: number): string {
   return `${Math.floor(s / 60)}:${String(s % 60).padStart(2, '0')}`;
 }
 
-/** One line for the status pill: what feeds the page now. */
-function summary(list: SourceStatus[]): { text: string; tone: string } {
+/**
+ * The status pill: what feeds the page now, in a few words that fit beside the toolbar's
+ * buttons (`short`), and in full (`full`: its tooltip, and what a screen reader reads).
+ */
+function summary(list: SourceStatus[]): { short: string; full: string; tone: string } {
   const first = list[0];
-  if (first === undefined) return { text: 'No receiver', tone: 'idle' };
-  if (first.kind === 'demo') return { text: `Demo receiver: ${list.length} simulated remotes (DSMX 11 ms)`, tone: 'demo' };
+  if (first === undefined) return { short: 'No receiver', full: 'No receiver', tone: 'idle' };
+  if (first.kind === 'demo')
+    return {
+      short: `Demo: ${list.map((x) => x.label).join(', ')}`,
+      full: `Demo receiver: ${plural(list.length, 'simulated remote')} (DSMX 11 ms)`,
+      tone: 'demo',
+    };
   if (first.kind === 'replay') {
-    const state = first.state === 'ended' ? ' (end)' : first.state === 'paused' ? ' (paused)' : '';
-    return { text: `${replayName.value ?? 'Replay'}${state}`, tone: 'replay' };
+    const name = replayName.value ?? 'Replay';
+    const state = first.state === 'ended' ? 'end' : first.state === 'paused' ? 'paused' : null;
+    return {
+      // The capture's name is in the replay bar just below.
+      short: state === 'end' ? 'Replay ended' : state === 'paused' ? 'Replay paused' : 'Replaying',
+      full: `${name}${state === null ? '' : ` (${state})`}`,
+      tone: 'replay',
+    };
   }
   const lost = list.some((s) => s.state === 'lost');
   const opening = list.some((s) => s.state === 'opening');
-  const text = list
+  // The remotes by state: "A, B reading", "A reading · B lost".
+  const word = (s: SourceStatus) => (s.state === 'lost' ? 'lost' : s.state === 'opening' ? 'opening' : 'reading');
+  const short = [...new Set(list.map(word))]
+    .map(
+      (w) =>
+        `${list
+          .filter((x) => word(x) === w)
+          .map((x) => x.label)
+          .join(', ')} ${w}`,
+    )
+    .join(' · ');
+  const full = list
     .map((s) => `${s.label}: ${s.name}${s.state === 'lost' ? ': device lost' : s.state === 'opening' ? ': opening…' : ''}`)
     .join(' · ');
-  return { text, tone: lost ? 'serial lost' : opening ? 'serial opening' : 'serial reading' };
+  return { short, full, tone: lost ? 'serial lost' : opening ? 'serial opening' : 'serial reading' };
 }
 
 function Sun() {
@@ -126,8 +153,15 @@ export function Toolbar({ granted, onBind }: { granted: SerialPort[]; onBind(): 
         </svg>
         <span>SatScope</span>
       </h1>
-      <div class={`pill ${pill.tone}`} role="status" data-testid="source-status" title={pill.text}>
-        {pill.text}
+      <div class={`pill ${pill.tone}`} role="status" data-testid="source-status" title={pill.full}>
+        {pill.short === pill.full ? (
+          pill.full
+        ) : (
+          <>
+            <span aria-hidden="true">{pill.short}</span>
+            <span class="sr-only">{pill.full}</span>
+          </>
+        )}
       </div>
       <div class="tb-group source" role="group" aria-label="Source">
         <div class="split">
@@ -241,7 +275,9 @@ export function Toolbar({ granted, onBind }: { granted: SerialPort[]; onBind(): 
                   >
                     raw .bin
                   </button>
-                  <p class="hint">Only the bytes, without times: for other tools.</p>
+                  <p class="hint">
+                    Only the bytes, without times, for other tools: one file per port, as a raw file cannot say which port a byte came from.
+                  </p>
                 </>
               )}
             </Menu>
@@ -256,7 +292,7 @@ export function Toolbar({ granted, onBind }: { granted: SerialPort[]; onBind(): 
           disabled={!canReport}
           title={
             canReport
-              ? 'One-page link-quality report of the capture being replayed, or of what was recorded live'
+              ? 'One-page link-quality report, or the decoded frames, of the capture being replayed or of what was recorded live'
               : 'Open a capture or record first: a report covers one of them'
           }
         >
@@ -280,6 +316,7 @@ export function Toolbar({ granted, onBind }: { granted: SerialPort[]; onBind(): 
               >
                 Report as data (JSON)
               </button>
+              <FramesExport close={close} />
             </>
           )}
         </Menu>

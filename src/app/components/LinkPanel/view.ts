@@ -1,0 +1,89 @@
+/**
+ * What the link panel says, from what is true now: a receiver's link state only while frames
+ * can arrive. A paused replay says it is paused and at which capture time, with the link state
+ * there; an ended one says it ended; a port that is gone says so (no frame can arrive, so the
+ * link's state is unknown), never "Live" or "Failsafe" of a link nobody can see.
+ */
+import { formatClock } from '../../../analysis/report-text.js';
+import type { LinkState } from '../../../decoder/index.js';
+
+export type LinkViewKey = LinkState | 'reading' | 'paused' | 'ended' | 'lost';
+
+export interface LinkView {
+  /** The panel's class (its colour). */
+  key: LinkViewKey;
+  /** The big word. */
+  label: string;
+  /** The sentence under it. */
+  hint: string;
+}
+
+/** What the panel is showing, as the page knows it. */
+export interface LinkFacts {
+  state: LinkState;
+  /** The selected source's kind and state ('reading', 'lost', 'playing', 'paused', 'ended'…). */
+  kind: 'serial' | 'demo' | 'replay';
+  sourceState: string;
+  /** The remote's label (A, B…). */
+  remote: string;
+  /** The capture is still being read (replay only). */
+  reading: boolean;
+  /** The replay position on the capture's clock, from its start, µs (NaN: not a replay). */
+  positionUs: number;
+  /** The source ended (a replay at its end). */
+  ended: boolean;
+  /** A forced resolution matching no frame: the resolution the stream looks like. */
+  mismatch: 1024 | 2048 | null;
+  forced: 'auto' | 1024 | 2048;
+}
+
+const WORD = { waiting: 'Waiting', live: 'Live', hold: 'Hold', failsafe: 'Failsafe' } as const;
+const HINT = {
+  waiting: 'No frame yet. Nothing for long? Check RX on the grey DATA wire and that the satellite is bound.',
+  live: 'Frames arriving.',
+  hold: 'Frames missing: last values held.',
+  failsafe: 'No frame for 1 s: failsafe.',
+} as const;
+
+/** The link state at a moment of a capture, as a clause: "the link was live there". */
+const WAS = {
+  waiting: 'no frame had come yet',
+  live: 'the link was live',
+  hold: 'the link was in hold (frames missing)',
+  failsafe: 'the link was in failsafe',
+} as const;
+
+export function linkView(f: LinkFacts): LinkView {
+  if (f.reading)
+    return {
+      key: 'reading',
+      label: 'Reading',
+      hint: 'Reading the capture: its link state shows once the whole file is read and it plays.',
+    };
+  if (f.kind === 'serial' && f.sourceState === 'lost')
+    return {
+      key: 'lost',
+      label: 'Port lost',
+      hint: `Remote ${f.remote}'s adapter is gone (unplugged?): no frame can arrive, so its link state is unknown. It reconnects by itself when plugged back in.`,
+    };
+  if (f.mismatch !== null && !f.ended)
+    return {
+      key: f.state,
+      label: WORD[f.state],
+      hint: `Forced ${f.forced}: no frame matches; the stream looks like ${f.mismatch}.`,
+    };
+  if (f.kind === 'replay') {
+    const at = formatClock(f.positionUs);
+    if (f.ended || f.sourceState === 'ended')
+      return { key: 'ended', label: 'Ended', hint: `Replay ended at ${at}: there ${WAS[f.state]}.` };
+    if (f.sourceState === 'paused')
+      return { key: 'paused', label: 'Paused', hint: `Paused at ${at} of the capture: there ${WAS[f.state]}.` };
+    if (f.state === 'waiting') return { key: 'waiting', label: WORD.waiting, hint: `No frame yet at ${at} of the capture.` };
+    return {
+      key: f.state,
+      label: WORD[f.state],
+      hint: `Replay at ${at}: ${HINT[f.state].charAt(0).toLowerCase()}${HINT[f.state].slice(1)}`,
+    };
+  }
+  return { key: f.state, label: WORD[f.state], hint: HINT[f.state] };
+}
