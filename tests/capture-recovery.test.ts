@@ -198,7 +198,7 @@ const crafted: Record<string, (size: number) => Uint8Array> = {
   // Intact empty records between headers announcing long records, so the reader keeps starting over.
   'intact empty records between headers announcing long records': (size) =>
     craft(size, (out, view, p, end) => {
-      out.set(new CaptureWriter().data(new Uint8Array(0), p), p);
+      out.set(new CaptureWriter().data(new Uint8Array(0), 0), p);
       out.set([...SYNC, 1, 0], p + 20);
       view.setUint32(p + 24, Math.max(0, end - p - 60), true);
       return 36;

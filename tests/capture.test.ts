@@ -81,7 +81,7 @@ const RECORDS: CaptureRecordInput[] = [
   { type: 'data', bytes: new Uint8Array(0), timeUs: 13_000 },
   { type: 'data', bytes: randomBytes(300, 1), timeUs: 22_000, port: 0 },
   { type: 'event', text: 'device lost 🔌', timeUs: 30_000, port: 1 },
-  { type: 'data', bytes: FRAME.subarray(7), timeUs: NaN, port: 255 },
+  { type: 'data', bytes: FRAME.subarray(7), timeUs: 33_000, port: 255 },
 ];
 const DATA_RECORDS = RECORDS.filter((r): r is Extract<CaptureRecordInput, { type: 'data' }> => r.type === 'data');
 
@@ -615,7 +615,8 @@ describe('captureChunks and capturePorts', () => {
   });
 
   it('gives undefined as push time for a chunk without a time', () => {
-    const last = [...captureChunks(parsed, 255)];
+    const untimed = parseCapture(encodeCapture({}, [{ type: 'data', bytes: FRAME, timeUs: NaN, port: 255 }]));
+    const last = [...captureChunks(untimed, 255)];
     expect(last).toHaveLength(1);
     expect(last[0]?.time).toBeUndefined();
   });

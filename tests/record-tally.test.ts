@@ -74,11 +74,17 @@ async function tallied(bytes: Uint8Array, sliceBytes: number | undefined, reserv
 
 describe('the chunk facts and span of a capture found as its records are walked', () => {
   it('are those of the passes over the capture the file reads as, for any slice size', async () => {
-    const seen = { outOfOrder: 0, untimed: 0, ports: new Set<number>(), empty: 0, eventOutside: 0 };
+    const seen = { outOfOrder: 0, untimed: 0, ports: new Set<number>(), empty: 0, eventOutside: 0, badTime: 0 };
     for (let seed = 0; seed < 60; seed++) {
       const bytes = made(seed);
       const capture = parseCapture(bytes);
-      expect(capture.issues).toEqual([]);
+      // A chunk time that is NaN among times is damage the reader steps over (time-rule.ts): the
+      // capture's times are then not the file's, and the replay seeds no fact the walk found.
+      if (capture.issues.length > 0) {
+        expect(capture.issues.map((i) => i.kind)).toEqual(['bad-time']);
+        seen.badTime++;
+        continue;
+      }
       const want = {
         chunksByPort: Array.from(captureChunksByPort(capture)),
         timesInOrder: captureTimesInOrder(capture),
@@ -100,6 +106,7 @@ describe('the chunk facts and span of a capture found as its records are walked'
     expect([...seen.ports].sort((a, b) => a - b)).toEqual([0, 1, 5, 200, 255]);
     expect(seen.empty).toBeGreaterThan(0);
     expect(seen.eventOutside).toBeGreaterThan(5);
+    expect(seen.badTime).toBeGreaterThan(5);
   });
 
   it('and of a long recording, each port’s chunk numbers grown as they come, with or without a guess of how many', async () => {

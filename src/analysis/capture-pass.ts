@@ -56,6 +56,13 @@ export function timingJitterUs(timing: CaptureTiming): number {
 export const SLICE_BYTES = 256;
 
 /**
+ * Bytes of an untimed chunk pushed at once. A timed chunk is pushed whole: its time is its last
+ * byte's, and a piece of it would stamp its earlier bytes with that. (Untimed chunks go to no
+ * doctor: `decodeCapture` takes one only with a timed capture, where no chunk is untimed.)
+ */
+const UNTIMED_PIECE_BYTES = 1 << 16;
+
+/**
  * Where the doctor's packet scan of `port` must start (a chunk and a byte in it) for the packets
  * it books from `fromUs` on to be exactly those a scan of every byte books, when nothing else of
  * the scan is read. Packets are booked at the time of the chunk their last byte came in, so
@@ -157,7 +164,10 @@ export function decodeCapture(
         for (let s = from; s < to; s += SLICE_BYTES) push(s, Math.min(s + SLICE_BYTES, to), byteTimesUs, 0);
       } else {
         const t = chunkTimesUs[i] ?? NaN;
-        push(from, to, Number.isNaN(t) ? undefined : t, i < scan.chunk ? to - from : i === scan.chunk ? scan.offset : 0);
+        if (Number.isNaN(t)) {
+          // Untimed (a raw dump is one chunk): pushed in pieces, so the decoder never copies the whole of it.
+          for (let s = from; s < to; s += UNTIMED_PIECE_BYTES) push(s, Math.min(s + UNTIMED_PIECE_BYTES, to), undefined, 0);
+        } else push(from, to, t, i < scan.chunk ? to - from : i === scan.chunk ? scan.offset : 0);
       }
     }
     from = to;

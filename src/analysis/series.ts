@@ -7,7 +7,14 @@
 import { LinkMonitor, type LinkOptions } from '../decoder/index.js';
 import type { DecodedFrame } from '../decoder/index.js';
 
-/** A growable Float64Array column. */
+/**
+ * The most bins a series holds: 12 days of 1 s bins, 29 h of 100 ms ones. Times are whatever a
+ * caller passes; one far from the rest must not make the series allocate for the span between
+ * them, so what falls past the last bin is counted (`unbinned`), never given bins.
+ */
+export const MAX_SERIES_BINS = 1 << 20;
+
+/** A growable Float64Array column (up to MAX_SERIES_BINS). */
 class Column {
   data: Float64Array;
   constructor(fill: number) {
@@ -19,6 +26,7 @@ class Column {
     if (n <= this.data.length) return;
     let size = this.data.length;
     while (size < n) size *= 2;
+    size = Math.min(size, Math.max(n, MAX_SERIES_BINS));
     const next = new Float64Array(size).fill(this.fill);
     next.set(this.data);
     this.data = next;
@@ -32,6 +40,8 @@ export class LinkSeries {
   #bins = 0;
   /** Bins below this are sealed (handed out): later additions go to the first open bin. */
   #sealed = 0;
+  /** Frames and missed frames whose time fell past MAX_SERIES_BINS. */
+  #unbinned = 0;
   readonly #frames = new Column(0);
   readonly #fades = new Column(0);
   readonly #lost = new Column(0);
@@ -79,9 +89,16 @@ export class LinkSeries {
     return this.#bins;
   }
 
+  /** Frames and missed frames not binned: their time fell more than MAX_SERIES_BINS bins after the origin. */
+  get unbinned(): number {
+    return this.#unbinned;
+  }
+
+  /** The bin time `t` (finite) goes in, made if need be; -1 when it is past MAX_SERIES_BINS. */
   #bin(t: number): number {
     if (Number.isNaN(this.#origin)) this.#origin = Math.floor(t / this.binUs) * this.binUs;
     const b = Math.max(this.#sealed, Math.floor((t - this.#origin) / this.binUs));
+    if (!(b < MAX_SERIES_BINS)) return -1;
     if (b >= this.#bins) {
       for (const c of this.#columns) c.ensure(b + 1);
       this.#bins = b + 1;
@@ -102,6 +119,10 @@ export class LinkSeries {
     // origin not known yet is NaN and fails the test).
     const at = Math.floor((t - this.#origin) / this.binUs);
     const b = at >= this.#sealed && at < this.#bins ? at : this.#bin(t);
+    if (b < 0) {
+      this.#unbinned++;
+      return;
+    }
     if (b !== this.#held) this.#hold(b);
     this.#heldFrames++;
     this.#heldFades += link.lastFades;
@@ -144,14 +165,46 @@ export class LinkSeries {
     this.#intervalN.data[b] = this.#heldIntervalN;
   }
 
-  /** `count` frames missing, due one `periodUs` apart from `fromUs`, none after `toUs`. */
+  /**
+   * `count` frames missing, due one `periodUs` apart from `fromUs`, none after `toUs` (those due
+   * later count at `toUs`). Each bin gets the frames whose time falls in it, worked out a bin at
+   * a time: the work follows the bins touched, not the count (a clock gone wild can ask for
+   * billions).
+   */
   missed(fromUs: number, toUs: number, count: number, periodUs: number): void {
-    if (!Number.isFinite(fromUs)) return;
+    if (!Number.isFinite(fromUs) || !(count > 0)) return;
+    const n = Math.floor(count);
     const p = Number.isFinite(periodUs) && periodUs > 0 ? periodUs : 0;
-    for (let k = 0; k < count; k++) {
-      const t = Math.min(fromUs + k * p, Number.isFinite(toUs) ? toUs : Infinity);
-      this.#lost.data[this.#bin(t)]! += 1;
+    const end = Number.isFinite(toUs) ? toUs : Infinity;
+    const at = (k: number): number => Math.min(fromUs + k * p, end);
+    // Frames 0 … due - 1 fall before `end`, the rest at it. Estimated, then set right where
+    // rounding put the estimate a frame off (a few steps at most).
+    let due = p === 0 ? (fromUs < end ? n : 0) : Math.min(n, Math.max(0, Math.ceil((end - fromUs) / p)));
+    for (let s = 0; s < 4 && due > 0 && !(fromUs + (due - 1) * p < end); s++) due--;
+    for (let s = 0; s < 4 && due < n && fromUs + due * p < end; s++) due++;
+    for (let k = 0; k < due; ) {
+      const b = this.#bin(at(k));
+      if (b < 0) {
+        this.#unbinned += n - k;
+        return;
+      }
+      // The last frame in bin b: estimated from the bin's end, then set right frame by frame.
+      let last = p === 0 ? due - 1 : Math.min(due - 1, Math.max(k, Math.ceil((this.startOf(b + 1) - fromUs) / p) - 1));
+      for (let s = 0; s < 4 && last > k && this.#target(at(last)) !== b; s++) last--;
+      for (let s = 0; s < 4 && last + 1 < due && this.#target(at(last + 1)) === b; s++) last++;
+      this.#lost.data[b]! += last - k + 1;
+      k = last + 1;
     }
+    if (due < n) {
+      const b = this.#bin(end);
+      if (b < 0) this.#unbinned += n - due;
+      else this.#lost.data[b]! += n - due;
+    }
+  }
+
+  /** The bin time `t` goes in (the origin known), without making it. */
+  #target(t: number): number {
+    return Math.max(this.#sealed, Math.floor((t - this.#origin) / this.binUs));
   }
 
   /** Seals the bins before `bin`: nothing is added to them any more (the live view has shown them). */
@@ -207,6 +260,7 @@ export class LinkSeries {
       originUs: this.#origin,
       bins: this.#bins,
       sealed: this.#sealed,
+      unbinned: this.#unbinned,
       columns: this.#columns.map((c) => c.data.slice(0, this.#bins)),
     };
   }
@@ -221,6 +275,7 @@ export class LinkSeries {
     this.#held = -1;
     this.#bins = cp.bins;
     this.#sealed = cp.sealed;
+    this.#unbinned = cp.unbinned ?? 0;
     this.#columns.forEach((c, i) => {
       c.data = new Float64Array(Math.max(64, cp.bins)).fill(c.fill);
       c.data.set(cp.columns[i] ?? []);
@@ -234,6 +289,8 @@ export interface LinkSeriesCheckpoint {
   readonly originUs: number;
   readonly bins: number;
   readonly sealed: number;
+  /** `unbinned` when it was taken (absent in checkpoints from before it was counted: 0). */
+  readonly unbinned?: number;
   /** Frames, fades, lost, RSSI sum, RSSI count, RSSI minimum, interval sum, interval count: one value a bin. */
   readonly columns: readonly Float64Array[];
 }

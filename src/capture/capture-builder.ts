@@ -20,6 +20,7 @@ import type { HeaderResult } from './header.js';
 import { primeRuns } from './prime-runs.js';
 import { copyPayload, grown, trimTo } from './records.js';
 import { utf8Decode } from './text.js';
+import { stepOverBadTimes } from './time-rule.js';
 
 /** Room for this many records and payload bytes at first: then as `expect` guesses, growing by half as needed. */
 const FIRST_RECORDS = 1 << 12;
@@ -117,7 +118,7 @@ export class CaptureBuilder {
   /** The capture of every record fed, with `header`'s metadata; the builder is not to be fed after. */
   capture(header: HeaderResult): ParsedCapture {
     const n = this.#chunks;
-    return {
+    return stepOverBadTimes({
       kind: 'sscap',
       meta: header.meta,
       timing: this.#anyTime ? 'per-chunk' : 'none',
@@ -129,7 +130,7 @@ export class CaptureBuilder {
       issues: [],
       version: header.version,
       headerLength: header.headerLength,
-    };
+    });
   }
 
   /** Room for at least `bytes` and `records`, by half as much again. */

@@ -66,7 +66,12 @@ export type CaptureIssueKind =
   /** CSV: a row of another type than async-serial data (Logic 2 `type` column). */
   | 'skipped-row'
   /** CSV: a byte the analyser flagged with a parity or framing error; left out of the data. */
-  | 'flagged-byte';
+  | 'flagged-byte'
+  /**
+   * Times that jump (non-finite, absurd, far back, or too far forward: time-rule.ts): stepped
+   * over, every byte kept. Its offset is that of the first byte it dates in `Capture.bytes`.
+   */
+  | 'bad-time';
 
 /** Something a reader skipped or distrusted. Readers report these instead of throwing. */
 export interface CaptureIssue {

@@ -13,6 +13,7 @@ import { readHeader } from './header.js';
 import { RecordProbe } from './record-probe.js';
 import { copyPayload, plannedSizes } from './records.js';
 import { utf8Decode } from './text.js';
+import { stepOverBadTimes } from './time-rule.js';
 
 /** One run of records: file offsets [from, to), and the first chunk index and data offset it fills. */
 export interface CapturePart {
@@ -134,7 +135,7 @@ export function readPart(bytes: Uint8Array, part: CapturePart, columns: CaptureC
 /** The capture, when every part was read intact (`reads` in the order of `plan.parts`); else null. */
 export function assembleParts(plan: CapturePlan, columns: CaptureColumns, reads: readonly PartRead[]): ParsedCapture | null {
   if (reads.length !== plan.parts.length || reads.some((r) => !r.intact)) return null;
-  return {
+  return stepOverBadTimes({
     kind: 'sscap',
     meta: plan.meta,
     timing: reads.some((r) => r.anyTime) ? 'per-chunk' : 'none',
@@ -146,5 +147,5 @@ export function assembleParts(plan: CapturePlan, columns: CaptureColumns, reads:
     issues: [],
     version: plan.version,
     headerLength: plan.headerLength,
-  };
+  });
 }

@@ -18,6 +18,7 @@ import { copyPayload, grown, plannedSizes, trimTo } from './records.js';
 import type { CaptureEvent, CaptureIssue, ParsedCapture } from './model.js';
 import { readHeader } from './header.js';
 import { CUT, type CaptureReaderWork, NOT_RECORD, RecordProbe } from './record-probe.js';
+import { stepOverBadTimes } from './time-rule.js';
 
 /**
  * Reads a .sscap file. Every intact record is recovered, whatever damage surrounds it, a damaged
@@ -178,7 +179,7 @@ function readSscap(bytes: Uint8Array, work: CaptureReaderWork, shared: boolean):
   }
   flushSkip(n, true);
 
-  return {
+  return stepOverBadTimes({
     kind: 'sscap',
     meta,
     timing: anyTime ? 'per-chunk' : 'none',
@@ -190,7 +191,7 @@ function readSscap(bytes: Uint8Array, work: CaptureReaderWork, shared: boolean):
     issues,
     version,
     headerLength,
-  };
+  });
 }
 
 /** A complete record header with a valid type and length (its CRC failed): a damaged record, not a stray sync byte. */

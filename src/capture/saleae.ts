@@ -3,6 +3,7 @@
  */
 import { utf8Decode, utf8Encode } from './text.js';
 import { CaptureFormatError } from './model.js';
+import { stepOverBadTimes } from './time-rule.js';
 import type { Capture, CaptureIssue, CaptureMeta } from './model.js';
 
 //
@@ -453,7 +454,7 @@ export function importSaleaeCsv(input: string | Uint8Array): Capture {
   // Every port has at least one byte (a port exists because a row gave it one).
   for (let p = 0; p < portCount; p++) chunkTimes[p] = byteTimes[(chunkEnds[p] ?? 0) - 1] ?? NaN;
 
-  return {
+  return stepOverBadTimes({
     kind: 'saleae-csv',
     meta,
     timing: 'per-byte',
@@ -464,5 +465,5 @@ export function importSaleaeCsv(input: string | Uint8Array): Capture {
     byteTimesUs: byteTimes,
     events: [],
     issues,
-  };
+  });
 }

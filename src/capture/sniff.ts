@@ -4,7 +4,7 @@
 import { isUtf8, utf8Decode } from './text.js';
 import { CAPTURE_FILE_EXTENSION, isCaptureMagicPrefix } from './layout.js';
 import { CaptureFormatError } from './model.js';
-import type { Capture } from './model.js';
+import type { Capture, CaptureKind } from './model.js';
 import { importRaw } from './raw.js';
 import { looksLikeCaptureMagic } from './header.js';
 import { parseCapture, type ReadOptions } from './reader.js';
@@ -65,19 +65,31 @@ function hasExtension(fileName: string | undefined, ext: string): boolean {
  */
 export function readCapture(bytes: Uint8Array, fileName?: string, options: ReadOptions = {}): Capture {
   if (!(bytes instanceof Uint8Array)) throw new TypeError('readCapture expects a Uint8Array');
+  const kind = captureKindOf(bytes, fileName);
+  return kind === 'sscap' ? parseCapture(bytes, options) : kind === 'saleae-csv' ? importSaleaeCsv(bytes) : importRaw(bytes);
+}
+
+/** How many of a file's first bytes `captureKindOf` needs to decide as it would on the whole file. */
+export const KIND_BYTES = SNIFF_BYTES + 1;
+
+/**
+ * Which reader `readCapture` gives a file, from its first `KIND_BYTES` bytes (or all of a
+ * shorter one): a reader that streams a file decides so before it reads the rest.
+ * @throws {CaptureFormatError} as `readCapture` does for an empty file or text that is not a capture
+ */
+export function captureKindOf(head: Uint8Array, fileName?: string): CaptureKind {
   const named = fileName ? ` (${fileName})` : '';
-  if (bytes.length === 0) throw new CaptureFormatError(`empty file${named}: there is nothing to decode`);
+  if (head.length === 0) throw new CaptureFormatError(`empty file${named}: there is nothing to decode`);
   const isBin = hasExtension(fileName, '.bin');
   // A file shorter than the signature that matches its start is a cut-off .sscap, unless named .bin.
-  if (looksLikeCaptureMagic(bytes) || (!isBin && isCaptureMagicPrefix(bytes)) || hasExtension(fileName, CAPTURE_FILE_EXTENSION)) {
-    return parseCapture(bytes, options);
-  }
-  const text = looksLikeText(bytes);
-  const [ls, le] = firstLine(bytes);
-  if (text && csvColumns(bytes, ls, le)) return importSaleaeCsv(bytes);
-  if (isBin || !text) return importRaw(bytes);
+  if (looksLikeCaptureMagic(head) || (!isBin && isCaptureMagicPrefix(head)) || hasExtension(fileName, CAPTURE_FILE_EXTENSION))
+    return 'sscap';
+  const text = looksLikeText(head);
+  const [ls, le] = firstLine(head);
+  if (text && csvColumns(head, ls, le)) return 'saleae-csv';
+  if (isBin || !text) return 'raw';
   throw new CaptureFormatError(
     `unrecognised file${named}: it looks like text but not a Saleae async-serial CSV ` +
-      `(its first line is ${quote(utf8Decode(bytes, ls, le))}; expected a header such as "Time [s],Value,Parity Error,Framing Error")`,
+      `(its first line is ${quote(utf8Decode(head, ls, le))}; expected a header such as "Time [s],Value,Parity Error,Framing Error")`,
   );
 }

@@ -5,9 +5,9 @@
  * Exit codes: 0 ok (also when the reader stops early), 1 the file could not be decoded or the
  * output not written, 2 bad usage or unreadable file.
  */
-import { readFileSync, writeFileSync } from 'node:fs';
+import { closeSync, readFileSync, writeFileSync } from 'node:fs';
 import { basename } from 'node:path';
-import { captureChunks, capturePorts, type Capture, type CaptureChunk } from '../capture/index.js';
+import { captureChunks, capturePorts, type Capture } from '../capture/index.js';
 import { SpektrumDecoder } from '../decoder/index.js';
 import { reportHtml, summarizeCapture } from '../analysis/index.js';
 import { threadedReport } from './report-threads.js';
@@ -16,6 +16,7 @@ import { fileProblem } from './file-problem.js';
 import { loadCapture } from './input.js';
 import { formatJsonLine, formatCsvHeader, formatCsvLine, formatReportVerdict, formatSummary } from './format.js';
 import { TextOutput } from './output.js';
+import { openRawFile, type RawFile, rawPieces as rawFilePieces } from './raw-file.js';
 
 const USAGE = `Usage:
   satscope decode FILE [--format jsonl|csv] [--resolution auto|1024|2048] [--port N]
@@ -55,6 +56,17 @@ async function main(argv: string[]): Promise<number> {
     out.text(`${pkg.version}\n`);
     return finish(out, 0);
   }
+  // A raw dump is decoded as it is read; on any other port, loadCapture says it has no data.
+  if (args.command === 'decode' && (args.port ?? 0) === 0) {
+    const raw = openRawFile(args.file);
+    if (raw !== null) {
+      try {
+        return await decode(rawPieces(raw), args, 0, out);
+      } finally {
+        closeSync(raw.fd);
+      }
+    }
+  }
   // The report decodes ports on two threads, which read the columns where they are.
   const loaded = loadCapture(args.file, { shared: args.command === 'report' });
   if ('error' in loaded) {
@@ -76,7 +88,7 @@ async function main(argv: string[]): Promise<number> {
     out.text(args.json ? `${JSON.stringify(summary, null, 2)}\n` : `${formatSummary(summary, basename(args.file))}\n`);
     return finish(out, summary.decoder.frames > 0 ? 0 : 1);
   }
-  return decode(capture, args, port, out);
+  return decode(capturePieces(capture, port), args, port, out);
 }
 
 /** `satscope info` of a capture with several ports and none chosen: each port's summary in turn. */
@@ -106,7 +118,7 @@ const PUSH_BYTES = 1 << 16;
  * last byte, and splitting would stamp earlier bytes with it (the .sscap format bounds those
  * chunks to 16 MiB anyway).
  */
-function* pieces(chunk: CaptureChunk): Generator<{ bytes: Uint8Array; time: number | Float64Array | undefined }> {
+function* pieces(chunk: { bytes: Uint8Array; time: Time }): Generator<{ bytes: Uint8Array; time: Time }> {
   const { bytes, time } = chunk;
   if (typeof time === 'number' || bytes.length <= PUSH_BYTES) {
     yield { bytes, time };
@@ -118,12 +130,25 @@ function* pieces(chunk: CaptureChunk): Generator<{ bytes: Uint8Array; time: numb
   }
 }
 
+/** A push's time argument. */
+type Time = number | Float64Array | undefined;
+
+/** The pieces of one port of a capture to push, in order. */
+function* capturePieces(capture: Capture, port: number): Generator<{ bytes: Uint8Array; time: Time }> {
+  for (const chunk of captureChunks(capture, port)) yield* pieces(chunk);
+}
+
+/** The pieces of a raw dump read from its file, untimed. */
+function* rawPieces(raw: RawFile): Generator<{ bytes: Uint8Array; time: Time }> {
+  for (const bytes of rawFilePieces(raw)) yield* pieces({ bytes, time: undefined });
+}
+
 /**
  * `satscope decode`: one line per frame, written as it is decoded. Nothing grows with the
  * capture: the decoder gets the bytes a piece at a time, each frame is formatted and handed to
  * the output at once, and decoding waits whenever the reader of stdout is behind.
  */
-async function decode(capture: Capture, args: Args, port: number, out: TextOutput): Promise<number> {
+async function decode(input: Iterable<{ bytes: Uint8Array; time: Time }>, args: Args, port: number, out: TextOutput): Promise<number> {
   const decoder = new SpektrumDecoder({ resolution: args.resolution });
   const format = args.format === 'csv' ? formatCsvLine : formatJsonLine;
   if (args.format === 'csv' && out.line(formatCsvHeader())) await out.ready();
@@ -134,12 +159,10 @@ async function decode(capture: Capture, args: Args, port: number, out: TextOutpu
       if (out.stopped) return;
     }
   };
-  for (const chunk of captureChunks(capture, port)) {
-    for (const piece of pieces(chunk)) {
-      decoder.push(piece.bytes, piece.time);
-      await drain();
-      if (out.stopped) return finish(out, 0);
-    }
+  for (const piece of input) {
+    decoder.push(piece.bytes, piece.time);
+    await drain();
+    if (out.stopped) return finish(out, 0);
   }
   decoder.end();
   await drain();

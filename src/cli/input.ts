@@ -48,7 +48,7 @@ function readBytes(file: string, big: number): { bytes: Uint8Array; bytesThere: 
       return { bytes: bytes.subarray(0, readFileRange(fd, bytes, 0, size)), bytesThere: 0, helper: null };
     }
     const bytes = new Uint8Array(new SharedArrayBuffer(size));
-    const half = size >> 1;
+    const half = Math.floor(size / 2);
     const data: ReadThreadData = { file, bytes, from: half, to: size };
     const helper = new WaitedWorker<ReadThreadResult>(new URL('./read-thread.js', import.meta.url), data);
     try {

@@ -292,7 +292,8 @@ export function keptCapture(mine: HelperRun, theirs: HelperRun): ParsedCapture |
   const kept = theirs.kept;
   if (kept === null || !mine.done || !theirs.done || mine.failed !== null || theirs.failed !== null) return null;
   if (!walkedAll(mine, kept)) return null;
-  if (mine.facts !== null) {
+  // Times stepped over as the capture was kept (bad-time) are not the ones the walk tallied.
+  if (mine.facts !== null && kept.issues.length === 0) {
     seedChunkFacts(kept, mine.facts);
     seedCaptureSpan(kept, mine.facts.span);
   }
