@@ -15,11 +15,19 @@ import { join, resolve } from 'node:path';
 import { describe, expect, it } from 'vitest';
 import type { FormatInfo, LinkEpisode, LinkStats } from '../src/decoder/index.js';
 import { encodeCapture, importRaw, readCapture, type Capture, type CaptureRecordInput } from '../src/capture/index.js';
-import { captureSpan, healthReport, summarizeCapture, timingJitterUs } from '../src/analysis/index.js';
+import {
+  captureSpan,
+  diagnosedHealthReport,
+  doctorCapture,
+  formatClock,
+  healthReport,
+  summarizeCapture,
+  timingJitterUs,
+} from '../src/analysis/index.js';
 import { preset, simulate } from '../src/simulator/index.js';
 import { Engine } from '../src/worker/engine.js';
 import { ReplaySource } from '../src/worker/sources/replay.js';
-import { usbChunks, perByteCapture } from './feeds.js';
+import { usbChunks, perByteCapture, recording } from './feeds.js';
 import { SimulatedClock } from './worker-fakes.js';
 
 const CAPTURES = resolve(import.meta.dirname, '../../shared/captures');
@@ -317,3 +325,183 @@ describe('every surface tells the same story about the same bytes', () => {
     });
   }
 });
+
+// ---------------------------------------------------------------------------------------------
+// The doctor states the figures the other surfaces state.
+
+/**
+ * What the doctor says that `info` (`summarizeCapture`) or the report also says, read from its
+ * sentences, checked against theirs: holds, failsafes and their times, the fade rate, missed
+ * frames, the windows it looks at; and the report's own diagnosis is the doctor's. Returns
+ * every disagreement, in words (none: []).
+ */
+function doctorDisagreements(capture: Capture): string[] {
+  const out: string[] = [];
+  const report = diagnosedHealthReport(capture);
+  const doctor = doctorCapture(capture);
+  const timed = capture.timing !== 'none';
+  const origin = report.timeline.originUs;
+  const clock = (us: number): string => formatClock(us - (origin ?? 0));
+  const span = report.timeline.durationUs;
+  const said = (f: { title: string; evidence: readonly { text: string }[] }): string =>
+    [f.title, ...f.evidence.map((e) => e.text)].join(' | ');
+  const lines = doctor.findings.map(said);
+  const reportLines = (report.diagnosis ?? []).map(said);
+  if (JSON.stringify(lines) !== JSON.stringify(reportLines))
+    out.push(`report's diagnosis ${JSON.stringify(reportLines)} ≠ doctor ${JSON.stringify(lines)}`);
+  for (const text of lines) {
+    for (const m of text.matchAll(/in the last (\d+) s/g))
+      if (!timed || span === null || Number(m[1]) > Math.ceil(span / 1e6))
+        out.push(`a window of ${m[1]} s in a capture of ${span} µs: ${text}`);
+    if (!timed && /a minute|\/min|\b\d+:\d\d\.\d\b| s without frames/.test(text)) out.push(`a time or rate in an untimed file: ${text}`);
+  }
+  for (const r of report.remotes) {
+    const info = summarizeCapture(capture, { port: r.port });
+    const episodes = info.episodes;
+    const holds = episodes.filter((e) => e.kind === 'hold');
+    const failsafes = episodes.filter((e) => e.kind === 'failsafe');
+    const weak = doctor.findings.find((f) => f.code === 'weak-link' && f.ports[0] === r.port);
+    const where = `port ${r.port}`;
+    if (info.link.holds !== r.holds.count) out.push(`${where}: info ${info.link.holds} holds, report ${r.holds.count}`);
+    if (failsafes.length > 0 && weak === undefined) out.push(`${where}: ${failsafes.length} failsafes, and the doctor sees no weak link`);
+    if (weak === undefined) continue;
+    if (/failsafe/.test(weak.title) !== failsafes.length > 0) out.push(`${where}: "${weak.title}" with ${failsafes.length} failsafes`);
+    const fsLines = weak.evidence.filter((e) => /^Failsafe/.test(e.text));
+    if (fsLines.length !== Math.min(5, failsafes.length))
+      out.push(`${where}: ${fsLines.length} failsafe lines for ${failsafes.length} failsafes`);
+    fsLines.forEach((e, i) => {
+      const f = failsafes.slice(-5)[i]!;
+      const want = `after ${clock(f.lastFrameUs)}${f.endUs === null ? ', still now' : `, back at ${clock(f.endUs)}`}`;
+      if (!e.text.includes(want)) out.push(`${where}: "${e.text}", info and the report: ${want}`);
+    });
+    for (const e of weak.evidence) {
+      const h = /^(\d+) holds? .*the last at ([\d:.]+)\./.exec(e.text);
+      if (/\bholds?\b/.test(e.text) && !/^Failsafe/.test(e.text)) {
+        if (h === null) out.push(`${where}: unread hold sentence "${e.text}"`);
+        else {
+          if (Number(h[1]) !== info.link.holds) out.push(`${where}: doctor ${h[1]} holds, info ${info.link.holds}`);
+          const last = holds.at(-1);
+          if (last === undefined || h[2] !== clock(last.startUs))
+            out.push(`${where}: last hold at ${h[2]}, the report's ${last && clock(last.startUs)}`);
+        }
+      }
+      const rate = /Fade rate ([\d.]+) a minute/.exec(e.text);
+      if (rate !== null) {
+        const per = r.fades?.perMinute ?? null;
+        if (per === null || rate[1] !== formatRate(per)) out.push(`${where}: doctor fade rate ${rate[1]}/min, report ${per}`);
+      }
+    }
+  }
+  const weakest = doctor.findings.find((f) => f.code === 'weakest-remote');
+  for (const e of weakest?.evidence ?? []) {
+    const m = /^(.+): (\d+) missed frames? in the (capture|file)\.$/.exec(e.text);
+    if (m === null) continue;
+    const r = report.remotes.find((x) => x.label === m[1]);
+    if (r === undefined || Number(m[2]) !== r.missedFrames) out.push(`"${e.text}", the report: ${r?.missedFrames} missed`);
+  }
+  return out;
+}
+
+const formatRate = (x: number): string => (x === 0 ? '0' : x >= 10 ? x.toFixed(0) : x.toFixed(1));
+
+/** A seeded choice of numbers. */
+function seeded(seed: number): () => number {
+  let x = seed;
+  return () => (x = (x * 1_103_515_245 + 12_345) % 2_147_483_648) / 2_147_483_648;
+}
+
+const DROPOUT_PRESETS = [
+  'dsmx-11ms-2048-internal',
+  'dsmx-22ms-2048-internal',
+  'dsm2-22ms-1024-external',
+  'dsmx-11ms-2048-external',
+  'rssi-spm4649t',
+];
+
+/** `n` streams of 4-6 s with one to four dropouts of 60-900 ms (no failsafe), every preset in turn. */
+function dropoutStreams(n: number, seed: number) {
+  const random = seeded(seed);
+  return Array.from({ length: n }, (_, i) => {
+    const at: { atUs: number; durationUs: number }[] = [];
+    const count = 1 + Math.floor(random() * 4);
+    for (let k = 0; k < count; k++) at.push({ atUs: 0.5e6 + k * 1.2e6 + random() * 0.3e6, durationUs: 60_000 + random() * 840_000 });
+    const name = DROPOUT_PRESETS[i % DROPOUT_PRESETS.length]!;
+    return { name, stream: simulate({ ...preset(name), seed: seed + i, dropouts: at }, 4e6 + random() * 2e6) };
+  });
+}
+
+describe('the doctor states what info and the report state', () => {
+  const classes: { name: string; captures: () => { name: string; capture: Capture }[] }[] = [
+    {
+      name: 'dropouts without failsafe, recorded through a USB adapter (.sscap)',
+      captures: () =>
+        dropoutStreams(24, 100).map((d, i) => ({ name: `${d.name} #${i}`, capture: sscap(usbChunks(d.stream.bytes, d.stream.timesUs)) })),
+    },
+    {
+      name: 'dropouts without failsafe, per-byte times (Saleae)',
+      captures: () => dropoutStreams(24, 200).map((d, i) => ({ name: `${d.name} #${i}`, capture: perByteCapture(d.stream) })),
+    },
+    {
+      name: 'dropouts without failsafe, untimed raw files',
+      captures: () => dropoutStreams(12, 300).map((d, i) => ({ name: `${d.name} #${i}`, capture: importRaw(d.stream.bytes) })),
+    },
+    {
+      name: 'the demo, failsafes and damage (several seeds and lengths)',
+      captures: () =>
+        [1, 2, 3, 4, 5, 6].flatMap((seed) => {
+          const demo = simulate({ ...preset('demo'), seed }, 4e6 + seed * 1.1e6);
+          const fs = simulate({ ...preset('dropouts-failsafe'), seed }, 4e6);
+          const dmg = simulate({ ...preset('dropouts-and-damage'), seed }, 4e6);
+          return [
+            { name: `demo ${seed} .sscap`, capture: sscap(usbChunks(demo.bytes, demo.timesUs)) },
+            { name: `dropouts-failsafe ${seed} per-byte`, capture: perByteCapture(fs) },
+            { name: `dropouts-and-damage ${seed} .sscap`, capture: sscap(usbChunks(dmg.bytes, dmg.timesUs)) },
+            { name: `dropouts-and-damage ${seed} raw`, capture: importRaw(dmg.bytes) },
+          ];
+        }),
+    },
+    {
+      name: 'multi-port recordings (a remote that fades most, remotes that drop out)',
+      captures: () =>
+        [1, 2, 3, 4, 5, 6].map((seed) => {
+          const random = seeded(seed * 7);
+          const drops = [0.8e6 + random() * 1e6, 2.4e6 + random() * 1e6].map((atUs) => ({ atUs, durationUs: 80_000 + random() * 400_000 }));
+          const a = simulate({ ...preset('dsmx-11ms-2048-internal'), seed, dropouts: drops, fades: { lossRate: 0.002 } }, 4e6);
+          const b = simulate(
+            { ...preset('dsmx-11ms-2048-external'), seed: seed + 50, fades: { start: 0, lossRate: 0.02 + random() * 0.03 } },
+            4e6,
+          );
+          return { name: `two ports ${seed}`, capture: recording([a, b], seed % 3 !== 0) };
+        }),
+    },
+  ];
+  if (present)
+    classes.push({
+      name: 'the real captures, whole and with 200 ms cut out three times',
+      captures: () =>
+        captureFiles(CAPTURES).flatMap((path) => {
+          const capture = readCapture(new Uint8Array(readFileSync(path)), path);
+          return [
+            { name: path.slice(CAPTURES.length + 1), capture },
+            { name: `${path.slice(CAPTURES.length + 1)}, cut`, capture: cutThrice(capture) },
+          ];
+        }),
+    });
+  for (const c of classes)
+    it(`agrees on ${c.name}`, () => {
+      const wrong = c.captures().flatMap(({ name, capture }) => doctorDisagreements(capture).map((w) => `${name}: ${w}`));
+      expect(wrong).toEqual([]);
+    });
+});
+
+/** A per-byte capture with 200 ms of bytes taken out at a quarter, half and three quarters of its length (three real dropouts). */
+function cutThrice(capture: Capture): Capture {
+  const times = capture.byteTimesUs;
+  if (times === undefined) return capture;
+  const t0 = times[0]!;
+  const t1 = times[times.length - 1]!;
+  const cuts = [0.25, 0.5, 0.75].map((f) => t0 + f * (t1 - t0));
+  const keep: number[] = [];
+  for (let i = 0; i < times.length; i++) if (!cuts.some((c) => times[i]! >= c && times[i]! < c + 200_000)) keep.push(i);
+  return perByteCapture({ bytes: Uint8Array.from(keep, (i) => capture.bytes[i]!), timesUs: Float64Array.from(keep, (i) => times[i]!) });
+}

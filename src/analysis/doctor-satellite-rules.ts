@@ -3,9 +3,9 @@
  * bound in, what its frames carry, and how weak its link is (failsafes, holds, fades, RSSI,
  * rebinds, restarts).
  */
-import { systemInfo, type FormatInfo, type Resolution } from '../decoder/index.js';
-import { REPORT_THRESHOLDS } from './report-thresholds.js';
-import { plural } from './report-text.js';
+import { systemInfo, type FormatInfo, type LinkStats, type Resolution } from '../decoder/index.js';
+import { fadesPerMinute, REPORT_THRESHOLDS } from './report-thresholds.js';
+import { plural, rate as rateText } from './report-text.js';
 import { ARDUPILOT_GUESS_FRAMES, bindPulses, channelSetText, satelliteSettings } from './doctor-stacks.js';
 import { dur, GUESS_MIN_DECISIONS, M_FADES, MIN_FADES, type FormatSnapshot, type PortState } from './doctor-state.js';
 import type { AddFinding, Confidence, DoctorPortSource, Evidence, RuleContext } from './doctor-types.js';
@@ -105,7 +105,7 @@ export function satelliteFindings(p: PortState, now: number, ctx: RuleContext, a
       confidence: 'certain',
       title: `${p.label}: X-Plus channels ${names.join(', ')} are sent; flight controllers drop or mix them`,
       evidence: [
-        { text: `X-Plus channels (ID 12 with a sub-ID, spec §8.6) seen since ${ctx.at(p.xplusFirstUs)}.`, timeUs: p.xplusFirstUs },
+        { text: `X-Plus channels (ID 12 with a sub-ID, spec §8.6) seen${ctx.when('since', p.xplusFirstUs)}.`, timeUs: p.xplusFirstUs },
       ],
       todo: [
         'Betaflight and iNav read channel IDs 0–11 only (SPEKTRUM_MAX_SUPPORTED_CHANNEL_COUNT 12): X-Plus channels are dropped.',
@@ -126,7 +126,7 @@ export function satelliteFindings(p: PortState, now: number, ctx: RuleContext, a
       title: `${p.label}: the transmitter sends VTX control in the channel slots`,
       evidence: [
         {
-          text: `${plural(p.vtxFrames, 'frame')} carried Spektrum VTX control in bytes 12–15 (0xE… 0xE…), first at ${ctx.at(p.vtxFirstUs)}.`,
+          text: `${plural(p.vtxFrames, 'frame')} carried Spektrum VTX control in bytes 12–15 (0xE… 0xE…)${ctx.when(', first at', p.vtxFirstUs)}.`,
           timeUs: p.vtxFirstUs,
         },
       ],
@@ -165,22 +165,22 @@ export function satelliteFindings(p: PortState, now: number, ctx: RuleContext, a
     });
   }
 
-  // The link.
+  // The link, in the link monitor's own figures: the holds and failsafes every surface counts
+  // (each failsafe began as a hold), and the fade rate the report states for a whole capture.
   const s = link.stats;
   const memoryStart = now - ctx.memoryUs;
   const episodes = link.episodes.filter((e) => (e.endUs ?? now) >= memoryStart);
   const failsafes = episodes.filter((e) => e.kind === 'failsafe');
+  const holds = episodes.filter((e) => e.kind === 'hold');
   // Holds that line damage explains (the frame that ended them came after discarded bytes) are
-  // the line's, not the link's.
+  // the line's, not the link's: counted, but no reason to call the link weak.
   const byLine = (e: { lastFrameUs: number; endUs: number | null }) =>
     e.endUs !== null && p.damagedAtUs.some((d) => d > e.lastFrameUs && d <= e.endUs! + 50_000);
-  const holds = episodes.filter((e) => e.kind === 'hold' && !failsafes.some((f) => f.lastFrameUs === e.lastFrameUs) && !byLine(e));
-  const fadesPerMin = s.fadeRate * 60;
-  // A rate needs a few fades behind it: one corrupted header is not a weak link.
-  const recentFades = p.bins.sum(M_FADES, Math.floor(now / 1e6) - 9, Math.floor(now / 1e6));
-  const fadeHigh = format.headerMode === 'fades' && fadesPerMin > REPORT_THRESHOLDS.fadeRateHighPerMin && recentFades >= MIN_FADES;
+  const linkHolds = holds.filter((e) => !failsafes.some((f) => f.lastFrameUs === e.lastFrameUs) && !byLine(e));
+  const rate = fadeRateOf(p, s, now, ctx);
+  const fadeHigh = format.headerMode === 'fades' && rate !== null && rate.perMinute > REPORT_THRESHOLDS.fadeRateHighPerMin && rate.enough;
   const rssiLow = Number.isFinite(s.minRssi) && s.minRssi < REPORT_THRESHOLDS.rssiLowDbm;
-  if (failsafes.length > 0 || holds.length > 0 || fadeHigh || rssiLow) {
+  if (failsafes.length > 0 || linkHolds.length > 0 || fadeHigh || rssiLow) {
     const evidence: Evidence[] = [];
     for (const e of failsafes.slice(-5))
       evidence.push({
@@ -189,14 +189,20 @@ export function satelliteFindings(p: PortState, now: number, ctx: RuleContext, a
       });
     if (holds.length > 0) {
       const last = holds[holds.length - 1] as (typeof holds)[number];
+      const became = holds.filter((e) => failsafes.some((f) => f.lastFrameUs === e.lastFrameUs)).length;
+      const line = holds.length - became - linkHolds.length;
+      const parts = [
+        became > 0 ? `${became} of them became ${became === 1 ? 'a failsafe' : 'failsafes'}` : '',
+        line > 0 ? `${line} ended at line damage` : '',
+      ].filter((x) => x !== '');
       evidence.push({
-        text: `${plural(holds.length, 'hold')} (frames stopped, last values held, recovered), the last at ${ctx.at(last.startUs)}.`,
+        text: `${plural(holds.length, 'hold')} (frames stopped, last values held${parts.length > 0 ? `; ${parts.join(', ')}` : ''}), the last at ${ctx.at(last.startUs)}.`,
         timeUs: last.startUs,
       });
     }
-    if (fadeHigh)
+    if (fadeHigh && rate !== null)
       evidence.push({
-        text: `Fade rate ${fadesPerMin.toFixed(0)} a minute over the last ~500 frames (over ${REPORT_THRESHOLDS.fadeRateHighPerMin} a minute is high).`,
+        text: `Fade rate ${rateText(rate.perMinute)} a minute ${rate.over} (over ${REPORT_THRESHOLDS.fadeRateHighPerMin} a minute is high).`,
         timeUs: null,
       });
     if (rssiLow)
@@ -209,7 +215,7 @@ export function satelliteFindings(p: PortState, now: number, ctx: RuleContext, a
       ports: [p.port],
       severity: failsafes.length > 0 ? 'problem' : 'warning',
       confidence: failsafes.length > 0 || fadeHigh || rssiLow || ctx.precise ? 'certain' : 'likely',
-      title: `${p.label}: the link is weak${failsafes.length > 0 ? ': failsafe' : holds.length > 0 ? ': frames lost' : ''}`,
+      title: `${p.label}: the link is weak${failsafes.length > 0 ? ': failsafe' : linkHolds.length > 0 ? ': frames lost' : ''}`,
       evidence,
       todo: LINK_ADVICE,
       settings: [],
@@ -229,7 +235,7 @@ export function satelliteFindings(p: PortState, now: number, ctx: RuleContext, a
       severity: 'warning',
       confidence: 'certain',
       title: `${p.label}: the receiver changed mode mid-session (a rebind?)`,
-      evidence: [{ text: `From ${name(c.from)} to ${name(c.to)} at ${ctx.at(c.timeUs)}.`, timeUs: c.timeUs }],
+      evidence: [{ text: `From ${name(c.from)} to ${name(c.to)}${ctx.when('at', c.timeUs)}.`, timeUs: c.timeUs }],
       todo: [
         'A satellite changes mode only when it is bound again: check that the flight controller does not send bind pulses at every power-up (Betaflight/iNav: spektrum_sat_bind back to 0, or spektrum_sat_bind_autoreset on).',
         `Set the flight controller for the new mode: ${c.to.resolution === 2048 ? 'SPEK2048' : 'SPEK1024'}.`,
@@ -306,4 +312,24 @@ function guessNotes(p: PortState, resolution: Resolution): { ardupilot: string; 
       ' It takes every X-Plus word as channel 13 whatever its sub-ID, and reports 13 channels as 12: X-Plus channels are not usable.';
   const px4 = `rc_input detects DSM by itself and guesses the resolution from the channel IDs (src/lib/rc/dsm.cpp)${p.xplusMask !== 0 ? '; its tests expect X-Plus channels as channels 13 and up (rc_tests/RCTest.cpp, 16 channels from a DX9)' : ''}.`;
   return { ardupilot, px4 };
+}
+
+/**
+ * The fade rate to judge, a minute, and over what: a whole capture's (the report's figure,
+ * `fadesPerMinute`), or live the link monitor's over its last frames; none without timing.
+ * `enough`: fades enough behind it (one corrupted header is not a weak link).
+ */
+function fadeRateOf(
+  p: PortState,
+  s: Readonly<LinkStats>,
+  now: number,
+  ctx: RuleContext,
+): { perMinute: number; over: string; enough: boolean } | null {
+  if (!ctx.timed) return null;
+  if (ctx.memoryUs === Infinity) {
+    const perMinute = fadesPerMinute(s.fades, p.firstFrameUs, p.prevFrameUs);
+    return perMinute === null ? null : { perMinute, over: 'over the capture', enough: s.fades >= MIN_FADES };
+  }
+  const recent = p.bins.sum(M_FADES, Math.floor(now / 1e6) - 9, Math.floor(now / 1e6));
+  return { perMinute: s.fadeRate * 60, over: 'over the last ~500 frames', enough: recent >= MIN_FADES };
 }

@@ -47,8 +47,10 @@ export const M_CHAR_ERRORS = 2;
 export const M_BREAKS = 3;
 export const M_OVERRUNS = 4;
 export const M_FADES = 5;
+/** The link monitor's missed frames (the receiver's count where it counts) and its lost frames (frames that did not arrive, every receiver). */
 export const M_MISSED = 6;
-export const M_PACKETS = 7; // + index in PACKET_KINDS
+export const M_LOST = 7;
+export const M_PACKETS = 8; // + index in PACKET_KINDS
 export const METRICS = M_PACKETS + PACKET_KINDS.length;
 
 /** Counters in one-second bins, the last 64 seconds. */
@@ -70,6 +72,12 @@ export class Bins {
    */
   slotOf(f: { readonly timeUs: number }): number {
     this.#time[0] = f.timeUs;
+    return this.#slot();
+  }
+
+  /** `slotOf` for a time that is not a frame's (not on the per-frame path). */
+  slotAt(timeUs: number): number {
+    this.#time[0] = timeUs;
     return this.#slot();
   }
 
@@ -166,8 +174,12 @@ export interface PortState {
   vtxFrames: number;
   vtxFirstUs: number;
   prevFades: number | null;
+  /** The first and the last frame's time (NaN: none, or untimed). */
+  firstFrameUs: number;
   prevFrameUs: number;
+  /** The link monitor's `missedFrames` and `lostFrames` at the last frame. */
   prevMissed: number;
+  prevLost: number;
   /** Decoder's discarded bytes at the last frame, and the frame times that came after a discard (line damage). */
   prevDiscarded: number;
   damagedAtUs: number[];

@@ -16,16 +16,17 @@ import { FRAME_SIZE, type DecodedFrame } from '../decoder/index.js';
 import { BurstClock, PACKET_KINDS, PacketScanner, type PacketKind } from './doctor-line.js';
 import { ArduPilotGuess } from './doctor-stacks.js';
 import { lineFindings, lineVerdict, nothingFindings } from './doctor-line-rules.js';
+import { formatClock } from './report-text.js';
 import { satelliteFindings } from './doctor-satellite-rules.js';
 import { systemFindings } from './doctor-system-rules.js';
 import {
   Bins,
-  dur,
   M_BYTES,
   M_BREAKS,
   M_CHAR_ERRORS,
   M_FADES,
   M_FRAME_BYTES,
+  M_LOST,
   M_MISSED,
   M_OVERRUNS,
   M_PACKETS,
@@ -48,6 +49,7 @@ const CONFIDENCE_ORDER: Record<Confidence, number> = { certain: 0, likely: 1, po
 export class Doctor {
   readonly #ports = new Map<number, PortState>();
   readonly #precise: boolean;
+  readonly #timed: boolean;
   readonly #memoryUs: number;
   readonly #since = new Map<string, number>();
   readonly #originUs: number;
@@ -57,20 +59,21 @@ export class Doctor {
   /** @throws {TypeError} on an option out of range. */
   constructor(options: DoctorOptions = {}) {
     const timing = options.timing ?? 'per-chunk';
-    if (timing !== 'per-byte' && timing !== 'per-chunk')
-      throw new TypeError(`timing must be 'per-byte' or 'per-chunk', not ${String(timing)}`);
+    if (timing !== 'per-byte' && timing !== 'per-chunk' && timing !== 'none')
+      throw new TypeError(`timing must be 'per-byte', 'per-chunk' or 'none', not ${String(timing)}`);
     const memory = options.memoryUs ?? 60_000_000;
     if (!(memory > 0)) throw new TypeError(`memoryUs must be positive, not ${memory}`);
     const origin = options.originUs ?? 0;
     if (!Number.isFinite(origin)) throw new TypeError(`originUs must be a finite number, not ${origin}`);
     this.#precise = timing === 'per-byte';
+    this.#timed = timing !== 'none';
     this.#memoryUs = memory;
     this.#originUs = origin;
   }
 
-  /** A time in a sentence, from the origin. Durations use `dur`. */
+  /** A time in a sentence, from the origin, as the health report writes it ("0:02.7"). */
   #at(us: number): string {
-    return dur(us - this.#originUs);
+    return formatClock(us - this.#originUs);
   }
 
   #port(port: number): PortState {
@@ -102,8 +105,10 @@ export class Doctor {
         vtxFrames: 0,
         vtxFirstUs: NaN,
         prevFades: null,
+        firstFrameUs: NaN,
         prevFrameUs: NaN,
         prevMissed: 0,
+        prevLost: 0,
         prevDiscarded: 0,
         damagedAtUs: [],
         first: null,
@@ -137,7 +142,8 @@ export class Doctor {
    */
   restored(port: number): void {
     const p = this.#port(port);
-    p.prevMissed = p.source?.link?.stats.lostFrames ?? 0;
+    p.prevMissed = p.source?.link?.stats.missedFrames ?? 0;
+    p.prevLost = p.source?.link?.stats.lostFrames ?? 0;
     p.prevDiscarded = p.source?.decoder.stats.discardedBytes ?? 0;
   }
 
@@ -285,8 +291,9 @@ export class Doctor {
   frame(port: number, f: DecodedFrame): void {
     const p = this.#port(port);
     const t = f.timeUs;
-    // The bin every counter of this frame goes in, found once.
-    const slot = p.bins.slotOf(f);
+    // The bin every counter of this frame goes in, found once (a frame without a time: where
+    // the bytes it came in were booked).
+    const slot = Number.isNaN(t) ? p.bins.slotAt(p.lastTimeUs) : p.bins.slotOf(f);
     p.frames++;
     p.bins.addTo(slot, M_FRAME_BYTES, FRAME_SIZE);
     p.guess.frame(f.words);
@@ -313,9 +320,11 @@ export class Doctor {
     }
     p.prevDiscarded = discarded;
     if (link !== undefined) {
-      const missed = link.stats.lostFrames;
-      p.bins.addTo(slot, M_MISSED, missed - p.prevMissed);
-      p.prevMissed = missed;
+      const { missedFrames, lostFrames } = link.stats;
+      p.bins.addTo(slot, M_MISSED, missedFrames - p.prevMissed);
+      p.bins.addTo(slot, M_LOST, lostFrames - p.prevLost);
+      p.prevMissed = missedFrames;
+      p.prevLost = lostFrames;
     }
     // A counter that went back down after a gap is a receiver that restarted (power), not a
     // wrap: a wrap after a gap adds about as many fades as frames were missed.
@@ -334,6 +343,7 @@ export class Doctor {
       else p.bins.addTo(slot, M_FADES, f.fadesDelta);
     }
     if (f.fades !== null) p.prevFades = f.fades;
+    if (p.frames === 1) p.firstFrameUs = t;
     p.prevFrameUs = t;
     // The format a remote was bound in; a change after that is a rebind (or another receiver).
     // (A snapshot is made only when it is kept: nothing is allocated per frame.)
@@ -353,7 +363,13 @@ export class Doctor {
       const evidence = f.evidence.map((e) => (e.timeUs === null || Number.isFinite(e.timeUs) ? e : { ...e, timeUs: null }));
       out.push({ ...f, evidence, sinceUs: f.sinceUs !== undefined && Number.isFinite(f.sinceUs) ? f.sinceUs : nowUs });
     };
-    const ctx: RuleContext = { at: (us) => this.#at(us), precise: this.#precise, memoryUs: this.#memoryUs };
+    const ctx: RuleContext = {
+      at: (us) => this.#at(us),
+      when: (word, us) => (this.#timed && Number.isFinite(us) ? ` ${word} ${this.#at(us)}` : ''),
+      precise: this.#precise,
+      timed: this.#timed,
+      memoryUs: this.#memoryUs,
+    };
     const ports = [...this.#ports.values()].sort((a, b) => a.port - b.port);
     for (const p of ports) {
       nothingFindings(p, nowUs, add);

@@ -17,7 +17,7 @@ import { looksInternal, readPorts } from './resolution-key.js';
 import { decodePort, type PortPass } from './report-port.js';
 import { adoptPortMessage, type PortReadingMessage } from './report-port-message.js';
 import { LEVEL_ORDER, remoteFindings, statusOf } from './report-findings.js';
-import { MAX_LISTED_HOLDS, REPORT_BIN_US, REPORT_THRESHOLDS } from './report-thresholds.js';
+import { fadesPerMinute, MAX_LISTED_HOLDS, REPORT_BIN_US, REPORT_THRESHOLDS } from './report-thresholds.js';
 import { finite, plural, r1, r1n, r3 } from './report-text.js';
 import type {
   HealthReport,
@@ -163,6 +163,7 @@ export function healthReportFeeding(
     const durationUs = hasClock && n > 0 ? last - first : NaN;
     const sys = format.system === null ? undefined : systemInfo(format.system);
     const duration = Number.isFinite(durationUs) ? durationUs : NaN;
+    const fadeRate = hasClock && n > 0 ? fadesPerMinute(fadesTotal, first, last) : null;
     const label = capture.meta.ports?.[d.port]?.name;
     const report: RemoteReport = {
       port: d.port,
@@ -186,7 +187,7 @@ export function healthReportFeeding(
         ? null
         : {
             total: fadesTotal,
-            perMinute: Number.isFinite(duration) && duration > 0 ? r3(fadesTotal / (duration / 60e6)) : null,
+            perMinute: fadeRate === null ? null : r3(fadeRate),
             counterMoved: d.fadeCounterMoved,
             implausibleJumps: fadeJumps,
           },
