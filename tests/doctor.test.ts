@@ -234,7 +234,7 @@ describe('bytes that are not a satellite stream', () => {
     expect(codes(after)).not.toContain('wrong-speed');
   });
 
-  it('says clean bytes at 115200 that are no known protocol (here GPS sentences) are not a satellite, after giving a decoder time to lock', () => {
+  it('says plainly that clean bytes in no known protocol (here GPS sentences) are no satellite stream, and that they are text, after giving a decoder time to lock', () => {
     const s = new Session();
     const sentence = new TextEncoder().encode('$GPGGA,123519,4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,*47\r\n');
     const n = 30;
@@ -245,8 +245,12 @@ describe('bytes that are not a satellite stream', () => {
       for (let j = 0; j < sentence.length; j++) timesUs[k * sentence.length + j] = 1000 + k * 100_000 + j * 86.8;
     }
     s.feed(0, { bytes, timesUs });
-    expect(codes(s.findings(1 * SECOND))).not.toContain('unknown-stream');
-    expect(find(s.findings(3 * SECOND), 'unknown-stream').title).toMatch(/clean bytes at 115200, but not Spektrum frames/);
+    expect(codes(s.findings(1 * SECOND))).not.toContain('no-satellite');
+    const f = find(s.findings(3 * SECOND), 'no-satellite');
+    expect(f.severity).toBe('problem');
+    expect(f.title).toMatch(/no Spektrum satellite stream/);
+    expect(f.evidence[1]!.text).toMatch(/100 % of them are printable text: a GPS/);
+    expect(codes(s.findings(3 * SECOND))).not.toContain('unknown-stream');
   });
 
   it('reports bytes lost to buffer overruns, and forgets them after the window', () => {

@@ -139,7 +139,7 @@ export function doctorCapture(capture: Capture, options: DoctorCaptureOptions = 
     if (firstUs < origin) origin = firstUs;
   });
   const doctor = new Doctor({
-    timing: capture.timing === 'per-byte' ? 'per-byte' : 'per-chunk',
+    timing: capture.timing,
     memoryUs: Infinity,
     originUs: Number.isFinite(origin) ? origin : 0,
   });
@@ -238,6 +238,7 @@ export function doctorCapture(capture: Capture, options: DoctorCaptureOptions = 
   // The links end where the capture does, as `decodeCapture` ends them (untimed: nowhere).
   const linkEnd = timed ? captureSpan(capture).endUs : NaN;
   for (const s of sources.values()) s.link.finish(linkEnd);
+  for (const port of sorted) doctor.ended(port);
   const findings = sample(end);
   // Times are real when the capture has timing, or holds only events (which always have times).
   const real = timed || bytes === 0;

@@ -50,7 +50,11 @@ export const M_FADES = 5;
 /** The link monitor's missed frames (the receiver's count where it counts) and its lost frames (frames that did not arrive, every receiver). */
 export const M_MISSED = 6;
 export const M_LOST = 7;
-export const M_PACKETS = 8; // + index in PACKET_KINDS
+/** What bytes are, counted while a port has shown no frame (`noSatelliteFinding`): 0x00, 0xFF, printable text. */
+export const M_ZERO = 8;
+export const M_FF = 9;
+export const M_TEXT = 10;
+export const M_PACKETS = 11; // + index in PACKET_KINDS
 export const METRICS = M_PACKETS + PACKET_KINDS.length;
 
 /** Counters in one-second bins, the last 64 seconds. */
@@ -156,6 +160,11 @@ export interface PortState {
   lastActivityUs: number;
   /** Bytes and errors since the port opened. */
   activity: number;
+  /** Bytes ever, and the first few of them (a file's signature). */
+  bytes: number;
+  head: number[];
+  /** The port's stream is over (`Doctor.ended`): judged on what it held, however short. */
+  ended: boolean;
   /** Time of the latest data: a chunk without a time takes it. */
   lastTimeUs: number;
   bins: Bins;

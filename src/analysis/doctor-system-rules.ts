@@ -72,8 +72,11 @@ export function systemFindings(ports: PortState[], now: number, ctx: RuleContext
   // are all compared by the frames that did not arrive, the one measure they share.
   const toS = Math.floor(now / 1e6);
   const fromS = toS - Math.min(BIN_COUNT - 1, Math.ceil(ctx.memoryUs / 1e6));
+  // Remotes whose missed frames rest on different evidence (a counter, the frames that arrived)
+  // are compared by the frames that did not arrive too.
   const modes = new Set(locked.map((p) => (p.source as DoctorPortSource).decoder.format.headerMode));
-  const mixed = modes.size > 1;
+  const bases = new Set(locked.map((p) => (p.source as DoctorPortSource).link.stats.missedBasis));
+  const mixed = modes.size > 1 || bases.size > 1;
   const metric = mixed ? M_LOST : M_MISSED;
   const lossOf = (p: PortState, s: number): number => p.bins.at(metric, s);
   // A whole capture: the monitor's own totals (what `info` and the report state); live: the window.

@@ -10,12 +10,15 @@ export type DoctorCode =
   // Nothing arrives
   | 'nothing-arrives'
   // Bytes, but not a satellite stream
+  | 'no-satellite'
   | 'inverted-line'
   | 'srxl-v1'
   | 'srxl2'
   | 'ibus'
   | 'sbus'
   | 'crsf'
+  | 'fport'
+  | 'ghst'
   | 'wrong-speed'
   | 'noise'
   | 'unknown-stream'

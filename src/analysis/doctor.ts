@@ -15,7 +15,7 @@
 import { FRAME_SIZE, type DecodedFrame } from '../decoder/index.js';
 import { BurstClock, PACKET_KINDS, PacketScanner, type PacketKind } from './doctor-line.js';
 import { ArduPilotGuess } from './doctor-stacks.js';
-import { lineFindings, lineVerdict, nothingFindings } from './doctor-line-rules.js';
+import { lineFindings, lineVerdict, noSatelliteFinding, nothingFindings } from './doctor-line-rules.js';
 import { formatClock } from './report-text.js';
 import { satelliteFindings } from './doctor-satellite-rules.js';
 import { systemFindings } from './doctor-system-rules.js';
@@ -23,6 +23,9 @@ import {
   Bins,
   M_BYTES,
   M_BREAKS,
+  M_FF,
+  M_TEXT,
+  M_ZERO,
   M_CHAR_ERRORS,
   M_FADES,
   M_FRAME_BYTES,
@@ -37,6 +40,9 @@ import {
   type PortState,
 } from './doctor-state.js';
 import type { AddFinding, Confidence, DoctorFinding, DoctorOptions, DoctorPortSource, RuleContext, Severity } from './doctor-types.js';
+
+/** Bytes of a port kept from its start, for a file's signature. */
+const HEAD_BYTES = 8;
 
 const SEVERITY_ORDER: Record<Severity, number> = { problem: 0, warning: 1, info: 2 };
 const CONFIDENCE_ORDER: Record<Confidence, number> = { certain: 0, likely: 1, possible: 2 };
@@ -91,13 +97,16 @@ export class Doctor {
         firstActivityUs: NaN,
         lastActivityUs: NaN,
         activity: 0,
+        bytes: 0,
+        head: [],
+        ended: false,
         lastTimeUs: NaN,
         bins: new Bins(),
         scanner: new PacketScanner((kind) => this.#packet(state, kind)),
         scanTimeUs: NaN,
         burst: new BurstClock(),
         confirmed: null,
-        probePackets: { ibus: 0, 'srxl-v1': 0, srxl2: 0, crsf: 0, sbus: 0 },
+        probePackets: { ibus: 0, 'srxl-v1': 0, srxl2: 0, crsf: 0, sbus: 0, fport: 0, ghst: 0 },
         frames: 0,
         guess: new ArduPilotGuess(),
         xplusMask: 0,
@@ -157,9 +166,10 @@ export class Doctor {
     const p = this.#ports.get(port);
     if (p === undefined) return undefined;
     // The snapshots and records in the lists are never changed once made: the lists are copied.
-    const { source: _source, bins, scanner, burst, guess, probePackets, damagedAtUs, changes, restarts, ...plain } = p;
+    const { source: _source, bins, scanner, burst, guess, probePackets, damagedAtUs, changes, restarts, head, ...plain } = p;
     return {
       ...plain,
+      head: [...head],
       probePackets: { ...probePackets },
       damagedAtUs: [...damagedAtUs],
       changes: [...changes],
@@ -179,10 +189,11 @@ export class Doctor {
   restorePort(port: number, cp: PortCheckpoint, source: DoctorPortSource): void {
     this.detach(port);
     const p = this.#port(port);
-    const { bins, scanner, burst, guess, probePackets, damagedAtUs, changes, restarts, ...plain } = cp;
+    const { bins, scanner, burst, guess, probePackets, damagedAtUs, changes, restarts, head, ...plain } = cp;
     Object.assign(p, plain, {
       port,
       source,
+      head: [...head],
       probePackets: { ...probePackets },
       damagedAtUs: [...damagedAtUs],
       changes: [...changes],
@@ -204,11 +215,20 @@ export class Doctor {
     if (p.baudRate !== 115_200 && baud === 115_200) this.#endProbe(p, timeUs);
     p.openUs = timeUs;
     p.baudRate = baud;
+    p.ended = false;
     p.firstActivityUs = NaN;
     p.activity = 0;
     p.bins.clear();
     p.burst.reset();
     for (const k of PACKET_KINDS) p.probePackets[k] = 0;
+  }
+
+  /**
+   * The port's stream is over (the end of a capture, a replay that ended): it is judged on all
+   * it held, however short (bytes without a frame: no satellite), until it opens again.
+   */
+  ended(port: number): void {
+    this.#port(port).ended = true;
   }
 
   /** The port was closed or lost: no "nothing arrives" for it until it opens again. */
@@ -264,12 +284,32 @@ export class Doctor {
       p.bins.add(M_BYTES, t, n);
     }
     this.#activity(p, t, n);
+    if (p.frames === 0) this.#census(p, bytes, start, end, time);
+    p.bytes += n;
     p.scanTimeUs = t;
     if (unscanned <= 0) p.scanner.push(bytes, start, end);
     else {
       p.scanner.pass(Math.min(unscanned, n));
       if (unscanned < n) p.scanner.push(bytes, start + unscanned, end);
     }
+  }
+
+  /** What bytes are, while the port has shown no frame: its first ones, and 0x00, 0xFF and text per second. */
+  #census(p: PortState, bytes: Uint8Array, start: number, end: number, time: number | Float64Array | undefined): void {
+    for (let i = start; i < end && p.head.length < HEAD_BYTES; i++) p.head.push(bytes[i] as number);
+    let zero = 0;
+    let ff = 0;
+    let text = 0;
+    for (let i = start; i < end; i++) {
+      const b = bytes[i] as number;
+      if (b === 0) zero++;
+      else if (b === 0xff) ff++;
+      else if ((b >= 0x20 && b < 0x7f) || b === 0x0a || b === 0x0d || b === 0x09) text++;
+    }
+    const t = time instanceof Float64Array ? (time[end - 1] ?? NaN) : (time ?? p.lastTimeUs);
+    p.bins.add(M_ZERO, t, zero);
+    p.bins.add(M_FF, t, ff);
+    p.bins.add(M_TEXT, t, text);
   }
 
   /**
@@ -374,7 +414,8 @@ export class Doctor {
     for (const p of ports) {
       nothingFindings(p, nowUs, add);
       const verdict = lineVerdict(p, nowUs, ctx);
-      lineFindings(p, verdict, nowUs, add);
+      lineFindings(p, verdict, nowUs, ctx, add);
+      noSatelliteFinding(p, verdict, nowUs, ctx, add);
       if (p.source !== null && p.frames > 0 && verdict.kind !== 'packets') satelliteFindings(p, nowUs, ctx, add);
     }
     systemFindings(

@@ -82,7 +82,7 @@ export class Diagnosis {
   }
 
   #restartReplay(startUs: number): void {
-    const timing = this.#capture?.timing === 'per-byte' ? 'per-byte' : 'per-chunk';
+    const timing = this.#capture?.timing ?? 'per-chunk';
     this.#doctor = new Doctor({ timing, memoryUs: Infinity, originUs: Number.isFinite(startUs) ? startUs : 0 });
     this.#nextEvent = 0;
   }
