@@ -363,7 +363,16 @@ function doctorDisagreements(capture: Capture): string[] {
     const weak = doctor.findings.find((f) => f.code === 'weak-link' && f.ports[0] === r.port);
     const where = `port ${r.port}`;
     if (info.link.holds !== r.holds.count) out.push(`${where}: info ${info.link.holds} holds, report ${r.holds.count}`);
-    if (failsafes.length > 0 && weak === undefined) out.push(`${where}: ${failsafes.length} failsafes, and the doctor sees no weak link`);
+    const restart = doctor.findings.find((f) => f.code === 'receiver-restart' && f.ports[0] === r.port);
+    if (failsafes.length > 0 && weak === undefined && restart === undefined)
+      out.push(`${where}: ${failsafes.length} failsafes, and the doctor sees no weak link or restart`);
+    // A restart is the receiver's, counted everywhere, and told as one.
+    if (info.link.restarts !== r.restarts.count) out.push(`${where}: info ${info.link.restarts} restarts, report ${r.restarts.count}`);
+    if (info.link.restarts > 0 !== (restart !== undefined)) out.push(`${where}: ${info.link.restarts} restarts, doctor ${restart?.title}`);
+    // A stall is the adapter's: never a hold, a failsafe or a weak link.
+    const stall = doctor.findings.find((f) => f.code === 'delivery-stall' && f.ports[0] === r.port);
+    if (timed && info.link.stalls > 0 !== (stall !== undefined)) out.push(`${where}: ${info.link.stalls} stalls, doctor ${stall?.title}`);
+    if (info.link.stalls !== (r.delivery.stalls ?? 0)) out.push(`${where}: info ${info.link.stalls} stalls, report ${r.delivery.stalls}`);
     if (weak === undefined) continue;
     if (/failsafe/.test(weak.title) !== failsafes.length > 0) out.push(`${where}: "${weak.title}" with ${failsafes.length} failsafes`);
     const fsLines = weak.evidence.filter((e) => /^Failsafe/.test(e.text));
@@ -431,7 +440,9 @@ function dropoutStreams(n: number, seed: number) {
 }
 
 describe('the doctor states what info and the report state', () => {
-  const classes: { name: string; captures: () => { name: string; capture: Capture }[] }[] = [
+  /** What the truth of a class says besides the surfaces agreeing: every disagreement in words. */
+  type Truth = (capture: Capture) => string[];
+  const classes: { name: string; captures: () => { name: string; capture: Capture }[]; truth?: Truth }[] = [
     {
       name: 'dropouts without failsafe, recorded through a USB adapter (.sscap)',
       captures: () =>
@@ -475,6 +486,49 @@ describe('the doctor states what info and the report state', () => {
         }),
     },
   ];
+  classes.push(
+    {
+      name: 'receiver restarts (the counter back to 0 after a silence), recorded and per-byte',
+      captures: () =>
+        RESTARTS.flatMap((r) => {
+          const s = restarted(r);
+          return [
+            { name: `${r.name} ${r.silenceUs / 1000} ms .sscap`, capture: sscap(usbChunks(s.bytes, s.timesUs)) },
+            { name: `${r.name} ${r.silenceUs / 1000} ms per-byte`, capture: perByteCapture(s) },
+          ];
+        }),
+      // One restart, one hold (a failsafe too past a second), and the doctor names the restart, not a weak link.
+      truth: (capture) => {
+        const { link, episodes } = summarizeCapture(capture);
+        const silence = episodes[0] === undefined ? 0 : (episodes.at(-1)!.endUs ?? 0) - episodes[0].lastFrameUs;
+        const codes = doctorCapture(capture).findings.map((f) => f.code);
+        const wrong = [];
+        if (link.restarts !== 1 || link.holds !== 1 || link.failsafes !== (silence >= 1e6 ? 1 : 0))
+          wrong.push(`${link.restarts} restarts, ${link.holds} holds, ${link.failsafes} failsafes`);
+        if (link.missedFrames < Math.round(silence / link.nominalPeriodUs) - 2) wrong.push(`${link.missedFrames} missed in ${silence} µs`);
+        if (!codes.includes('receiver-restart') || codes.includes('weak-link')) wrong.push(`doctor: ${codes.join(', ')}`);
+        return wrong;
+      },
+    },
+    {
+      name: 'USB stalls: frames held back and delivered at once, on receivers with and without a counter',
+      captures: () =>
+        STALLS.map((c) => {
+          const s = simulate({ ...preset(c.name), header: c.header, seed: c.seed, fades: { lossRate: 0, randomRate: 0 } }, 12e6);
+          return { name: `${c.name} ${c.header} ${c.stallUs / 1000} ms`, capture: sscap(heldBack(s, c.stallUs, 2e6, 1.1e6)) };
+        }),
+      // Nothing was lost: no hold, no failsafe, no missed frame, no weak link.
+      truth: (capture) => {
+        const { link } = summarizeCapture(capture);
+        const codes = doctorCapture(capture).findings.map((f) => f.code);
+        const wrong = [];
+        if (link.holds + link.failsafes + link.missedFrames > 0)
+          wrong.push(`${link.holds} holds, ${link.failsafes} failsafes, ${link.missedFrames} missed`);
+        if (codes.includes('weak-link')) wrong.push(`doctor: ${codes.join(', ')}`);
+        return wrong;
+      },
+    },
+  );
   if (present)
     classes.push({
       name: 'the real captures, whole and with 200 ms cut out three times',
@@ -489,10 +543,69 @@ describe('the doctor states what info and the report state', () => {
     });
   for (const c of classes)
     it(`agrees on ${c.name}`, () => {
-      const wrong = c.captures().flatMap(({ name, capture }) => doctorDisagreements(capture).map((w) => `${name}: ${w}`));
+      const wrong = c
+        .captures()
+        .flatMap(({ name, capture }) => [...doctorDisagreements(capture), ...(c.truth?.(capture) ?? [])].map((w) => `${name}: ${w}`));
       expect(wrong).toEqual([]);
     });
 });
+
+const RESTARTS = [
+  ...[120_000, 250_000, 496_000, 700_000, 900_000].flatMap((silenceUs) =>
+    ['dsmx-11ms-2048-internal', 'dsmx-22ms-2048-internal'].map((name) => ({ name, silenceUs })),
+  ),
+  ...[496_000, 1_300_000, 2_000_000].flatMap((silenceUs) =>
+    ['dsmx-11ms-2048-external', 'dsm2-22ms-1024-external'].map((name) => ({ name, silenceUs })),
+  ),
+];
+
+/** A receiver that counted 40 fades and more, went silent for `silenceUs` and started again from 0 (a power dip). */
+function restarted(r: { name: string; silenceUs: number }): { bytes: Uint8Array; timesUs: Float64Array } {
+  const quiet = { lossRate: 0, randomRate: 0 };
+  const a = simulate({ ...preset(r.name), fades: { ...quiet, start: 40 }, seed: 1 }, 2e6);
+  const b = simulate({ ...preset(r.name), fades: { ...quiet, start: 0 }, seed: 2 }, 2e6);
+  const shift = a.timesUs[a.timesUs.length - 1]! + r.silenceUs - b.timesUs[0]!;
+  const bytes = new Uint8Array(a.bytes.length + b.bytes.length);
+  bytes.set(a.bytes);
+  bytes.set(b.bytes, a.bytes.length);
+  const timesUs = new Float64Array(bytes.length);
+  timesUs.set(a.timesUs);
+  b.timesUs.forEach((t, i) => {
+    timesUs[a.bytes.length + i] = t + shift;
+  });
+  return { bytes, timesUs };
+}
+
+const STALLS = [150_000, 300_000, 1_200_000].flatMap((stallUs) =>
+  (['zero', 'spec'] as const).flatMap((header) =>
+    ['dsmx-11ms-2048-internal', 'dsm2-22ms-1024-external'].flatMap((name) => [2, 3].map((seed) => ({ name, header, seed, stallUs }))),
+  ),
+);
+
+/**
+ * 16 ms USB chunks of a stream, except that for `stallUs` every `everyUs` (from `fromUs`) the
+ * adapter holds them back and delivers them all with the next chunk.
+ */
+function heldBack(s: { bytes: Uint8Array; timesUs: Float64Array }, stallUs: number, everyUs: number, fromUs: number) {
+  const out: { bytes: Uint8Array; timeUs: number }[] = [];
+  let held: Uint8Array[] = [];
+  for (const c of usbChunks(s.bytes, s.timesUs)) {
+    const phase = (c.timeUs - fromUs + 100 * everyUs) % everyUs;
+    if (c.timeUs >= fromUs && phase <= stallUs) {
+      held.push(c.bytes);
+      continue;
+    }
+    const bytes = new Uint8Array(held.reduce((n, h) => n + h.length, c.bytes.length));
+    let at = 0;
+    for (const h of [...held, c.bytes]) {
+      bytes.set(h, at);
+      at += h.length;
+    }
+    out.push({ bytes, timeUs: c.timeUs });
+    held = [];
+  }
+  return out;
+}
 
 /** A per-byte capture with 200 ms of bytes taken out at a quarter, half and three quarters of its length (three real dropouts). */
 function cutThrice(capture: Capture): Capture {

@@ -5,9 +5,9 @@
  */
 import { systemInfo, type FormatInfo, type LinkStats, type Resolution } from '../decoder/index.js';
 import { fadesPerMinute, REPORT_THRESHOLDS } from './report-thresholds.js';
-import { plural, rate as rateText } from './report-text.js';
+import { formatDuration, plural, rate as rateText } from './report-text.js';
 import { ARDUPILOT_GUESS_FRAMES, bindPulses, channelSetText, satelliteSettings } from './doctor-stacks.js';
-import { dur, GUESS_MIN_DECISIONS, M_FADES, MIN_FADES, type FormatSnapshot, type PortState } from './doctor-state.js';
+import { GUESS_MIN_DECISIONS, M_FADES, MIN_FADES, type FormatSnapshot, type PortState } from './doctor-state.js';
 import type { AddFinding, Confidence, DoctorPortSource, Evidence, RuleContext } from './doctor-types.js';
 
 /** Advice from spec §5 for a weak link. */
@@ -176,11 +176,15 @@ export function satelliteFindings(p: PortState, now: number, ctx: RuleContext, a
   // the line's, not the link's: counted, but no reason to call the link weak.
   const byLine = (e: { lastFrameUs: number; endUs: number | null }) =>
     e.endUs !== null && p.damagedAtUs.some((d) => d > e.lastFrameUs && d <= e.endUs! + 50_000);
-  const linkHolds = holds.filter((e) => !failsafes.some((f) => f.lastFrameUs === e.lastFrameUs) && !byLine(e));
+  // Silences a receiver restart ended are the restart's (its own finding), not the radio link's.
+  const restarts = link.restarts.filter((r) => r.timeUs >= memoryStart);
+  const byRestart = (e: { lastFrameUs: number }) => restarts.some((r) => r.timeUs - r.gapUs === e.lastFrameUs);
+  const linkFailsafes = failsafes.filter((e) => !byRestart(e));
+  const linkHolds = holds.filter((e) => !failsafes.some((f) => f.lastFrameUs === e.lastFrameUs) && !byLine(e) && !byRestart(e));
   const rate = fadeRateOf(p, s, now, ctx);
   const fadeHigh = format.headerMode === 'fades' && rate !== null && rate.perMinute > REPORT_THRESHOLDS.fadeRateHighPerMin && rate.enough;
   const rssiLow = Number.isFinite(s.minRssi) && s.minRssi < REPORT_THRESHOLDS.rssiLowDbm;
-  if (failsafes.length > 0 || linkHolds.length > 0 || fadeHigh || rssiLow) {
+  if (linkFailsafes.length > 0 || linkHolds.length > 0 || fadeHigh || rssiLow) {
     const evidence: Evidence[] = [];
     for (const e of failsafes.slice(-5))
       evidence.push({
@@ -190,9 +194,11 @@ export function satelliteFindings(p: PortState, now: number, ctx: RuleContext, a
     if (holds.length > 0) {
       const last = holds[holds.length - 1] as (typeof holds)[number];
       const became = holds.filter((e) => failsafes.some((f) => f.lastFrameUs === e.lastFrameUs)).length;
-      const line = holds.length - became - linkHolds.length;
+      const restarted = holds.filter((e) => byRestart(e) && !failsafes.some((f) => f.lastFrameUs === e.lastFrameUs)).length;
+      const line = holds.length - became - restarted - linkHolds.length;
       const parts = [
         became > 0 ? `${became} of them became ${became === 1 ? 'a failsafe' : 'failsafes'}` : '',
+        restarted > 0 ? `${restarted} ended in a receiver restart` : '',
         line > 0 ? `${line} ended at line damage` : '',
       ].filter((x) => x !== '');
       evidence.push({
@@ -213,9 +219,9 @@ export function satelliteFindings(p: PortState, now: number, ctx: RuleContext, a
     add({
       code: 'weak-link',
       ports: [p.port],
-      severity: failsafes.length > 0 ? 'problem' : 'warning',
-      confidence: failsafes.length > 0 || fadeHigh || rssiLow || ctx.precise ? 'certain' : 'likely',
-      title: `${p.label}: the link is weak${failsafes.length > 0 ? ': failsafe' : linkHolds.length > 0 ? ': frames lost' : ''}`,
+      severity: linkFailsafes.length > 0 ? 'problem' : 'warning',
+      confidence: linkFailsafes.length > 0 || fadeHigh || rssiLow || ctx.precise ? 'certain' : 'likely',
+      title: `${p.label}: the link is weak${linkFailsafes.length > 0 ? ': failsafe' : linkHolds.length > 0 ? ': frames lost' : ''}`,
       evidence,
       todo: LINK_ADVICE,
       settings: [],
@@ -245,19 +251,23 @@ export function satelliteFindings(p: PortState, now: number, ctx: RuleContext, a
       sinceUs: c.timeUs,
     });
   }
-  const restarts = p.restarts.filter((r) => r.timeUs >= memoryStart);
   if (restarts.length > 0) {
     const r = restarts[restarts.length - 1] as (typeof restarts)[number];
+    const failsafe = restarts.some((x) => failsafes.some((f) => f.lastFrameUs === x.timeUs - x.gapUs));
     add({
       code: 'receiver-restart',
       ports: [p.port],
-      severity: 'warning',
+      severity: failsafe ? 'problem' : 'warning',
       confidence: 'likely',
-      title: `${p.label}: the receiver restarted (power dip?)`,
+      title: `${p.label}: the receiver restarted (power dip?)${failsafe ? ': failsafe' : ''}`,
       evidence: [
         {
-          text: `${plural(restarts.length, 'restart')}: the fade counter went from ${r.from} back to ${r.to} after ${dur(r.gapUs)} without frames, at ${ctx.at(r.timeUs)}; a counter only starts again from 0 at power-up.`,
+          text: `${plural(restarts.length, 'restart')}: the fade counter went from ${r.from} back to ${r.to} after ${formatDuration(r.gapUs)} without frames, at ${ctx.at(r.timeUs)}; a counter only starts again from 0 at power-up.`,
           timeUs: r.timeUs,
+        },
+        {
+          text: `The flight controller held the last values through ${restarts.length === 1 ? 'that silence' : 'each silence'} (a hold${failsafe ? ', then failsafe' : ''}); the frames due in it are counted missed.`,
+          timeUs: null,
         },
       ],
       todo: [
@@ -267,6 +277,26 @@ export function satelliteFindings(p: PortState, now: number, ctx: RuleContext, a
       settings: [],
       confirm: null,
       sinceUs: r.timeUs,
+    });
+  }
+  if (s.stalls > 0 && ctx.timed) {
+    add({
+      code: 'delivery-stall',
+      ports: [p.port],
+      severity: 'info',
+      confidence: 'likely',
+      title: `${p.label}: frames reached the computer late (the link lost none of them)`,
+      evidence: [
+        {
+          text: `${plural(s.stalls, 'silence')}, the longest ${formatDuration(s.longestStallUs)}, ${s.stalls === 1 ? 'was' : 'were'} the USB adapter or the computer holding frames back: ${s.missedBasis === 'fade-counter' ? "the receiver's fade counter did not move" : 'the frames came afterwards, all at once'}. Not counted as holds or failsafes: the flight controller, on the receiver's own line, had them in time.`,
+          timeUs: null,
+        },
+      ],
+      todo: [
+        'For a recording that shows only the link: a USB port without a hub, no other program reading the port, the computer kept from sleeping or throttling USB; an FTDI adapter with a lower latency timer.',
+      ],
+      settings: [],
+      confirm: null,
     });
   }
   if (format.headerMode === 'rssi') {

@@ -26,8 +26,6 @@ export function lineWindow(nowUs: number): { fromS: number; toS: number } {
   const toS = Math.floor(nowUs / 1e6);
   return { fromS: toS - LINE_WINDOW_BINS + 1, toS };
 }
-/** A fade-counter drop after a gap this long is a restart, not a wrap. */
-export const RESTART_MIN_GAP_US = 100_000;
 /** Seconds with fades on two remotes or more, out of the seconds with fades on any, above which they fade together. */
 export const TOGETHER_RATIO = 0.6;
 export const TOGETHER_MIN_SECONDS = 3;
@@ -182,7 +180,6 @@ export interface PortState {
   xplusFirstUs: number;
   vtxFrames: number;
   vtxFirstUs: number;
-  prevFades: number | null;
   /** The first and the last frame's time (NaN: none, or untimed). */
   firstFrameUs: number;
   prevFrameUs: number;
@@ -194,7 +191,6 @@ export interface PortState {
   damagedAtUs: number[];
   first: FormatSnapshot | null;
   changes: { timeUs: number; from: FormatSnapshot; to: FormatSnapshot }[];
-  restarts: { timeUs: number; from: number; to: number; gapUs: number }[];
   rssiFrames: number;
 }
 

@@ -39,6 +39,7 @@ export type DoctorCode =
   | 'resolution-mismatch'
   | 'rebind'
   | 'receiver-restart'
+  | 'delivery-stall'
   | 'rssi-receiver';
 
 export type Severity = 'problem' | 'warning' | 'info';

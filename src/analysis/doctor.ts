@@ -33,7 +33,6 @@ import {
   M_MISSED,
   M_OVERRUNS,
   M_PACKETS,
-  RESTART_MIN_GAP_US,
   SETUP_MIN_FRAMES,
   type FormatSnapshot,
   type PortCheckpoint,
@@ -113,7 +112,6 @@ export class Doctor {
         xplusFirstUs: NaN,
         vtxFrames: 0,
         vtxFirstUs: NaN,
-        prevFades: null,
         firstFrameUs: NaN,
         prevFrameUs: NaN,
         prevMissed: 0,
@@ -122,7 +120,6 @@ export class Doctor {
         damagedAtUs: [],
         first: null,
         changes: [],
-        restarts: [],
         rssiFrames: 0,
       };
       p = state;
@@ -166,14 +163,13 @@ export class Doctor {
     const p = this.#ports.get(port);
     if (p === undefined) return undefined;
     // The snapshots and records in the lists are never changed once made: the lists are copied.
-    const { source: _source, bins, scanner, burst, guess, probePackets, damagedAtUs, changes, restarts, head, ...plain } = p;
+    const { source: _source, bins, scanner, burst, guess, probePackets, damagedAtUs, changes, head, ...plain } = p;
     return {
       ...plain,
       head: [...head],
       probePackets: { ...probePackets },
       damagedAtUs: [...damagedAtUs],
       changes: [...changes],
-      restarts: [...restarts],
       bins: bins.checkpoint(),
       scanner: scanner.checkpoint(),
       burst: burst.checkpoint(),
@@ -189,7 +185,7 @@ export class Doctor {
   restorePort(port: number, cp: PortCheckpoint, source: DoctorPortSource): void {
     this.detach(port);
     const p = this.#port(port);
-    const { bins, scanner, burst, guess, probePackets, damagedAtUs, changes, restarts, head, ...plain } = cp;
+    const { bins, scanner, burst, guess, probePackets, damagedAtUs, changes, head, ...plain } = cp;
     Object.assign(p, plain, {
       port,
       source,
@@ -197,7 +193,6 @@ export class Doctor {
       probePackets: { ...probePackets },
       damagedAtUs: [...damagedAtUs],
       changes: [...changes],
-      restarts: [...restarts],
     });
     p.bins.restore(bins);
     p.scanner.restore(scanner);
@@ -366,23 +361,8 @@ export class Doctor {
       p.prevMissed = missedFrames;
       p.prevLost = lostFrames;
     }
-    // A counter that went back down after a gap is a receiver that restarted (power), not a
-    // wrap: a wrap after a gap adds about as many fades as frames were missed.
-    if (f.fades !== null && p.prevFades !== null && Number.isFinite(t) && Number.isFinite(p.prevFrameUs)) {
-      const gap = t - p.prevFrameUs;
-      // Only a counter that went down after a long gap can be a restart (the rest is per frame).
-      let restarted = false;
-      if (f.fades < p.prevFades && gap >= RESTART_MIN_GAP_US) {
-        const modulus = f.remote === 'internal' ? 256 : 65536;
-        const period = link !== undefined && Number.isFinite(link.stats.nominalPeriodUs) ? link.stats.nominalPeriodUs : 22_000;
-        const expected = Math.max(0, Math.round(gap / period) - 1);
-        const wrapped = (f.fades - p.prevFades + modulus) % modulus;
-        restarted = Math.abs(wrapped - expected) > Math.max(8, 0.5 * expected);
-      }
-      if (restarted) p.restarts.push({ timeUs: t, from: p.prevFades, to: f.fades, gapUs: gap });
-      else p.bins.addTo(slot, M_FADES, f.fadesDelta);
-    }
-    if (f.fades !== null) p.prevFades = f.fades;
+    // Fades per second (a restarted counter's fall is none: the decoder gives it no delta).
+    if (f.fadesDelta > 0) p.bins.addTo(slot, M_FADES, f.fadesDelta);
     if (p.frames === 1) p.firstFrameUs = t;
     p.prevFrameUs = t;
     // The format a remote was bound in; a change after that is a rebind (or another receiver).

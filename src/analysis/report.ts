@@ -180,7 +180,17 @@ export function healthReportFeeding(
       expectedFrames: haveMissed ? stats.frames + missed : null,
       missedFrames: haveMissed ? missed : null,
       missedBasis: ls.missedBasis,
-      delivery: { delayUs: hasClock ? r1n(ls.deliveryDelayUs) : null, jitterUs: hasClock ? r1n(ls.deliveryJitterUs) : null },
+      undeliveredFrames: havePeriod ? ls.lostFrames : null,
+      delivery: {
+        delayUs: hasClock ? r1n(ls.deliveryDelayUs) : null,
+        jitterUs: hasClock ? r1n(ls.deliveryJitterUs) : null,
+        stalls: hasClock ? ls.stalls : null,
+        longestStallUs: hasClock && ls.stalls > 0 ? r1(ls.longestStallUs) : null,
+      },
+      restarts: {
+        count: ls.restarts,
+        lastAtUs: hasClock && link.restarts.length > 0 ? r1((link.restarts.at(-1)?.timeUs ?? NaN) - origin) : null,
+      },
       lostRatio: haveMissed ? Math.round((missed / Math.max(1, stats.frames + missed)) * 1e6) / 1e6 : null,
       nominalPeriodUs: havePeriod ? period : null,
       fades: rssiMode
