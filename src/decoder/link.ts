@@ -164,6 +164,8 @@ export function holdThresholdUs(nominalPeriodUs: number, jitterUs: number): numb
 }
 
 const PERIOD_WINDOW = 33;
+/** A mean frame interval below this (0.8 × 11 ms) is no system's period: frames a delivery burst brought together. */
+const BURST_MEAN_US = 0.8 * FRAME_PERIOD_11MS_US;
 const RATE_WINDOW = 512;
 
 export class LinkMonitor {
@@ -756,8 +758,11 @@ export class LinkMonitor {
       const s = this.#stats;
       if (!Number.isFinite(this.#systemPeriod) && (!Number.isFinite(s.nominalPeriodUs) || this.#periodCount === PERIOD_WINDOW)) {
         // Without a system byte: snap the mean interval to 11 or 22 ms, first over 8 intervals,
-        // then again over every full window, so a few frames missing early do not stick.
-        s.nominalPeriodUs = nominalPeriodOf((t - (times[this.#periodOldest] ?? NaN)) / (this.#periodCount - 1));
+        // then again over every full window, so a few frames missing early do not stick. A
+        // window that a delivery burst crowds (frames a stall held back, dated together) is
+        // faster than any system sends: it says nothing of the period.
+        const mean = (t - (times[this.#periodOldest] ?? NaN)) / (this.#periodCount - 1);
+        if (!(mean < BURST_MEAN_US)) s.nominalPeriodUs = nominalPeriodOf(mean);
       }
       this.#periodOwed = true;
     }
