@@ -8,7 +8,11 @@
  * - the worker's replay source driving the worker's engine, on a simulated clock, at 1×, 4× and
  *   as fast as possible, and after seeking;
  * - the live engine fed the bytes in 16 ms USB chunks at the capture's pace (per-byte times
- *   hidden, as a browser sees them), within the batching for episode times.
+ *   hidden, as a browser sees them), within the batching for episode times;
+ * - the doctor (`satscope doctor`, the report's diagnosis, the page's on a replay): every figure
+ *   it states that info or the report states (holds, failsafes and their times, fade rate, missed
+ *   frames, restarts, stalls, windows), on dropouts, restarts, USB stalls, multi-port recordings,
+ *   damage, untimed files and the real captures.
  */
 import { existsSync, readdirSync, readFileSync, statSync } from 'node:fs';
 import { join, resolve } from 'node:path';
@@ -19,13 +23,17 @@ import {
   captureSpan,
   diagnosedHealthReport,
   doctorCapture,
+  type DoctorFinding,
   formatClock,
   healthReport,
   summarizeCapture,
   timingJitterUs,
 } from '../src/analysis/index.js';
 import { preset, simulate } from '../src/simulator/index.js';
+import { Diagnosis } from '../src/worker/diagnosis.js';
 import { Engine } from '../src/worker/engine.js';
+import type { Clock } from '../src/worker/host.js';
+import type { FromWorker } from '../src/worker/protocol.js';
 import { ReplaySource } from '../src/worker/sources/replay.js';
 import { usbChunks, perByteCapture, recording } from './feeds.js';
 import { SimulatedClock } from './worker-fakes.js';
@@ -349,6 +357,12 @@ function doctorDisagreements(capture: Capture): string[] {
   const reportLines = (report.diagnosis ?? []).map(said);
   if (JSON.stringify(lines) !== JSON.stringify(reportLines))
     out.push(`report's diagnosis ${JSON.stringify(reportLines)} ≠ doctor ${JSON.stringify(lines)}`);
+  // The page's doctor, on the replay of the same file at full speed, says the same.
+  if (report.remotes.length === 1 && report.remotes[0]!.port === 0) {
+    const page = replayDoctorSays(capture).map(said);
+    if (JSON.stringify(page) !== JSON.stringify(lines))
+      out.push(`the page's replay ${JSON.stringify(page)} ≠ doctor ${JSON.stringify(lines)}`);
+  }
   for (const text of lines) {
     for (const m of text.matchAll(/in the last (\d+) s/g))
       if (!timed || span === null || Number(m[1]) > Math.ceil(span / 1e6))
@@ -409,6 +423,39 @@ function doctorDisagreements(capture: Capture): string[] {
     if (r === undefined || Number(m[2]) !== r.missedFrames) out.push(`"${e.text}", the report: ${r?.missedFrames} missed`);
   }
   return out;
+}
+
+/** The worker's doctor (the page's Diagnosis) on a replay of a one-port capture at full speed, judged at its end. */
+function replayDoctorSays(capture: Capture): DoctorFinding[] {
+  const clock = new SimulatedClock();
+  const posts: FromWorker[] = [];
+  const engine = new Engine({ resolution: 'auto', jitterUs: timingJitterUs(capture.timing) });
+  let ended = false;
+  const r: ReplaySource = new ReplaySource(
+    capture,
+    (_port, bytes, time) => engine.push(bytes, time, 0),
+    () => engine.batch(r.linkNowUs(0)),
+    () => {
+      engine.end(r.recordedTiming ? r.endUs : Number.NaN);
+      engine.batch(r.linkNowUs(0));
+      ended = true;
+    },
+    { clock },
+  );
+  const diagnosis = new Diagnosis(
+    (m) => posts.push(m),
+    () => r.positionUs,
+    () => [],
+    { now: () => clock.ms, after: () => undefined } as unknown as Clock,
+  );
+  diagnosis.replay(capture, r.startUs);
+  diagnosis.attach(0, engine, 'Port 0');
+  r.setSpeed(0);
+  r.play();
+  clock.run(() => ended);
+  diagnosis.ended();
+  const last = posts.filter((p) => p.type === 'diagnosis').at(-1);
+  return last?.type === 'diagnosis' ? last.diagnosis.findings : [];
 }
 
 const formatRate = (x: number): string => (x === 0 ? '0' : x >= 10 ? x.toFixed(0) : x.toFixed(1));
