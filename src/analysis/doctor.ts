@@ -40,6 +40,8 @@ import {
 } from './doctor-state.js';
 import type { AddFinding, Confidence, DoctorFinding, DoctorOptions, DoctorPortSource, RuleContext, Severity } from './doctor-types.js';
 
+/** The census's metrics: 0x00, 0xFF, printable text. */
+const CENSUS = [M_ZERO, M_FF, M_TEXT];
 /** Bytes of a port kept from its start, for a file's signature. */
 const HEAD_BYTES = 8;
 
@@ -289,22 +291,23 @@ export class Doctor {
     }
   }
 
-  /** What bytes are, while the port has shown no frame: its first ones, and 0x00, 0xFF and text per second. */
+  /**
+   * What bytes are, while the port has shown no frame: its first ones, and 0x00, 0xFF and text
+   * per second, each byte booked where `bytes()` books it (per-byte times: its own).
+   */
   #census(p: PortState, bytes: Uint8Array, start: number, end: number, time: number | Float64Array | undefined): void {
     for (let i = start; i < end && p.head.length < HEAD_BYTES; i++) p.head.push(bytes[i] as number);
-    let zero = 0;
-    let ff = 0;
-    let text = 0;
+    const counts = [0, 0, 0]; // 0x00, 0xFF, text
     for (let i = start; i < end; i++) {
       const b = bytes[i] as number;
-      if (b === 0) zero++;
-      else if (b === 0xff) ff++;
-      else if ((b >= 0x20 && b < 0x7f) || b === 0x0a || b === 0x0d || b === 0x09) text++;
+      const kind = b === 0 ? 0 : b === 0xff ? 1 : (b >= 0x20 && b < 0x7f) || b === 0x0a || b === 0x0d || b === 0x09 ? 2 : -1;
+      if (kind < 0) continue;
+      if (time instanceof Float64Array) p.bins.add(CENSUS[kind] as number, time[i] ?? NaN, 1);
+      else counts[kind] = (counts[kind] as number) + 1;
     }
-    const t = time instanceof Float64Array ? (time[end - 1] ?? NaN) : (time ?? p.lastTimeUs);
-    p.bins.add(M_ZERO, t, zero);
-    p.bins.add(M_FF, t, ff);
-    p.bins.add(M_TEXT, t, text);
+    if (time instanceof Float64Array) return;
+    const t = time ?? p.lastTimeUs;
+    for (let k = 0; k < 3; k++) if ((counts[k] as number) > 0) p.bins.add(CENSUS[k] as number, t, counts[k] as number);
   }
 
   /**
