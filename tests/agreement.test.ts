@@ -8,18 +8,34 @@
  * - the worker's replay source driving the worker's engine, on a simulated clock, at 1×, 4× and
  *   as fast as possible, and after seeking;
  * - the live engine fed the bytes in 16 ms USB chunks at the capture's pace (per-byte times
- *   hidden, as a browser sees them), within the batching for episode times.
+ *   hidden, as a browser sees them), within the batching for episode times;
+ * - the doctor (`satscope doctor`, the report's diagnosis, the page's on a replay): every figure
+ *   it states that info or the report states (holds, failsafes and their times, fade rate, missed
+ *   frames, restarts, stalls, windows), on dropouts, restarts, USB stalls, multi-port recordings,
+ *   damage, untimed files and the real captures.
  */
 import { existsSync, readdirSync, readFileSync, statSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 import { describe, expect, it } from 'vitest';
 import type { FormatInfo, LinkEpisode, LinkStats } from '../src/decoder/index.js';
 import { encodeCapture, importRaw, readCapture, type Capture, type CaptureRecordInput } from '../src/capture/index.js';
-import { captureSpan, healthReport, summarizeCapture, timingJitterUs } from '../src/analysis/index.js';
+import {
+  captureSpan,
+  diagnosedHealthReport,
+  doctorCapture,
+  type DoctorFinding,
+  formatClock,
+  healthReport,
+  summarizeCapture,
+  timingJitterUs,
+} from '../src/analysis/index.js';
 import { preset, simulate } from '../src/simulator/index.js';
+import { Diagnosis } from '../src/worker/diagnosis.js';
 import { Engine } from '../src/worker/engine.js';
+import type { Clock } from '../src/worker/host.js';
+import type { FromWorker } from '../src/worker/protocol.js';
 import { ReplaySource } from '../src/worker/sources/replay.js';
-import { usbChunks, perByteCapture } from './feeds.js';
+import { usbChunks, perByteCapture, recording } from './feeds.js';
 import { SimulatedClock } from './worker-fakes.js';
 
 const CAPTURES = resolve(import.meta.dirname, '../../shared/captures');
@@ -317,3 +333,340 @@ describe('every surface tells the same story about the same bytes', () => {
     });
   }
 });
+
+// ---------------------------------------------------------------------------------------------
+// The doctor states the figures the other surfaces state.
+
+/**
+ * What the doctor says that `info` (`summarizeCapture`) or the report also says, read from its
+ * sentences, checked against theirs: holds, failsafes and their times, the fade rate, missed
+ * frames, the windows it looks at; and the report's own diagnosis is the doctor's. Returns
+ * every disagreement, in words (none: []).
+ */
+function doctorDisagreements(capture: Capture): string[] {
+  const out: string[] = [];
+  const report = diagnosedHealthReport(capture);
+  const doctor = doctorCapture(capture);
+  const timed = capture.timing !== 'none';
+  const origin = report.timeline.originUs;
+  const clock = (us: number): string => formatClock(us - (origin ?? 0));
+  const span = report.timeline.durationUs;
+  const said = (f: { title: string; evidence: readonly { text: string }[] }): string =>
+    [f.title, ...f.evidence.map((e) => e.text)].join(' | ');
+  const lines = doctor.findings.map(said);
+  const reportLines = (report.diagnosis ?? []).map(said);
+  if (JSON.stringify(lines) !== JSON.stringify(reportLines))
+    out.push(`report's diagnosis ${JSON.stringify(reportLines)} ≠ doctor ${JSON.stringify(lines)}`);
+  // The page's doctor, on the replay of the same file at full speed, says the same.
+  if (report.remotes.length === 1 && report.remotes[0]!.port === 0) {
+    const page = replayDoctorSays(capture).map(said);
+    if (JSON.stringify(page) !== JSON.stringify(lines))
+      out.push(`the page's replay ${JSON.stringify(page)} ≠ doctor ${JSON.stringify(lines)}`);
+  }
+  for (const text of lines) {
+    for (const m of text.matchAll(/in the last (\d+) s/g))
+      if (!timed || span === null || Number(m[1]) > Math.ceil(span / 1e6))
+        out.push(`a window of ${m[1]} s in a capture of ${span} µs: ${text}`);
+    if (!timed && /a minute|\/min|\b\d+:\d\d\.\d\b| s without frames/.test(text)) out.push(`a time or rate in an untimed file: ${text}`);
+  }
+  for (const r of report.remotes) {
+    const info = summarizeCapture(capture, { port: r.port });
+    const episodes = info.episodes;
+    const holds = episodes.filter((e) => e.kind === 'hold');
+    const failsafes = episodes.filter((e) => e.kind === 'failsafe');
+    const weak = doctor.findings.find((f) => f.code === 'weak-link' && f.ports[0] === r.port);
+    const where = `port ${r.port}`;
+    if (info.link.holds !== r.holds.count) out.push(`${where}: info ${info.link.holds} holds, report ${r.holds.count}`);
+    const restart = doctor.findings.find((f) => f.code === 'receiver-restart' && f.ports[0] === r.port);
+    if (failsafes.length > 0 && weak === undefined && restart === undefined)
+      out.push(`${where}: ${failsafes.length} failsafes, and the doctor sees no weak link or restart`);
+    // A restart is the receiver's, counted everywhere, and told as one.
+    if (info.link.restarts !== r.restarts.count) out.push(`${where}: info ${info.link.restarts} restarts, report ${r.restarts.count}`);
+    if (info.link.restarts > 0 !== (restart !== undefined)) out.push(`${where}: ${info.link.restarts} restarts, doctor ${restart?.title}`);
+    // A stall is the adapter's: never a hold, a failsafe or a weak link.
+    const stall = doctor.findings.find((f) => f.code === 'delivery-stall' && f.ports[0] === r.port);
+    if (timed && info.link.stalls > 0 !== (stall !== undefined)) out.push(`${where}: ${info.link.stalls} stalls, doctor ${stall?.title}`);
+    if (info.link.stalls !== (r.delivery.stalls ?? 0)) out.push(`${where}: info ${info.link.stalls} stalls, report ${r.delivery.stalls}`);
+    if (weak === undefined) continue;
+    if (/failsafe/.test(weak.title) !== failsafes.length > 0) out.push(`${where}: "${weak.title}" with ${failsafes.length} failsafes`);
+    const fsLines = weak.evidence.filter((e) => /^Failsafe/.test(e.text));
+    if (fsLines.length !== Math.min(5, failsafes.length))
+      out.push(`${where}: ${fsLines.length} failsafe lines for ${failsafes.length} failsafes`);
+    fsLines.forEach((e, i) => {
+      const f = failsafes.slice(-5)[i]!;
+      const want = `after ${clock(f.lastFrameUs)}${f.endUs === null ? ', still now' : `, back at ${clock(f.endUs)}`}`;
+      if (!e.text.includes(want)) out.push(`${where}: "${e.text}", info and the report: ${want}`);
+    });
+    for (const e of weak.evidence) {
+      const h = /^(\d+) holds? .*the last at ([\d:.]+)\./.exec(e.text);
+      if (/\bholds?\b/.test(e.text) && !/^Failsafe/.test(e.text)) {
+        if (h === null) out.push(`${where}: unread hold sentence "${e.text}"`);
+        else {
+          if (Number(h[1]) !== info.link.holds) out.push(`${where}: doctor ${h[1]} holds, info ${info.link.holds}`);
+          const last = holds.at(-1);
+          if (last === undefined || h[2] !== clock(last.startUs))
+            out.push(`${where}: last hold at ${h[2]}, the report's ${last && clock(last.startUs)}`);
+        }
+      }
+      const rate = /Fade rate ([\d.]+) a minute/.exec(e.text);
+      if (rate !== null) {
+        const per = r.fades?.perMinute ?? null;
+        if (per === null || rate[1] !== formatRate(per)) out.push(`${where}: doctor fade rate ${rate[1]}/min, report ${per}`);
+      }
+    }
+  }
+  const weakest = doctor.findings.find((f) => f.code === 'weakest-remote');
+  for (const e of weakest?.evidence ?? []) {
+    const m = /^(.+): (\d+) missed frames? in the (capture|file)\.$/.exec(e.text);
+    if (m === null) continue;
+    const r = report.remotes.find((x) => x.label === m[1]);
+    if (r === undefined || Number(m[2]) !== r.missedFrames) out.push(`"${e.text}", the report: ${r?.missedFrames} missed`);
+  }
+  return out;
+}
+
+/** The worker's doctor (the page's Diagnosis) on a replay of a one-port capture at full speed, judged at its end. */
+function replayDoctorSays(capture: Capture): DoctorFinding[] {
+  const clock = new SimulatedClock();
+  const posts: FromWorker[] = [];
+  const engine = new Engine({ resolution: 'auto', jitterUs: timingJitterUs(capture.timing) });
+  let ended = false;
+  const r: ReplaySource = new ReplaySource(
+    capture,
+    (_port, bytes, time) => engine.push(bytes, time, 0),
+    () => engine.batch(r.linkNowUs(0)),
+    () => {
+      engine.end(r.recordedTiming ? r.endUs : Number.NaN);
+      engine.batch(r.linkNowUs(0));
+      ended = true;
+    },
+    { clock },
+  );
+  const diagnosis = new Diagnosis(
+    (m) => posts.push(m),
+    () => r.positionUs,
+    () => [],
+    { now: () => clock.ms, after: () => undefined } as unknown as Clock,
+  );
+  diagnosis.replay(capture, r.startUs);
+  diagnosis.attach(0, engine, 'Port 0');
+  r.setSpeed(0);
+  r.play();
+  clock.run(() => ended);
+  diagnosis.ended();
+  const last = posts.filter((p) => p.type === 'diagnosis').at(-1);
+  return last?.type === 'diagnosis' ? last.diagnosis.findings : [];
+}
+
+const formatRate = (x: number): string => (x === 0 ? '0' : x >= 10 ? x.toFixed(0) : x.toFixed(1));
+
+/** A seeded choice of numbers. */
+function seeded(seed: number): () => number {
+  let x = seed;
+  return () => (x = (x * 1_103_515_245 + 12_345) % 2_147_483_648) / 2_147_483_648;
+}
+
+const DROPOUT_PRESETS = [
+  'dsmx-11ms-2048-internal',
+  'dsmx-22ms-2048-internal',
+  'dsm2-22ms-1024-external',
+  'dsmx-11ms-2048-external',
+  'rssi-spm4649t',
+];
+
+/** `n` streams of 4-6 s with one to four dropouts of 60-900 ms (no failsafe), every preset in turn. */
+function dropoutStreams(n: number, seed: number) {
+  const random = seeded(seed);
+  return Array.from({ length: n }, (_, i) => {
+    const at: { atUs: number; durationUs: number }[] = [];
+    const count = 1 + Math.floor(random() * 4);
+    for (let k = 0; k < count; k++) at.push({ atUs: 0.5e6 + k * 1.2e6 + random() * 0.3e6, durationUs: 60_000 + random() * 840_000 });
+    const name = DROPOUT_PRESETS[i % DROPOUT_PRESETS.length]!;
+    return { name, stream: simulate({ ...preset(name), seed: seed + i, dropouts: at }, 4e6 + random() * 2e6) };
+  });
+}
+
+describe('the doctor states what info and the report state', () => {
+  /** What the truth of a class says besides the surfaces agreeing: every disagreement in words. */
+  type Truth = (capture: Capture) => string[];
+  const classes: { name: string; captures: () => { name: string; capture: Capture }[]; truth?: Truth }[] = [
+    {
+      name: 'dropouts without failsafe, recorded through a USB adapter (.sscap)',
+      captures: () =>
+        dropoutStreams(24, 100).map((d, i) => ({ name: `${d.name} #${i}`, capture: sscap(usbChunks(d.stream.bytes, d.stream.timesUs)) })),
+    },
+    {
+      name: 'dropouts without failsafe, per-byte times (Saleae)',
+      captures: () => dropoutStreams(24, 200).map((d, i) => ({ name: `${d.name} #${i}`, capture: perByteCapture(d.stream) })),
+    },
+    {
+      name: 'dropouts without failsafe, untimed raw files',
+      captures: () => dropoutStreams(12, 300).map((d, i) => ({ name: `${d.name} #${i}`, capture: importRaw(d.stream.bytes) })),
+    },
+    {
+      name: 'the demo, failsafes and damage (several seeds and lengths)',
+      captures: () =>
+        [1, 2, 3, 4, 5, 6].flatMap((seed) => {
+          const demo = simulate({ ...preset('demo'), seed }, 4e6 + seed * 1.1e6);
+          const fs = simulate({ ...preset('dropouts-failsafe'), seed }, 4e6);
+          const dmg = simulate({ ...preset('dropouts-and-damage'), seed }, 4e6);
+          return [
+            { name: `demo ${seed} .sscap`, capture: sscap(usbChunks(demo.bytes, demo.timesUs)) },
+            { name: `dropouts-failsafe ${seed} per-byte`, capture: perByteCapture(fs) },
+            { name: `dropouts-and-damage ${seed} .sscap`, capture: sscap(usbChunks(dmg.bytes, dmg.timesUs)) },
+            { name: `dropouts-and-damage ${seed} raw`, capture: importRaw(dmg.bytes) },
+          ];
+        }),
+    },
+    {
+      name: 'multi-port recordings (a remote that fades most, remotes that drop out)',
+      captures: () =>
+        [1, 2, 3, 4, 5, 6].map((seed) => {
+          const random = seeded(seed * 7);
+          const drops = [0.8e6 + random() * 1e6, 2.4e6 + random() * 1e6].map((atUs) => ({ atUs, durationUs: 80_000 + random() * 400_000 }));
+          const a = simulate({ ...preset('dsmx-11ms-2048-internal'), seed, dropouts: drops, fades: { lossRate: 0.002 } }, 4e6);
+          const b = simulate(
+            { ...preset('dsmx-11ms-2048-external'), seed: seed + 50, fades: { start: 0, lossRate: 0.02 + random() * 0.03 } },
+            4e6,
+          );
+          return { name: `two ports ${seed}`, capture: recording([a, b], seed % 3 !== 0) };
+        }),
+    },
+  ];
+  classes.push(
+    {
+      name: 'receiver restarts (the counter back to 0 after a silence), recorded and per-byte',
+      captures: () =>
+        RESTARTS.flatMap((r) => {
+          const s = restarted(r);
+          return [
+            { name: `${r.name} ${r.silenceUs / 1000} ms .sscap`, capture: sscap(usbChunks(s.bytes, s.timesUs)) },
+            { name: `${r.name} ${r.silenceUs / 1000} ms per-byte`, capture: perByteCapture(s) },
+          ];
+        }),
+      // One restart, one hold (a failsafe too past a second), and the doctor names the restart, not a weak link.
+      truth: (capture) => {
+        const { link, episodes } = summarizeCapture(capture);
+        const silence = episodes[0] === undefined ? 0 : (episodes.at(-1)!.endUs ?? 0) - episodes[0].lastFrameUs;
+        const codes = doctorCapture(capture).findings.map((f) => f.code);
+        const wrong = [];
+        if (link.restarts !== 1 || link.holds !== 1 || link.failsafes !== (silence >= 1e6 ? 1 : 0))
+          wrong.push(`${link.restarts} restarts, ${link.holds} holds, ${link.failsafes} failsafes`);
+        if (link.missedFrames < Math.round(silence / link.nominalPeriodUs) - 2) wrong.push(`${link.missedFrames} missed in ${silence} µs`);
+        if (!codes.includes('receiver-restart') || codes.includes('weak-link')) wrong.push(`doctor: ${codes.join(', ')}`);
+        return wrong;
+      },
+    },
+    {
+      name: 'USB stalls: frames held back and delivered at once, on receivers with and without a counter',
+      captures: () =>
+        STALLS.map((c) => {
+          const s = simulate({ ...preset(c.name), header: c.header, seed: c.seed, fades: { lossRate: 0, randomRate: 0 } }, 12e6);
+          return {
+            name: `${c.name} ${c.header} ${c.stallUs / 1000} ms`,
+            capture: sscap(heldBack(s, c.stallUs, 2e6, 1e6 + ((c.seed * 123_457) % 500_000))),
+          };
+        }),
+      // Nothing was lost: no hold, no failsafe, no missed frame, no weak link.
+      truth: (capture) => {
+        const { link } = summarizeCapture(capture);
+        const codes = doctorCapture(capture).findings.map((f) => f.code);
+        const wrong = [];
+        if (link.holds + link.failsafes + link.missedFrames > 0)
+          wrong.push(`${link.holds} holds, ${link.failsafes} failsafes, ${link.missedFrames} missed`);
+        if (codes.includes('weak-link')) wrong.push(`doctor: ${codes.join(', ')}`);
+        return wrong;
+      },
+    },
+  );
+  if (present)
+    classes.push({
+      name: 'the real captures, whole and with 200 ms cut out three times',
+      captures: () =>
+        captureFiles(CAPTURES).flatMap((path) => {
+          const capture = readCapture(new Uint8Array(readFileSync(path)), path);
+          return [
+            { name: path.slice(CAPTURES.length + 1), capture },
+            { name: `${path.slice(CAPTURES.length + 1)}, cut`, capture: cutThrice(capture) },
+          ];
+        }),
+    });
+  for (const c of classes)
+    it(`agrees on ${c.name}`, () => {
+      const wrong = c
+        .captures()
+        .flatMap(({ name, capture }) => [...doctorDisagreements(capture), ...(c.truth?.(capture) ?? [])].map((w) => `${name}: ${w}`));
+      expect(wrong).toEqual([]);
+    });
+});
+
+const RESTARTS = [
+  ...[120_000, 250_000, 496_000, 700_000, 900_000].flatMap((silenceUs) =>
+    ['dsmx-11ms-2048-internal', 'dsmx-22ms-2048-internal'].map((name) => ({ name, silenceUs })),
+  ),
+  ...[496_000, 1_300_000, 2_000_000].flatMap((silenceUs) =>
+    ['dsmx-11ms-2048-external', 'dsm2-22ms-1024-external'].map((name) => ({ name, silenceUs })),
+  ),
+];
+
+/** A receiver that counted 40 fades and more, went silent for `silenceUs` and started again from 0 (a power dip). */
+function restarted(r: { name: string; silenceUs: number }): { bytes: Uint8Array; timesUs: Float64Array } {
+  const quiet = { lossRate: 0, randomRate: 0 };
+  const a = simulate({ ...preset(r.name), fades: { ...quiet, start: 40 }, seed: 1 }, 2e6);
+  const b = simulate({ ...preset(r.name), fades: { ...quiet, start: 0 }, seed: 2 }, 2e6);
+  const shift = a.timesUs[a.timesUs.length - 1]! + r.silenceUs - b.timesUs[0]!;
+  const bytes = new Uint8Array(a.bytes.length + b.bytes.length);
+  bytes.set(a.bytes);
+  bytes.set(b.bytes, a.bytes.length);
+  const timesUs = new Float64Array(bytes.length);
+  timesUs.set(a.timesUs);
+  b.timesUs.forEach((t, i) => {
+    timesUs[a.bytes.length + i] = t + shift;
+  });
+  return { bytes, timesUs };
+}
+
+const STALLS = [150_000, 300_000, 600_000, 1_200_000].flatMap((stallUs) =>
+  (['zero', 'spec'] as const).flatMap((header) =>
+    ['dsmx-11ms-2048-internal', 'dsmx-22ms-2048-internal', 'dsm2-22ms-1024-external'].flatMap((name) =>
+      [1, 2, 3].map((seed) => ({ name, header, seed, stallUs })),
+    ),
+  ),
+);
+
+/**
+ * 16 ms USB chunks of a stream, except that for `stallUs` every `everyUs` (from `fromUs`) the
+ * adapter holds them back and delivers them all with the next chunk.
+ */
+function heldBack(s: { bytes: Uint8Array; timesUs: Float64Array }, stallUs: number, everyUs: number, fromUs: number) {
+  const out: { bytes: Uint8Array; timeUs: number }[] = [];
+  let held: Uint8Array[] = [];
+  for (const c of usbChunks(s.bytes, s.timesUs)) {
+    const phase = (c.timeUs - fromUs + 100 * everyUs) % everyUs;
+    if (c.timeUs >= fromUs && phase <= stallUs) {
+      held.push(c.bytes);
+      continue;
+    }
+    const bytes = new Uint8Array(held.reduce((n, h) => n + h.length, c.bytes.length));
+    let at = 0;
+    for (const h of [...held, c.bytes]) {
+      bytes.set(h, at);
+      at += h.length;
+    }
+    out.push({ bytes, timeUs: c.timeUs });
+    held = [];
+  }
+  return out;
+}
+
+/** A per-byte capture with 200 ms of bytes taken out at a quarter, half and three quarters of its length (three real dropouts). */
+function cutThrice(capture: Capture): Capture {
+  const times = capture.byteTimesUs;
+  if (times === undefined) return capture;
+  const t0 = times[0]!;
+  const t1 = times[times.length - 1]!;
+  const cuts = [0.25, 0.5, 0.75].map((f) => t0 + f * (t1 - t0));
+  const keep: number[] = [];
+  for (let i = 0; i < times.length; i++) if (!cuts.some((c) => times[i]! >= c && times[i]! < c + 200_000)) keep.push(i);
+  return perByteCapture({ bytes: Uint8Array.from(keep, (i) => capture.bytes[i]!), timesUs: Float64Array.from(keep, (i) => times[i]!) });
+}

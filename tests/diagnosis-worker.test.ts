@@ -6,6 +6,7 @@
  */
 import { describe, expect, it } from 'vitest';
 import type { DoctorFinding } from '../src/analysis/index.js';
+import { importRaw } from '../src/capture/index.js';
 import { crsfStream, receiveAs } from '../src/simulator/index.js';
 import { Diagnosis, type ProbeHooks } from '../src/worker/diagnosis.js';
 import { Engine } from '../src/worker/engine.js';
@@ -136,5 +137,40 @@ describe("the worker's doctor", () => {
     ).resolves.toMatch(/Not a line setting/);
     expect(port.opened).toHaveLength(1);
     await serial.close();
+  });
+});
+
+describe('the worker doctor on a replayed file without a Spektrum stream', () => {
+  it('says so plainly as it plays (on the replay pace), and at the end of a file too short for that', () => {
+    for (const length of [20_000, 300]) {
+      let clock = 0;
+      const posts: FromWorker[] = [];
+      const diagnosis = new Diagnosis(
+        (m) => posts.push(m),
+        () => clock,
+        () => [],
+      );
+      const bytes = Uint8Array.from({ length }, (_, i) => (i * 37 + (i >> 3)) & 0xff);
+      bytes.set([0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a]);
+      diagnosis.replay(importRaw(bytes), 0);
+      const engine = new Engine({ resolution: 'auto', jitterUs: 0 });
+      diagnosis.attach(0, engine, 'Port 0');
+      // As the replay feeds an untimed file: 16 bytes every 11 ms, without a time.
+      for (let at = 0; at < bytes.length; at += 16) {
+        clock += 11_000;
+        engine.push(bytes.subarray(at, at + 16), undefined, 0);
+      }
+      const codes = (): string[] => {
+        diagnosis.tick(true);
+        const last = posts.filter((p) => p.type === 'diagnosis').at(-1);
+        return last?.type === 'diagnosis' ? last.diagnosis.findings.map((f) => f.code) : [];
+      };
+      if (length > 10_000) expect(codes()).toContain('no-satellite');
+      else {
+        expect(codes()).not.toContain('no-satellite');
+        diagnosis.ended();
+        expect(codes()).toContain('no-satellite');
+      }
+    }
   });
 });

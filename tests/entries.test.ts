@@ -15,7 +15,8 @@ describe('package entries in a bundle', () => {
     // The figure the README quotes, with room for small changes (14.1 kB since the decoder's
     // slots are read written out, not looped: 1.4x the decoding speed for 0.3 kB; 14.9 kB since
     // the link monitor's checkpoints share settled episodes, episode-log.ts: 0.5 kB for
-    // checkpoints that no longer grow with every episode before them).
-    expect(sizes.satscope.gzip).toBeLessThan(15.2 * 1024);
+    // checkpoints that no longer grow with every episode before them; 15.4 kB since the link
+    // monitor tells receiver restarts and delivery stalls from loss: 0.4 kB).
+    expect(sizes.satscope.gzip).toBeLessThan(15.6 * 1024);
   }, 60_000);
 });

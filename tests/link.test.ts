@@ -91,10 +91,11 @@ describe('LinkMonitor: hold and failsafe', () => {
       link.frame(frame(t + (i % 5 === 2 ? (t < 2_000_000 ? 3000 : 500) : 0)));
       if (i % 50 === 0) jitterAt.push(link.stats.deliveryJitterUs);
     }
-    // Read every 0.55 s: from 1.1 s the wide windows count; at 6.6 s the last of them has left
-    // the 8 (a window counts once the next one is closed too), and only the narrow ones count.
+    // Read every 0.55 s: from 1.1 s the wide windows count; at 7.15 s the last of them has left
+    // the 8 (a window counts once the next one is closed too; each window is its first frame and
+    // 0.5 s of frames after it, 47 frames), and only the narrow ones count.
     expect(jitterAt.slice(0, 2)).toEqual([Number.NaN, Number.NaN]);
-    expect(jitterAt.slice(2)).toEqual([...Array(10).fill(3000), ...Array(jitterAt.length - 12).fill(500)]);
+    expect(jitterAt.slice(2)).toEqual([...Array(11).fill(3000), ...Array(jitterAt.length - 13).fill(500)]);
   });
 
   it('waits longer before a hold on a stream whose delivery jitters: the measured jitter is added', () => {
@@ -356,5 +357,79 @@ describe('LinkMonitor: period and bounds', () => {
   it('rejects durations that are not finite numbers ≥ 0', () => {
     expect(() => new LinkMonitor({ holdAfterUs: -1 })).toThrow(TypeError);
     expect(() => new LinkMonitor({ maxEpisodes: Number.NaN })).toThrow(/maxEpisodes/);
+  });
+});
+
+describe('LinkMonitor: breaks the receiver explains', () => {
+  /** Frames every 11 ms from `fromUs` to `toUs` with fade counts from `count` on (a DSMX 11 ms internal remote). */
+  function run(link: LinkMonitor, fromUs: number, toUs: number, count: number, delta = 0, remote = 'internal'): number {
+    let c = count;
+    for (let t = fromUs; t < toUs; t += 11_000) {
+      link.frame({ ...frame(t, delta, remote === 'internal' ? 0xb2 : null, c), remote } as DecodedFrame);
+      c = (c + delta) % (remote === 'internal' ? 256 : 65536);
+    }
+    return c;
+  }
+
+  it('a receiver restart (its counter back to 0 after a silence) is a hold, its silence is missed frames, and it is recorded', () => {
+    // An 8-bit counter's fall after a second or more could be a wrap: a 16-bit one's cannot.
+    for (const [silence, remote] of [
+      [150_000, 'internal'],
+      [496_000, 'internal'],
+      [800_000, 'internal'],
+      [1_300_000, 'external'],
+    ] as const) {
+      const link = new LinkMonitor();
+      const at = run(link, 0, 1_000_000, 40, 1, remote) - 1;
+      // The last frame at 990 ms, the next `silence` later, counting from 0 again.
+      const resume = 990_000 + silence;
+      run(link, resume, resume + 500_000, 0, 0, remote);
+      const due = Math.round(silence / 11_000) - 1;
+      expect(link.stats, `${silence}`).toMatchObject({ holds: 1, failsafes: silence >= 1_000_000 ? 1 : 0, restarts: 1, stalls: 0 });
+      expect(link.stats.missedFrames).toBe(91 + due);
+      expect(link.restarts).toEqual([{ timeUs: resume, from: at, to: 0, gapUs: silence }]);
+    }
+  });
+
+  it('a counter that wraps in a silence, or falls after a short break, is no restart', () => {
+    const link = new LinkMonitor();
+    const c = run(link, 0, 1_000_000, 200, 1);
+    // 400 ms: 35 frames due, the 8-bit count wraps by as many (the decoder's delta says so).
+    link.frame({ ...frame(990_000 + 400_000, 35, 0xb2, (c + 35) % 256), remote: 'internal' } as DecodedFrame);
+    run(link, 990_000 + 411_000, 2_000_000, (c + 35) % 256, 0);
+    expect(link.stats.restarts).toBe(0);
+    expect(link.stats.holds).toBe(1);
+  });
+
+  it('a silence the counter says lost nothing is a delivery stall, even past a second: no hold, no failsafe', () => {
+    for (const stall of [300_000, 1_200_000]) {
+      const link = new LinkMonitor({ jitterUs: 16_000 });
+      const retracted: number[] = [];
+      run(link, 0, 1_000_000, 40, 1);
+      // The frames of the silence all come at its end, dated a frame time apart; the count moved on as they were sent.
+      const burst = Math.round(stall / 11_000);
+      const end = 990_000 + stall;
+      const c = (40 + 91) % 256;
+      link.update(end - 1);
+      for (let k = 0; k < burst; k++)
+        link.frame({ ...frame(end - (burst - 1 - k) * 1_389, 0, 0xb2, c), remote: 'internal' } as DecodedFrame);
+      // Then on the receiver's schedule again.
+      run(link, 990_000 + (burst + 1) * 11_000, end + 2_000_000, c);
+      retracted.push(...link.takeRetracted());
+      const { holds, failsafes, stalls, restarts } = link.stats;
+      expect({ holds, failsafes, stalls, restarts }, `${stall}`).toEqual({ holds: 0, failsafes: 0, stalls: 1, restarts: 0 });
+      // From the last frame to the burst's first, dated back from its arrival.
+      expect(link.stats.longestStallUs).toBe(stall - (burst - 1) * 1_389);
+      expect(link.episodes).toEqual([]);
+      expect(retracted.length).toBe(stall >= 1_000_000 ? 2 : 1);
+    }
+  });
+
+  it('a real silence past a second stays a failsafe: the counter counts its frames', () => {
+    const link = new LinkMonitor({ jitterUs: 16_000 });
+    const c = run(link, 0, 1_000_000, 40, 1);
+    link.frame({ ...frame(990_000 + 1_200_000, 108, 0xb2, (c + 108) % 256), remote: 'internal' } as DecodedFrame);
+    run(link, 990_000 + 1_211_000, 3_000_000, (c + 108) % 256, 0);
+    expect(link.stats).toMatchObject({ holds: 1, failsafes: 1, stalls: 0 });
   });
 });

@@ -697,3 +697,43 @@ describe('satscope report', () => {
     expect(satscope('--help').out).toMatch(/satscope report FILE \[--out REPORT\.html\] \[--json\]/);
   });
 });
+
+describe('the report on breaks the receiver explains', () => {
+  it("counts a receiver restart's hold and missed frames, and says it was a restart", () => {
+    const quiet = { lossRate: 0, randomRate: 0 };
+    const a = simulate({ ...preset('dsmx-11ms-2048-internal'), fades: { ...quiet, start: 40 }, seed: 1 }, 2e6);
+    const b = simulate({ ...preset('dsmx-11ms-2048-internal'), fades: { ...quiet, start: 0 }, seed: 2 }, 2e6);
+    const shift = a.timesUs[a.timesUs.length - 1]! + 496_000 - b.timesUs[0]!;
+    const bytes = new Uint8Array([...a.bytes, ...b.bytes]);
+    const timesUs = Float64Array.from([...a.timesUs, ...Array.from(b.timesUs, (t) => t + shift)]);
+    const r = healthReport(perByteCapture({ bytes, timesUs })).remotes[0]!;
+    expect(r.restarts.count).toBe(1);
+    expect(r.holds.count).toBe(1);
+    expect(r.missedFrames).toBeGreaterThanOrEqual(43);
+    expect(r.undeliveredFrames).toBe(r.missedFrames);
+    expect(r.findings.find((f) => f.code === 'restarts')?.text).toMatch(
+      /1 receiver restart: the fade counter started again from 0 .*the last at 0:02\.\d/,
+    );
+  });
+
+  it('calls frames an adapter held back and delivered at once delivery stalls, not holds or failsafes', () => {
+    const s = simulate({ ...preset('dsmx-11ms-2048-internal'), fades: { lossRate: 0, randomRate: 0 } }, 4e6);
+    // 16 ms chunks, those from 1 s to 2.2 s held back and delivered with the next.
+    const records: CaptureRecordInput[] = [];
+    let held: Uint8Array[] = [];
+    for (let t = 16_000, i = 0; i < s.bytes.length; t += 16_000) {
+      let j = i;
+      while (j < s.bytes.length && s.timesUs[j]! < t) j++;
+      held.push(s.bytes.subarray(i, j));
+      i = j;
+      if (t > 1e6 && t < 2.2e6) continue;
+      records.push({ type: 'data', bytes: new Uint8Array(held.flatMap((h) => [...h])), timeUs: t, port: 0 });
+      held = [];
+    }
+    const r = healthReport(readCapture(encodeCapture({ baudRate: 115200, source: 'test' }, records), 'stall.sscap')).remotes[0]!;
+    expect(r).toMatchObject({ holds: { count: 0 }, failsafes: [], missedFrames: 0, delivery: { stalls: 1 } });
+    // Past a second: the failsafe the silence would have been is withdrawn with its hold.
+    expect(r.delivery.longestStallUs).toBeGreaterThan(1_000_000);
+    expect(r.findings.find((f) => f.code === 'delivery')?.text).toMatch(/1 delivery stall, the longest 1\.\d s: frames the USB adapter/);
+  });
+});

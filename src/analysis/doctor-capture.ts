@@ -4,12 +4,13 @@
  * arrive, with the capture's events ("port opened", line errors) fed in where they happened.
  * Pure: same capture, same findings.
  */
-import { BYTE_TIME_US, LinkMonitor, SpektrumDecoder, USB_CHUNK_JITTER_US, type Resolution } from '../decoder/index.js';
+import { BYTE_TIME_US, LinkMonitor, SpektrumDecoder, type Resolution } from '../decoder/index.js';
 import { capturePorts, chunkFirstByteUs, type Capture, type CaptureKind, type CaptureTiming } from '../capture/index.js';
 import { Doctor } from './doctor.js';
 import type { DoctorCode, DoctorFinding, Severity } from './doctor-types.js';
 import { doctorEvent } from './doctor-events.js';
-import { SLICE_BYTES } from './capture-pass.js';
+import { SLICE_BYTES, timingJitterUs } from './capture-pass.js';
+import { captureSpan } from './capture-span.js';
 import { portResolutions } from './resolution-key.js';
 
 export interface DoctorCaptureOptions {
@@ -44,11 +45,12 @@ export interface DoctorReport {
 /** One piece of what arrived, as `arrival` hands it over: data (with `bytes`) or an event (with `text`). */
 type Visit = (
   port: number,
-  /** The time of its last byte (data) or the event's time. */
+  /** The time of its last byte (data) or the event's time: for an untimed capture, its place on a clock of the doctor's own. */
   timeUs: number,
   /** The earliest time anything in it can carry: its first byte's (estimated for a chunk). */
   firstUs: number,
   bytes: Uint8Array | null,
+  /** The recorded time the decoder is given (undefined: none, as `decodeCapture` gives it). */
   time: number | Float64Array | undefined,
   text: string,
 ) => void;
@@ -96,7 +98,7 @@ function arrival(capture: Capture): { each: (visit: Visit) => void; bytes: numbe
         const t = timed ? chunkTime : to * BYTE_TIME_US;
         // A decoder dates a chunk's frames back from its arrival at 115200: none is earlier than this.
         const first = chunkFirstByteUs(t, to - from, BYTE_TIME_US);
-        visit(port, t, first, bytes.subarray(from, to), timed ? (Number.isNaN(chunkTime) ? undefined : chunkTime) : t, '');
+        visit(port, t, first, bytes.subarray(from, to), timed && !Number.isNaN(chunkTime) ? chunkTime : undefined, '');
       }
       from = to;
     }
@@ -137,7 +139,7 @@ export function doctorCapture(capture: Capture, options: DoctorCaptureOptions = 
     if (firstUs < origin) origin = firstUs;
   });
   const doctor = new Doctor({
-    timing: capture.timing === 'per-byte' ? 'per-byte' : 'per-chunk',
+    timing: capture.timing,
     memoryUs: Infinity,
     originUs: Number.isFinite(origin) ? origin : 0,
   });
@@ -151,7 +153,7 @@ export function doctorCapture(capture: Capture, options: DoctorCaptureOptions = 
       resolution: setting?.resolution ?? options.resolution ?? 'auto',
       resolutionFrom: setting?.from ?? 'user',
     });
-    const link = new LinkMonitor({ jitterUs: capture.timing === 'per-chunk' ? USB_CHUNK_JITTER_US : 0 });
+    const link = new LinkMonitor({ jitterUs: timingJitterUs(capture.timing) });
     sources.set(port, { decoder, link });
     const label = names?.[port]?.name;
     doctor.attach(port, { decoder, link, label: typeof label === 'string' && label !== '' ? label : `Port ${port}` });
@@ -201,9 +203,10 @@ export function doctorCapture(capture: Capture, options: DoctorCaptureOptions = 
         nextSample = Math.floor(firstUs / step) * step + step;
       }
       // Take the findings at each step this piece starts after: everything before it has been
-      // fed, so no link monitor is advanced past a frame it has not seen yet.
+      // fed. The link monitors are not advanced to the step: a decoder holds its last frame until
+      // the next confirms it, so the silence a monitor would see there is not the link's (the
+      // monitors count exactly as `decodeCapture`'s, which every other surface reads).
       while (firstUs >= nextSample) {
-        for (const s of sources.values()) s.link.update(nextSample);
         sample(nextSample);
         nextSample += step;
       }
@@ -215,7 +218,9 @@ export function doctorCapture(capture: Capture, options: DoctorCaptureOptions = 
     }
     const source = sources.get(port);
     if (source === undefined) return;
-    doctor.bytes(port, data, time);
+    // Untimed, the doctor's line windows run on the clock of the bytes; the decoder, as in
+    // `decodeCapture`, gets no time, and so the link monitor claims no period, gap or rate.
+    doctor.bytes(port, data, time ?? t);
     source.decoder.push(data, time);
     for (let f = source.decoder.next(); f !== undefined; f = source.decoder.next()) {
       source.link.frame(f);
@@ -230,7 +235,10 @@ export function doctorCapture(capture: Capture, options: DoctorCaptureOptions = 
     }
   }
   const end = Number.isFinite(now) ? now : 0;
-  for (const s of sources.values()) s.link.update(end);
+  // The links end where the capture does, as `decodeCapture` ends them (untimed: nowhere).
+  const linkEnd = timed ? captureSpan(capture).endUs : NaN;
+  for (const s of sources.values()) s.link.finish(linkEnd);
+  for (const port of sorted) doctor.ended(port);
   const findings = sample(end);
   // Times are real when the capture has timing, or holds only events (which always have times).
   const real = timed || bytes === 0;

@@ -11,16 +11,19 @@ import {
   M_BREAKS,
   M_BYTES,
   M_CHAR_ERRORS,
+  M_FF,
   M_FRAME_BYTES,
   M_OVERRUNS,
   M_PACKETS,
+  M_TEXT,
+  M_ZERO,
   NOTHING_AFTER_US,
   NOTHING_CERTAIN_US,
   UNKNOWN_AFTER_US,
   type PortState,
 } from './doctor-state.js';
 import type { AddFinding, Confidence, ConfirmProbe, Evidence, RuleContext } from './doctor-types.js';
-import { plural } from './report-text.js';
+import { formatDuration, plural } from './report-text.js';
 
 export const NOTHING_TODO = [
   'Transmitter off, or the satellite not bound to this transmitter and model memory (most common). Satellite LED off: it has power but no link. Turn the transmitter on with the right model; if the LED stays off, bind again.',
@@ -29,6 +32,19 @@ export const NOTHING_TODO = [
   "No common ground. LED solid, DATA on RX, still nothing: connect black (GND) to the adapter's GND.",
   'No power. LED never lights, not even for a moment at power-up: 3.3 V on orange (pin 1), GND on black; never 5 V on a satellite.',
 ];
+
+const UART_115200 = '115200 8N1';
+
+/** How each protocol's packets are recognised, and the line setting its bytes are sent at. */
+const PACKET_SHAPES: Readonly<Record<PacketKind, { what: string; setting: string }>> = {
+  ibus: { what: '32-byte packets starting 0x20 0x40 with valid checksums', setting: UART_115200 },
+  srxl2: { what: 'packets starting 0xA6 with valid CRCs', setting: UART_115200 },
+  'srxl-v1': { what: '18-byte packets starting 0xA5 with valid CRCs', setting: UART_115200 },
+  crsf: { what: 'packets starting 0xC8 (or 0xEE, 0xEA) with a length and a valid CRC-8', setting: '420000 8N1' },
+  sbus: { what: '25-byte packets from 0x0F to 0x00, one after another', setting: '100000 8E2, inverted' },
+  fport: { what: 'frames between 0x7E flags with valid checksums', setting: '115200 8N1, inverted' },
+  ghst: { what: 'packets starting with a Ghost address (0x80–0x8A), a length and a valid CRC-8', setting: '420000 8N1' },
+};
 
 export function nothingFindings(p: PortState, now: number, add: AddFinding): void {
   if (!Number.isFinite(p.openUs) || p.activity > 0) return;
@@ -60,7 +76,7 @@ export function lineVerdict(p: PortState, now: number, ctx: RuleContext): LineVe
     0,
     (Math.min(now, Number.isFinite(p.lastActivityUs) ? Math.max(p.lastActivityUs, windowStart) : now) - windowStart) / 1e6,
   );
-  const packets = { ibus: 0, 'srxl-v1': 0, srxl2: 0, crsf: 0, sbus: 0 } as Record<PacketKind, number>;
+  const packets = { ibus: 0, 'srxl-v1': 0, srxl2: 0, crsf: 0, sbus: 0, fport: 0, ghst: 0 } as Record<PacketKind, number>;
   PACKET_KINDS.forEach((k, i) => {
     packets[k] = p.bins.sum(M_PACKETS + i, fromS, toS);
   });
@@ -75,7 +91,21 @@ export function lineVerdict(p: PortState, now: number, ctx: RuleContext): LineVe
   });
 }
 
-export function lineFindings(p: PortState, v: LineVerdict, now: number, add: AddFinding): void {
+/**
+ * The line window in words, never longer than what the port has shown: the last 3 s, or the
+ * time since its first byte; untimed (a raw file), the file or its last bytes.
+ */
+export function windowText(p: PortState, now: number, ctx: RuleContext): string {
+  const { fromS, toS } = lineWindow(now);
+  if (!ctx.timed) {
+    const bytes = p.bins.sum(M_BYTES, fromS, toS);
+    return bytes >= p.bytes ? 'in the file' : `in the file's last ${plural(bytes, 'byte')}`;
+  }
+  const since = now - p.firstActivityUs;
+  return since < LINE_WINDOW_BINS * 1e6 ? `in ${formatDuration(since)}` : `in the last ${LINE_WINDOW_BINS} s`;
+}
+
+export function lineFindings(p: PortState, v: LineVerdict, now: number, ctx: RuleContext, add: AddFinding): void {
   const { fromS, toS } = lineWindow(now);
   const overruns = p.bins.sum(M_OVERRUNS, fromS, toS);
   if (overruns > 0) {
@@ -85,7 +115,7 @@ export function lineFindings(p: PortState, v: LineVerdict, now: number, add: Add
       severity: 'info',
       confidence: 'certain',
       title: `${p.label}: bytes were lost before they reached SatScope`,
-      evidence: [{ text: `${plural(overruns, 'buffer overrun')} reported by the port in the last ${LINE_WINDOW_BINS} s.`, timeUs: null }],
+      evidence: [{ text: `${plural(overruns, 'buffer overrun')} reported by the port ${windowText(p, now, ctx)}.`, timeUs: null }],
       todo: [
         "Close other programs that read the port; use a shorter USB cable or another USB port; gaps in the data around these times are not the satellite's.",
       ],
@@ -98,7 +128,7 @@ export function lineFindings(p: PortState, v: LineVerdict, now: number, add: Add
     return;
   }
   if (p.baudRate !== 115_200) return; // probing: judged when the port returns to 115200
-  const window = `in the last ${LINE_WINDOW_BINS} s`;
+  const window = windowText(p, now, ctx);
   const foreign = (
     protocol: ForeignProtocol,
     confidence: Confidence,
@@ -138,12 +168,13 @@ export function lineFindings(p: PortState, v: LineVerdict, now: number, add: Add
       return;
     case 'packets': {
       const bytes = p.bins.sum(M_BYTES, fromS, toS);
-      const what =
-        v.protocol === 'ibus'
-          ? '32-byte packets starting 0x20 0x40 with valid checksums'
-          : v.protocol === 'srxl2'
-            ? `packets starting 0xA6 with valid CRCs${p.scanner.lastSrxl2Type === 0xcd ? ' (channel data, 0xA6 0xCD)' : p.scanner.lastSrxl2Type === 0x21 ? ' (handshakes, 0xA6 0x21)' : ''}`
-            : '18-byte packets starting 0xA5 with valid CRCs';
+      const { what, setting } = PACKET_SHAPES[v.protocol];
+      const shape =
+        v.protocol === 'srxl2' && p.scanner.lastSrxl2Type === 0xcd
+          ? `${what} (channel data, 0xA6 0xCD)`
+          : v.protocol === 'srxl2' && p.scanner.lastSrxl2Type === 0x21
+            ? `${what} (handshakes, 0xA6 0x21)`
+            : what;
       const extra =
         v.protocol === 'srxl2'
           ? [
@@ -157,7 +188,7 @@ export function lineFindings(p: PortState, v: LineVerdict, now: number, add: Add
         v.count >= 10 ? 'certain' : 'likely',
         [
           {
-            text: `${plural(v.count, 'packet')} ${window}: ${what}, in ${plural(bytes, 'byte')} at 115200 8N1; no Spektrum satellite frames.`,
+            text: `${plural(v.count, 'packet')} ${window}: ${shape}, in ${plural(bytes, 'byte')}${setting === UART_115200 ? ' at 115200 8N1' : `, as read at its own setting (${setting})`}; no Spektrum satellite frames.`,
             timeUs: null,
           },
         ],
@@ -294,8 +325,9 @@ export function lineFindings(p: PortState, v: LineVerdict, now: number, add: Add
       });
       return;
     case 'unknown-115200':
-      // A satellite's first frames wait for the decoder's evidence: give it time to lock.
-      if (now - p.firstActivityUs < UNKNOWN_AFTER_US || p.source?.decoder.format.locked === true) return;
+      // A satellite's first frames wait for the decoder's evidence: give it time to lock. Bytes
+      // without any frame are `noSatelliteFinding`'s, which says so plainly.
+      if (now - p.firstActivityUs < UNKNOWN_AFTER_US || p.source?.decoder.format.locked === true || emptyStream(p, now)) return;
       add({
         code: 'unknown-stream',
         ports: [p.port],
@@ -304,7 +336,7 @@ export function lineFindings(p: PortState, v: LineVerdict, now: number, add: Add
         title: `${p.label}: clean bytes at 115200, but not Spektrum frames`,
         evidence: [
           {
-            text: `${plural(v.bytes, 'byte')} ${window} without line errors, in no known RC packet (Spektrum, SRXL, SRXL2, IBUS).`,
+            text: `${plural(v.bytes, 'byte')} ${window} without line errors, in no known RC packet (${KNOWN_PACKETS}).`,
             timeUs: null,
           },
         ],
@@ -316,4 +348,72 @@ export function lineFindings(p: PortState, v: LineVerdict, now: number, add: Add
       });
       return;
   }
+}
+
+const KNOWN_PACKETS = 'Spektrum, SRXL, SRXL2, IBUS, SBUS, CRSF, FPort, GHST';
+
+/**
+ * Whether a port's bytes are judged to hold no Spektrum stream: bytes came, not one frame
+ * decoded, and either the stream is over (`Doctor.ended`: a capture, however short) or a
+ * satellite has had time to lock (`UNKNOWN_AFTER_US`).
+ */
+export function emptyStream(p: PortState, now: number): boolean {
+  return p.frames === 0 && p.bytes > 0 && (p.ended || now - p.firstActivityUs >= UNKNOWN_AFTER_US);
+}
+
+/** File signatures a user may open by mistake, by their first bytes. */
+const SIGNATURES: readonly { name: string; head: readonly number[] }[] = [
+  { name: 'a PNG image', head: [0x89, 0x50, 0x4e, 0x47] },
+  { name: 'a JPEG image', head: [0xff, 0xd8, 0xff] },
+  { name: 'a GIF image', head: [0x47, 0x49, 0x46, 0x38] },
+  { name: 'a PDF document', head: [0x25, 0x50, 0x44, 0x46] },
+  { name: 'a ZIP archive', head: [0x50, 0x4b, 0x03, 0x04] },
+  { name: 'a gzip archive', head: [0x1f, 0x8b] },
+  { name: 'an ELF program', head: [0x7f, 0x45, 0x4c, 0x46] },
+];
+
+/** What a port's bytes look like, in a sentence, when they hold no frame and no named protocol. */
+function lookOf(p: PortState, fromS: number, toS: number, bytes: number): string {
+  const head = p.head;
+  const sig = SIGNATURES.find((s) => s.head.every((b, i) => head[i] === b));
+  if (sig !== undefined)
+    return `They begin like ${sig.name} (${sig.head.map((b) => b.toString(16).toUpperCase().padStart(2, '0')).join(' ')}), not a serial capture.`;
+  const zero = p.bins.sum(M_ZERO, fromS, toS);
+  const ff = p.bins.sum(M_FF, fromS, toS);
+  const text = p.bins.sum(M_TEXT, fromS, toS);
+  if (zero === bytes)
+    return 'Every byte is 0x00: a line held low reads as zeros (DATA shorted to ground, an inverted line, or a receiver without power).';
+  if (ff === bytes) return 'Every byte is 0xFF: an idle line read as data, or an input that floats high.';
+  if (text >= 0.9 * bytes)
+    return `${Math.round((text / bytes) * 100)} % of them are printable text: a GPS, a console or a log, not a receiver.`;
+  return `They are in no known RC packet (${KNOWN_PACKETS}).`;
+}
+
+/**
+ * Bytes that hold no Spektrum stream, said plainly (a problem: every surface then says no
+ * satellite was found), with what they look like, unless a line finding already named them.
+ */
+export function noSatelliteFinding(p: PortState, v: LineVerdict, now: number, ctx: RuleContext, add: AddFinding): void {
+  if (!emptyStream(p, now) || (v.kind !== 'too-little' && v.kind !== 'unknown-115200')) return;
+  const { fromS, toS } = lineWindow(now);
+  const windowBytes = p.bins.sum(M_BYTES, fromS, toS);
+  const whole = windowBytes === p.bytes;
+  const amount = whole ? plural(p.bytes, 'byte') : `${plural(p.bytes, 'byte')} (${plural(windowBytes, 'byte')} ${windowText(p, now, ctx)})`;
+  add({
+    code: 'no-satellite',
+    ports: [p.port],
+    severity: 'problem',
+    confidence: 'certain',
+    title: `${p.label}: no Spektrum satellite stream`,
+    evidence: [
+      { text: `${amount} and not one Spektrum frame in them (a satellite sends a 16-byte frame every 11 or 22 ms).`, timeUs: null },
+      { text: windowBytes > 0 ? lookOf(p, fromS, toS, windowBytes) : lookOf(p, -Infinity, Infinity, p.bytes), timeUs: null },
+    ],
+    todo: [
+      "If this should be a satellite: its grey DATA wire on the adapter's RX, black GND to GND, 3.3 V on orange, and a bound transmitter on (its LED solid).",
+      'If this is a file: open a SatScope recording (.sscap), a raw dump of the DATA line (.bin) or a Saleae async-serial export (.csv) at 115200 8N1.',
+    ],
+    settings: [],
+    confirm: null,
+  });
 }

@@ -7,7 +7,7 @@
  */
 
 /** Packets recognised by their own structure and checksum. */
-export const PACKET_KINDS = ['ibus', 'srxl-v1', 'srxl2', 'crsf', 'sbus'] as const;
+export const PACKET_KINDS = ['ibus', 'srxl-v1', 'srxl2', 'crsf', 'sbus', 'fport', 'ghst'] as const;
 export type PacketKind = (typeof PACKET_KINDS)[number];
 
 /** IBUS: 0x20 0x40, 32 bytes, checksum 0xFFFF − sum of the first 30, little-endian. */
@@ -19,18 +19,37 @@ const SRXL_MAX_LENGTH = 80;
 const SRXL_MIN_LENGTH = 5;
 /** CRSF: sync, length (type + payload + CRC, 2…62), type, payload, CRC-8/DVB-S2. */
 const CRSF_MAX_LENGTH = 62;
+/** GHST (ImmersionRC Ghost): an address 0x80…0x8A, then as CRSF, the length at most 22 (Betaflight's GHST_FRAME_SIZE_MAX 24 less address and length). */
+const GHST_MAX_LENGTH = 22;
+const GHST_FIRST_ADDRESS = 0x80;
+const GHST_LAST_ADDRESS = 0x8a;
+/**
+ * FPort (FrSky): 0x7E, length, type, payload, checksum, 0x7E, with 0x7D escaping 0x7E and 0x7D
+ * (the next byte XOR 0x20); the bytes from the length to the checksum sum to 0xFF, carries
+ * folded in. A control frame is 29 bytes unescaped (length 0x19).
+ */
+const FPORT_FLAG = 0x7e;
+const FPORT_ESCAPE = 0x7d;
+const FPORT_MAX_LENGTH = 40;
 /** SBUS: 25 bytes, 0x0F … footer 0x00 (or an SBUS2 telemetry slot footer 0x04/0x14/0x24/0x34). */
 const SBUS_LENGTH = 25;
 const HISTORY = 128;
 const MAX_PENDING = 16;
-/** The candidate a byte starts, by byte value: 0 SRXL v1 (0xA5), 1 SRXL2 (0xA6), 2 CRSF (its sync bytes), −1 none. Built on first use. */
+/**
+ * The candidate a byte starts, by byte value: 0 SRXL v1 (0xA5), 1 SRXL2 (0xA6), 2 CRSF (its
+ * sync bytes), 3 GHST (its addresses), 4 an FPort flag (0x7E), −1 none. Built on first use.
+ */
 let startKinds: Int8Array | undefined;
+const START_GHST = 3;
+const START_FPORT = 4;
 
 function buildStartKinds(): Int8Array {
   const t = new Int8Array(256).fill(-1);
   t[0xa5] = 0;
   t[0xa6] = 1;
   for (const sync of [0xc8, 0xee, 0xea]) t[sync] = 2;
+  for (let a = GHST_FIRST_ADDRESS; a <= GHST_LAST_ADDRESS; a++) t[a] = START_GHST;
+  t[FPORT_FLAG] = START_FPORT;
   return t;
 }
 
@@ -77,13 +96,13 @@ function crc8DvbS2(ring: Uint8Array, start: number, length: number): number {
  */
 export const SCAN_MEMORY = HISTORY - 1;
 
-/** Whether a byte starts a candidate the scanner keeps pending (SRXL v1 0xA5, SRXL2 0xA6, CRSF's sync bytes). */
+/** Whether a byte starts a candidate the scanner keeps pending (SRXL v1 0xA5, SRXL2 0xA6, CRSF's sync bytes, GHST's addresses, FPort's flag). */
 export function startsCandidate(byte: number): boolean {
   return ((startKinds ??= buildStartKinds())[byte] ?? -1) >= 0;
 }
 
 /**
- * Finds IBUS, SRXL v1, SRXL2, CRSF and SBUS packets in a byte stream, fed in any chunking.
+ * Finds IBUS, SRXL v1, SRXL2, CRSF, SBUS, FPort and GHST packets in a byte stream, fed in any chunking.
  * Each packet is checked by its checksum (SBUS, which has none, by its header and footer and
  * the next header 25 bytes on). `onPacket` is called once per packet with its kind and the
  * stream index of its last byte.
@@ -96,16 +115,23 @@ export interface PacketScannerCheckpoint {
   readonly pendingKind: Uint8Array;
   readonly pending: number;
   readonly lastSrxl2Type: number;
+  readonly fport: Uint8Array;
+  readonly fportLength: number;
+  readonly fportEscape: boolean;
 }
 
 export class PacketScanner {
   readonly #ring = new Uint8Array(HISTORY);
   /** Stream index of the next byte. */
   #n = 0;
-  /** Candidate starts: stream index, and kind code (0 SRXL v1, 1 SRXL2, 2 CRSF). */
+  /** Candidate starts: stream index, and kind code (0 SRXL v1, 1 SRXL2, 2 CRSF, 3 GHST). */
   readonly #pendingAt = new Float64Array(MAX_PENDING);
   readonly #pendingKind = new Uint8Array(MAX_PENDING);
   #pending = 0;
+  /** The FPort frame since the last flag, unescaped (`#fportLength` bytes; −1: none open). */
+  readonly #fport = new Uint8Array(FPORT_MAX_LENGTH);
+  #fportLength = -1;
+  #fportEscape = false;
   /** Whether bytes were scanned since the last `pass` (else the ring is still clear). */
   #scanned = true;
   /** Last SRXL2 packet type seen (0x21 handshake, 0xCD control data…). */
@@ -122,6 +148,9 @@ export class PacketScanner {
       pendingKind: this.#pendingKind.slice(),
       pending: this.#pending,
       lastSrxl2Type: this.lastSrxl2Type,
+      fport: this.#fport.slice(),
+      fportLength: this.#fportLength,
+      fportEscape: this.#fportEscape,
     };
   }
 
@@ -133,6 +162,9 @@ export class PacketScanner {
     this.#pendingKind.set(cp.pendingKind);
     this.#pending = cp.pending;
     this.lastSrxl2Type = cp.lastSrxl2Type;
+    this.#fport.set(cp.fport);
+    this.#fportLength = cp.fportLength;
+    this.#fportEscape = cp.fportEscape;
     this.#scanned = true;
   }
 
@@ -147,6 +179,8 @@ export class PacketScanner {
     this.#n += count;
     if (!this.#scanned) return; // cleared already: a run of passes clears once
     this.#pending = 0;
+    this.#fportLength = -1;
+    this.#fportEscape = false;
     this.#ring.fill(0);
     this.#scanned = false;
   }
@@ -176,7 +210,9 @@ export class PacketScanner {
       // Packets announced by a length byte: check the ones that end here.
       if (pending > 0) pending = this.#checkPending(k, pending);
       const start = starts[b] as number;
-      if (start >= 0) {
+      if (start === START_FPORT) this.#fportFlag(k);
+      else if (this.#fportLength >= 0) this.#fportByte(b);
+      if (start >= 0 && start !== START_FPORT) {
         if (pending === MAX_PENDING) {
           pendingAt.copyWithin(0, 1);
           pendingKind.copyWithin(0, 1);
@@ -190,6 +226,36 @@ export class PacketScanner {
     this.#pending = pending;
     this.#n = k;
     if (end > start) this.#scanned = true;
+  }
+
+  /** An FPort flag at stream index `k`: it ends the frame open (checked and reported) and opens the next. */
+  #fportFlag(k: number): void {
+    const n = this.#fportLength;
+    const f = this.#fport;
+    if (n >= 4 && !this.#fportEscape && n === (f[0] ?? 0) + 2) {
+      let sum = 0;
+      for (let i = 0; i < n; i++) sum += f[i] ?? 0;
+      while (sum > 0xff) sum = (sum & 0xff) + (sum >> 8);
+      if (sum === 0xff) this.onPacket('fport', k);
+    }
+    this.#fportLength = 0;
+    this.#fportEscape = false;
+  }
+
+  /** A byte inside an open FPort frame, unescaped; a frame longer than any FPort frame is dropped. */
+  #fportByte(b: number): void {
+    if (b === FPORT_ESCAPE && !this.#fportEscape) {
+      this.#fportEscape = true;
+      return;
+    }
+    const n = this.#fportLength;
+    if (n >= FPORT_MAX_LENGTH) {
+      this.#fportLength = -1;
+      return;
+    }
+    this.#fport[n] = this.#fportEscape ? b ^ 0x20 : b;
+    this.#fportEscape = false;
+    this.#fportLength = n + 1;
   }
 
   /** An IBUS packet that may end at stream index `k` (its first byte is 0x20): checked and reported. */
@@ -218,7 +284,9 @@ export class PacketScanner {
     for (let p = 0; p < pending; p++) {
       const at = pendingAt[p] ?? 0;
       const kind = pendingKind[p] ?? 0;
-      const lengthAt = at + (kind === 2 ? 1 : 2);
+      // CRSF and GHST: the length right after the first byte, CRC-8 over type and payload.
+      const crc8 = kind === 2 || kind === START_GHST;
+      const lengthAt = at + (crc8 ? 1 : 2);
       let keep = true;
       if (kind === 0) {
         // SRXL v1 has no length byte: a fixed 18 bytes.
@@ -229,14 +297,16 @@ export class PacketScanner {
         }
       } else if (k === lengthAt) {
         const length = ring[k & mask] ?? 0;
-        keep = kind === 2 ? length >= 2 && length <= CRSF_MAX_LENGTH : length >= SRXL_MIN_LENGTH && length <= SRXL_MAX_LENGTH;
+        keep = crc8
+          ? length >= 2 && length <= (kind === 2 ? CRSF_MAX_LENGTH : GHST_MAX_LENGTH)
+          : length >= SRXL_MIN_LENGTH && length <= SRXL_MAX_LENGTH;
       } else if (k > lengthAt) {
         const length = ring[lengthAt & mask] ?? 0;
-        const total = kind === 2 ? length + 2 : length;
+        const total = crc8 ? length + 2 : length;
         if (k === at + total - 1) {
           keep = false;
-          if (kind === 2) {
-            if (crc8DvbS2(ring, at + 2, total - 3) === ring[k & mask]) this.onPacket('crsf', k);
+          if (crc8) {
+            if (crc8DvbS2(ring, at + 2, total - 3) === ring[k & mask]) this.onPacket(kind === 2 ? 'crsf' : 'ghst', k);
           } else {
             const crc = ((ring[(k - 1) & mask] ?? 0) << 8) | (ring[k & mask] ?? 0);
             if (crc16Xmodem(ring, at, total - 2) === crc) {
@@ -282,7 +352,7 @@ export interface LineCounts {
 export type LineVerdict =
   | { kind: 'satellite' }
   | { kind: 'too-little' }
-  | { kind: 'packets'; protocol: 'ibus' | 'srxl-v1' | 'srxl2'; count: number }
+  | { kind: 'packets'; protocol: PacketKind; count: number }
   | { kind: 'inverted-satellite'; periodUs: number; breaksPerSecond: number; bytesPerBreak: number; confident: boolean }
   | { kind: 'sbus'; periodUs: number; breaksPerSecond: number; bytesPerBreak: number; confident: boolean }
   | { kind: 'idle-low'; breaksPerSecond: number; bytesPerBreak: number }
@@ -295,6 +365,14 @@ export type LineVerdict =
 export const LINE_MIN_BYTES = 64;
 /** Known packets before a protocol is named (each passed its checksum). */
 export const LINE_MIN_PACKETS = 3;
+/**
+ * CRSF, SBUS, FPort and GHST packets are found in bytes only where those bytes were read at
+ * their own line setting (a logic analyser's export, a raw dump), never at 115200, and their
+ * checks are weak (an 8-bit CRC; SBUS's fixed header and footer): named only when they come at
+ * least once every this many bytes. A stream of them sends one every 25-40 bytes; random bytes
+ * pass a CRC-8 check about once in 100 000.
+ */
+export const PACKET_SPACING_MAX = 256;
 /** Share of the bytes that decoded as Spektrum frames above which the line is a satellite. */
 export const SATELLITE_SHARE = 0.5;
 /** Share of characters with errors above which the line is not 115200 8N1. */
@@ -308,7 +386,8 @@ const CRSF_PERIODS_US = [20_000, 6_667, 4_000, 2_000];
  * Names what is on a line from one window of counts. The rules, first match wins:
  *
  * 1. Most bytes decoded as Spektrum frames: a satellite.
- * 2. IBUS, SRXL2 or SRXL v1 packets with valid checksums: that protocol at 115200.
+ * 2. IBUS, SRXL2 or SRXL v1 packets with valid checksums: that protocol at 115200; CRSF, SBUS,
+ *    FPort or GHST packets, densely: that protocol's bytes, read at its own setting.
  * 3. Break conditions repeating: the line idles low (inverted). A satellite's 16 bytes, seen
  *    through an inverter at its own speed, come out as about 10 bytes and one break per frame;
  *    SBUS's 25 bytes at 100000 8E2 as about 16 and one break per frame. Fewer than 3 bytes a
@@ -323,6 +402,10 @@ export function classifyLine(c: LineCounts): LineVerdict {
   for (const protocol of ['srxl2', 'ibus', 'srxl-v1'] as const) {
     const count = c.packets[protocol];
     if (count >= LINE_MIN_PACKETS) return { kind: 'packets', protocol, count };
+  }
+  for (const protocol of ['crsf', 'sbus', 'fport', 'ghst'] as const) {
+    const count = c.packets[protocol];
+    if (count >= LINE_MIN_PACKETS && count * PACKET_SPACING_MAX >= c.bytes) return { kind: 'packets', protocol, count };
   }
   if (chars + c.breaks < LINE_MIN_BYTES || !(c.seconds > 0)) return { kind: 'too-little' };
   const errorRatio = c.characterErrors / Math.max(1, chars);

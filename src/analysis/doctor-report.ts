@@ -65,6 +65,7 @@ export function diagnosedHealthReport(capture: Capture, options: HealthReportOpt
         { port, doctor, resolution: options.resolution ?? 'auto', originUs: span.startUs, endUs: span.endUs },
         () => {},
       );
+    for (const port of new Set([...data, ...quiet])) doctor.ended(port);
     findings = doctor.findings(Number.isFinite(span.endUs) ? span.endUs : 0);
   }
   return {

@@ -3,11 +3,11 @@
  * bound in, what its frames carry, and how weak its link is (failsafes, holds, fades, RSSI,
  * rebinds, restarts).
  */
-import { systemInfo, type FormatInfo, type Resolution } from '../decoder/index.js';
-import { REPORT_THRESHOLDS } from './report-thresholds.js';
-import { plural } from './report-text.js';
+import { systemInfo, type FormatInfo, type LinkStats, type Resolution } from '../decoder/index.js';
+import { fadesPerMinute, REPORT_THRESHOLDS } from './report-thresholds.js';
+import { formatDuration, plural, rate as rateText } from './report-text.js';
 import { ARDUPILOT_GUESS_FRAMES, bindPulses, channelSetText, satelliteSettings } from './doctor-stacks.js';
-import { dur, GUESS_MIN_DECISIONS, M_FADES, MIN_FADES, type FormatSnapshot, type PortState } from './doctor-state.js';
+import { GUESS_MIN_DECISIONS, M_FADES, MIN_FADES, type FormatSnapshot, type PortState } from './doctor-state.js';
 import type { AddFinding, Confidence, DoctorPortSource, Evidence, RuleContext } from './doctor-types.js';
 
 /** Advice from spec §5 for a weak link. */
@@ -105,7 +105,7 @@ export function satelliteFindings(p: PortState, now: number, ctx: RuleContext, a
       confidence: 'certain',
       title: `${p.label}: X-Plus channels ${names.join(', ')} are sent; flight controllers drop or mix them`,
       evidence: [
-        { text: `X-Plus channels (ID 12 with a sub-ID, spec §8.6) seen since ${ctx.at(p.xplusFirstUs)}.`, timeUs: p.xplusFirstUs },
+        { text: `X-Plus channels (ID 12 with a sub-ID, spec §8.6) seen${ctx.when('since', p.xplusFirstUs)}.`, timeUs: p.xplusFirstUs },
       ],
       todo: [
         'Betaflight and iNav read channel IDs 0–11 only (SPEKTRUM_MAX_SUPPORTED_CHANNEL_COUNT 12): X-Plus channels are dropped.',
@@ -126,7 +126,7 @@ export function satelliteFindings(p: PortState, now: number, ctx: RuleContext, a
       title: `${p.label}: the transmitter sends VTX control in the channel slots`,
       evidence: [
         {
-          text: `${plural(p.vtxFrames, 'frame')} carried Spektrum VTX control in bytes 12–15 (0xE… 0xE…), first at ${ctx.at(p.vtxFirstUs)}.`,
+          text: `${plural(p.vtxFrames, 'frame')} carried Spektrum VTX control in bytes 12–15 (0xE… 0xE…)${ctx.when(', first at', p.vtxFirstUs)}.`,
           timeUs: p.vtxFirstUs,
         },
       ],
@@ -165,22 +165,26 @@ export function satelliteFindings(p: PortState, now: number, ctx: RuleContext, a
     });
   }
 
-  // The link.
+  // The link, in the link monitor's own figures: the holds and failsafes every surface counts
+  // (each failsafe began as a hold), and the fade rate the report states for a whole capture.
   const s = link.stats;
   const memoryStart = now - ctx.memoryUs;
   const episodes = link.episodes.filter((e) => (e.endUs ?? now) >= memoryStart);
   const failsafes = episodes.filter((e) => e.kind === 'failsafe');
+  const holds = episodes.filter((e) => e.kind === 'hold');
   // Holds that line damage explains (the frame that ended them came after discarded bytes) are
-  // the line's, not the link's.
+  // the line's, not the link's: counted, but no reason to call the link weak.
   const byLine = (e: { lastFrameUs: number; endUs: number | null }) =>
     e.endUs !== null && p.damagedAtUs.some((d) => d > e.lastFrameUs && d <= e.endUs! + 50_000);
-  const holds = episodes.filter((e) => e.kind === 'hold' && !failsafes.some((f) => f.lastFrameUs === e.lastFrameUs) && !byLine(e));
-  const fadesPerMin = s.fadeRate * 60;
-  // A rate needs a few fades behind it: one corrupted header is not a weak link.
-  const recentFades = p.bins.sum(M_FADES, Math.floor(now / 1e6) - 9, Math.floor(now / 1e6));
-  const fadeHigh = format.headerMode === 'fades' && fadesPerMin > REPORT_THRESHOLDS.fadeRateHighPerMin && recentFades >= MIN_FADES;
+  // Silences a receiver restart ended are the restart's (its own finding), not the radio link's.
+  const restarts = link.restarts.filter((r) => r.timeUs >= memoryStart);
+  const byRestart = (e: { lastFrameUs: number }) => restarts.some((r) => r.timeUs - r.gapUs === e.lastFrameUs);
+  const linkFailsafes = failsafes.filter((e) => !byRestart(e));
+  const linkHolds = holds.filter((e) => !failsafes.some((f) => f.lastFrameUs === e.lastFrameUs) && !byLine(e) && !byRestart(e));
+  const rate = fadeRateOf(p, s, now, ctx);
+  const fadeHigh = format.headerMode === 'fades' && rate !== null && rate.perMinute > REPORT_THRESHOLDS.fadeRateHighPerMin && rate.enough;
   const rssiLow = Number.isFinite(s.minRssi) && s.minRssi < REPORT_THRESHOLDS.rssiLowDbm;
-  if (failsafes.length > 0 || holds.length > 0 || fadeHigh || rssiLow) {
+  if (linkFailsafes.length > 0 || linkHolds.length > 0 || fadeHigh || rssiLow) {
     const evidence: Evidence[] = [];
     for (const e of failsafes.slice(-5))
       evidence.push({
@@ -189,14 +193,22 @@ export function satelliteFindings(p: PortState, now: number, ctx: RuleContext, a
       });
     if (holds.length > 0) {
       const last = holds[holds.length - 1] as (typeof holds)[number];
+      const became = holds.filter((e) => failsafes.some((f) => f.lastFrameUs === e.lastFrameUs)).length;
+      const restarted = holds.filter((e) => byRestart(e) && !failsafes.some((f) => f.lastFrameUs === e.lastFrameUs)).length;
+      const line = holds.length - became - restarted - linkHolds.length;
+      const parts = [
+        became > 0 ? `${became} of them became ${became === 1 ? 'a failsafe' : 'failsafes'}` : '',
+        restarted > 0 ? `${restarted} ended in a receiver restart` : '',
+        line > 0 ? `${line} ended at line damage` : '',
+      ].filter((x) => x !== '');
       evidence.push({
-        text: `${plural(holds.length, 'hold')} (frames stopped, last values held, recovered), the last at ${ctx.at(last.startUs)}.`,
+        text: `${plural(holds.length, 'hold')} (frames stopped, last values held${parts.length > 0 ? `; ${parts.join(', ')}` : ''}), the last at ${ctx.at(last.startUs)}.`,
         timeUs: last.startUs,
       });
     }
-    if (fadeHigh)
+    if (fadeHigh && rate !== null)
       evidence.push({
-        text: `Fade rate ${fadesPerMin.toFixed(0)} a minute over the last ~500 frames (over ${REPORT_THRESHOLDS.fadeRateHighPerMin} a minute is high).`,
+        text: `Fade rate ${rateText(rate.perMinute)} a minute ${rate.over} (over ${REPORT_THRESHOLDS.fadeRateHighPerMin} a minute is high).`,
         timeUs: null,
       });
     if (rssiLow)
@@ -207,9 +219,9 @@ export function satelliteFindings(p: PortState, now: number, ctx: RuleContext, a
     add({
       code: 'weak-link',
       ports: [p.port],
-      severity: failsafes.length > 0 ? 'problem' : 'warning',
-      confidence: failsafes.length > 0 || fadeHigh || rssiLow || ctx.precise ? 'certain' : 'likely',
-      title: `${p.label}: the link is weak${failsafes.length > 0 ? ': failsafe' : holds.length > 0 ? ': frames lost' : ''}`,
+      severity: linkFailsafes.length > 0 ? 'problem' : 'warning',
+      confidence: linkFailsafes.length > 0 || fadeHigh || rssiLow || ctx.precise ? 'certain' : 'likely',
+      title: `${p.label}: the link is weak${linkFailsafes.length > 0 ? ': failsafe' : linkHolds.length > 0 ? ': frames lost' : ''}`,
       evidence,
       todo: LINK_ADVICE,
       settings: [],
@@ -229,7 +241,7 @@ export function satelliteFindings(p: PortState, now: number, ctx: RuleContext, a
       severity: 'warning',
       confidence: 'certain',
       title: `${p.label}: the receiver changed mode mid-session (a rebind?)`,
-      evidence: [{ text: `From ${name(c.from)} to ${name(c.to)} at ${ctx.at(c.timeUs)}.`, timeUs: c.timeUs }],
+      evidence: [{ text: `From ${name(c.from)} to ${name(c.to)}${ctx.when('at', c.timeUs)}.`, timeUs: c.timeUs }],
       todo: [
         'A satellite changes mode only when it is bound again: check that the flight controller does not send bind pulses at every power-up (Betaflight/iNav: spektrum_sat_bind back to 0, or spektrum_sat_bind_autoreset on).',
         `Set the flight controller for the new mode: ${c.to.resolution === 2048 ? 'SPEK2048' : 'SPEK1024'}.`,
@@ -239,19 +251,23 @@ export function satelliteFindings(p: PortState, now: number, ctx: RuleContext, a
       sinceUs: c.timeUs,
     });
   }
-  const restarts = p.restarts.filter((r) => r.timeUs >= memoryStart);
   if (restarts.length > 0) {
     const r = restarts[restarts.length - 1] as (typeof restarts)[number];
+    const failsafe = restarts.some((x) => failsafes.some((f) => f.lastFrameUs === x.timeUs - x.gapUs));
     add({
       code: 'receiver-restart',
       ports: [p.port],
-      severity: 'warning',
+      severity: failsafe ? 'problem' : 'warning',
       confidence: 'likely',
-      title: `${p.label}: the receiver restarted (power dip?)`,
+      title: `${p.label}: the receiver restarted (power dip?)${failsafe ? ': failsafe' : ''}`,
       evidence: [
         {
-          text: `${plural(restarts.length, 'restart')}: the fade counter went from ${r.from} back to ${r.to} after ${dur(r.gapUs)} without frames, at ${ctx.at(r.timeUs)}; a counter only starts again from 0 at power-up.`,
+          text: `${plural(restarts.length, 'restart')}: the fade counter went from ${r.from} back to ${r.to} after ${formatDuration(r.gapUs)} without frames, at ${ctx.at(r.timeUs)}; a counter only starts again from 0 at power-up.`,
           timeUs: r.timeUs,
+        },
+        {
+          text: `The flight controller held the last values through ${restarts.length === 1 ? 'that silence' : 'each silence'} (a hold${failsafe ? ', then failsafe' : ''}); the frames due in it are counted missed.`,
+          timeUs: null,
         },
       ],
       todo: [
@@ -261,6 +277,26 @@ export function satelliteFindings(p: PortState, now: number, ctx: RuleContext, a
       settings: [],
       confirm: null,
       sinceUs: r.timeUs,
+    });
+  }
+  if (s.stalls > 0 && ctx.timed) {
+    add({
+      code: 'delivery-stall',
+      ports: [p.port],
+      severity: 'info',
+      confidence: 'likely',
+      title: `${p.label}: frames reached the computer late (the link lost none of them)`,
+      evidence: [
+        {
+          text: `${plural(s.stalls, 'silence')}, the longest ${formatDuration(s.longestStallUs)}, ${s.stalls === 1 ? 'was' : 'were'} the USB adapter or the computer holding frames back: ${s.missedBasis === 'fade-counter' ? "the receiver's fade counter did not move" : 'the frames came afterwards, all at once'}. Not counted as holds or failsafes: the flight controller, on the receiver's own line, had them in time.`,
+          timeUs: null,
+        },
+      ],
+      todo: [
+        'For a recording that shows only the link: a USB port without a hub, no other program reading the port, the computer kept from sleeping or throttling USB; an FTDI adapter with a lower latency timer.',
+      ],
+      settings: [],
+      confirm: null,
     });
   }
   if (format.headerMode === 'rssi') {
@@ -306,4 +342,24 @@ function guessNotes(p: PortState, resolution: Resolution): { ardupilot: string; 
       ' It takes every X-Plus word as channel 13 whatever its sub-ID, and reports 13 channels as 12: X-Plus channels are not usable.';
   const px4 = `rc_input detects DSM by itself and guesses the resolution from the channel IDs (src/lib/rc/dsm.cpp)${p.xplusMask !== 0 ? '; its tests expect X-Plus channels as channels 13 and up (rc_tests/RCTest.cpp, 16 channels from a DX9)' : ''}.`;
   return { ardupilot, px4 };
+}
+
+/**
+ * The fade rate to judge, a minute, and over what: a whole capture's (the report's figure,
+ * `fadesPerMinute`), or live the link monitor's over its last frames; none without timing.
+ * `enough`: fades enough behind it (one corrupted header is not a weak link).
+ */
+function fadeRateOf(
+  p: PortState,
+  s: Readonly<LinkStats>,
+  now: number,
+  ctx: RuleContext,
+): { perMinute: number; over: string; enough: boolean } | null {
+  if (!ctx.timed) return null;
+  if (ctx.memoryUs === Infinity) {
+    const perMinute = fadesPerMinute(s.fades, p.firstFrameUs, p.prevFrameUs);
+    return perMinute === null ? null : { perMinute, over: 'over the capture', enough: s.fades >= MIN_FADES };
+  }
+  const recent = p.bins.sum(M_FADES, Math.floor(now / 1e6) - 9, Math.floor(now / 1e6));
+  return { perMinute: s.fadeRate * 60, over: 'over the last ~500 frames', enough: recent >= MIN_FADES };
 }

@@ -37,7 +37,7 @@ export interface StackSetting {
 //   PX4/PX4-Autopilot src/lib/rc/dsm.cpp.
 
 /** A foreign protocol the doctor can name. */
-export type ForeignProtocol = 'srxl-v1' | 'srxl2' | 'ibus' | 'sbus' | 'crsf';
+export type ForeignProtocol = 'srxl-v1' | 'srxl2' | 'ibus' | 'sbus' | 'crsf' | 'fport' | 'ghst';
 
 /** The provider to select for a protocol in each stack: `null` where the stack has none. */
 export const PROTOCOL_SETTINGS: Readonly<
@@ -52,6 +52,10 @@ export const PROTOCOL_SETTINGS: Readonly<
   ibus: { name: 'FlySky IBUS', betaflight: 'IBUS', inav: 'IBUS', ardupilot: true, px4: false },
   sbus: { name: 'SBUS', betaflight: 'SBUS', inav: 'SBUS', ardupilot: true, px4: true },
   crsf: { name: 'CRSF (Crossfire / ExpressLRS)', betaflight: 'CRSF', inav: 'CRSF', ardupilot: true, px4: true },
+  // Betaflight and iNav name both FPORT and GHST providers; ArduPilot has AP_RCProtocol_FPort and
+  // AP_RCProtocol_GHST; PX4's rc_input reads neither.
+  fport: { name: 'FrSky FPort', betaflight: 'FPORT', inav: 'FPORT', ardupilot: true, px4: false },
+  ghst: { name: 'ImmersionRC Ghost (GHST)', betaflight: 'GHST', inav: 'GHST', ardupilot: true, px4: false },
 };
 
 /** The settings for a flight controller that should read `protocol` instead of a satellite. */

@@ -26,8 +26,6 @@ export function lineWindow(nowUs: number): { fromS: number; toS: number } {
   const toS = Math.floor(nowUs / 1e6);
   return { fromS: toS - LINE_WINDOW_BINS + 1, toS };
 }
-/** A fade-counter drop after a gap this long is a restart, not a wrap. */
-export const RESTART_MIN_GAP_US = 100_000;
 /** Seconds with fades on two remotes or more, out of the seconds with fades on any, above which they fade together. */
 export const TOGETHER_RATIO = 0.6;
 export const TOGETHER_MIN_SECONDS = 3;
@@ -47,8 +45,14 @@ export const M_CHAR_ERRORS = 2;
 export const M_BREAKS = 3;
 export const M_OVERRUNS = 4;
 export const M_FADES = 5;
+/** The link monitor's missed frames (the receiver's count where it counts) and its lost frames (frames that did not arrive, every receiver). */
 export const M_MISSED = 6;
-export const M_PACKETS = 7; // + index in PACKET_KINDS
+export const M_LOST = 7;
+/** What bytes are, counted while a port has shown no frame (`noSatelliteFinding`): 0x00, 0xFF, printable text. */
+export const M_ZERO = 8;
+export const M_FF = 9;
+export const M_TEXT = 10;
+export const M_PACKETS = 11; // + index in PACKET_KINDS
 export const METRICS = M_PACKETS + PACKET_KINDS.length;
 
 /** Counters in one-second bins, the last 64 seconds. */
@@ -70,6 +74,12 @@ export class Bins {
    */
   slotOf(f: { readonly timeUs: number }): number {
     this.#time[0] = f.timeUs;
+    return this.#slot();
+  }
+
+  /** `slotOf` for a time that is not a frame's (not on the per-frame path). */
+  slotAt(timeUs: number): number {
+    this.#time[0] = timeUs;
     return this.#slot();
   }
 
@@ -148,6 +158,11 @@ export interface PortState {
   lastActivityUs: number;
   /** Bytes and errors since the port opened. */
   activity: number;
+  /** Bytes ever, and the first few of them (a file's signature). */
+  bytes: number;
+  head: number[];
+  /** The port's stream is over (`Doctor.ended`): judged on what it held, however short. */
+  ended: boolean;
   /** Time of the latest data: a chunk without a time takes it. */
   lastTimeUs: number;
   bins: Bins;
@@ -165,15 +180,17 @@ export interface PortState {
   xplusFirstUs: number;
   vtxFrames: number;
   vtxFirstUs: number;
-  prevFades: number | null;
+  /** The first and the last frame's time (NaN: none, or untimed). */
+  firstFrameUs: number;
   prevFrameUs: number;
+  /** The link monitor's `missedFrames` and `lostFrames` at the last frame. */
   prevMissed: number;
+  prevLost: number;
   /** Decoder's discarded bytes at the last frame, and the frame times that came after a discard (line damage). */
   prevDiscarded: number;
   damagedAtUs: number[];
   first: FormatSnapshot | null;
   changes: { timeUs: number; from: FormatSnapshot; to: FormatSnapshot }[];
-  restarts: { timeUs: number; from: number; to: number; gapUs: number }[];
   rssiFrames: number;
 }
 

@@ -3,7 +3,7 @@
  * resolution and period, the weakest remote, remotes that fade together.
  */
 import { plural } from './report-text.js';
-import { BIN_COUNT, M_FADES, M_MISSED, TOGETHER_MIN_SECONDS, TOGETHER_RATIO, type PortState } from './doctor-state.js';
+import { BIN_COUNT, M_LOST, M_MISSED, TOGETHER_MIN_SECONDS, TOGETHER_RATIO, type PortState } from './doctor-state.js';
 import type { AddFinding, DoctorPortSource, RuleContext } from './doctor-types.js';
 
 /** Findings about several remotes together. */
@@ -66,17 +66,31 @@ export function systemFindings(ports: PortState[], now: number, ctx: RuleContext
       confirm: null,
     });
   }
-  // Who fades most, and do they fade together (per second over the memory window).
+  // Who loses most frames, and do they lose them together (per second over the memory window).
+  // Frames missed as the link monitor counts them (the receiver's count where it keeps one);
+  // an SPM4649T counts no fades (byte 0 is RSSI): when one is among fade-counting remotes, they
+  // are all compared by the frames that did not arrive, the one measure they share.
   const toS = Math.floor(now / 1e6);
-  const fromS = Math.max(toS - Math.min(BIN_COUNT - 1, Math.ceil(ctx.memoryUs / 1e6)), -Infinity);
-  // An SPM4649T counts no fades (byte 0 is RSSI): when one is among fade-counting remotes,
-  // compare them all by frames lost, the one measure they share.
+  const fromS = toS - Math.min(BIN_COUNT - 1, Math.ceil(ctx.memoryUs / 1e6));
+  // Remotes whose missed frames rest on different evidence (a counter, the frames that arrived)
+  // are compared by the frames that did not arrive too.
   const modes = new Set(locked.map((p) => (p.source as DoctorPortSource).decoder.format.headerMode));
-  const mixed = modes.size > 1;
-  const lossOf = (p: PortState, s: number): number => (mixed ? 0 : p.bins.at(M_FADES, s)) + p.bins.at(M_MISSED, s);
+  const bases = new Set(locked.map((p) => (p.source as DoctorPortSource).link.stats.missedBasis));
+  const mixed = modes.size > 1 || bases.size > 1;
+  const metric = mixed ? M_LOST : M_MISSED;
+  const lossOf = (p: PortState, s: number): number => p.bins.at(metric, s);
+  // A whole capture: the monitor's own totals (what `info` and the report state); live: the window.
+  const whole = ctx.memoryUs === Infinity;
   const totals = locked
-    .map((p) => ({ p, loss: (mixed ? 0 : p.bins.sum(M_FADES, fromS, toS)) + p.bins.sum(M_MISSED, fromS, toS) }))
+    .map((p) => {
+      const stats = (p.source as DoctorPortSource).link.stats;
+      return { p, loss: whole ? (mixed ? stats.lostFrames : stats.missedFrames) : p.bins.sum(metric, fromS, toS) };
+    })
     .sort((a, b) => b.loss - a.loss);
+  // The window as far as it goes back: never before the first byte.
+  const first = Math.min(...locked.map((p) => p.firstActivityUs));
+  const seconds = Math.min(toS - fromS + 1, Math.ceil((now - first) / 1e6));
+  const over = whole ? (ctx.timed ? 'in the capture' : 'in the file') : `in the last ${seconds} s`;
   const top = totals[0];
   const second = totals[1];
   if (top !== undefined && second !== undefined && top.loss >= 10 && top.loss >= 2 * Math.max(1, second.loss)) {
@@ -88,11 +102,16 @@ export function systemFindings(ports: PortState[], now: number, ctx: RuleContext
       title: `${top.p.label} fades most`,
       evidence: [
         ...totals.map((t) => ({
-          text: `${t.p.label}: ${mixed ? plural(t.loss, 'lost frame') : plural(t.loss, 'fade or lost frame', 'fades and lost frames')} in the last ${Math.min(toS - fromS + 1, BIN_COUNT)} s.`,
+          text: `${t.p.label}: ${mixed ? plural(t.loss, 'frame that did not arrive', 'frames that did not arrive') : plural(t.loss, 'missed frame')} ${over}.`,
           timeUs: null,
         })),
         ...(mixed
-          ? [{ text: 'Compared by frames lost only: one remote sends RSSI in byte 0 (SPM4649T) and counts no fades.', timeUs: null }]
+          ? [
+              {
+                text: 'Compared by the frames that did not arrive: one remote sends RSSI in byte 0 (SPM4649T) and counts no fades.',
+                timeUs: null,
+              },
+            ]
           : []),
       ],
       todo: [

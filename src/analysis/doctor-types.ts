@@ -10,12 +10,15 @@ export type DoctorCode =
   // Nothing arrives
   | 'nothing-arrives'
   // Bytes, but not a satellite stream
+  | 'no-satellite'
   | 'inverted-line'
   | 'srxl-v1'
   | 'srxl2'
   | 'ibus'
   | 'sbus'
   | 'crsf'
+  | 'fport'
+  | 'ghst'
   | 'wrong-speed'
   | 'noise'
   | 'unknown-stream'
@@ -36,6 +39,7 @@ export type DoctorCode =
   | 'resolution-mismatch'
   | 'rebind'
   | 'receiver-restart'
+  | 'delivery-stall'
   | 'rssi-receiver';
 
 export type Severity = 'problem' | 'warning' | 'info';
@@ -81,9 +85,11 @@ export interface DoctorOptions {
   /**
    * How byte and error times were taken: 'per-byte' (a logic analyser, the line model), where
    * the gaps between bursts are the sender's; or 'per-chunk' (WebSerial, .sscap), where they
-   * are the USB adapter's batching and are not used. Default 'per-chunk'.
+   * are the USB adapter's batching and are not used; or 'none' (a raw file): the times given
+   * are only the bytes' places in the stream at 115200, which the line findings' windows run on,
+   * and no sentence states a time, a duration or a rate. Default 'per-chunk'.
    */
-  timing?: 'per-byte' | 'per-chunk';
+  timing?: 'per-byte' | 'per-chunk' | 'none';
   /** How far back link findings (holds, failsafes, fades, restarts, rebinds) look, µs. Default 60 s; a whole capture: Infinity. */
   memoryUs?: number;
   /**
@@ -107,10 +113,14 @@ export type AddFinding = (f: Omit<DoctorFinding, 'sinceUs'> & { sinceUs?: number
 
 /** What the rules read from the doctor itself. */
 export interface RuleContext {
-  /** A time in a sentence, from the session's origin ("12.3 s"). */
+  /** A time in a sentence, from the session's origin, as the report writes it ("0:12.3"). */
   at(us: number): string;
+  /** `word` and the time (" since 0:12.3"), or nothing when the time is not a recorded one. */
+  when(word: string, us: number): string;
   /** Per-byte times (a logic analyser): bursts and gaps are the sender's. */
   precise: boolean;
+  /** Times are recorded ones (not only the bytes' places in an untimed file): times, durations and rates may be stated. */
+  timed: boolean;
   /** How far back link findings look, µs. */
   memoryUs: number;
 }

@@ -15,27 +15,35 @@
 import { FRAME_SIZE, type DecodedFrame } from '../decoder/index.js';
 import { BurstClock, PACKET_KINDS, PacketScanner, type PacketKind } from './doctor-line.js';
 import { ArduPilotGuess } from './doctor-stacks.js';
-import { lineFindings, lineVerdict, nothingFindings } from './doctor-line-rules.js';
+import { lineFindings, lineVerdict, noSatelliteFinding, nothingFindings } from './doctor-line-rules.js';
+import { formatClock } from './report-text.js';
 import { satelliteFindings } from './doctor-satellite-rules.js';
 import { systemFindings } from './doctor-system-rules.js';
 import {
   Bins,
-  dur,
   M_BYTES,
   M_BREAKS,
+  M_FF,
+  M_TEXT,
+  M_ZERO,
   M_CHAR_ERRORS,
   M_FADES,
   M_FRAME_BYTES,
+  M_LOST,
   M_MISSED,
   M_OVERRUNS,
   M_PACKETS,
-  RESTART_MIN_GAP_US,
   SETUP_MIN_FRAMES,
   type FormatSnapshot,
   type PortCheckpoint,
   type PortState,
 } from './doctor-state.js';
 import type { AddFinding, Confidence, DoctorFinding, DoctorOptions, DoctorPortSource, RuleContext, Severity } from './doctor-types.js';
+
+/** The census's metrics: 0x00, 0xFF, printable text. */
+const CENSUS = [M_ZERO, M_FF, M_TEXT];
+/** Bytes of a port kept from its start, for a file's signature. */
+const HEAD_BYTES = 8;
 
 const SEVERITY_ORDER: Record<Severity, number> = { problem: 0, warning: 1, info: 2 };
 const CONFIDENCE_ORDER: Record<Confidence, number> = { certain: 0, likely: 1, possible: 2 };
@@ -48,6 +56,7 @@ const CONFIDENCE_ORDER: Record<Confidence, number> = { certain: 0, likely: 1, po
 export class Doctor {
   readonly #ports = new Map<number, PortState>();
   readonly #precise: boolean;
+  readonly #timed: boolean;
   readonly #memoryUs: number;
   readonly #since = new Map<string, number>();
   readonly #originUs: number;
@@ -57,20 +66,21 @@ export class Doctor {
   /** @throws {TypeError} on an option out of range. */
   constructor(options: DoctorOptions = {}) {
     const timing = options.timing ?? 'per-chunk';
-    if (timing !== 'per-byte' && timing !== 'per-chunk')
-      throw new TypeError(`timing must be 'per-byte' or 'per-chunk', not ${String(timing)}`);
+    if (timing !== 'per-byte' && timing !== 'per-chunk' && timing !== 'none')
+      throw new TypeError(`timing must be 'per-byte', 'per-chunk' or 'none', not ${String(timing)}`);
     const memory = options.memoryUs ?? 60_000_000;
     if (!(memory > 0)) throw new TypeError(`memoryUs must be positive, not ${memory}`);
     const origin = options.originUs ?? 0;
     if (!Number.isFinite(origin)) throw new TypeError(`originUs must be a finite number, not ${origin}`);
     this.#precise = timing === 'per-byte';
+    this.#timed = timing !== 'none';
     this.#memoryUs = memory;
     this.#originUs = origin;
   }
 
-  /** A time in a sentence, from the origin. Durations use `dur`. */
+  /** A time in a sentence, from the origin, as the health report writes it ("0:02.7"). */
   #at(us: number): string {
-    return dur(us - this.#originUs);
+    return formatClock(us - this.#originUs);
   }
 
   #port(port: number): PortState {
@@ -88,27 +98,30 @@ export class Doctor {
         firstActivityUs: NaN,
         lastActivityUs: NaN,
         activity: 0,
+        bytes: 0,
+        head: [],
+        ended: false,
         lastTimeUs: NaN,
         bins: new Bins(),
         scanner: new PacketScanner((kind) => this.#packet(state, kind)),
         scanTimeUs: NaN,
         burst: new BurstClock(),
         confirmed: null,
-        probePackets: { ibus: 0, 'srxl-v1': 0, srxl2: 0, crsf: 0, sbus: 0 },
+        probePackets: { ibus: 0, 'srxl-v1': 0, srxl2: 0, crsf: 0, sbus: 0, fport: 0, ghst: 0 },
         frames: 0,
         guess: new ArduPilotGuess(),
         xplusMask: 0,
         xplusFirstUs: NaN,
         vtxFrames: 0,
         vtxFirstUs: NaN,
-        prevFades: null,
+        firstFrameUs: NaN,
         prevFrameUs: NaN,
         prevMissed: 0,
+        prevLost: 0,
         prevDiscarded: 0,
         damagedAtUs: [],
         first: null,
         changes: [],
-        restarts: [],
         rssiFrames: 0,
       };
       p = state;
@@ -137,7 +150,8 @@ export class Doctor {
    */
   restored(port: number): void {
     const p = this.#port(port);
-    p.prevMissed = p.source?.link?.stats.lostFrames ?? 0;
+    p.prevMissed = p.source?.link?.stats.missedFrames ?? 0;
+    p.prevLost = p.source?.link?.stats.lostFrames ?? 0;
     p.prevDiscarded = p.source?.decoder.stats.discardedBytes ?? 0;
   }
 
@@ -151,13 +165,13 @@ export class Doctor {
     const p = this.#ports.get(port);
     if (p === undefined) return undefined;
     // The snapshots and records in the lists are never changed once made: the lists are copied.
-    const { source: _source, bins, scanner, burst, guess, probePackets, damagedAtUs, changes, restarts, ...plain } = p;
+    const { source: _source, bins, scanner, burst, guess, probePackets, damagedAtUs, changes, head, ...plain } = p;
     return {
       ...plain,
+      head: [...head],
       probePackets: { ...probePackets },
       damagedAtUs: [...damagedAtUs],
       changes: [...changes],
-      restarts: [...restarts],
       bins: bins.checkpoint(),
       scanner: scanner.checkpoint(),
       burst: burst.checkpoint(),
@@ -173,14 +187,14 @@ export class Doctor {
   restorePort(port: number, cp: PortCheckpoint, source: DoctorPortSource): void {
     this.detach(port);
     const p = this.#port(port);
-    const { bins, scanner, burst, guess, probePackets, damagedAtUs, changes, restarts, ...plain } = cp;
+    const { bins, scanner, burst, guess, probePackets, damagedAtUs, changes, head, ...plain } = cp;
     Object.assign(p, plain, {
       port,
       source,
+      head: [...head],
       probePackets: { ...probePackets },
       damagedAtUs: [...damagedAtUs],
       changes: [...changes],
-      restarts: [...restarts],
     });
     p.bins.restore(bins);
     p.scanner.restore(scanner);
@@ -198,11 +212,20 @@ export class Doctor {
     if (p.baudRate !== 115_200 && baud === 115_200) this.#endProbe(p, timeUs);
     p.openUs = timeUs;
     p.baudRate = baud;
+    p.ended = false;
     p.firstActivityUs = NaN;
     p.activity = 0;
     p.bins.clear();
     p.burst.reset();
     for (const k of PACKET_KINDS) p.probePackets[k] = 0;
+  }
+
+  /**
+   * The port's stream is over (the end of a capture, a replay that ended): it is judged on all
+   * it held, however short (bytes without a frame: no satellite), until it opens again.
+   */
+  ended(port: number): void {
+    this.#port(port).ended = true;
   }
 
   /** The port was closed or lost: no "nothing arrives" for it until it opens again. */
@@ -258,12 +281,33 @@ export class Doctor {
       p.bins.add(M_BYTES, t, n);
     }
     this.#activity(p, t, n);
+    if (p.frames === 0) this.#census(p, bytes, start, end, time);
+    p.bytes += n;
     p.scanTimeUs = t;
     if (unscanned <= 0) p.scanner.push(bytes, start, end);
     else {
       p.scanner.pass(Math.min(unscanned, n));
       if (unscanned < n) p.scanner.push(bytes, start + unscanned, end);
     }
+  }
+
+  /**
+   * What bytes are, while the port has shown no frame: its first ones, and 0x00, 0xFF and text
+   * per second, each byte booked where `bytes()` books it (per-byte times: its own).
+   */
+  #census(p: PortState, bytes: Uint8Array, start: number, end: number, time: number | Float64Array | undefined): void {
+    for (let i = start; i < end && p.head.length < HEAD_BYTES; i++) p.head.push(bytes[i] as number);
+    const counts = [0, 0, 0]; // 0x00, 0xFF, text
+    for (let i = start; i < end; i++) {
+      const b = bytes[i] as number;
+      const kind = b === 0 ? 0 : b === 0xff ? 1 : (b >= 0x20 && b < 0x7f) || b === 0x0a || b === 0x0d || b === 0x09 ? 2 : -1;
+      if (kind < 0) continue;
+      if (time instanceof Float64Array) p.bins.add(CENSUS[kind] as number, time[i] ?? NaN, 1);
+      else counts[kind] = (counts[kind] as number) + 1;
+    }
+    if (time instanceof Float64Array) return;
+    const t = time ?? p.lastTimeUs;
+    for (let k = 0; k < 3; k++) if ((counts[k] as number) > 0) p.bins.add(CENSUS[k] as number, t, counts[k] as number);
   }
 
   /**
@@ -285,8 +329,9 @@ export class Doctor {
   frame(port: number, f: DecodedFrame): void {
     const p = this.#port(port);
     const t = f.timeUs;
-    // The bin every counter of this frame goes in, found once.
-    const slot = p.bins.slotOf(f);
+    // The bin every counter of this frame goes in, found once (a frame without a time: where
+    // the bytes it came in were booked).
+    const slot = Number.isNaN(t) ? p.bins.slotAt(p.lastTimeUs) : p.bins.slotOf(f);
     p.frames++;
     p.bins.addTo(slot, M_FRAME_BYTES, FRAME_SIZE);
     p.guess.frame(f.words);
@@ -313,27 +358,15 @@ export class Doctor {
     }
     p.prevDiscarded = discarded;
     if (link !== undefined) {
-      const missed = link.stats.lostFrames;
-      p.bins.addTo(slot, M_MISSED, missed - p.prevMissed);
-      p.prevMissed = missed;
+      const { missedFrames, lostFrames } = link.stats;
+      p.bins.addTo(slot, M_MISSED, missedFrames - p.prevMissed);
+      p.bins.addTo(slot, M_LOST, lostFrames - p.prevLost);
+      p.prevMissed = missedFrames;
+      p.prevLost = lostFrames;
     }
-    // A counter that went back down after a gap is a receiver that restarted (power), not a
-    // wrap: a wrap after a gap adds about as many fades as frames were missed.
-    if (f.fades !== null && p.prevFades !== null && Number.isFinite(t) && Number.isFinite(p.prevFrameUs)) {
-      const gap = t - p.prevFrameUs;
-      // Only a counter that went down after a long gap can be a restart (the rest is per frame).
-      let restarted = false;
-      if (f.fades < p.prevFades && gap >= RESTART_MIN_GAP_US) {
-        const modulus = f.remote === 'internal' ? 256 : 65536;
-        const period = link !== undefined && Number.isFinite(link.stats.nominalPeriodUs) ? link.stats.nominalPeriodUs : 22_000;
-        const expected = Math.max(0, Math.round(gap / period) - 1);
-        const wrapped = (f.fades - p.prevFades + modulus) % modulus;
-        restarted = Math.abs(wrapped - expected) > Math.max(8, 0.5 * expected);
-      }
-      if (restarted) p.restarts.push({ timeUs: t, from: p.prevFades, to: f.fades, gapUs: gap });
-      else p.bins.addTo(slot, M_FADES, f.fadesDelta);
-    }
-    if (f.fades !== null) p.prevFades = f.fades;
+    // Fades per second (a restarted counter's fall is none: the decoder gives it no delta).
+    if (f.fadesDelta > 0) p.bins.addTo(slot, M_FADES, f.fadesDelta);
+    if (p.frames === 1) p.firstFrameUs = t;
     p.prevFrameUs = t;
     // The format a remote was bound in; a change after that is a rebind (or another receiver).
     // (A snapshot is made only when it is kept: nothing is allocated per frame.)
@@ -353,12 +386,19 @@ export class Doctor {
       const evidence = f.evidence.map((e) => (e.timeUs === null || Number.isFinite(e.timeUs) ? e : { ...e, timeUs: null }));
       out.push({ ...f, evidence, sinceUs: f.sinceUs !== undefined && Number.isFinite(f.sinceUs) ? f.sinceUs : nowUs });
     };
-    const ctx: RuleContext = { at: (us) => this.#at(us), precise: this.#precise, memoryUs: this.#memoryUs };
+    const ctx: RuleContext = {
+      at: (us) => this.#at(us),
+      when: (word, us) => (this.#timed && Number.isFinite(us) ? ` ${word} ${this.#at(us)}` : ''),
+      precise: this.#precise,
+      timed: this.#timed,
+      memoryUs: this.#memoryUs,
+    };
     const ports = [...this.#ports.values()].sort((a, b) => a.port - b.port);
     for (const p of ports) {
       nothingFindings(p, nowUs, add);
       const verdict = lineVerdict(p, nowUs, ctx);
-      lineFindings(p, verdict, nowUs, add);
+      lineFindings(p, verdict, nowUs, ctx, add);
+      noSatelliteFinding(p, verdict, nowUs, ctx, add);
       if (p.source !== null && p.frames > 0 && verdict.kind !== 'packets') satelliteFindings(p, nowUs, ctx, add);
     }
     systemFindings(

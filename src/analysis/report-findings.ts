@@ -54,6 +54,18 @@ export function remoteFindings(r: RemoteReport, timing: CaptureTiming): ReportFi
         `${plural(h.recovered, 'hold')} (last values held, recovered before failsafe), ${h.recovered > 1 ? 'longest ' : ''}${formatDuration(h.longestUs)} at ${formatClock(h.longestAtUs)}`,
       );
     }
+    if (r.restarts.count > 0)
+      add(
+        'warning',
+        'restarts',
+        `${plural(r.restarts.count, 'receiver restart')}: the fade counter started again from 0 after a silence${r.restarts.lastAtUs !== null ? ` (the last at ${formatClock(r.restarts.lastAtUs)})` : ''}, a power dip or a loose contact; the hold is counted`,
+      );
+    if (r.delivery.stalls !== null && r.delivery.stalls > 0 && r.delivery.longestStallUs !== null)
+      add(
+        'info',
+        'delivery',
+        `${plural(r.delivery.stalls, 'delivery stall')}, the longest ${formatDuration(r.delivery.longestStallUs)}: frames the USB adapter or the computer held back and delivered at once, not counted as holds or lost frames`,
+      );
     if (r.lostRatio !== null && r.missedFrames !== null && r.expectedFrames !== null) {
       const level: FindingLevel = r.lostRatio >= LOST_RATIO_PROBLEM ? 'problem' : r.lostRatio >= LOST_RATIO_WARN ? 'warning' : 'ok';
       const judged = level === 'problem' ? ' is high' : level === 'warning' ? ' is more than a healthy link loses' : '';

@@ -15,6 +15,15 @@ export const REPORT_BIN_US = 1_000_000;
 export const FADE_RATE_HIGH_PER_MIN = 10;
 
 /**
+ * A capture's fade rate: its fades per minute from its first frame to its last, the one figure
+ * the report and the doctor state for a whole capture; null without that span (no timing, one frame).
+ */
+export function fadesPerMinute(fades: number, firstFrameUs: number, lastFrameUs: number): number | null {
+  const span = lastFrameUs - firstFrameUs;
+  return Number.isFinite(span) && span > 0 ? fades / (span / 60e6) : null;
+}
+
+/**
  * Lost-frame ratio (missed ÷ expected) worth a warning: 1 %. A healthy link close by loses
  * well under 0.5 % of its frames; above 1 % the flight controller sees stutter.
  */

@@ -25,6 +25,8 @@ export type FindingCode =
   | 'format-changes'
   | 'no-timing'
   | 'chunk-timing'
+  | 'restarts'
+  | 'delivery'
   | 'file-issues';
 
 /** One plain-English finding. */
@@ -142,10 +144,22 @@ export interface RemoteReport {
   /** What `missedFrames` rests on. */
   missedBasis: MissedBasis;
   /**
-   * How late frames reached the recorder against the receiver's own schedule (mean) and the
-   * spread of that lateness, µs: the adapter's delivery, not link loss. `null` without timing.
+   * Frames due that did not reach the recorder (frames expected against frames received, over
+   * windows that absorb delivery bursts), whatever the receiver's counter says: where the
+   * receiver counts (`missedBasis` 'fade-counter'), `missedFrames` is what the radio lost and
+   * the rest of these were lost on the way (line damage, bytes an adapter dropped). `null`
+   * without timing.
    */
-  delivery: { delayUs: number | null; jitterUs: number | null };
+  undeliveredFrames: number | null;
+  /**
+   * How late frames reached the recorder against the receiver's own schedule (mean) and the
+   * spread of that lateness, µs; silences that were the adapter holding frames back (`stalls`,
+   * the longest `longestStallUs`: not holds, not lost). The adapter's delivery, not link loss;
+   * `null` without timing.
+   */
+  delivery: { delayUs: number | null; jitterUs: number | null; stalls: number | null; longestStallUs: number | null };
+  /** Receiver restarts: the fade counter started again from 0 after a silence (a power dip); each such silence is a hold. */
+  restarts: { count: number; lastAtUs: number | null };
   /** missedFrames ÷ expectedFrames. */
   lostRatio: number | null;
   /** 11000 or 22000 µs. */

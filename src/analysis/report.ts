@@ -17,7 +17,7 @@ import { looksInternal, readPorts } from './resolution-key.js';
 import { decodePort, type PortPass } from './report-port.js';
 import { adoptPortMessage, type PortReadingMessage } from './report-port-message.js';
 import { LEVEL_ORDER, remoteFindings, statusOf } from './report-findings.js';
-import { MAX_LISTED_HOLDS, REPORT_BIN_US, REPORT_THRESHOLDS } from './report-thresholds.js';
+import { fadesPerMinute, MAX_LISTED_HOLDS, REPORT_BIN_US, REPORT_THRESHOLDS } from './report-thresholds.js';
 import { finite, plural, r1, r1n, r3 } from './report-text.js';
 import type {
   HealthReport,
@@ -163,6 +163,7 @@ export function healthReportFeeding(
     const durationUs = hasClock && n > 0 ? last - first : NaN;
     const sys = format.system === null ? undefined : systemInfo(format.system);
     const duration = Number.isFinite(durationUs) ? durationUs : NaN;
+    const fadeRate = hasClock && n > 0 ? fadesPerMinute(fadesTotal, first, last) : null;
     const label = capture.meta.ports?.[d.port]?.name;
     const report: RemoteReport = {
       port: d.port,
@@ -179,14 +180,24 @@ export function healthReportFeeding(
       expectedFrames: haveMissed ? stats.frames + missed : null,
       missedFrames: haveMissed ? missed : null,
       missedBasis: ls.missedBasis,
-      delivery: { delayUs: hasClock ? r1n(ls.deliveryDelayUs) : null, jitterUs: hasClock ? r1n(ls.deliveryJitterUs) : null },
+      undeliveredFrames: havePeriod ? ls.lostFrames : null,
+      delivery: {
+        delayUs: hasClock ? r1n(ls.deliveryDelayUs) : null,
+        jitterUs: hasClock ? r1n(ls.deliveryJitterUs) : null,
+        stalls: hasClock ? ls.stalls : null,
+        longestStallUs: hasClock && ls.stalls > 0 ? r1(ls.longestStallUs) : null,
+      },
+      restarts: {
+        count: ls.restarts,
+        lastAtUs: hasClock && link.restarts.length > 0 ? r1((link.restarts.at(-1)?.timeUs ?? NaN) - origin) : null,
+      },
       lostRatio: haveMissed ? Math.round((missed / Math.max(1, stats.frames + missed)) * 1e6) / 1e6 : null,
       nominalPeriodUs: havePeriod ? period : null,
       fades: rssiMode
         ? null
         : {
             total: fadesTotal,
-            perMinute: Number.isFinite(duration) && duration > 0 ? r3(fadesTotal / (duration / 60e6)) : null,
+            perMinute: fadeRate === null ? null : r3(fadeRate),
             counterMoved: d.fadeCounterMoved,
             implausibleJumps: fadeJumps,
           },

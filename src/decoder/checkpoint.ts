@@ -13,7 +13,7 @@
 import { FrameSlots } from './frame.js';
 import type { Resolution } from './spec.js';
 import type { DecoderStats, RemoteKind, ResolutionReason } from './types.js';
-import type { LinkEpisode, LinkState, LinkStats } from './link.js';
+import type { LinkEpisode, LinkRestart, LinkState, LinkStats } from './link.js';
 
 /** A copy of `from`'s slot arrays and counts in `into` (a fresh set when none is given). */
 export function copySlots(from: FrameSlots, into: FrameSlots = new FrameSlots()): FrameSlots {
@@ -159,6 +159,8 @@ export interface LinkCheckpoint {
   readonly ledger: LedgerCheckpoint;
   readonly closesSeen: number;
   readonly counting: boolean;
+  readonly prevCount: number;
+  readonly restarts: readonly LinkRestart[];
   readonly lastFades: number;
   readonly lastInterval: number;
   readonly finished: boolean;

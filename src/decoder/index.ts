@@ -14,6 +14,7 @@ export {
   nominalPeriodOf,
   type LinkEpisode,
   type LinkOptions,
+  type LinkRestart,
   type LinkState,
   type LinkStats,
   type MissedBasis,

@@ -31,7 +31,7 @@ export class FrameLedger {
    * between calls, so it is no part of the ledger's state (`checkpoint()` leaves it out).
    */
   #nowUs = NaN;
-  // The open window.
+  // The open window, from its first frame.
   #winStartUs = NaN;
   #winFrames = 0;
   #winMinL = Infinity;
@@ -129,6 +129,7 @@ export class FrameLedger {
   }
 
   #take(t: number, late: number, slot: number): void {
+    if (this.#winFrames === 0) this.#winStartUs = t;
     this.#winFrames++;
     this.#winSumL += late;
     if (late > this.#winMaxL) this.#winMaxL = late;
@@ -170,7 +171,10 @@ export class FrameLedger {
     this.#refUs = this.#winMinUs;
     this.#refSlot = this.#winMinSlot + k;
     this.#slot += k;
-    this.#openWindow(this.#lastUs);
+    // The next window starts at its own first frame: one that began at this frame would close
+    // on the frames of a delivery burst alone after a stall longer than a window, all late,
+    // and count the frames the burst brought as missing.
+    this.#openWindow(NaN);
     return k;
   }
 

@@ -21,6 +21,12 @@
  *   same whatever its timing. Failsafe follows one second after the last frame (§7.1).
  * - **Delivery delay and jitter** (how late frames reach us against the receiver's own
  *   schedule) are a measure of their own (`deliveryDelayUs`, `deliveryJitterUs`), never loss.
+ *   A silence whose frames the evidence shows were sent (the fade counter did not move, or a
+ *   burst brought them all) is a **delivery stall** (`stalls`): its hold, and its failsafe, are
+ *   withdrawn, since the flight controller, which reads the receiver directly, saw neither.
+ * - **A receiver restart**: after a silence of `RESTART_MIN_GAP_US` or more, a fade counter that
+ *   fell by more than a wrap explains started again from 0 at power-up (`restarts`). Its count
+ *   then says nothing about the silence: the hold stands and the frames due in it are missed.
  * - **The frame period** snaps to 11 or 22 ms at `PERIOD_SNAP_US` (`nominalPeriodOf`).
  * - Fades are the decoder's `fadesDelta`: the decoder already leaves out counter jumps it cannot
  *   attribute to the receiver (`DecoderStats.fadeJumps`).
@@ -32,6 +38,14 @@ import { FrameLedger } from './ledger.js';
 import { copyEpisodes, type LinkCheckpoint } from './checkpoint.js';
 
 export type LinkState = 'waiting' | 'live' | 'hold' | 'failsafe';
+
+/** A receiver that started again: its fade counter fell from `from` to `to` after a silence of `gapUs`, at `timeUs` (the first frame after). */
+export interface LinkRestart {
+  timeUs: number;
+  from: number;
+  to: number;
+  gapUs: number;
+}
 
 /** A stretch without frames. `endUs` is null while it lasts. */
 export interface LinkEpisode {
@@ -93,6 +107,14 @@ export interface LinkStats {
   /** Hold episodes (each failsafe began as a hold). */
   holds: number;
   failsafes: number;
+  /** Receiver restarts (`LinkRestart`): each ended a silence its counter does not account for. */
+  restarts: number;
+  /**
+   * Silences that were the adapter holding frames back (a delivery stall: the receiver sent
+   * them, as its counter or the burst after showed), not counted as holds, and the longest, µs.
+   */
+  stalls: number;
+  longestStallUs: number;
   /** Measured frame period over the last 32 frames without a gap, µs; NaN until known. */
   periodUs: number;
   /** 11000 or 22000: the system byte's period, else the measured one snapped (`nominalPeriodOf`). */
@@ -112,6 +134,11 @@ export interface LinkStats {
   /** The spread of that lateness over the last few windows, µs: what a gap must exceed to mean anything. NaN until measured. */
   deliveryJitterUs: number;
 }
+
+/** A fade counter that falls after a silence at least this long is a restart, not line damage (a restart takes a satellite longer). */
+export const RESTART_MIN_GAP_US = 100_000;
+/** Restarts kept in `restarts` (the count in `stats` keeps counting). */
+const RESTARTS_KEPT = 64;
 
 /** §7.1 has no hold threshold: a gap shorter than this (and 2.5 periods) is never a hold. */
 export const HOLD_MIN_US = 40_000;
@@ -137,6 +164,8 @@ export function holdThresholdUs(nominalPeriodUs: number, jitterUs: number): numb
 }
 
 const PERIOD_WINDOW = 33;
+/** A mean frame interval below this (0.8 × 11 ms) is no system's period: frames a delivery burst brought together. */
+const BURST_MEAN_US = 0.8 * FRAME_PERIOD_11MS_US;
 const RATE_WINDOW = 512;
 
 export class LinkMonitor {
@@ -196,6 +225,9 @@ export class LinkMonitor {
   #closesSeen = 0;
   /** The fade counter has shown that it counts (a value other than 0, or a rise). */
   #counting = false;
+  /** The last frame's fade count (NaN: none yet), and the last restarts. */
+  #prevCount = NaN;
+  readonly #restarts: LinkRestart[] = [];
   #lastFades = 0;
   #lastInterval = NaN;
   #finished = false;
@@ -207,6 +239,9 @@ export class LinkMonitor {
     lostFrames: 0,
     holds: 0,
     failsafes: 0,
+    restarts: 0,
+    stalls: 0,
+    longestStallUs: 0,
     periodUs: NaN,
     nominalPeriodUs: NaN,
     fadeRate: 0,
@@ -247,6 +282,11 @@ export class LinkMonitor {
   /** The hold and failsafe episodes kept (all, unless `maxEpisodes`), oldest first; the last may still be open. */
   get episodes(): readonly LinkEpisode[] {
     return this.#episodes;
+  }
+
+  /** The last receiver restarts (up to 64), oldest first. */
+  get restarts(): readonly LinkRestart[] {
+    return this.#restarts;
   }
 
   /** Time of the last frame, µs (NaN before the first, without timing, or after `interrupt()`). */
@@ -307,6 +347,7 @@ export class LinkMonitor {
       if (Number.isFinite(t) && !(t - last >= (Number.isFinite(p) ? p : FRAME_PERIOD_11MS_US) / 2)) this.#burst.frames++;
       else this.#endBurst();
     }
+    const restartDue = this.#restarted(frame, gap);
     const fades = frame.fadesDelta;
     s.fades += fades;
     this.#lastFades = fades;
@@ -333,6 +374,12 @@ export class LinkMonitor {
     }
     if (this.#counting) {
       s.missedBasis = 'fade-counter';
+      if (restartDue > 0) {
+        // The restarted counter does not count the silence: the frames due in it are missed.
+        const p = s.nominalPeriodUs;
+        s.missedFrames += restartDue;
+        this.#onMissed?.(t - gap + p, t, restartDue, p);
+      }
       if (fades > 0) {
         s.missedFrames += fades;
         if (Number.isFinite(t)) {
@@ -358,7 +405,7 @@ export class LinkMonitor {
       const u = this.#unconfirmed[at];
       if (u !== undefined && this.#counting) {
         this.#unconfirmed.splice(at, 1);
-        this.#judge(u.episode, fades);
+        this.#judge(u.episode, restartDue > 0 ? restartDue : fades);
       } else if (u !== undefined) {
         u.endFades = fades;
         this.#burst = { episode: u.episode, frames: 1 };
@@ -366,6 +413,29 @@ export class LinkMonitor {
       this.#open = null;
     }
     this.#state = 'live';
+  }
+
+  /**
+   * Whether `frame` ends a silence of `gapUs` with a restarted counter (recorded, and counted in
+   * `stats.restarts`); returns the frames due in the silence (0: no restart). A wrap in the
+   * silence adds about as many as were due: a fall further from that than 8 frames, or half of
+   * them, is no wrap.
+   */
+  #restarted(frame: DecodedFrame, gapUs: number): number {
+    const count = frame.fades;
+    if (count === null) return 0;
+    const prev = this.#prevCount;
+    this.#prevCount = count;
+    const p = this.#stats.nominalPeriodUs;
+    if (!(count < prev) || !(gapUs >= RESTART_MIN_GAP_US) || !Number.isFinite(p)) return 0;
+    const modulus = frame.remote === 'internal' ? 256 : 65536;
+    const due = Math.max(0, Math.round(gapUs / p) - 1);
+    const wrapped = (count - prev + modulus) % modulus;
+    if (Math.abs(wrapped - due) <= Math.max(8, 0.5 * due)) return 0;
+    this.#stats.restarts++;
+    this.#restarts.push({ timeUs: frame.timeUs, from: prev, to: count, gapUs });
+    if (this.#restarts.length > RESTARTS_KEPT) this.#restarts.shift();
+    return Math.max(1, due);
   }
 
   /**
@@ -406,25 +476,47 @@ export class LinkMonitor {
     if (at >= 0 && this.#judge(b.episode, missed)) this.#unconfirmed.splice(at, 1);
   }
 
-  /** Frames a hold's silence would have held had the link lost them (0 while it is open or no period is known). */
+  /** Frames a hold's silence (through its failsafe, if it became one) would have held had the link lost them (0 while it is open or no period is known). */
   #dueIn(e: LinkEpisode): number {
     const p = this.#stats.nominalPeriodUs;
-    return Number.isFinite(p) && e.endUs !== null ? Math.round((e.endUs - e.lastFrameUs) / p) - 1 : 0;
+    const end = this.#silenceEndUs(e);
+    return Number.isFinite(p) && end !== null ? Math.round((end - e.lastFrameUs) / p) - 1 : 0;
+  }
+
+  /** Where the silence a hold began ended: the hold's end, or its failsafe's (null while it lasts). */
+  #silenceEndUs(e: LinkEpisode): number | null {
+    for (let i = this.#episodes.length - 1; i >= 0; i--) {
+      const f = this.#episodes[i] as LinkEpisode;
+      if (f.kind === 'failsafe' && f.lastFrameUs === e.lastFrameUs) return f.endUs;
+      if (f.lastFrameUs < e.lastFrameUs) break;
+    }
+    return e.endUs;
   }
 
   /**
    * Keeps a hold that ended, or withdraws it (and says so): `missed` is how many frames the
    * evidence says were lost in its silence. A stall delivers the frames it held after it, so a
-   * hold that lost under half of them was the adapter's.
+   * hold that lost under half of them was the adapter's: a delivery stall, and so is the
+   * failsafe it became (the flight controller, on the receiver's own line, had its frames).
    */
   #judge(e: LinkEpisode, missed: number): boolean {
     const due = this.#dueIn(e);
-    const failsafe = this.#episodes.some((f) => f.kind === 'failsafe' && f.lastFrameUs === e.lastFrameUs);
-    if (failsafe || due < 2 || missed >= due / 2) return false;
-    const at = this.#episodes.indexOf(e);
-    if (at >= 0) this.#episodes.splice(at, 1);
-    this.#stats.holds--;
-    this.#retracted.push(e.id);
+    if (due < 2 || missed >= due / 2) return false;
+    const s = this.#stats;
+    const silence = (this.#silenceEndUs(e) ?? e.lastFrameUs) - e.lastFrameUs;
+    for (let i = this.#episodes.length - 1; i >= 0; i--) {
+      const x = this.#episodes[i] as LinkEpisode;
+      if (x.lastFrameUs !== e.lastFrameUs) {
+        if (x.lastFrameUs < e.lastFrameUs) break;
+        continue;
+      }
+      this.#episodes.splice(i, 1);
+      if (x.kind === 'hold') s.holds--;
+      else s.failsafes--;
+      this.#retracted.push(x.id);
+    }
+    s.stalls++;
+    if (silence > s.longestStallUs) s.longestStallUs = silence;
     return true;
   }
 
@@ -554,6 +646,8 @@ export class LinkMonitor {
       ledger: this.#ledger.checkpoint(),
       closesSeen: this.#closesSeen,
       counting: this.#counting,
+      prevCount: this.#prevCount,
+      restarts: this.#restarts.map((r) => ({ ...r })),
       lastFades: this.#lastFades,
       lastInterval: this.#lastInterval,
       finished: this.#finished,
@@ -595,6 +689,8 @@ export class LinkMonitor {
     this.#ledger.restore(cp.ledger);
     this.#closesSeen = cp.closesSeen;
     this.#counting = cp.counting;
+    this.#prevCount = cp.prevCount;
+    this.#restarts.splice(0, this.#restarts.length, ...cp.restarts.map((r) => ({ ...r })));
     this.#lastFades = cp.lastFades;
     this.#lastInterval = cp.lastInterval;
     this.#finished = cp.finished;
@@ -611,8 +707,8 @@ export class LinkMonitor {
   readonly #settled = (e: LinkEpisode): boolean =>
     e.endUs !== null &&
     !(this.#open !== null && e.lastFrameUs === this.#open.lastFrameUs) &&
-    this.#burst?.episode !== e &&
-    !this.#unconfirmed.some((u) => u.episode === e);
+    this.#burst?.episode.lastFrameUs !== e.lastFrameUs &&
+    !this.#unconfirmed.some((u) => u.episode.lastFrameUs === e.lastFrameUs);
 
   /** Re-dates the episodes counted from `fromUs` to count from the frame at `lastUs`. */
   #redate(fromUs: number, lastUs: number): void {
@@ -662,8 +758,11 @@ export class LinkMonitor {
       const s = this.#stats;
       if (!Number.isFinite(this.#systemPeriod) && (!Number.isFinite(s.nominalPeriodUs) || this.#periodCount === PERIOD_WINDOW)) {
         // Without a system byte: snap the mean interval to 11 or 22 ms, first over 8 intervals,
-        // then again over every full window, so a few frames missing early do not stick.
-        s.nominalPeriodUs = nominalPeriodOf((t - (times[this.#periodOldest] ?? NaN)) / (this.#periodCount - 1));
+        // then again over every full window, so a few frames missing early do not stick. A
+        // window that a delivery burst crowds (frames a stall held back, dated together) is
+        // faster than any system sends: it says nothing of the period.
+        const mean = (t - (times[this.#periodOldest] ?? NaN)) / (this.#periodCount - 1);
+        if (!(mean < BURST_MEAN_US)) s.nominalPeriodUs = nominalPeriodOf(mean);
       }
       this.#periodOwed = true;
     }

@@ -82,7 +82,7 @@ export class Diagnosis {
   }
 
   #restartReplay(startUs: number): void {
-    const timing = this.#capture?.timing === 'per-byte' ? 'per-byte' : 'per-chunk';
+    const timing = this.#capture?.timing ?? 'per-chunk';
     this.#doctor = new Doctor({ timing, memoryUs: Infinity, originUs: Number.isFinite(startUs) ? startUs : 0 });
     this.#nextEvent = 0;
   }
@@ -105,10 +105,21 @@ export class Diagnosis {
           const t = time instanceof Float64Array ? time[0] : time;
           if (t !== undefined) this.#eventsUntil(t);
         }
-        doctor().bytes(id, bytes, time);
+        // A replay without recorded timing feeds its bytes untimed: the doctor's line windows
+        // run on the replay's pace instead (its 'none' timing states no time from it).
+        doctor().bytes(id, bytes, time ?? (this.#mode === 'replay' ? this.clockUs() : undefined));
       },
       frame: (f) => doctor().frame(id, f),
     };
+  }
+
+  /**
+   * The replay reached the end of its capture: every port is judged on all it held, however
+   * short (bytes without a frame: no satellite), as `satscope doctor` judges the file.
+   */
+  ended(): void {
+    for (const id of this.#labels.keys()) this.#doctor.ended(id);
+    this.tick(true);
   }
 
   /** A source's decoder and link monitor were restored from a checkpoint: the doctor counts from there. */
