@@ -7,7 +7,7 @@ import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { CaptureWriter, readCapture } from '../src/capture/index.js';
-import { summarizeCapture } from '../src/analysis/index.js';
+import { formatClock, summarizeCapture } from '../src/analysis/index.js';
 import { preset, simulate } from '../src/simulator/index.js';
 import { concatBytes } from './bytes.js';
 import { usbChunks } from './feeds.js';
@@ -205,6 +205,11 @@ describe('satscope decode', () => {
   });
 });
 
+interface Ep {
+  startUs: number;
+  endUs: number;
+}
+
 /** "1 hold", "2 holds": the count as the summary words it. */
 const counted = (n: number, word: string): string => `${n} ${word}${n === 1 ? '' : 's'}`;
 
@@ -220,7 +225,14 @@ describe('satscope info', () => {
     const gaps = sim.truth!.gaps.filter((g) => g.failsafe).length;
     expect(gaps).toBeGreaterThan(0);
     expect(r.out).toMatch(new RegExp(`Failsafe\\s+\\d+ holds?, ${counted(gaps, 'failsafe')}\n`));
-    expect(r.out).toMatch(/failsafe +from [\d.]+ s until [\d.]+ s/);
+    // Each episode dated as the report dates it: from the capture's start, on the report's clock.
+    const report = JSON.parse(satscope('report', join(dir, 'run.csv'), '--json').out);
+    const remote = report.remotes[0];
+    const dated = [...remote.holds.episodes.map((e: Ep) => ['hold', e]), ...remote.failsafes.map((e: Ep) => ['failsafe', e])]
+      .sort((a, b) => a[1].startUs - b[1].startUs || (a[0] === 'hold' ? -1 : 1))
+      .map(([kind, e]) => `  ${kind.padEnd(8)} from ${formatClock(e.startUs)} until ${formatClock(e.endUs)}`);
+    expect(dated.length).toBeGreaterThan(1);
+    expect(r.out.split('\n').filter((l) => /^ {2}(hold|failsafe) /.test(l))).toEqual(dated);
     expect(r.out).toMatch(/ 0 Throttle/);
   });
 

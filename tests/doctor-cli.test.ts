@@ -53,7 +53,7 @@ describe('satscope doctor', () => {
   it('names IBUS, says what to set, and exits 1 for a problem', () => {
     const r = run(join(dir, 'ibus.sscap'));
     expect(r.code).toBe(1);
-    expect(r.out).toMatch(/^satscope doctor: ibus\.sscap \(sscap, per-chunk timing, 1 port, \d+ bytes, 3\.\d s\)/);
+    expect(r.out).toMatch(/^satscope doctor: ibus\.sscap \(sscap, a time per chunk, 1 port, \d+ bytes, 3\.\d s\)/);
     expect(r.out).toMatch(/PROBLEM {2}Port 0: this is FlySky IBUS, not a Spektrum satellite {2}\[certain, since 0:00\.\d\]/);
     expect(r.out).toMatch(/Betaflight: .*\n {6}set serialrx_provider = IBUS/);
     expect(r.err).toBe('');
@@ -62,7 +62,7 @@ describe('satscope doctor', () => {
   it('names IBUS in a raw byte dump too (no times: as if the bytes came back to back)', () => {
     const r = run(join(dir, 'ibus.bin'));
     expect(r.code).toBe(1);
-    expect(r.out).toMatch(/^satscope doctor: ibus\.bin \(raw, none timing/);
+    expect(r.out).toMatch(/^satscope doctor: ibus\.bin \(raw, no times, 1 port/);
     expect(r.out).toMatch(/this is FlySky IBUS/);
   });
 

@@ -9,7 +9,7 @@ import { closeSync, readFileSync, writeFileSync } from 'node:fs';
 import { basename } from 'node:path';
 import { captureChunks, capturePorts, type Capture } from '../capture/index.js';
 import { SpektrumDecoder } from '../decoder/index.js';
-import { reportHtml, summarizeCapture } from '../analysis/index.js';
+import { captureSpan, reportHtml, summarizeCapture } from '../analysis/index.js';
 import { threadedReport } from './report-threads.js';
 import { parseCommandLine, UsageError, type Args } from './args.js';
 import { fileProblem } from './file-problem.js';
@@ -85,7 +85,8 @@ async function main(argv: string[]): Promise<number> {
   }
   if (args.command === 'info') {
     const summary = summarizeCapture(capture, { resolution: args.resolution, port });
-    out.text(args.json ? `${JSON.stringify(summary, null, 2)}\n` : `${formatSummary(summary, basename(args.file))}\n`);
+    const text = () => formatSummary(summary, basename(args.file), capturePorts(capture), captureSpan(capture).startUs);
+    out.text(args.json ? `${JSON.stringify(summary, null, 2)}\n` : `${text()}\n`);
     return finish(out, summary.decoder.frames > 0 ? 0 : 1);
   }
   return decode(capturePieces(capture, port), args, port, out);
@@ -95,7 +96,8 @@ async function main(argv: string[]): Promise<number> {
 function infoAll(capture: Capture, args: Args, out: TextOutput): Promise<number> {
   const ports = capturePorts(capture);
   const blocks = ports.map((port) => summarizeCapture(capture, { resolution: args.resolution, port }));
-  out.text(`${blocks.map((s) => formatSummary(s, basename(args.file), ports)).join('\n\n')}\n`);
+  const origin = captureSpan(capture).startUs;
+  out.text(`${blocks.map((s) => formatSummary(s, basename(args.file), ports, origin)).join('\n\n')}\n`);
   return finish(out, blocks.some((s) => s.decoder.frames > 0) ? 0 : 1);
 }
 

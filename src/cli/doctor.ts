@@ -9,6 +9,8 @@ import { basename } from 'node:path';
 import { parseArgs } from 'node:util';
 import { doctorCapture, formatClock, type DoctorFinding, type DoctorReport } from '../analysis/index.js';
 import { loadCapture } from './input.js';
+import { TIMING_WORDS } from './format.js';
+import { plural } from '../analysis/report-text.js';
 
 export const DOCTOR_USAGE = `Usage:
   satscope doctor FILE [--json] [--resolution auto|1024|2048]
@@ -85,7 +87,7 @@ export function formatDoctorReport(r: DoctorReport, name: string): string {
   const origin = r.source.startUs;
   const span = r.source.startUs !== null && r.source.endUs !== null ? `, ${((r.source.endUs - r.source.startUs) / 1e6).toFixed(1)} s` : '';
   lines.push(
-    `satscope doctor: ${name} (${r.source.kind}, ${r.source.timing} timing, ${r.source.ports.length === 1 ? '1 port' : `${r.source.ports.length} ports`}, ${r.source.bytes} bytes${span})`,
+    `satscope doctor: ${name} (${r.source.kind}, ${TIMING_WORDS[r.source.timing]}, ${plural(r.source.ports.length, 'port')}, ${plural(r.source.bytes, 'byte')}${span})`,
   );
   lines.push('');
   if (r.findings.length === 0) lines.push('No findings: nothing wrong was seen at the end of the capture.');

@@ -1,7 +1,7 @@
 /** Text forms of frames and summaries for the CLI. */
 import type { HealthReport, ReportFinding } from '../analysis/index.js';
 import type { CaptureSummary } from '../analysis/index.js';
-import { plural } from '../analysis/report-text.js';
+import { formatClock, plural } from '../analysis/report-text.js';
 import type { CaptureTiming } from '../capture/index.js';
 import { systemInfo } from '../decoder/spec.js';
 
@@ -22,7 +22,7 @@ export const TIMING_WORDS: Record<CaptureTiming, string> = {
  * The human summary `satscope info` prints of one port. `ports` lists every port of the capture
  * with data, so that a summary of one of several says which one it is and names the others.
  */
-export function formatSummary(s: CaptureSummary, name: string, ports: readonly number[] = [s.port]): string {
+export function formatSummary(s: CaptureSummary, name: string, ports: readonly number[] = [s.port], originUs = 0): string {
   const lines: string[] = [];
   const add = (label: string, value: string): void => {
     lines.push(`${label.padEnd(14)}${value}`);
@@ -73,9 +73,10 @@ export function formatSummary(s: CaptureSummary, name: string, ports: readonly n
     );
     add('Gaps', `${plural(l.missedFrames, 'missed frame')}, longest gap ${ms(l.longestGapUs)}`);
     add('Failsafe', `${plural(l.holds, 'hold')}, ${plural(l.failsafes, 'failsafe')}`);
+    // Times from the capture's start, as the report and the doctor state them.
     for (const e of s.episodes) {
-      const end = e.endUs === null ? 'to the end' : `until ${(e.endUs / 1e6).toFixed(3)} s`;
-      lines.push(`  ${e.kind.padEnd(8)} from ${(e.startUs / 1e6).toFixed(3)} s ${end}`);
+      const end = e.endUs === null ? 'to the end' : `until ${formatClock(e.endUs - originUs)}`;
+      lines.push(`  ${e.kind.padEnd(8)} from ${formatClock(e.startUs - originUs)} ${end}`);
     }
   } else {
     add('Timing', 'none in this file: no frame period, gaps or failsafe episodes');
