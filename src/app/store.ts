@@ -55,6 +55,7 @@ const IDLE: SourceStatus = {
     systemValid: false,
     headerMode: 'fades',
     forcedMismatch: null,
+    withheld: null,
   },
 };
 

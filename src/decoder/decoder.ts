@@ -10,7 +10,8 @@
  *   and a fade byte that only rises, slowly; an external one: a UINT16 fade count that only
  *   rises, slowly). Every slot must hold a valid channel ID (or 0xFFFF, or VTX) with no repeats.
  *   Contiguous channel sets, layouts that recur every other frame and a system byte that agrees
- *   with the resolution score higher. The winning chain is emitted as it stands.
+ *   with the resolution score higher. The chain's first frame must carry channels: filler (runs
+ *   of 0xFF are frames of seven empty slots) never locks. The winning chain is emitted as it stands.
  * - Locked, a frame is emitted when it continues the last one (same model, fade count risen by
  *   less than FADE_STEP) and the whole next frame is valid and continues it: one frame period
  *   of latency. A frame whose slot layout is new must also not overlap a frame that continues
@@ -25,7 +26,18 @@
  * (emitted unconditionally): so `next()` always returns after bounded work.
  */
 import { FRAME_SIZE, systemInfo, type Resolution } from './spec.js';
-import { byteAt, countZeroWords, createFrame, FrameSlots, INVALID, layoutChannels, readFrame, showSlots, slotLayout } from './frame.js';
+import {
+  byteAt,
+  channelEvidence,
+  countZeroWords,
+  createFrame,
+  FrameSlots,
+  INVALID,
+  layoutChannels,
+  readFrame,
+  showSlots,
+  slotLayout,
+} from './frame.js';
 import { copySlots, type DecoderCheckpoint } from './checkpoint.js';
 import type {
   DecodedFrame,
@@ -36,6 +48,7 @@ import type {
   HeaderReading,
   RemoteKind,
   ResolutionReason,
+  Withheld,
 } from './types.js';
 
 export interface DecoderOptions {
@@ -90,6 +103,14 @@ const FADE_STEP = 8;
  * two (a foreign byte read as its fade count) moves them anywhere.
  */
 const ACQUIRE_FADE_STEP = 3;
+/**
+ * Channels the first frame of a chain must carry in words that are not filler
+ * (`channelEvidence`) for a lock: a transmitter sends four channels or more, every frame it
+ * sends carries four or more (a pair of 8 to 12 channels, 5 to 7 in each), and this leaves
+ * room for one on a filler word. Runs of 0xFF carry none, and a shifted reading of
+ * frames of filler slots takes their header for one or two channel words.
+ */
+const EVIDENCE_CHANNELS = 3;
 /** How far a locked decoder searches for a frame that continues the stream before it acquires afresh. */
 const MAX_RESYNC_BYTES = 8 * FRAME_SIZE;
 /** Slot layouts remembered (a transmitter uses two to four). */
@@ -122,6 +143,13 @@ function byte0Follows(prev: number, next: number, mode: number, step = FADE_STEP
   if (mode === B0_FADES) return rise;
   if (mode === B0_RSSI) return plausibleRssi(next);
   return rise || (plausibleRssi(prev) && plausibleRssi(next));
+}
+
+/** The number of bits set in `x` (a 32-bit mask). */
+function bitCount(x: number): number {
+  let n = 0;
+  for (let m = x; m !== 0; m &= m - 1) n++;
+  return n;
 }
 
 /** `t[i]` at an index the caller knows is inside `t`: a typed read (an index past the end, a bug, reads as NaN). */
@@ -184,6 +212,8 @@ export class SpektrumDecoder {
   #b0Mode = B0_FADES;
   /** The resolution the bytes fit when a forced one fits nothing, else null. */
   #forcedMismatch: Resolution | null = null;
+  /** Why bytes that read as frames give none, until a lock (`format.withheld`). */
+  #withheld: Withheld | null = null;
   /** Header bytes of the last emitted frame (for deltas and continuity), valid when #haveLast. */
   #last0 = 0;
   #last1 = 0;
@@ -227,6 +257,8 @@ export class SpektrumDecoder {
   #candFrames = 0;
   /** Index in the chain of a frame with a damaged header, skipped over (not confirmed), or -1. */
   #candSkipped = -1;
+  /** The best score #score found for a chain that starts without channels (filler), since #best reset it; -1: none. */
+  #fillerScore = -1;
   /** Who fixed the resolution, when it is fixed. */
   #fixedBy: 'user' | 'internal-remote' = 'user';
 
@@ -460,6 +492,7 @@ export class SpektrumDecoder {
     this.#system = null;
     this.#b0Mode = B0_FADES;
     this.#forcedMismatch = null;
+    this.#withheld = null;
     this.#haveLast = false;
     this.#jumpTrusted = false;
     this.#layoutCount = this.#layoutNext = 0;
@@ -486,6 +519,7 @@ export class SpektrumDecoder {
       systemValid: this.#system !== null && systemInfo(this.#system) !== undefined,
       headerMode: this.#headerReading(),
       forcedMismatch: this.#forcedMismatch,
+      withheld: this.#withheld,
     };
   }
 
@@ -956,6 +990,7 @@ export class SpektrumDecoder {
     }
     const forced = this.#options.resolution;
     const best = this.#best(p, avail, forced === 'auto' ? 0 : forced);
+    if (best.filler) this.#withhold('filler', p);
     if (best.score < 0 || (best.shift >= ACQUIRE_COMMIT && avail >= window)) {
       if (best.score < 0 && forced !== 'auto') {
         // Say so when the bytes are frames, only not at the resolution the caller forced.
@@ -1012,6 +1047,7 @@ export class SpektrumDecoder {
     this.#nextAt = -1;
     this.#everLocked = true;
     this.#forcedMismatch = null;
+    this.#withheld = null;
     // Each frame of the chain is confirmed by the one after it; the last waits for its own next
     // (or the stream's end) like any other, and so does a frame with a damaged header.
     const confirmed = skipped >= 0 ? skipped : frames - (this.#ended && o + frames * FRAME_SIZE >= this.#tail - FRAME_SIZE ? 0 : 1);
@@ -1024,6 +1060,16 @@ export class SpektrumDecoder {
     this.#event({ type: 'locked', offset: this.#base + o, format: this.format });
     if (changed) this.#event({ type: 'format-changed', offset: this.#base + o, format: this.format });
     return true;
+  }
+
+  /**
+   * Says why bytes that read as frames give none (`format.withheld`), with a format-changed
+   * event when the reason is new: it stands until a lock.
+   */
+  #withhold(why: Withheld, o: number): void {
+    if (this.#withheld === why) return;
+    this.#withheld = why;
+    this.#event({ type: 'format-changed', offset: this.#base + o, format: this.format });
   }
 
   /** Whether `layout` is the layout of one of the `frames` frames from `o`. */
@@ -1051,8 +1097,15 @@ export class SpektrumDecoder {
     return countFollows((byteAt(buf, a) << 8) | byteAt(buf, a + 1), (byteAt(buf, b) << 8) | byteAt(buf, b + 1), ACQUIRE_FADE_STEP);
   }
 
-  /** The best-scoring start among the next ACQUIRE_SHIFTS offsets, at one resolution or (0) both. */
-  #best(p: number, avail: number, only: 0 | Resolution): { score: number; shift: number; resolution: Resolution } {
+  /**
+   * The best-scoring start among the next ACQUIRE_SHIFTS offsets, at one resolution or (0) both.
+   * None (score -1, `filler`) when a chain that starts without channels (see
+   * EVIDENCE_CHANNELS) reads better than any that starts with them: those are then shifted
+   * readings of the filler and its headers (`00 B2` then seven 0xFFFF slots, read a byte
+   * early, has a channel 6 at 0x2FF), not frames.
+   */
+  #best(p: number, avail: number, only: 0 | Resolution): { score: number; shift: number; resolution: Resolution; filler: boolean } {
+    this.#fillerScore = -1;
     let score = -1;
     let shift = 0;
     let resolution: Resolution = 2048;
@@ -1076,7 +1129,8 @@ export class SpektrumDecoder {
         }
       }
     }
-    return { score, shift, resolution };
+    const filler = this.#fillerScore > score;
+    return { score: filler ? -1 : score, shift, resolution, filler };
   }
 
   /** Whether every frame of the chain at `o` has a layout the lock knows. */
@@ -1181,9 +1235,11 @@ export class SpektrumDecoder {
     let recurring = 0;
     let layout1 = INVALID;
     let layout2 = INVALID;
+    let leads = false;
     for (let k = 0; k < length; k++) {
       const f = o + k * FRAME_SIZE;
       const layout = slotLayout(buf, f, resolution);
+      if (k === 0) leads = bitCount(channelEvidence(buf, f, layout, resolution)) >= EVIDENCE_CHANNELS;
       const b0 = byteAt(buf, f);
       if (!plausibleRssi(b0)) positive = true;
       else if (k > 0 && b0 < byteAt(buf, f - FRAME_SIZE)) fell = true;
@@ -1209,6 +1265,13 @@ export class SpektrumDecoder {
     if (((byteAt(buf, o) << 8) | s) === 0xffff) score -= 3;
     // Transmitters send channels 0…N-1: a contiguous set is the signature of the right reading.
     if ((channels & (channels + 1)) === 0) score += 2;
+    // A chain whose first frame carries too few channels is filler that happens to parse (or
+    // filler whose chain runs into the frames after it): never a lock, but #best weighs it
+    // against the other readings.
+    if (!leads) {
+      if (score > this.#fillerScore) this.#fillerScore = score;
+      return -1;
+    }
     this.#candInternal = internal;
     this.#candSystem = s;
     this.#candFrames = length;
@@ -1258,6 +1321,9 @@ export class SpektrumDecoder {
     const other = this.#forcedMismatch;
     if (other !== null) {
       return `Forced ${this.#options.resolution}: no frame matches; the stream looks like ${other}.`;
+    }
+    if (!this.#locked && this.#withheld === 'filler') {
+      return `${this.#everLocked ? 'Looking for frames again' : 'No frames'}: the bytes read as frames only of empty slots (0xFFFF) or 0x00/0xFF filler, which carry no channel.`;
     }
     if (!this.#everLocked) return 'Not locked on to frames yet.';
     if (!this.#locked) return 'Looking for frames again: the format changed or the frames stopped making sense.';
@@ -1383,6 +1449,7 @@ export class SpektrumDecoder {
       system: this.#system,
       b0Mode: this.#b0Mode,
       forcedMismatch: this.#forcedMismatch,
+      withheld: this.#withheld,
       last0: this.#last0,
       last1: this.#last1,
       haveLast: this.#haveLast,
@@ -1449,6 +1516,7 @@ export class SpektrumDecoder {
     this.#system = cp.system;
     this.#b0Mode = cp.b0Mode;
     this.#forcedMismatch = cp.forcedMismatch;
+    this.#withheld = cp.withheld;
     this.#last0 = cp.last0;
     this.#last1 = cp.last1;
     this.#haveLast = cp.haveLast;

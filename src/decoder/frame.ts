@@ -130,6 +130,26 @@ export function layoutChannels(layout: number): number {
   return mask;
 }
 
+/**
+ * The channels (bit n: channel n, 0–19) that the valid frame at `o` (its layout `layout` under
+ * `resolution`) carries in words that are not filler: evidence of a transmitter. Filler is a
+ * word of one byte value twice (a run of one byte: 0xFF the empty slot's and an idle line's,
+ * 0x00 a line held low) or of 0x00 and 0xFF. Runs and patterns of such bytes read as valid
+ * frames (seven 0xFFFF slots are one, and 0x00FF reads as channel 0) but say nothing about a
+ * transmitter; and a shifted reading of filler frames takes their header for a slot, one
+ * channel a frame. A channel word is filler for about 1 position in 256.
+ */
+export function channelEvidence(b: Uint8Array, o: number, layout: number, resolution: Resolution): number {
+  let channels = 0;
+  for (let i = 0; i < SLOTS_PER_FRAME; i++) {
+    if (((layout >> (CODE_BITS * i)) & CODE_MASK) > CODE_XPLUS) continue; // empty or VTX
+    const hi = byteAt(b, o + 2 + 2 * i);
+    const lo = byteAt(b, o + 3 + 2 * i);
+    if (hi !== lo && !((hi === 0 || hi === 0xff) && (lo === 0 || lo === 0xff))) channels |= 1 << slotChannel(hi, resolution);
+  }
+  return channels;
+}
+
 /** Whether a layout has a slot with a given raw 16-bit word of zero (a header read as a slot). */
 export function countZeroWords(b: Uint8Array, o: number): number {
   let n = 0;

@@ -111,7 +111,18 @@ export interface FormatInfo {
    * resolution: nothing is decoded, and that is a setting, not link loss.
    */
   forcedMismatch: Resolution | null;
+  /** Why bytes that read as frames give none, while not locked (see `Withheld`); null otherwise. */
+  withheld: Withheld | null;
 }
+
+/**
+ * Why the decoder gives no frame from bytes that read as frames:
+ * - 'filler': they carry no channel, only 0xFFFF empty slots or 0x00/0xFF filler (runs of
+ *   0xFF parse as frames of seven empty slots), which is no evidence of a transmitter;
+ * - 'forced': they are frames, but not under the resolution, remote or header mode the caller
+ *   forced (see also `forcedMismatch`).
+ */
+export type Withheld = 'filler' | 'forced';
 
 /** Counters. Every byte pushed ends up in exactly one of `frameBytes`, `discardedBytes` or `pendingBytes`. */
 export interface DecoderStats {
