@@ -104,13 +104,13 @@ const FADE_STEP = 8;
  */
 const ACQUIRE_FADE_STEP = 3;
 /**
- * Channels the first frame of a chain must carry in words that are not filler
- * (`channelEvidence`) for a lock: a transmitter sends four channels or more, every frame it
- * sends carries four or more (a pair of 8 to 12 channels, 5 to 7 in each), and this leaves
- * room for one on a filler word. Runs of 0xFF carry none, and a shifted reading of
- * frames of filler slots takes their header for one or two channel words.
+ * Bytes of channel words that are not filler (`channelEvidence`) the first frame of a chain
+ * must carry for a lock: more than a header's two, which is all a shifted reading of frames of
+ * filler slots finds. A transmitter sends four channels or more, and every frame it sends
+ * carries four or more (a pair of 8 to 12 channels, 5 to 7 in each), one such byte each at
+ * least (a centred channel's low byte is 0x00).
  */
-const EVIDENCE_CHANNELS = 3;
+const EVIDENCE_BYTES = 3;
 /** How far a locked decoder searches for a frame that continues the stream before it acquires afresh. */
 const MAX_RESYNC_BYTES = 8 * FRAME_SIZE;
 /** Slot layouts remembered (a transmitter uses two to four). */
@@ -143,13 +143,6 @@ function byte0Follows(prev: number, next: number, mode: number, step = FADE_STEP
   if (mode === B0_FADES) return rise;
   if (mode === B0_RSSI) return plausibleRssi(next);
   return rise || (plausibleRssi(prev) && plausibleRssi(next));
-}
-
-/** The number of bits set in `x` (a 32-bit mask). */
-function bitCount(x: number): number {
-  let n = 0;
-  for (let m = x; m !== 0; m &= m - 1) n++;
-  return n;
 }
 
 /** `t[i]` at an index the caller knows is inside `t`: a typed read (an index past the end, a bug, reads as NaN). */
@@ -1100,7 +1093,7 @@ export class SpektrumDecoder {
   /**
    * The best-scoring start among the next ACQUIRE_SHIFTS offsets, at one resolution or (0) both.
    * None (score -1, `filler`) when a chain that starts without channels (see
-   * EVIDENCE_CHANNELS) reads better than any that starts with them: those are then shifted
+   * EVIDENCE_BYTES) reads better than any that starts with them: those are then shifted
    * readings of the filler and its headers (`00 B2` then seven 0xFFFF slots, read a byte
    * early, has a channel 6 at 0x2FF), not frames.
    */
@@ -1239,7 +1232,7 @@ export class SpektrumDecoder {
     for (let k = 0; k < length; k++) {
       const f = o + k * FRAME_SIZE;
       const layout = slotLayout(buf, f, resolution);
-      if (k === 0) leads = bitCount(channelEvidence(buf, f, layout, resolution)) >= EVIDENCE_CHANNELS;
+      if (k === 0) leads = channelEvidence(buf, f, layout) >= EVIDENCE_BYTES;
       const b0 = byteAt(buf, f);
       if (!plausibleRssi(b0)) positive = true;
       else if (k > 0 && b0 < byteAt(buf, f - FRAME_SIZE)) fell = true;
@@ -1265,7 +1258,7 @@ export class SpektrumDecoder {
     if (((byteAt(buf, o) << 8) | s) === 0xffff) score -= 3;
     // Transmitters send channels 0…N-1: a contiguous set is the signature of the right reading.
     if ((channels & (channels + 1)) === 0) score += 2;
-    // A chain whose first frame carries too few channels is filler that happens to parse (or
+    // A chain whose first frame carries no channel is filler that happens to parse (or
     // filler whose chain runs into the frames after it): never a lock, but #best weighs it
     // against the other readings.
     if (!leads) {

@@ -131,23 +131,25 @@ export function layoutChannels(layout: number): number {
 }
 
 /**
- * The channels (bit n: channel n, 0–19) that the valid frame at `o` (its layout `layout` under
- * `resolution`) carries in words that are not filler: evidence of a transmitter. Filler is a
- * word of one byte value twice (a run of one byte: 0xFF the empty slot's and an idle line's,
- * 0x00 a line held low) or of 0x00 and 0xFF. Runs and patterns of such bytes read as valid
- * frames (seven 0xFFFF slots are one, and 0x00FF reads as channel 0) but say nothing about a
- * transmitter; and a shifted reading of filler frames takes their header for a slot, one
- * channel a frame. A channel word is filler for about 1 position in 256.
+ * How much the valid frame at `o` (its layout `layout`) says about a transmitter: the bytes of
+ * its channel words (0–11 and X-Plus) that are not filler, 0x00 (a line held low) or 0xFF (the
+ * empty slot's and an idle line's), in words whose two bytes differ (a run of one byte is
+ * filler whatever its value). Runs and patterns of filler read as valid frames (seven 0xFFFF
+ * slots are one, and 0x00FF reads as channel 0) and carry none; a shifted reading of frames of
+ * filler slots takes a header for slots, two bytes at most. A transmitter's frame carries four
+ * channels or more, each with one such byte at least.
  */
-export function channelEvidence(b: Uint8Array, o: number, layout: number, resolution: Resolution): number {
-  let channels = 0;
+export function channelEvidence(b: Uint8Array, o: number, layout: number): number {
+  let n = 0;
   for (let i = 0; i < SLOTS_PER_FRAME; i++) {
     if (((layout >> (CODE_BITS * i)) & CODE_MASK) > CODE_XPLUS) continue; // empty or VTX
     const hi = byteAt(b, o + 2 + 2 * i);
     const lo = byteAt(b, o + 3 + 2 * i);
-    if (hi !== lo && !((hi === 0 || hi === 0xff) && (lo === 0 || lo === 0xff))) channels |= 1 << slotChannel(hi, resolution);
+    if (hi === lo) continue;
+    if (hi !== 0 && hi !== 0xff) n++;
+    if (lo !== 0 && lo !== 0xff) n++;
   }
-  return channels;
+  return n;
 }
 
 /** Whether a layout has a slot with a given raw 16-bit word of zero (a header read as a slot). */
