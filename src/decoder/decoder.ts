@@ -70,6 +70,17 @@ export interface DecoderOptions {
   fastPath?: boolean;
 }
 
+/** A start acquisition may lock on: its score (-1: none), shift from the head and resolution; `filler`: see #best. */
+interface Best {
+  score: number;
+  shift: number;
+  resolution: Resolution;
+  filler: boolean;
+}
+
+/** The options #score reads with no option forced. */
+const FREE = { remote: 'auto', headerMode: 'auto' } as const;
+
 /** Frames looked at before a lock. */
 const ACQUIRE_FRAMES = 4;
 /** Fewest of them that must chain for a lock: two frames that happen to parse are common. */
@@ -459,6 +470,7 @@ export class SpektrumDecoder {
     this.#options.resolution = resolution;
     this.#fixedBy = fixedBy;
     this.#forcedMismatch = null;
+    if (this.#withheld === 'forced') this.#withheld = null;
     if (!this.#locked) return;
     if (resolution === 'auto' ? this.#reason === 'override' || this.#reason === 'internal-remote' : resolution !== this.#resolution) {
       this.#unlock();
@@ -982,15 +994,11 @@ export class SpektrumDecoder {
       return false;
     }
     const forced = this.#options.resolution;
-    const best = this.#best(p, avail, forced === 'auto' ? 0 : forced);
+    let best = this.#best(p, avail, forced === 'auto' ? 0 : forced, false);
     if (best.filler) this.#withhold('filler', p);
+    else if (forced !== 'auto' || this.#options.remote !== 'auto' || this.#options.headerMode !== 'auto')
+      best = this.#matchForced(p, avail, best);
     if (best.score < 0 || (best.shift >= ACQUIRE_COMMIT && avail >= window)) {
-      if (best.score < 0 && forced !== 'auto') {
-        // Say so when the bytes are frames, only not at the resolution the caller forced.
-        // (Once said, it stands until a lock or a new setting clears it: no need to score again.)
-        const other: Resolution = forced === 2048 ? 1024 : 2048;
-        if (this.#forcedMismatch !== other && this.#best(p, avail, other).score >= 0) this.#forcedMismatch = other;
-      }
       // No alignment starting in these 16 bytes works (or the best starts too late to commit).
       this.#discard(p, Math.min(FRAME_SIZE, avail), lost);
       return true;
@@ -1097,7 +1105,7 @@ export class SpektrumDecoder {
    * readings of the filler and its headers (`00 B2` then seven 0xFFFF slots, read a byte
    * early, has a channel 6 at 0x2FF), not frames.
    */
-  #best(p: number, avail: number, only: 0 | Resolution): { score: number; shift: number; resolution: Resolution; filler: boolean } {
+  #best(p: number, avail: number, only: 0 | Resolution, free: boolean): Best {
     this.#fillerScore = -1;
     let score = -1;
     let shift = 0;
@@ -1106,7 +1114,7 @@ export class SpektrumDecoder {
       const frames = Math.min(ACQUIRE_FRAMES, Math.floor((avail - s) / FRAME_SIZE));
       if (frames < 1) break;
       if (only !== 1024) {
-        const v = this.#score(p + s, 2048, frames);
+        const v = this.#score(p + s, 2048, frames, free);
         if (v > score) {
           score = v;
           shift = s;
@@ -1114,7 +1122,7 @@ export class SpektrumDecoder {
         }
       }
       if (only !== 2048) {
-        const v = this.#score(p + s, 1024, frames);
+        const v = this.#score(p + s, 1024, frames, free);
         if (v > score) {
           score = v;
           shift = s;
@@ -1124,6 +1132,40 @@ export class SpektrumDecoder {
     }
     const filler = this.#fillerScore > score;
     return { score: filler ? -1 : score, shift, resolution, filler };
+  }
+
+  /**
+   * Forced options choose how frames are read, never where they lie: the best reading under
+   * them (`best`) stands only at the alignment the bytes show with no option forced. A shifted
+   * reading can fit a forced option that the frames do not (1024 forced on DSMX 22 ms 2048
+   * frames reads slots as headers; a channel held still reads as an internal remote's system
+   * byte), and its frames would match nothing that was sent. Where nothing reads as frames
+   * with no option forced there is no lock yet (none, score -1). At the free reading's
+   * alignment the forced reading is scored again; where it fits no frame there, the result is
+   * none, `format.withheld` is 'forced' and `forcedMismatch` names the resolution the frames
+   * have when it is not the forced one (both stand until a lock or a new setting: no need to
+   * score again meanwhile).
+   */
+  #matchForced(p: number, avail: number, best: Best): Best {
+    if (best.score < 0 && this.#withheld === 'forced') return best;
+    const free = this.#best(p, avail, 0, true);
+    if (free.score < 0) return free;
+    if (best.score >= 0 && (best.shift - free.shift) % FRAME_SIZE === 0) return best;
+    const frames = Math.min(ACQUIRE_FRAMES, Math.floor((avail - free.shift) / FRAME_SIZE));
+    const forced = this.#options.resolution;
+    let score = -1;
+    let resolution: Resolution = free.resolution;
+    for (const r of forced === 'auto' ? ([2048, 1024] as const) : [forced]) {
+      const v = this.#score(p + free.shift, r, frames);
+      if (v > score) {
+        score = v;
+        resolution = r;
+      }
+    }
+    if (score >= 0) return { score, shift: free.shift, resolution, filler: false };
+    this.#forcedMismatch = forced !== 'auto' && free.resolution !== forced ? free.resolution : null;
+    this.#withhold('forced', p);
+    return { score: -1, shift: 0, resolution, filler: false };
   }
 
   /** Whether every frame of the chain at `o` has a layout the lock knows. */
@@ -1160,9 +1202,9 @@ export class SpektrumDecoder {
    * less). Leaves the reading in #candInternal / #candSystem / #candB0 and its length in
    * #candFrames.
    */
-  #score(o: number, resolution: Resolution, frames: number): number {
+  #score(o: number, resolution: Resolution, frames: number, free = false): number {
     const buf = this.#buf;
-    const { remote, headerMode } = this.#options;
+    const { remote, headerMode } = free ? FREE : this.#options;
     const s = byteAt(buf, o + 1);
     const forcedB0 = headerMode === 'rssi' ? B0_RSSI_FORCED : headerMode === 'fades' ? B0_FADES : B0_UNKNOWN;
     // How far each header reading carries the chain.
@@ -1215,7 +1257,7 @@ export class SpektrumDecoder {
     // Where the stream ends too: fewer frames are no evidence (its last frames may go). An
     // unlisted system byte (read as one only after an internal remote) needs a full window.
     if (length < (internal && info === undefined ? ACQUIRE_FRAMES : MIN_CHAIN)) return -1;
-    if (internal && info !== undefined && info.resolution !== resolution && this.#options.resolution === 'auto') {
+    if (internal && info !== undefined && info.resolution !== resolution && (free || this.#options.resolution === 'auto')) {
       // Contradict a §8.3 system byte only where its resolution cannot read the frames.
       let readable = 0;
       for (let k = 0; k < length; k++) if (slotLayout(buf, o + k * FRAME_SIZE, info.resolution) !== INVALID) readable++;
@@ -1314,6 +1356,15 @@ export class SpektrumDecoder {
     const other = this.#forcedMismatch;
     if (other !== null) {
       return `Forced ${this.#options.resolution}: no frame matches; the stream looks like ${other}.`;
+    }
+    if (!this.#locked && this.#withheld === 'forced') {
+      const { resolution, remote, headerMode } = this.#options;
+      const set = [
+        resolution === 'auto' ? '' : `resolution ${resolution}`,
+        remote === 'auto' ? '' : `remote ${remote}`,
+        headerMode === 'auto' ? '' : `header mode ${headerMode}`,
+      ].filter((x) => x !== '');
+      return `No frame matches the forced ${set.join(', ')}: the bytes are frames, read another way; nothing is decoded.`;
     }
     if (!this.#locked && this.#withheld === 'filler') {
       return `${this.#everLocked ? 'Looking for frames again' : 'No frames'}: the bytes read as frames only of empty slots (0xFFFF) or 0x00/0xFF filler, which carry no channel.`;
