@@ -1024,8 +1024,15 @@ export class SpektrumDecoder {
       (internal ? this.#system === system : true) &&
       this.#resolution === resolution;
     let b0Mode = this.#candB0;
-    // The same remote going on keeps what its byte 0 was shown to be, if byte 0 goes on too.
-    if (internal && b0Mode === B0_UNKNOWN && sameRemote && byte0Follows(this.#last0, byteAt(this.#buf, o), this.#b0Mode))
+    // The same remote going on keeps what its byte 0 was shown to be: where byte 0 goes on, and
+    // where it jumped across a break with the layouts it used before (a 1.5 s dropout takes a
+    // fade count from 40 to 176, which reads as RSSI as well until it moves).
+    if (
+      internal &&
+      b0Mode === B0_UNKNOWN &&
+      sameRemote &&
+      (byte0Follows(this.#last0, byteAt(this.#buf, o), this.#b0Mode) || this.#chainKnown(o, resolution, frames))
+    )
       b0Mode = this.#b0Mode;
     if (internal && b0Mode === B0_UNKNOWN) {
       // Byte 0 has only been a plausible RSSI and never fallen: read further along the chain before deciding.
