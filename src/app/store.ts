@@ -56,6 +56,7 @@ const IDLE: SourceStatus = {
     headerMode: 'fades',
     forcedMismatch: null,
     withheld: null,
+    remoteAmbiguous: false,
   },
 };
 

@@ -53,6 +53,7 @@ export interface DecoderCheckpoint {
   readonly b0Mode: number;
   readonly forcedMismatch: Resolution | null;
   readonly withheld: Withheld | null;
+  readonly ambiguous: boolean;
   readonly last0: number;
   readonly last1: number;
   readonly haveLast: boolean;

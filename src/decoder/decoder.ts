@@ -218,6 +218,8 @@ export class SpektrumDecoder {
   #forcedMismatch: Resolution | null = null;
   /** Why bytes that read as frames give none, until a lock (`format.withheld`). */
   #withheld: Withheld | null = null;
+  /** The internal reading may be an external count whose low byte is a §8.3 system byte (`format.remoteAmbiguous`). */
+  #ambiguous = false;
   /** Header bytes of the last emitted frame (for deltas and continuity), valid when #haveLast. */
   #last0 = 0;
   #last1 = 0;
@@ -498,6 +500,7 @@ export class SpektrumDecoder {
     this.#b0Mode = B0_FADES;
     this.#forcedMismatch = null;
     this.#withheld = null;
+    this.#ambiguous = false;
     this.#haveLast = false;
     this.#jumpTrusted = false;
     this.#layoutCount = this.#layoutNext = 0;
@@ -525,6 +528,7 @@ export class SpektrumDecoder {
       headerMode: this.#headerReading(),
       forcedMismatch: this.#forcedMismatch,
       withheld: this.#withheld,
+      remoteAmbiguous: this.#ambiguous,
     };
   }
 
@@ -560,6 +564,7 @@ export class SpektrumDecoder {
       const layout = at === this.#nextAt ? this.#nextLayout : slotLayout(this.#buf, o, resolution);
       // Frames acquisition confirmed go out as they stand.
       if (at < this.#confirmedUntil && layout !== INVALID) return this.#emit(o, layout);
+      if (layout !== INVALID && this.#countMoved(o, layout)) this.#rereadExternal(o);
       const fits = layout !== INVALID && this.#fitsLast(o);
       if (fits) {
         // The whole next frame must be in: a header alone is too weak (`00 00` read one byte
@@ -675,6 +680,8 @@ export class SpektrumDecoder {
     if (internal) {
       const mode = this.#b0Mode;
       if (b1 !== this.#system || buf[n + 1] !== b1) return null;
+      // Byte 0 moving decides an ambiguous remote: the general path's job.
+      if (this.#ambiguous === true && b0 !== this.#last0) return null;
       if (mode === 0) {
         // B0_FADES: #fitsLast and #follows with FADE_STEP, and #fadeDelta's rise without an event.
         delta = (b0 - this.#last0) & 0xff;
@@ -905,6 +912,9 @@ export class SpektrumDecoder {
     let delta = 0;
     if (remote === 'internal') {
       frame.system = b1;
+      // Byte 0 moved under a still byte 1: an internal remote (an external count moves its low
+      // byte first). The reading stands, only surer: no event.
+      if (this.#ambiguous && this.#haveLast && b0 !== this.#last0) this.#ambiguous = false;
       if (this.#b0Mode === B0_UNKNOWN && this.#haveLast) this.#decideByte0(o, b0);
       if (this.#b0Mode === B0_RSSI || this.#b0Mode === B0_RSSI_FORCED) {
         frame.rssi = b0 >= 0x80 ? b0 - 0x100 : b0;
@@ -1040,6 +1050,16 @@ export class SpektrumDecoder {
       if (evidence === NEED_MORE) return false;
       b0Mode = evidence;
     }
+    // Byte 0 still under a §8.3 system byte reads as an external count whose low byte is that
+    // byte as well (18, 162, 178, 434 ...): the bytes tell only when byte 0 moves (internal) or
+    // byte 1 does (external; see #countMoved). A remote shown internal that goes on stays so.
+    const ambiguous =
+      internal &&
+      this.#options.remote === 'auto' &&
+      b0Mode !== B0_RSSI_FORCED &&
+      systemInfo(system) !== undefined &&
+      this.#byte0Still(o, frames) &&
+      !(sameRemote && !this.#ambiguous);
     if (o > p) this.#discard(p, o - p, lost);
     if (this.#resolution !== resolution) this.#layoutCount = 0;
     // A count that jumped across the break is the receiver's own when the same remote goes on
@@ -1064,6 +1084,7 @@ export class SpektrumDecoder {
     this.#remote = internal ? 'internal' : 'external';
     this.#system = internal ? system : null;
     this.#b0Mode = internal ? b0Mode : B0_FADES;
+    this.#ambiguous = ambiguous;
     this.#setReason(resolution);
     this.#event({ type: 'locked', offset: this.#base + o, format: this.format });
     if (changed) this.#event({ type: 'format-changed', offset: this.#base + o, format: this.format });
@@ -1173,6 +1194,42 @@ export class SpektrumDecoder {
     this.#forcedMismatch = forced !== 'auto' && free.resolution !== forced ? free.resolution : null;
     this.#withhold('forced', p);
     return { score: -1, shift: 0, resolution, filler: false };
+  }
+
+  /** Whether byte 0 is the same in each of the `frames` frames from `o`. */
+  #byte0Still(o: number, frames: number): boolean {
+    const b0 = byteAt(this.#buf, o);
+    for (let k = 1; k < frames; k++) if (byteAt(this.#buf, o + k * FRAME_SIZE) !== b0) return false;
+    return true;
+  }
+
+  /**
+   * Whether the frame at `o` (valid, its layout `layout`) shows that the internal remote the
+   * lock may have misread (#ambiguous) is an external one whose count moved in its low byte:
+   * byte 1, a true system byte that never changes, rose as a count does from the last frame,
+   * with a layout the lock knows, and the whole next frame goes on as that count (a flipped
+   * bit in byte 1 goes back).
+   */
+  #countMoved(o: number, layout: number): boolean {
+    if (!this.#ambiguous || !this.#haveLast || !this.#knownLayout(layout) || o + 2 * FRAME_SIZE > this.#tail) return false;
+    const buf = this.#buf;
+    const last = (this.#last0 << 8) | this.#last1;
+    const count = (byteAt(buf, o) << 8) | byteAt(buf, o + 1);
+    if (count === last || !countFollows(last, count)) return false;
+    const next = (byteAt(buf, o + FRAME_SIZE) << 8) | byteAt(buf, o + FRAME_SIZE + 1);
+    return slotLayout(buf, o + FRAME_SIZE, this.#resolution) !== INVALID && countFollows(count, next);
+  }
+
+  /** The lock read an external remote as internal (#ambiguous): it reads it as the external one it is from here. */
+  #rereadExternal(o: number): void {
+    this.#remote = 'external';
+    this.#system = null;
+    this.#b0Mode = B0_FADES;
+    this.#ambiguous = false;
+    this.#nextAt = -1;
+    this.#stagedAt = -1;
+    this.#setReason(this.#resolution);
+    this.#event({ type: 'format-changed', offset: this.#base + o, format: this.format });
   }
 
   /** Whether every frame of the chain at `o` has a layout the lock knows. */
@@ -1389,8 +1446,11 @@ export class SpektrumDecoder {
           : this.#b0Mode === B0_FADES
             ? ''
             : '; byte 0 is SPM4649T RSSI';
+      const or = this.#ambiguous
+        ? `; or an external remote whose fade count's low byte is ${hex(this.#system ?? 0)}: not yet known which (byte 0 moving says internal, byte 1 moving external)`
+        : '';
       remote = sys
-        ? `internal remote (system byte ${hex(this.#system ?? 0)}, ${sys.name})${b0}`
+        ? `internal remote (system byte ${hex(this.#system ?? 0)}, ${sys.name})${b0}${or}`
         : `internal remote (system byte ${hex(this.#system ?? 0)} is none of the four in §8.3: ignored)${b0}`;
     }
     switch (this.#reason) {
@@ -1501,6 +1561,7 @@ export class SpektrumDecoder {
       b0Mode: this.#b0Mode,
       forcedMismatch: this.#forcedMismatch,
       withheld: this.#withheld,
+      ambiguous: this.#ambiguous,
       last0: this.#last0,
       last1: this.#last1,
       haveLast: this.#haveLast,
@@ -1568,6 +1629,7 @@ export class SpektrumDecoder {
     this.#b0Mode = cp.b0Mode;
     this.#forcedMismatch = cp.forcedMismatch;
     this.#withheld = cp.withheld;
+    this.#ambiguous = cp.ambiguous;
     this.#last0 = cp.last0;
     this.#last1 = cp.last1;
     this.#haveLast = cp.haveLast;

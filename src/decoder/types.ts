@@ -113,6 +113,15 @@ export interface FormatInfo {
   forcedMismatch: Resolution | null;
   /** Why bytes that read as frames give none, while not locked (see `Withheld`); null otherwise. */
   withheld: Withheld | null;
+  /**
+   * True while the lock reads an internal remote whose header could as well be an external
+   * remote's UINT16 fade count whose low byte is a §8.3 system byte (`00 B2`: internal, 0 fades,
+   * DSMX 11 ms; or external, 178 fades): byte 0 has not moved under it. The decoder reads the
+   * likelier internal remote and says it is not sure; byte 0 moving settles it (internal), the
+   * count moving in byte 1 re-reads it as external from there (a `format-changed` event, not a
+   * new remote).
+   */
+  remoteAmbiguous: boolean;
 }
 
 /**
