@@ -159,10 +159,13 @@ describe('remote kind and system byte', () => {
 describe('frames that carry nothing', () => {
   it('decodes frames of seven empty slots as frames without channels, never inventing a throttle', () => {
     const frame = hex(`00b2${'ffff'.repeat(7)}`);
-    const { frames, decoder } = decodeAll(join(Array(50).fill(frame)));
-    expect(frames).toHaveLength(50);
-    expect(frames.every((f) => f.channels.length === 0 && f.remote === 'internal' && f.system === 0xb2)).toBe(true);
+    const around = (from: number) => Array.from({ length: 6 }, (_, i) => internal(from + i, 0));
+    const { frames, decoder } = decodeAll(join([...around(0), ...Array(50).fill(frame), ...around(56)]));
+    expect(frames).toHaveLength(62);
+    expect(frames.slice(6, 56).every((f) => f.channels.length === 0 && f.remote === 'internal' && f.system === 0xb2)).toBe(true);
     expect(decoder.stats.emptySlots).toBe(350);
+    // Alone, they are no evidence of a transmitter (issue 34): tests/decoder.filler.test.ts.
+    expect(decodeAll(join(Array(50).fill(frame))).frames).toHaveLength(0);
   });
 });
 

@@ -55,6 +55,8 @@ const IDLE: SourceStatus = {
     systemValid: false,
     headerMode: 'fades',
     forcedMismatch: null,
+    withheld: null,
+    remoteAmbiguous: false,
   },
 };
 

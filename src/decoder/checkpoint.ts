@@ -12,7 +12,7 @@
  */
 import { FrameSlots } from './frame.js';
 import type { Resolution } from './spec.js';
-import type { DecoderStats, RemoteKind, ResolutionReason } from './types.js';
+import type { DecoderStats, RemoteKind, ResolutionReason, Withheld } from './types.js';
 import type { LinkEpisode, LinkRestart, LinkState, LinkStats } from './link.js';
 
 /** A copy of `from`'s slot arrays and counts in `into` (a fresh set when none is given). */
@@ -52,6 +52,8 @@ export interface DecoderCheckpoint {
   readonly system: number | null;
   readonly b0Mode: number;
   readonly forcedMismatch: Resolution | null;
+  readonly withheld: Withheld | null;
+  readonly ambiguous: boolean;
   readonly last0: number;
   readonly last1: number;
   readonly haveLast: boolean;

@@ -10,7 +10,8 @@
  *   and a fade byte that only rises, slowly; an external one: a UINT16 fade count that only
  *   rises, slowly). Every slot must hold a valid channel ID (or 0xFFFF, or VTX) with no repeats.
  *   Contiguous channel sets, layouts that recur every other frame and a system byte that agrees
- *   with the resolution score higher. The winning chain is emitted as it stands.
+ *   with the resolution score higher. The chain's first frame must carry channels: filler (runs
+ *   of 0xFF are frames of seven empty slots) never locks. The winning chain is emitted as it stands.
  * - Locked, a frame is emitted when it continues the last one (same model, fade count risen by
  *   less than FADE_STEP) and the whole next frame is valid and continues it: one frame period
  *   of latency. A frame whose slot layout is new must also not overlap a frame that continues
@@ -25,7 +26,18 @@
  * (emitted unconditionally): so `next()` always returns after bounded work.
  */
 import { FRAME_SIZE, systemInfo, type Resolution } from './spec.js';
-import { byteAt, countZeroWords, createFrame, FrameSlots, INVALID, layoutChannels, readFrame, showSlots, slotLayout } from './frame.js';
+import {
+  byteAt,
+  channelEvidence,
+  countZeroWords,
+  createFrame,
+  FrameSlots,
+  INVALID,
+  layoutChannels,
+  readFrame,
+  showSlots,
+  slotLayout,
+} from './frame.js';
 import { copySlots, type DecoderCheckpoint } from './checkpoint.js';
 import type {
   DecodedFrame,
@@ -36,6 +48,7 @@ import type {
   HeaderReading,
   RemoteKind,
   ResolutionReason,
+  Withheld,
 } from './types.js';
 
 export interface DecoderOptions {
@@ -56,6 +69,17 @@ export interface DecoderOptions {
    */
   fastPath?: boolean;
 }
+
+/** A start acquisition may lock on: its score (-1: none), shift from the head and resolution; `filler`: see #best. */
+interface Best {
+  score: number;
+  shift: number;
+  resolution: Resolution;
+  filler: boolean;
+}
+
+/** The options #score reads with no option forced. */
+const FREE = { remote: 'auto', headerMode: 'auto' } as const;
 
 /** Frames looked at before a lock. */
 const ACQUIRE_FRAMES = 4;
@@ -90,6 +114,14 @@ const FADE_STEP = 8;
  * two (a foreign byte read as its fade count) moves them anywhere.
  */
 const ACQUIRE_FADE_STEP = 3;
+/**
+ * Bytes of channel words that are not filler (`channelEvidence`) the first frame of a chain
+ * must carry for a lock: more than a header's two, which is all a shifted reading of frames of
+ * filler slots finds. A transmitter sends four channels or more, and every frame it sends
+ * carries four or more (a pair of 8 to 12 channels, 5 to 7 in each), one such byte each at
+ * least (a centred channel's low byte is 0x00).
+ */
+const EVIDENCE_BYTES = 3;
 /** How far a locked decoder searches for a frame that continues the stream before it acquires afresh. */
 const MAX_RESYNC_BYTES = 8 * FRAME_SIZE;
 /** Slot layouts remembered (a transmitter uses two to four). */
@@ -184,6 +216,10 @@ export class SpektrumDecoder {
   #b0Mode = B0_FADES;
   /** The resolution the bytes fit when a forced one fits nothing, else null. */
   #forcedMismatch: Resolution | null = null;
+  /** Why bytes that read as frames give none, until a lock (`format.withheld`). */
+  #withheld: Withheld | null = null;
+  /** The internal reading may be an external count whose low byte is a §8.3 system byte (`format.remoteAmbiguous`). */
+  #ambiguous = false;
   /** Header bytes of the last emitted frame (for deltas and continuity), valid when #haveLast. */
   #last0 = 0;
   #last1 = 0;
@@ -227,6 +263,8 @@ export class SpektrumDecoder {
   #candFrames = 0;
   /** Index in the chain of a frame with a damaged header, skipped over (not confirmed), or -1. */
   #candSkipped = -1;
+  /** The best score #score found for a chain that starts without channels (filler), since #best reset it; -1: none. */
+  #fillerScore = -1;
   /** Who fixed the resolution, when it is fixed. */
   #fixedBy: 'user' | 'internal-remote' = 'user';
 
@@ -434,6 +472,7 @@ export class SpektrumDecoder {
     this.#options.resolution = resolution;
     this.#fixedBy = fixedBy;
     this.#forcedMismatch = null;
+    if (this.#withheld === 'forced') this.#withheld = null;
     if (!this.#locked) return;
     if (resolution === 'auto' ? this.#reason === 'override' || this.#reason === 'internal-remote' : resolution !== this.#resolution) {
       this.#unlock();
@@ -460,6 +499,8 @@ export class SpektrumDecoder {
     this.#system = null;
     this.#b0Mode = B0_FADES;
     this.#forcedMismatch = null;
+    this.#withheld = null;
+    this.#ambiguous = false;
     this.#haveLast = false;
     this.#jumpTrusted = false;
     this.#layoutCount = this.#layoutNext = 0;
@@ -486,6 +527,8 @@ export class SpektrumDecoder {
       systemValid: this.#system !== null && systemInfo(this.#system) !== undefined,
       headerMode: this.#headerReading(),
       forcedMismatch: this.#forcedMismatch,
+      withheld: this.#withheld,
+      remoteAmbiguous: this.#ambiguous,
     };
   }
 
@@ -521,6 +564,7 @@ export class SpektrumDecoder {
       const layout = at === this.#nextAt ? this.#nextLayout : slotLayout(this.#buf, o, resolution);
       // Frames acquisition confirmed go out as they stand.
       if (at < this.#confirmedUntil && layout !== INVALID) return this.#emit(o, layout);
+      if (layout !== INVALID && this.#countMoved(o, layout)) this.#rereadExternal(o);
       const fits = layout !== INVALID && this.#fitsLast(o);
       if (fits) {
         // The whole next frame must be in: a header alone is too weak (`00 00` read one byte
@@ -636,6 +680,8 @@ export class SpektrumDecoder {
     if (internal) {
       const mode = this.#b0Mode;
       if (b1 !== this.#system || buf[n + 1] !== b1) return null;
+      // Byte 0 moving decides an ambiguous remote: the general path's job.
+      if (this.#ambiguous === true && b0 !== this.#last0) return null;
       if (mode === 0) {
         // B0_FADES: #fitsLast and #follows with FADE_STEP, and #fadeDelta's rise without an event.
         delta = (b0 - this.#last0) & 0xff;
@@ -866,6 +912,9 @@ export class SpektrumDecoder {
     let delta = 0;
     if (remote === 'internal') {
       frame.system = b1;
+      // Byte 0 moved under a still byte 1: an internal remote (an external count moves its low
+      // byte first). The reading stands, only surer: no event.
+      if (this.#ambiguous && this.#haveLast && b0 !== this.#last0) this.#ambiguous = false;
       if (this.#b0Mode === B0_UNKNOWN && this.#haveLast) this.#decideByte0(o, b0);
       if (this.#b0Mode === B0_RSSI || this.#b0Mode === B0_RSSI_FORCED) {
         frame.rssi = b0 >= 0x80 ? b0 - 0x100 : b0;
@@ -955,14 +1004,11 @@ export class SpektrumDecoder {
       return false;
     }
     const forced = this.#options.resolution;
-    const best = this.#best(p, avail, forced === 'auto' ? 0 : forced);
+    let best = this.#best(p, avail, forced === 'auto' ? 0 : forced, false);
+    if (best.filler) this.#withhold('filler', p);
+    else if (forced !== 'auto' || this.#options.remote !== 'auto' || this.#options.headerMode !== 'auto')
+      best = this.#matchForced(p, avail, best);
     if (best.score < 0 || (best.shift >= ACQUIRE_COMMIT && avail >= window)) {
-      if (best.score < 0 && forced !== 'auto') {
-        // Say so when the bytes are frames, only not at the resolution the caller forced.
-        // (Once said, it stands until a lock or a new setting clears it: no need to score again.)
-        const other: Resolution = forced === 2048 ? 1024 : 2048;
-        if (this.#forcedMismatch !== other && this.#best(p, avail, other).score >= 0) this.#forcedMismatch = other;
-      }
       // No alignment starting in these 16 bytes works (or the best starts too late to commit).
       this.#discard(p, Math.min(FRAME_SIZE, avail), lost);
       return true;
@@ -988,8 +1034,15 @@ export class SpektrumDecoder {
       (internal ? this.#system === system : true) &&
       this.#resolution === resolution;
     let b0Mode = this.#candB0;
-    // The same remote going on keeps what its byte 0 was shown to be, if byte 0 goes on too.
-    if (internal && b0Mode === B0_UNKNOWN && sameRemote && byte0Follows(this.#last0, byteAt(this.#buf, o), this.#b0Mode))
+    // The same remote going on keeps what its byte 0 was shown to be: where byte 0 goes on, and
+    // where it jumped across a break with the layouts it used before (a 1.5 s dropout takes a
+    // fade count from 40 to 176, which reads as RSSI as well until it moves).
+    if (
+      internal &&
+      b0Mode === B0_UNKNOWN &&
+      sameRemote &&
+      (byte0Follows(this.#last0, byteAt(this.#buf, o), this.#b0Mode) || this.#chainKnown(o, resolution, frames))
+    )
       b0Mode = this.#b0Mode;
     if (internal && b0Mode === B0_UNKNOWN) {
       // Byte 0 has only been a plausible RSSI and never fallen: read further along the chain before deciding.
@@ -997,6 +1050,16 @@ export class SpektrumDecoder {
       if (evidence === NEED_MORE) return false;
       b0Mode = evidence;
     }
+    // Byte 0 still under a §8.3 system byte reads as an external count whose low byte is that
+    // byte as well (18, 162, 178, 434 ...): the bytes tell only when byte 0 moves (internal) or
+    // byte 1 does (external; see #countMoved). A remote shown internal that goes on stays so.
+    const ambiguous =
+      internal &&
+      this.#options.remote === 'auto' &&
+      b0Mode !== B0_RSSI_FORCED &&
+      systemInfo(system) !== undefined &&
+      this.#byte0Still(o, frames) &&
+      !(sameRemote && !this.#ambiguous);
     if (o > p) this.#discard(p, o - p, lost);
     if (this.#resolution !== resolution) this.#layoutCount = 0;
     // A count that jumped across the break is the receiver's own when the same remote goes on
@@ -1012,6 +1075,7 @@ export class SpektrumDecoder {
     this.#nextAt = -1;
     this.#everLocked = true;
     this.#forcedMismatch = null;
+    this.#withheld = null;
     // Each frame of the chain is confirmed by the one after it; the last waits for its own next
     // (or the stream's end) like any other, and so does a frame with a damaged header.
     const confirmed = skipped >= 0 ? skipped : frames - (this.#ended && o + frames * FRAME_SIZE >= this.#tail - FRAME_SIZE ? 0 : 1);
@@ -1020,10 +1084,21 @@ export class SpektrumDecoder {
     this.#remote = internal ? 'internal' : 'external';
     this.#system = internal ? system : null;
     this.#b0Mode = internal ? b0Mode : B0_FADES;
+    this.#ambiguous = ambiguous;
     this.#setReason(resolution);
     this.#event({ type: 'locked', offset: this.#base + o, format: this.format });
     if (changed) this.#event({ type: 'format-changed', offset: this.#base + o, format: this.format });
     return true;
+  }
+
+  /**
+   * Says why bytes that read as frames give none (`format.withheld`), with a format-changed
+   * event when the reason is new: it stands until a lock.
+   */
+  #withhold(why: Withheld, o: number): void {
+    if (this.#withheld === why) return;
+    this.#withheld = why;
+    this.#event({ type: 'format-changed', offset: this.#base + o, format: this.format });
   }
 
   /** Whether `layout` is the layout of one of the `frames` frames from `o`. */
@@ -1051,8 +1126,15 @@ export class SpektrumDecoder {
     return countFollows((byteAt(buf, a) << 8) | byteAt(buf, a + 1), (byteAt(buf, b) << 8) | byteAt(buf, b + 1), ACQUIRE_FADE_STEP);
   }
 
-  /** The best-scoring start among the next ACQUIRE_SHIFTS offsets, at one resolution or (0) both. */
-  #best(p: number, avail: number, only: 0 | Resolution): { score: number; shift: number; resolution: Resolution } {
+  /**
+   * The best-scoring start among the next ACQUIRE_SHIFTS offsets, at one resolution or (0) both.
+   * None (score -1, `filler`) when a chain that starts without channels (see
+   * EVIDENCE_BYTES) reads better than any that starts with them: those are then shifted
+   * readings of the filler and its headers (`00 B2` then seven 0xFFFF slots, read a byte
+   * early, has a channel 6 at 0x2FF), not frames.
+   */
+  #best(p: number, avail: number, only: 0 | Resolution, free: boolean): Best {
+    this.#fillerScore = -1;
     let score = -1;
     let shift = 0;
     let resolution: Resolution = 2048;
@@ -1060,7 +1142,7 @@ export class SpektrumDecoder {
       const frames = Math.min(ACQUIRE_FRAMES, Math.floor((avail - s) / FRAME_SIZE));
       if (frames < 1) break;
       if (only !== 1024) {
-        const v = this.#score(p + s, 2048, frames);
+        const v = this.#score(p + s, 2048, frames, free);
         if (v > score) {
           score = v;
           shift = s;
@@ -1068,7 +1150,7 @@ export class SpektrumDecoder {
         }
       }
       if (only !== 2048) {
-        const v = this.#score(p + s, 1024, frames);
+        const v = this.#score(p + s, 1024, frames, free);
         if (v > score) {
           score = v;
           shift = s;
@@ -1076,7 +1158,78 @@ export class SpektrumDecoder {
         }
       }
     }
-    return { score, shift, resolution };
+    const filler = this.#fillerScore > score;
+    return { score: filler ? -1 : score, shift, resolution, filler };
+  }
+
+  /**
+   * Forced options choose how frames are read, never where they lie: the best reading under
+   * them (`best`) stands only at the alignment the bytes show with no option forced. A shifted
+   * reading can fit a forced option that the frames do not (1024 forced on DSMX 22 ms 2048
+   * frames reads slots as headers; a channel held still reads as an internal remote's system
+   * byte), and its frames would match nothing that was sent. Where nothing reads as frames
+   * with no option forced there is no lock yet (none, score -1). At the free reading's
+   * alignment the forced reading is scored again; where it fits no frame there, the result is
+   * none, `format.withheld` is 'forced' and `forcedMismatch` names the resolution the frames
+   * have when it is not the forced one (both stand until a lock or a new setting: no need to
+   * score again meanwhile).
+   */
+  #matchForced(p: number, avail: number, best: Best): Best {
+    if (best.score < 0 && this.#withheld === 'forced') return best;
+    const free = this.#best(p, avail, 0, true);
+    if (free.score < 0) return free;
+    if (best.score >= 0 && (best.shift - free.shift) % FRAME_SIZE === 0) return best;
+    const frames = Math.min(ACQUIRE_FRAMES, Math.floor((avail - free.shift) / FRAME_SIZE));
+    const forced = this.#options.resolution;
+    let score = -1;
+    let resolution: Resolution = free.resolution;
+    for (const r of forced === 'auto' ? ([2048, 1024] as const) : [forced]) {
+      const v = this.#score(p + free.shift, r, frames);
+      if (v > score) {
+        score = v;
+        resolution = r;
+      }
+    }
+    if (score >= 0) return { score, shift: free.shift, resolution, filler: false };
+    this.#forcedMismatch = forced !== 'auto' && free.resolution !== forced ? free.resolution : null;
+    this.#withhold('forced', p);
+    return { score: -1, shift: 0, resolution, filler: false };
+  }
+
+  /** Whether byte 0 is the same in each of the `frames` frames from `o`. */
+  #byte0Still(o: number, frames: number): boolean {
+    const b0 = byteAt(this.#buf, o);
+    for (let k = 1; k < frames; k++) if (byteAt(this.#buf, o + k * FRAME_SIZE) !== b0) return false;
+    return true;
+  }
+
+  /**
+   * Whether the frame at `o` (valid, its layout `layout`) shows that the internal remote the
+   * lock may have misread (#ambiguous) is an external one whose count moved in its low byte:
+   * byte 1, a true system byte that never changes, rose as a count does from the last frame,
+   * with a layout the lock knows, and the whole next frame goes on as that count (a flipped
+   * bit in byte 1 goes back).
+   */
+  #countMoved(o: number, layout: number): boolean {
+    if (!this.#ambiguous || !this.#haveLast || !this.#knownLayout(layout) || o + 2 * FRAME_SIZE > this.#tail) return false;
+    const buf = this.#buf;
+    const last = (this.#last0 << 8) | this.#last1;
+    const count = (byteAt(buf, o) << 8) | byteAt(buf, o + 1);
+    if (count === last || !countFollows(last, count)) return false;
+    const next = (byteAt(buf, o + FRAME_SIZE) << 8) | byteAt(buf, o + FRAME_SIZE + 1);
+    return slotLayout(buf, o + FRAME_SIZE, this.#resolution) !== INVALID && countFollows(count, next);
+  }
+
+  /** The lock read an external remote as internal (#ambiguous): it reads it as the external one it is from here. */
+  #rereadExternal(o: number): void {
+    this.#remote = 'external';
+    this.#system = null;
+    this.#b0Mode = B0_FADES;
+    this.#ambiguous = false;
+    this.#nextAt = -1;
+    this.#stagedAt = -1;
+    this.#setReason(this.#resolution);
+    this.#event({ type: 'format-changed', offset: this.#base + o, format: this.format });
   }
 
   /** Whether every frame of the chain at `o` has a layout the lock knows. */
@@ -1113,9 +1266,9 @@ export class SpektrumDecoder {
    * less). Leaves the reading in #candInternal / #candSystem / #candB0 and its length in
    * #candFrames.
    */
-  #score(o: number, resolution: Resolution, frames: number): number {
+  #score(o: number, resolution: Resolution, frames: number, free = false): number {
     const buf = this.#buf;
-    const { remote, headerMode } = this.#options;
+    const { remote, headerMode } = free ? FREE : this.#options;
     const s = byteAt(buf, o + 1);
     const forcedB0 = headerMode === 'rssi' ? B0_RSSI_FORCED : headerMode === 'fades' ? B0_FADES : B0_UNKNOWN;
     // How far each header reading carries the chain.
@@ -1168,7 +1321,7 @@ export class SpektrumDecoder {
     // Where the stream ends too: fewer frames are no evidence (its last frames may go). An
     // unlisted system byte (read as one only after an internal remote) needs a full window.
     if (length < (internal && info === undefined ? ACQUIRE_FRAMES : MIN_CHAIN)) return -1;
-    if (internal && info !== undefined && info.resolution !== resolution && this.#options.resolution === 'auto') {
+    if (internal && info !== undefined && info.resolution !== resolution && (free || this.#options.resolution === 'auto')) {
       // Contradict a §8.3 system byte only where its resolution cannot read the frames.
       let readable = 0;
       for (let k = 0; k < length; k++) if (slotLayout(buf, o + k * FRAME_SIZE, info.resolution) !== INVALID) readable++;
@@ -1181,9 +1334,11 @@ export class SpektrumDecoder {
     let recurring = 0;
     let layout1 = INVALID;
     let layout2 = INVALID;
+    let leads = false;
     for (let k = 0; k < length; k++) {
       const f = o + k * FRAME_SIZE;
       const layout = slotLayout(buf, f, resolution);
+      if (k === 0) leads = channelEvidence(buf, f, layout) >= EVIDENCE_BYTES;
       const b0 = byteAt(buf, f);
       if (!plausibleRssi(b0)) positive = true;
       else if (k > 0 && b0 < byteAt(buf, f - FRAME_SIZE)) fell = true;
@@ -1209,6 +1364,13 @@ export class SpektrumDecoder {
     if (((byteAt(buf, o) << 8) | s) === 0xffff) score -= 3;
     // Transmitters send channels 0…N-1: a contiguous set is the signature of the right reading.
     if ((channels & (channels + 1)) === 0) score += 2;
+    // A chain whose first frame carries no channel is filler that happens to parse (or
+    // filler whose chain runs into the frames after it): never a lock, but #best weighs it
+    // against the other readings.
+    if (!leads) {
+      if (score > this.#fillerScore) this.#fillerScore = score;
+      return -1;
+    }
     this.#candInternal = internal;
     this.#candSystem = s;
     this.#candFrames = length;
@@ -1259,6 +1421,18 @@ export class SpektrumDecoder {
     if (other !== null) {
       return `Forced ${this.#options.resolution}: no frame matches; the stream looks like ${other}.`;
     }
+    if (!this.#locked && this.#withheld === 'forced') {
+      const { resolution, remote, headerMode } = this.#options;
+      const set = [
+        resolution === 'auto' ? '' : `resolution ${resolution}`,
+        remote === 'auto' ? '' : `remote ${remote}`,
+        headerMode === 'auto' ? '' : `header mode ${headerMode}`,
+      ].filter((x) => x !== '');
+      return `No frame matches the forced ${set.join(', ')}: the bytes are frames, read another way; nothing is decoded.`;
+    }
+    if (!this.#locked && this.#withheld === 'filler') {
+      return `${this.#everLocked ? 'Looking for frames again' : 'No frames'}: the bytes read as frames only of empty slots (0xFFFF) or 0x00/0xFF filler, which carry no channel.`;
+    }
     if (!this.#everLocked) return 'Not locked on to frames yet.';
     if (!this.#locked) return 'Looking for frames again: the format changed or the frames stopped making sense.';
     const res = this.#resolution;
@@ -1272,8 +1446,11 @@ export class SpektrumDecoder {
           : this.#b0Mode === B0_FADES
             ? ''
             : '; byte 0 is SPM4649T RSSI';
+      const or = this.#ambiguous
+        ? `; or an external remote whose fade count's low byte is ${hex(this.#system ?? 0)}: not yet known which (byte 0 moving says internal, byte 1 moving external)`
+        : '';
       remote = sys
-        ? `internal remote (system byte ${hex(this.#system ?? 0)}, ${sys.name})${b0}`
+        ? `internal remote (system byte ${hex(this.#system ?? 0)}, ${sys.name})${b0}${or}`
         : `internal remote (system byte ${hex(this.#system ?? 0)} is none of the four in §8.3: ignored)${b0}`;
     }
     switch (this.#reason) {
@@ -1383,6 +1560,8 @@ export class SpektrumDecoder {
       system: this.#system,
       b0Mode: this.#b0Mode,
       forcedMismatch: this.#forcedMismatch,
+      withheld: this.#withheld,
+      ambiguous: this.#ambiguous,
       last0: this.#last0,
       last1: this.#last1,
       haveLast: this.#haveLast,
@@ -1449,6 +1628,8 @@ export class SpektrumDecoder {
     this.#system = cp.system;
     this.#b0Mode = cp.b0Mode;
     this.#forcedMismatch = cp.forcedMismatch;
+    this.#withheld = cp.withheld;
+    this.#ambiguous = cp.ambiguous;
     this.#last0 = cp.last0;
     this.#last1 = cp.last1;
     this.#haveLast = cp.haveLast;

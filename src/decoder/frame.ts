@@ -130,6 +130,28 @@ export function layoutChannels(layout: number): number {
   return mask;
 }
 
+/**
+ * How much the valid frame at `o` (its layout `layout`) says about a transmitter: the bytes of
+ * its channel words (0–11 and X-Plus) that are not filler, 0x00 (a line held low) or 0xFF (the
+ * empty slot's and an idle line's), in words whose two bytes differ (a run of one byte is
+ * filler whatever its value). Runs and patterns of filler read as valid frames (seven 0xFFFF
+ * slots are one, and 0x00FF reads as channel 0) and carry none; a shifted reading of frames of
+ * filler slots takes a header for slots, two bytes at most. A transmitter's frame carries four
+ * channels or more, each with one such byte at least.
+ */
+export function channelEvidence(b: Uint8Array, o: number, layout: number): number {
+  let n = 0;
+  for (let i = 0; i < SLOTS_PER_FRAME; i++) {
+    if (((layout >> (CODE_BITS * i)) & CODE_MASK) > CODE_XPLUS) continue; // empty or VTX
+    const hi = byteAt(b, o + 2 + 2 * i);
+    const lo = byteAt(b, o + 3 + 2 * i);
+    if (hi === lo) continue;
+    if (hi !== 0 && hi !== 0xff) n++;
+    if (lo !== 0 && lo !== 0xff) n++;
+  }
+  return n;
+}
+
 /** Whether a layout has a slot with a given raw 16-bit word of zero (a header read as a slot). */
 export function countZeroWords(b: Uint8Array, o: number): number {
   let n = 0;

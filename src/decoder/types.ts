@@ -111,7 +111,27 @@ export interface FormatInfo {
    * resolution: nothing is decoded, and that is a setting, not link loss.
    */
   forcedMismatch: Resolution | null;
+  /** Why bytes that read as frames give none, while not locked (see `Withheld`); null otherwise. */
+  withheld: Withheld | null;
+  /**
+   * True while the lock reads an internal remote whose header could as well be an external
+   * remote's UINT16 fade count whose low byte is a §8.3 system byte (`00 B2`: internal, 0 fades,
+   * DSMX 11 ms; or external, 178 fades): byte 0 has not moved under it. The decoder reads the
+   * likelier internal remote and says it is not sure; byte 0 moving settles it (internal), the
+   * count moving in byte 1 re-reads it as external from there (a `format-changed` event, not a
+   * new remote).
+   */
+  remoteAmbiguous: boolean;
 }
+
+/**
+ * Why the decoder gives no frame from bytes that read as frames:
+ * - 'filler': they carry no channel, only 0xFFFF empty slots or 0x00/0xFF filler (runs of
+ *   0xFF parse as frames of seven empty slots), which is no evidence of a transmitter;
+ * - 'forced': they are frames, but not under the resolution, remote or header mode the caller
+ *   forced (see also `forcedMismatch`).
+ */
+export type Withheld = 'filler' | 'forced';
 
 /** Counters. Every byte pushed ends up in exactly one of `frameBytes`, `discardedBytes` or `pendingBytes`. */
 export interface DecoderStats {
