@@ -96,7 +96,8 @@ describe('a big capture read on two threads', () => {
   });
 
   it('a file of 64 MB: both threads take parts, and the capture is the one readCapture makes, damaged or not', async () => {
-    // The records of the small file again and again (the reader does not ask times to rise): big
+    // The records of the small file again and again (their times step back at each copy, which the
+    // reader dates and reports as bad times, keeping every byte): big
     // enough that the other thread is up and takes parts before this one has read them all.
     const headerLength = parseCapture(bytes).headerLength;
     const records = bytes.subarray(headerLength);
@@ -115,7 +116,8 @@ describe('a big capture read on two threads', () => {
     big[at] = (big[at] ?? 0) ^ 0x40;
     const damaged = await load('big-damaged.sscap', big);
     expect(damaged.partsThere).toBe(0);
-    expect(damaged.capture?.issues.length).toBe(1);
+    // One damaged record (the copies' times, which step back at every copy, are bad-time issues of their own).
+    expect(damaged.capture?.issues.filter((i) => i.kind !== 'bad-time').length).toBe(1);
     expect(digest(damaged.capture)).toEqual(digest(readCapture(big, 'big-damaged.sscap')));
   });
 
