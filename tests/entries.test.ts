@@ -16,7 +16,9 @@ describe('package entries in a bundle', () => {
     // slots are read written out, not looped: 1.4x the decoding speed for 0.3 kB; 14.9 kB since
     // the link monitor's checkpoints share settled episodes, episode-log.ts: 0.5 kB for
     // checkpoints that no longer grow with every episode before them; 15.4 kB since the link
-    // monitor tells receiver restarts and delivery stalls from loss: 0.4 kB).
-    expect(sizes.satscope.gzip).toBeLessThan(15.6 * 1024);
+    // monitor tells receiver restarts and delivery stalls from loss: 0.4 kB; 16.3 kB since a lock
+    // needs evidence of a channel, forced options never pick the alignment and an ambiguous
+    // header is said and re-read: 0.9 kB).
+    expect(sizes.satscope.gzip).toBeLessThan(16.5 * 1024);
   }, 60_000);
 });
