@@ -38,7 +38,7 @@ beforeAll(() => {
   writeFileSync(join(dir, 'ibus.sscap'), recording(ibus.bytes, ibus.timesUs));
   writeFileSync(join(dir, 'ibus.bin'), ibus.bytes);
   const dsm2 = simulate(
-    { ...preset('dsm2-22ms-1024-internal'), fades: { lossRate: 0, randomRate: 0 }, timing: { startUs: 50_000 } },
+    { ...preset('dsm2-22ms-1024-internal'), fades: { lossRate: 0, randomRate: 0.01 }, timing: { startUs: 50_000 } },
     3 * SECOND,
   );
   writeFileSync(join(dir, 'dsm2.sscap'), recording(dsm2.bytes, dsm2.timesUs));

@@ -27,9 +27,15 @@ export function satelliteFindings(p: PortState, now: number, ctx: RuleContext, a
   const remote = format.remote;
   const period = link.stats.nominalPeriodUs;
   const info = format.system !== null ? systemInfo(format.system) : undefined;
-  const sure: Confidence = format.resolutionReason === 'channel-ids' ? 'likely' : 'certain';
-  const protocolText =
-    info !== undefined ? info.name : `${resolution}, ${Number.isFinite(period) ? `${period / 1000} ms` : 'period not yet measured'}`;
+  // A header that reads both ways (internal, or an external count whose low byte is a system
+  // byte) leaves the remote's kind and bind mode unproven: never 'certain' until its bytes tell.
+  const sure: Confidence = format.remoteAmbiguous ? 'likely' : format.resolutionReason === 'channel-ids' ? 'likely' : 'certain';
+  const protocolText = format.remoteAmbiguous
+    ? `${resolution}, ${Number.isFinite(period) ? `${period / 1000} ms` : 'period not yet measured'}`
+    : info !== undefined
+      ? info.name
+      : `${resolution}, ${Number.isFinite(period) ? `${period / 1000} ms` : 'period not yet measured'}`;
+  const remoteText = format.remoteAmbiguous ? 'internal or external' : remote;
 
   // What to set.
   const guessNote = guessNotes(p, resolution);
@@ -38,7 +44,7 @@ export function satelliteFindings(p: PortState, now: number, ctx: RuleContext, a
     ports: [p.port],
     severity: 'info',
     confidence: sure,
-    title: `${p.label}: flight controller settings for this ${protocolText} ${remote} remote`,
+    title: `${p.label}: flight controller settings for this ${protocolText} ${remoteText} remote`,
     evidence: [{ text: format.explanation, timeUs: null }],
     todo: [`Betaflight / iNav: serialrx_provider = ${resolution === 2048 ? 'SPEK2048' : 'SPEK1024'} (lines below).`],
     settings: [

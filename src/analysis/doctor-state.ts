@@ -144,6 +144,8 @@ export interface FormatSnapshot {
   system: number | null;
   resolution: Resolution;
   remote: 'internal' | 'external';
+  /** The decoder's `remoteAmbiguous`: read internal, but the header could be an external count. */
+  ambiguous: boolean;
   timeUs: number;
 }
 

@@ -14,12 +14,15 @@ export function systemFindings(ports: PortState[], now: number, ctx: RuleContext
   const all = locked.map((p) => p.port);
   // §7.3: exactly one internal ("A") remote.
   const internal = locked.filter((p) => (p.source as DoctorPortSource).decoder.format.remote === 'internal');
+  // Remotes read internal on a header that reads both ways may be external: a count that rests
+  // on them is a possibility, said as one, until their bytes settle it.
+  const unsure = internal.filter((p) => (p.source as DoctorPortSource).decoder.format.remoteAmbiguous);
   if (locked.length >= 2 && internal.length !== 1) {
     add({
       code: 'internal-count',
       ports: all,
-      severity: 'problem',
-      confidence: 'certain',
+      severity: unsure.length > 0 ? 'warning' : 'problem',
+      confidence: unsure.length > 0 ? 'possible' : 'certain',
       title:
         internal.length === 0
           ? 'No internal ("A") remote among these remotes'
@@ -32,6 +35,14 @@ export function systemFindings(ports: PortState[], now: number, ctx: RuleContext
               : `${labels(internal)} each send a system byte in byte 1 (internal frames).`,
           timeUs: null,
         },
+        ...(unsure.length > 0
+          ? [
+              {
+                text: `${labels(unsure)}: byte 1 has not moved and byte 0 has not either, so ${unsure.length === 1 ? 'it' : 'each'} may be an external remote whose fade count's low byte is a system byte; the first fade tells.`,
+                timeUs: null,
+              },
+            ]
+          : []),
       ],
       todo: [
         'Spec §7.3: exactly one remote binds internal ("A"); it negotiates with the transmitter for all. With none, binding fails; with several, "the results cannot be predicted".',

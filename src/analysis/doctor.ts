@@ -371,10 +371,17 @@ export class Doctor {
     // The format a remote was bound in; a change after that is a rebind (or another receiver).
     // (A snapshot is made only when it is kept: nothing is allocated per frame.)
     const ref = p.changes.length > 0 ? (p.changes[p.changes.length - 1] as { to: FormatSnapshot }).to : p.first;
+    const ambiguous = p.source?.decoder.format.remoteAmbiguous ?? false;
+    const snapshot = (): FormatSnapshot => ({ system: f.system, resolution: f.resolution, remote: f.remote, ambiguous, timeUs: t });
     if (ref === null) {
-      if (p.frames >= 2) p.first = { system: f.system, resolution: f.resolution, remote: f.remote, timeUs: t }; // the decoder may revise its first reading once
+      if (p.frames >= 2) p.first = snapshot(); // the decoder may revise its first reading once
+    } else if (ref.ambiguous && ref.remote === 'internal' && f.remote === 'external' && ref.resolution === f.resolution) {
+      // The decoder re-read a header that read both ways: the same remote, read right from here.
+      Object.assign(ref, snapshot());
     } else if (ref.system !== f.system || ref.resolution !== f.resolution || ref.remote !== f.remote) {
-      p.changes.push({ timeUs: t, from: ref, to: { system: f.system, resolution: f.resolution, remote: f.remote, timeUs: t } });
+      p.changes.push({ timeUs: t, from: ref, to: snapshot() });
+    } else if (ref.ambiguous && !ambiguous) {
+      ref.ambiguous = false; // byte 0 moved: internal after all
     }
   }
 
