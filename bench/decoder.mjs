@@ -33,12 +33,32 @@ const STREAMS = {
   2048: { preset: 'dsmx-11ms-2048-internal', hours: 1, resolution: 2048, label: 'DSMX 11 ms 2048, internal remote, 1 h' },
   1024: { preset: 'dsm2-22ms-1024-internal', hours: 2, resolution: 1024, label: 'DSM2 22 ms 1024, internal remote, 2 h' },
   external: { preset: 'dsmx-11ms-2048-external', hours: 1, resolution: 2048, label: 'DSMX 11 ms 2048, external remote, 1 h' },
+  // No stream at all: what a line held high (or runs of empty slots) and line noise cost to rule out.
+  filler: { fill: () => new Uint8Array(5_200_000).fill(0xff), resolution: 2048, label: '0xFF filler, 5.2 MB' },
+  noise: { fill: () => randomBytes(5_200_000), resolution: 2048, label: 'random bytes, 5.2 MB' },
 };
+
+/** `length` bytes from a fixed-seed xorshift: the same noise every run. */
+function randomBytes(length) {
+  const out = new Uint8Array(length);
+  let x = 0x9e3779b9;
+  for (let i = 0; i < length; i++) {
+    x ^= x << 13;
+    x ^= x >>> 17;
+    x ^= x << 5;
+    out[i] = x & 0xff;
+  }
+  return out;
+}
 
 function makeStream(key) {
   const s = STREAMS[key];
-  const sim = new Simulator({ ...preset(s.preset), seed: 1 });
-  const { bytes, timesUs } = sim.generate(sim.scenario.timing.startUs + s.hours * HOUR_US);
+  let bytes = s.fill?.();
+  let timesUs = null;
+  if (bytes === undefined) {
+    const sim = new Simulator({ ...preset(s.preset), seed: 1 });
+    ({ bytes, timesUs } = sim.generate(sim.scenario.timing.startUs + s.hours * HOUR_US));
+  }
   // What a serial port hands over: 64-byte views with the time of each one's last byte. Made up
   // front so that the timed loops allocate nothing of their own.
   const views = [];
@@ -47,8 +67,9 @@ function makeStream(key) {
   for (let i = 0, k = 0; i < bytes.length; i += CHUNK, k++) {
     const end = Math.min(bytes.length, i + CHUNK);
     views.push(bytes.subarray(i, end));
-    byteTimes.push(timesUs.subarray(i, end));
-    chunkTimes[k] = timesUs[end - 1];
+    // A stream without times (filler, noise) is timed at line rate: 86.8 µs a byte.
+    byteTimes.push(timesUs ? timesUs.subarray(i, end) : Float64Array.from({ length: end - i }, (_, j) => (i + j) * 86.8));
+    chunkTimes[k] = timesUs ? timesUs[end - 1] : (end - 1) * 86.8;
   }
   return { ...s, key, bytes, timesUs, views, byteTimes, chunkTimes };
 }
@@ -263,6 +284,8 @@ const CASES = [
     base: 'baseline JS loop, 2048 external',
     vs: CHUNK_CASE,
   },
+  { name: 'no stream: 0xFF filler, 64-byte chunks', stream: 'filler', run: chunkTimes, base: null, vs: CHUNK_CASE },
+  { name: 'no stream: random bytes, 64-byte chunks', stream: 'noise', run: chunkTimes, base: null, vs: CHUNK_CASE },
 ].filter(
   (c, _i, all) => only === '' || c.name.includes(only) || all.some((x) => (x.base === c.name || x.vs === c.name) && x.name.includes(only)),
 );

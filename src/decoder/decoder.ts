@@ -1138,7 +1138,12 @@ export class SpektrumDecoder {
     let score = -1;
     let shift = 0;
     let resolution: Resolution = 2048;
+    // Where no start can carry a channel, no chain leads: all that is left to learn is whether
+    // the bytes parse as filler, which the first reading that parses tells (runs of 0xFF or
+    // 0x00 would otherwise be scored at every shift, both ways, again every 16 bytes).
+    const leadable = this.#leadable(p, avail);
     for (let s = 0; s < ACQUIRE_SHIFTS; s++) {
+      if (!leadable && this.#fillerScore > -1) break;
       const frames = Math.min(ACQUIRE_FRAMES, Math.floor((avail - s) / FRAME_SIZE));
       if (frames < 1) break;
       if (only !== 1024) {
@@ -1160,6 +1165,27 @@ export class SpektrumDecoder {
     }
     const filler = this.#fillerScore > score;
     return { score: filler ? -1 : score, shift, resolution, filler };
+  }
+
+  /**
+   * Whether a frame starting at one of the next ACQUIRE_SHIFTS offsets has EVIDENCE_BYTES bytes
+   * other than 0x00 and 0xFF after its header: what `channelEvidence` needs at the least, so
+   * where none has, no chain can lead.
+   */
+  #leadable(p: number, avail: number): boolean {
+    const buf = this.#buf;
+    const filler = (i: number): number => {
+      const b = byteAt(buf, i);
+      return b === 0 || b === 0xff ? 0 : 1;
+    };
+    const words = FRAME_SIZE - 2;
+    let n = 0;
+    for (let i = p + 2; i < p + 2 + words && i < p + avail; i++) n += filler(i);
+    for (let s = 0; s < ACQUIRE_SHIFTS && s + FRAME_SIZE <= avail; s++) {
+      if (n >= EVIDENCE_BYTES) return true;
+      n += (s + FRAME_SIZE < avail ? filler(p + s + FRAME_SIZE) : 0) - filler(p + s + 2);
+    }
+    return false;
   }
 
   /**
