@@ -198,6 +198,20 @@ describe('a file without a Spektrum stream', () => {
     short.ended(0);
     expect(short.findings(20_000).map((f) => f.code)).toContain('no-satellite');
   });
+  it('names what a live port carried once its bytes have stopped, past the line window', () => {
+    const doctor = new Doctor();
+    const decoder = new SpektrumDecoder();
+    doctor.attach(0, { decoder, link: new LinkMonitor() });
+    doctor.open(0, 0);
+    const ibus = ibusStream({ durationUs: 2 * SECOND });
+    // Byte by byte at its own time, as a live port delivers it.
+    for (let i = 0; i < ibus.bytes.length; i += 32) doctor.bytes(0, ibus.bytes.subarray(i, i + 32), ibus.timesUs[i]!);
+    expect(doctor.findings(2 * SECOND).map((f) => f.code)).toContain('ibus');
+    const later = doctor.findings(100 * SECOND); // silent far past the 64 s the bins keep
+    expect(later.map((f) => f.code)).not.toContain('ibus');
+    const none = later.find((f) => f.code === 'no-satellite');
+    expect(none?.evidence.map((e) => e.text).join(' ')).toMatch(/They were \d+ FlySky IBUS packets, and the line has been silent since/);
+  });
 });
 
 describe("another protocol's bytes in a raw file or a logic analyser's export", () => {

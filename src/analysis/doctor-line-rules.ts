@@ -390,6 +390,20 @@ function lookOf(p: PortState, fromS: number, toS: number, bytes: number): string
 }
 
 /**
+ * What a port's bytes were once they have stopped: the protocol whose packets they held (at
+ * least 3, the probe's bar), or null. The bins forget after 64 s; the port's count does not.
+ */
+function pastPackets(p: PortState): string | null {
+  const kind = PACKET_KINDS.reduce<PacketKind | null>(
+    (best, k) => (p.packetsEver[k] >= 3 && (best === null || p.packetsEver[k] > p.packetsEver[best]) ? k : best),
+    null,
+  );
+  return kind === null
+    ? null
+    : `They were ${plural(p.packetsEver[kind], `${PROTOCOL_SETTINGS[kind].name} packet`)}, and the line has been silent since.`;
+}
+
+/**
  * Bytes that hold no Spektrum stream, said plainly (a problem: every surface then says no
  * satellite was found), with what they look like, unless a line finding already named them.
  */
@@ -407,7 +421,10 @@ export function noSatelliteFinding(p: PortState, v: LineVerdict, now: number, ct
     title: `${p.label}: no Spektrum satellite stream`,
     evidence: [
       { text: `${amount} and not one Spektrum frame in them (a satellite sends a 16-byte frame every 11 or 22 ms).`, timeUs: null },
-      { text: windowBytes > 0 ? lookOf(p, fromS, toS, windowBytes) : lookOf(p, -Infinity, Infinity, p.bytes), timeUs: null },
+      {
+        text: windowBytes > 0 ? lookOf(p, fromS, toS, windowBytes) : (pastPackets(p) ?? lookOf(p, -Infinity, Infinity, p.bytes)),
+        timeUs: null,
+      },
     ],
     todo: [
       "If this should be a satellite: its grey DATA wire on the adapter's RX, black GND to GND, 3.3 V on orange, and a bound transmitter on (its LED solid).",

@@ -175,6 +175,8 @@ export interface PortState {
   /** A protocol recognised at another speed while probing, kept until a satellite shows up. */
   confirmed: { protocol: ForeignProtocol; timeUs: number; packets: number; baudRate: number } | null;
   probePackets: Record<PacketKind, number>;
+  /** Foreign packets ever seen on this port, at any speed (what its bytes were once they stop). */
+  packetsEver: Record<PacketKind, number>;
   // Frames
   frames: number;
   guess: ArduPilotGuess;

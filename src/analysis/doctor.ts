@@ -108,6 +108,7 @@ export class Doctor {
         burst: new BurstClock(),
         confirmed: null,
         probePackets: { ibus: 0, 'srxl-v1': 0, srxl2: 0, crsf: 0, sbus: 0, fport: 0, ghst: 0 },
+        packetsEver: { ibus: 0, 'srxl-v1': 0, srxl2: 0, crsf: 0, sbus: 0, fport: 0, ghst: 0 },
         frames: 0,
         guess: new ArduPilotGuess(),
         xplusMask: 0,
@@ -134,6 +135,7 @@ export class Doctor {
   #packet(p: PortState, kind: PacketKind): void {
     p.bins.add(M_PACKETS + PACKET_KINDS.indexOf(kind), p.scanTimeUs, 1);
     if (p.baudRate !== 115_200) p.probePackets[kind]++;
+    p.packetsEver[kind]++;
   }
 
   /** The decoder and link monitor whose frames `frame()` will get for this port. */
@@ -165,11 +167,12 @@ export class Doctor {
     const p = this.#ports.get(port);
     if (p === undefined) return undefined;
     // The snapshots and records in the lists are never changed once made: the lists are copied.
-    const { source: _source, bins, scanner, burst, guess, probePackets, damagedAtUs, changes, head, ...plain } = p;
+    const { source: _source, bins, scanner, burst, guess, probePackets, packetsEver, damagedAtUs, changes, head, ...plain } = p;
     return {
       ...plain,
       head: [...head],
       probePackets: { ...probePackets },
+      packetsEver: { ...packetsEver },
       damagedAtUs: [...damagedAtUs],
       changes: [...changes],
       bins: bins.checkpoint(),
@@ -187,12 +190,13 @@ export class Doctor {
   restorePort(port: number, cp: PortCheckpoint, source: DoctorPortSource): void {
     this.detach(port);
     const p = this.#port(port);
-    const { bins, scanner, burst, guess, probePackets, damagedAtUs, changes, head, ...plain } = cp;
+    const { bins, scanner, burst, guess, probePackets, packetsEver, damagedAtUs, changes, head, ...plain } = cp;
     Object.assign(p, plain, {
       port,
       source,
       head: [...head],
       probePackets: { ...probePackets },
+      packetsEver: { ...packetsEver },
       damagedAtUs: [...damagedAtUs],
       changes: [...changes],
     });
