@@ -53,6 +53,26 @@ function captureFiles(dir: string): string[] {
   return out;
 }
 
+/**
+ * A recording whose adapter was unplugged: 6 s of a clean stream through a USB adapter, the
+ * chunks between `fromUs` and `toUs` never recorded, a "device lost" event at the last chunk
+ * before and "device reconnected" before the first after (as the worker's recorder writes them).
+ * `events: false`: the same chunks without the events.
+ */
+function unplugged(seed: number, fromUs: number, toUs: number, events = true): Capture {
+  const s = simulate({ ...preset('dsmx-11ms-2048-internal'), seed, fades: { lossRate: 0, randomRate: 0 } }, 6e6);
+  const chunks = usbChunks(s.bytes, s.timesUs);
+  const before = chunks.filter((c) => c.timeUs < fromUs);
+  const after = chunks.filter((c) => c.timeUs >= toUs);
+  const records: CaptureRecordInput[] = [
+    ...before.map((c) => ({ type: 'data' as const, ...c, port: 0 })),
+    ...(events ? [{ type: 'event' as const, text: 'device lost', timeUs: before.at(-1)!.timeUs + 500, port: 0 }] : []),
+    ...(events ? [{ type: 'event' as const, text: 'device reconnected', timeUs: after[0]!.timeUs - 2_000, port: 0 }] : []),
+    ...after.map((c) => ({ type: 'data' as const, ...c, port: 0 })),
+  ];
+  return readCapture(encodeCapture({ baudRate: 115200, source: 'test' }, records), 'unplugged.sscap');
+}
+
 function sscap(chunks: { bytes: Uint8Array; timeUs: number }[]): Capture {
   const records: CaptureRecordInput[] = chunks.map((c) => ({ type: 'data', bytes: c.bytes, timeUs: c.timeUs, port: 0 }));
   return readCapture(encodeCapture({ baudRate: 115200, source: 'test' }, records), 'test.sscap');
@@ -137,7 +157,7 @@ function fromReplay(capture: Capture, speed: number, seekAtUs?: number): Story {
       engine.batch(r.linkNowUs(0));
       ended = true;
     },
-    { clock },
+    { clock, onStop: (_port, atUs) => engine.interrupt(atUs) },
   );
   r.setSpeed(speed);
   r.play();
@@ -243,6 +263,13 @@ const CASES: Case[] = [
     },
     live: false,
     expect: { holds: 2, failsafes: 1 },
+  },
+  {
+    // The adapter was away, not the link: no hold, failsafe or missed frame for the 2 s unplugged.
+    name: 'a recording with the adapter unplugged for 2 s ("device lost", then reconnected)',
+    capture: () => unplugged(11, 2e6, 4e6),
+    live: false,
+    expect: { holds: 0, failsafes: 0, missedFrames: 0 },
   },
   {
     name: 'simulator dropouts-failsafe as a raw .bin (no timing)',
@@ -440,7 +467,7 @@ function replayDoctorSays(capture: Capture): DoctorFinding[] {
       engine.batch(r.linkNowUs(0));
       ended = true;
     },
-    { clock },
+    { clock, onStop: (_port, atUs) => engine.interrupt(atUs) },
   );
   const diagnosis = new Diagnosis(
     (m) => posts.push(m),
@@ -485,6 +512,16 @@ function dropoutStreams(n: number, seed: number) {
     return { name, stream: simulate({ ...preset(name), seed: seed + i, dropouts: at }, 4e6 + random() * 2e6) };
   });
 }
+
+describe('a recorded unplug', () => {
+  it('is what tells the adapter away from the link: the same chunks without its events are a failsafe', () => {
+    const told = summarizeCapture(unplugged(11, 2e6, 4e6)).link;
+    const silent = summarizeCapture(unplugged(11, 2e6, 4e6, false)).link;
+    expect([told.holds, told.failsafes, told.missedFrames]).toEqual([0, 0, 0]);
+    expect([silent.holds, silent.failsafes]).toEqual([1, 1]);
+    expect(silent.missedFrames).toBeGreaterThan(150);
+  });
+});
 
 describe('the doctor states what info and the report state', () => {
   /** What the truth of a class says besides the surfaces agreeing: every disagreement in words. */
@@ -554,6 +591,22 @@ describe('the doctor states what info and the report state', () => {
           wrong.push(`${link.restarts} restarts, ${link.holds} holds, ${link.failsafes} failsafes`);
         if (link.missedFrames < Math.round(silence / link.nominalPeriodUs) - 2) wrong.push(`${link.missedFrames} missed in ${silence} µs`);
         if (!codes.includes('receiver-restart') || codes.includes('weak-link')) wrong.push(`doctor: ${codes.join(', ')}`);
+        return wrong;
+      },
+    },
+    {
+      name: 'recordings with the adapter unplugged ("device lost"), 0.3 to 3 s',
+      captures: () =>
+        [0.3e6, 1.2e6, 3e6].map((us, i) => ({ name: `unplugged ${us / 1e3} ms`, capture: unplugged(20 + i, 1.5e6, 1.5e6 + us) })),
+      // The adapter was away: no hold, failsafe or missed frame, no weak link; the same chunks
+      // without the events (a silence the recording does not explain) are a hold.
+      truth: (capture) => {
+        const { link } = summarizeCapture(capture);
+        const codes = doctorCapture(capture).findings.map((f) => f.code);
+        const wrong = [];
+        if (link.holds + link.failsafes + link.missedFrames > 0)
+          wrong.push(`${link.holds} holds, ${link.failsafes} failsafes, ${link.missedFrames} missed`);
+        if (codes.includes('weak-link')) wrong.push(`doctor: ${codes.join(', ')}`);
         return wrong;
       },
     },

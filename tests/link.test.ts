@@ -260,6 +260,31 @@ describe('LinkMonitor: missed means missed', () => {
     expect(link.stats).toMatchObject({ holds: 0, failsafes: 0, missedFrames: 0 });
     expect(link.episodes).toEqual([]);
   });
+
+  it('counts nothing for the time a source was stopped(), though frames from before it still come in after the call', () => {
+    const link = new LinkMonitor();
+    for (let i = 0; i < 50; i++) link.frame(bare(i * 11_000));
+    // The port is lost at 0.56 s; the decoder still held the frame of 0.55 s, counted after the call.
+    link.stopped(560_000);
+    link.frame(bare(50 * 11_000));
+    // Judged no later than the stop, whenever asked.
+    expect(link.update(5_000_000)).toBe('live');
+    expect(link.checkpoint().stoppedUs).toBe(560_000);
+    const restored = new LinkMonitor();
+    restored.restore(link.checkpoint());
+    for (const l of [link, restored]) {
+      for (let i = 0; i < 100; i++) l.frame(bare(6_000_000 + i * 11_000));
+      l.finish(6_000_000 + 99 * 11_000 + 2_000);
+      expect(l.stats).toMatchObject({ holds: 0, failsafes: 0, missedFrames: 0, frames: 151 });
+      expect(l.episodes).toEqual([]);
+    }
+    // A stream that ends while its source is away: no silence is judged after the stop.
+    const ended = new LinkMonitor();
+    for (let i = 0; i < 50; i++) ended.frame(bare(i * 11_000));
+    ended.stopped(560_000);
+    expect(ended.finish(9_000_000)).toBe('waiting');
+    expect(ended.stats).toMatchObject({ holds: 0, failsafes: 0, missedFrames: 0 });
+  });
 });
 
 describe('LinkMonitor: period and bounds', () => {

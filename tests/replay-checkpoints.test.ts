@@ -219,6 +219,32 @@ describe('a long capture in the worker', () => {
   });
 });
 
+describe("a recording's unplug in the overview", () => {
+  it('draws no failsafe for the time the adapter was away ("device lost"), in one go, read as it goes and split per port', () => {
+    const a = simulate({ ...preset('dsmx-11ms-2048-internal'), seed: 5, fades: { lossRate: 0, randomRate: 0 } }, 8e6);
+    const chunks = usbChunks(a.bytes, a.timesUs);
+    const before = chunks.filter((c) => c.timeUs < 3e6);
+    const after = chunks.filter((c) => c.timeUs >= 5.5e6);
+    const make = (events: boolean) =>
+      readCapture(
+        encodeCapture({ baudRate: 115200 }, [
+          ...before.map((c) => ({ type: 'data' as const, ...c, port: 0 })),
+          ...(events ? [{ type: 'event' as const, text: 'device lost', timeUs: before.at(-1)!.timeUs + 300, port: 0 }] : []),
+          ...after.map((c) => ({ type: 'data' as const, ...c, port: 0 })),
+        ]),
+      );
+    const failsafes = (capture: Capture): number[] => {
+      const { startUs, endUs } = captureSpan(capture);
+      const pass = new ReplayPass(capture, [0], 'auto', startUs, endUs);
+      let clock = 0;
+      while (!pass.step(1, () => (clock += 1)));
+      return [overviewOf(capture, [0], 'auto').overview.failsafe.length, pass.overview().failsafe.length];
+    };
+    expect(failsafes(make(false))).toEqual([1, 1]);
+    expect(failsafes(make(true))).toEqual([0, 0]);
+  });
+});
+
 describe('where the checkpoints fall in a capture', () => {
   /** The rule as the replay pass applies it, chunk by chunk: the reference. */
   function walked(times: number[], originUs: number): { chunk: number; fedUntilUs: number }[] {

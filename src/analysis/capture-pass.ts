@@ -13,7 +13,7 @@ import type { Capture, CaptureEvent, CaptureTiming } from '../capture/index.js';
 import { SpektrumDecoder, USB_CHUNK_JITTER_US, type DecodedFrame, type DecoderOptions } from '../decoder/index.js';
 import type { LinkMonitor } from '../decoder/index.js';
 import type { Doctor } from './doctor.js';
-import { doctorEvent } from './doctor-events.js';
+import { doctorEvent, stopsPort } from './doctor-events.js';
 import { SCAN_MEMORY, startsCandidate } from './doctor-line.js';
 import { lineWindow } from './doctor-state.js';
 import { LinkSeries, monitorWithSeries } from './series.js';
@@ -118,12 +118,14 @@ export function decodeCapture(
   const link = monitorWithSeries({ jitterUs: timingJitterUs(capture.timing) }, series);
   if (doctor !== undefined && capture.timing === 'none')
     throw new TypeError('decodeCapture: a doctor needs a timed capture (doctorCapture gives an untimed one a clock)');
-  const events = doctor !== undefined ? portEvents(capture, port) : [];
+  const events = portEvents(capture, port);
   let nextEvent = 0;
-  /** Feeds the doctor this port's events recorded before chunk `upTo` (all that are left: Infinity). */
+  /** This port's events recorded before chunk `upTo` (all that are left: Infinity), to the link and the doctor. */
   const eventsBefore = (upTo: number): void => {
-    for (let e = events[nextEvent]; e !== undefined && e.chunkIndex <= upTo; e = events[++nextEvent])
+    for (let e = events[nextEvent]; e !== undefined && e.chunkIndex <= upTo; e = events[++nextEvent]) {
+      if (stopsPort(e.text)) link.stopped(e.timeUs);
       if (doctor !== undefined) doctorEvent(doctor, port, e.text, e.timeUs);
+    }
   };
   if (doctor !== undefined) {
     const label = capture.meta.ports?.[port]?.name;

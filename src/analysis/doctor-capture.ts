@@ -8,7 +8,7 @@ import { BYTE_TIME_US, LinkMonitor, SpektrumDecoder, type Resolution } from '../
 import { capturePorts, chunkFirstByteUs, type Capture, type CaptureKind, type CaptureTiming } from '../capture/index.js';
 import { Doctor } from './doctor.js';
 import type { DoctorCode, DoctorFinding, Severity } from './doctor-types.js';
-import { doctorEvent } from './doctor-events.js';
+import { doctorEvent, stopsPort } from './doctor-events.js';
 import { SLICE_BYTES, timingJitterUs } from './capture-pass.js';
 import { captureSpan } from './capture-span.js';
 import { portResolutions } from './resolution-key.js';
@@ -213,6 +213,7 @@ export function doctorCapture(capture: Capture, options: DoctorCaptureOptions = 
       if (!(now >= t)) now = t;
     }
     if (data === null) {
+      if (stopsPort(text)) sources.get(port)?.link.stopped(t);
       doctorEvent(doctor, port, text, t);
       return;
     }

@@ -1,9 +1,10 @@
 /**
- * What a recorded capture event tells the doctor: the words the worker's recorder writes
+ * What a recorded capture event tells the doctor and the link: the words the worker's recorder writes
  * ("port opened", "device lost", "line error: FramingError"…) read back as the calls live use
  * makes. The live worker, `doctorCapture` and the report's one pass all go through here, so a
  * recording says what was seen.
  */
+import type { Capture } from '../capture/index.js';
 import type { Doctor } from './doctor.js';
 
 /** A capture event's text names a WebSerial read error, e.g. "line error: FramingError". */
@@ -12,6 +13,29 @@ const LINE_ERROR = /\b(FramingError|ParityError|BreakError|BufferOverrunError)\b
 const OPENED = /\b(port opened|device reconnected)\b/i;
 const CLOSED = /\b(device lost|port closed)\b/i;
 const BAUD = /\b(\d{4,7})\s*baud\b/i;
+
+/**
+ * Whether a recorded event says the port's source went away ("device lost", "port closed"):
+ * its link is then `LinkMonitor.stopped` there, on every surface that reads the recording.
+ */
+export function stopsPort(text: string): boolean {
+  return CLOSED.test(text);
+}
+
+/** A recorded stop (`stopsPort`): its port, the capture's chunk it came before, and its time. */
+export interface RecordedStop {
+  readonly port: number;
+  readonly chunkIndex: number;
+  readonly timeUs: number;
+}
+
+/** The capture's recorded stops in the order they were recorded among its chunks. */
+export function recordedStops(capture: Capture): RecordedStop[] {
+  return capture.events
+    .filter((e) => stopsPort(e.text))
+    .map((e) => ({ port: e.port, chunkIndex: e.chunkIndex, timeUs: e.timeUs }))
+    .sort((a, b) => a.chunkIndex - b.chunkIndex);
+}
 
 /**
  * Feeds one recorded event to a doctor: "port opened" / "device reconnected" (optionally
@@ -25,5 +49,5 @@ export function doctorEvent(doctor: Doctor, port: number, text: string, timeUs: 
   else if (OPENED.test(text)) {
     const baud = BAUD.exec(text);
     doctor.open(port, timeUs, baud !== null ? { baudRate: Number(baud[1]) } : {});
-  } else if (CLOSED.test(text)) doctor.close(port);
+  } else if (stopsPort(text)) doctor.close(port);
 }

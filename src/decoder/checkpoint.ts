@@ -166,5 +166,6 @@ export interface LinkCheckpoint {
   readonly lastFades: number;
   readonly lastInterval: number;
   readonly finished: boolean;
+  readonly stoppedUs: number;
   readonly stats: Readonly<LinkStats>;
 }

@@ -231,6 +231,8 @@ export class LinkMonitor {
   #lastFades = 0;
   #lastInterval = NaN;
   #finished = false;
+  /** Where the source stopped delivering (`stopped()`), until its first frame after that; NaN when not. */
+  #stoppedUs = NaN;
   readonly #stats: LinkStats = {
     frames: 0,
     fades: 0,
@@ -319,6 +321,11 @@ export class LinkMonitor {
   frame(frame: DecodedFrame): void {
     const s = this.#stats;
     const t = frame.timeUs;
+    if (t > this.#stoppedUs) {
+      // The first frame after the source came back: its absence is no silence of the link.
+      this.interrupt(this.#stoppedUs);
+      this.#stoppedUs = NaN;
+    }
     s.frames++;
     if (frame.rssi !== null) {
       s.rssi = frame.rssi;
@@ -536,6 +543,8 @@ export class LinkMonitor {
    * the frame comes.
    */
   update(nowUs: number, pendingUs = Number.NaN): LinkState {
+    // While the source is away, the link is judged no later than when it stopped.
+    if (nowUs > this.#stoppedUs) nowUs = this.#stoppedUs;
     const last = pendingUs > this.#lastUs ? pendingUs : this.#lastUs;
     if (this.#state === 'waiting' || !Number.isFinite(last) || !Number.isFinite(nowUs)) return this.#state;
     const gap = nowUs - last;
@@ -568,6 +577,11 @@ export class LinkMonitor {
   finish(endUs: number): LinkState {
     if (this.#finished) return this.#state;
     this.#finished = true;
+    if (Number.isFinite(this.#stoppedUs)) {
+      // The stream ended with its source away: nothing after the stop is the link's.
+      this.interrupt(this.#stoppedUs);
+      this.#stoppedUs = NaN;
+    }
     if (this.#burst !== null) this.#endBurst();
     const state = this.update(endUs);
     const s = this.#stats;
@@ -615,6 +629,18 @@ export class LinkMonitor {
   }
 
   /**
+   * The source stopped delivering at `atUs` for a reason that is not the link (its port was lost,
+   * the demo's simulation paused over a stall). The link stops being judged now (`interrupt`),
+   * and again at the first frame after `atUs`, once the frames the decoder still held from before
+   * it are counted: no hold, failsafe or missed frame is counted for the time the source was away.
+   * Live, replayed and in every command alike (a recorded "device lost" event).
+   */
+  stopped(atUs: number): void {
+    this.interrupt(atUs);
+    this.#stoppedUs = atUs;
+  }
+
+  /**
    * The monitor's whole state now (checkpoint.ts): state, episodes (copies), the period and
    * fade-rate windows, the ledger, the holds not yet judged and the counters.
    */
@@ -651,6 +677,7 @@ export class LinkMonitor {
       lastFades: this.#lastFades,
       lastInterval: this.#lastInterval,
       finished: this.#finished,
+      stoppedUs: this.#stoppedUs,
       stats: { ...this.#stats },
     };
   }
@@ -694,6 +721,7 @@ export class LinkMonitor {
     this.#lastFades = cp.lastFades;
     this.#lastInterval = cp.lastInterval;
     this.#finished = cp.finished;
+    this.#stoppedUs = cp.stoppedUs;
     Object.assign(this.#stats, cp.stats);
     // Its stats were settled when it was taken.
     this.#periodOwed = false;

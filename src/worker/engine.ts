@@ -100,8 +100,6 @@ export class Engine {
   readonly #pushTimes = new Array<Float64Array | undefined>(PUSHES_KEPT).fill(undefined);
   /** Pushes so far. */
   #pushCount = 0;
-  /** Where the source stopped sending for a reason not the link's (`interrupt()`), NaN when not. */
-  #interruptUs = Number.NaN;
   /** Whether the resolution is forced (only then can it match no frame). */
   #forced: boolean;
 
@@ -149,13 +147,10 @@ export class Engine {
 
   /**
    * The source stopped sending at `atUs` for a reason that is not the link (its port was lost,
-   * the demo's simulation paused over a stall): no hold, failsafe or missed frame is counted
-   * from there to its next frame. The link stops being judged now, and is told again at the
-   * first frame after `atUs`, once the frames the decoder still held from before are counted.
+   * the demo's simulation paused over a stall, a recorded "device lost"): `LinkMonitor.stopped`.
    */
   interrupt(atUs: number): void {
-    this.link.interrupt(atUs);
-    this.#interruptUs = atUs;
+    this.link.stopped(atUs);
     this.#changed = true;
   }
 
@@ -198,10 +193,6 @@ export class Engine {
       this.inspector.onFrame(f);
       const t = f.timeUs;
       this.#currentUs = t;
-      if (t > this.#interruptUs) {
-        this.link.interrupt(this.#interruptUs);
-        this.#interruptUs = Number.NaN;
-      }
       this.link.frame(f);
       this.series.frame(f, this.link);
       this.traces.frame(f, this.link.holdAfterUs);

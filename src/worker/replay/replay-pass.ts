@@ -9,6 +9,7 @@
 import { type DecoderCheckpoint, type LinkCheckpoint, type LinkMonitor, SpektrumDecoder } from '../../decoder/index.js';
 import { type Capture, recordTimeUs } from '../../capture/index.js';
 import { LinkSeries, monitorWithSeries, timingJitterUs } from '../../analysis/index.js';
+import { type RecordedStop, recordedStops } from '../../analysis/doctor-events.js';
 import { failsafeAsRead, failsafesOf, overviewBinUs, sumOverview } from './overview.js';
 import type { Overview } from '../protocol.js';
 
@@ -81,6 +82,9 @@ export class ReplayPass implements OverviewPass {
   readonly #at = new Float64Array(1);
   #nextCheckpointUs: number;
   #done = false;
+  /** The capture's recorded stops ("device lost"), and the next to tell its port's link. */
+  #stops: RecordedStop[];
+  #nextStop = 0;
 
   /**
    * @param originUs, endUs the capture's span (`captureSpan`): bin 0 starts at the first, the links are judged at the last
@@ -98,6 +102,7 @@ export class ReplayPass implements OverviewPass {
   ) {
     this.#capture = capture;
     this.#prefix = prefix;
+    this.#stops = capture === null ? [] : recordedStops(capture);
     this.#binUs = overviewBinUs(endUs - originUs);
     this.#ports = ports.map((port) => {
       const series = new LinkSeries(this.#binUs, originUs);
@@ -142,6 +147,8 @@ export class ReplayPass implements OverviewPass {
     }
     this.#capture = capture;
     this.#prefix = false;
+    this.#stops = recordedStops(capture);
+    while ((this.#stops[this.#nextStop]?.chunkIndex ?? Infinity) < n) this.#nextStop++; // told already, if the head had them
     return true;
   }
 
@@ -158,6 +165,7 @@ export class ReplayPass implements OverviewPass {
     const n = chunkEnds.length;
     let i = this.#chunk;
     while (i < n) {
+      this.#stopsBefore(i);
       // A range of the capture's bytes, not a view of them: a view a chunk is most of a chunk's cost.
       this.feed(bytes, i === 0 ? 0 : (chunkEnds[i - 1] ?? 0), chunkEnds[i] ?? 0, chunkTimesUs[i] ?? Number.NaN, chunkPorts[i] ?? -1);
       i++;
@@ -206,9 +214,16 @@ export class ReplayPass implements OverviewPass {
     this.#chunk++;
   }
 
+  /** Tells each link its recorded stops before the capture's chunk `chunk` (`LinkMonitor.stopped`). */
+  #stopsBefore(chunk: number): void {
+    for (let e = this.#stops[this.#nextStop]; e !== undefined && e.chunkIndex <= chunk; e = this.#stops[++this.#nextStop])
+      this.#byPort[e.port]?.link.stopped(e.timeUs);
+  }
+
   /** The end of the stream: every decoder flushed, every link judged at the capture's end. */
   finish(): void {
     if (this.#done) return;
+    this.#stopsBefore(Infinity);
     for (const p of this.#ports) {
       p.decoder.end();
       drain(p);

@@ -196,7 +196,11 @@ export class ReplaySession implements Driver {
         parts.batcher.flush();
         this.status();
       },
-      { untimedPeriodUs: periodUs, clock: host.clock },
+      {
+        untimedPeriodUs: periodUs,
+        clock: host.clock,
+        onStop: (port, atUs) => registry.get(port)?.engine.interrupt(atUs),
+      },
     );
   }
 

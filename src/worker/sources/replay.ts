@@ -21,6 +21,8 @@ export interface ReplayOptions {
    * nothing is measured from a made-up clock. Default 11 ms.
    */
   untimedPeriodUs?: number;
+  /** A port's recorded stop ("device lost" at `atUs`), told before the first byte recorded after it. */
+  onStop?: (port: number, atUs: number) => void;
 }
 
 /**
@@ -55,6 +57,7 @@ export class ReplaySource {
   /** False for a capture without timing: its clock is the receiver's pace, not a recording. */
   readonly recordedTiming: boolean;
   readonly #clock: ReplayClock;
+  readonly #onStop: (port: number, atUs: number) => void;
   #clockUs: number;
   #wallMs = 0;
   #speed = 1;
@@ -78,6 +81,7 @@ export class ReplaySource {
     options: ReplayOptions = {},
   ) {
     this.#clock = options.clock ?? BROWSER_CLOCK;
+    this.#onStop = options.onStop ?? (() => {});
     this.ports = capturePorts(capture);
     const span = captureSpan(capture);
     this.recordedTiming = Number.isFinite(span.startUs);
@@ -176,7 +180,9 @@ export class ReplaySource {
     this.pause();
   }
 
-  #feed(port: number, bytes: Uint8Array, time: number | Float64Array | undefined, atUs: number): void {
+  #feed(c: PortChunks, bytes: Uint8Array, time: number | Float64Array | undefined, atUs: number): void {
+    const port = c.port;
+    if (c.nextByte === 0) for (const t of c.takeStops(c.next)) this.#onStop(port, t);
     if (Number.isFinite(atUs) && !(atUs <= this.#lastFedUs)) this.#lastFedUs = atUs;
     this.sink(port, bytes, time, atUs, this.#fedAtMs);
   }
@@ -203,7 +209,7 @@ export class ReplaySource {
           const first = c.bytesBeforeChunk(c.next);
           const due = Math.min(chunk.bytes.length, Math.floor(clockUs / c.usPerByte + 1e-9) - first);
           if (due > c.nextByte) {
-            this.#feed(c.port, chunk.bytes.subarray(c.nextByte, due), undefined, (first + due) * c.usPerByte);
+            this.#feed(c, chunk.bytes.subarray(c.nextByte, due), undefined, (first + due) * c.usPerByte);
             c.nextByte = due;
           }
           if (c.nextByte === chunk.bytes.length) {
@@ -216,7 +222,7 @@ export class ReplaySource {
         if (chunk.byteTimes === undefined) {
           if (chunk.atUs > clockUs) break;
           // Without recorded timing the bytes go in untimed: the pace is not a measurement.
-          this.#feed(c.port, chunk.bytes, c.timed && !Number.isNaN(chunk.atUs) ? chunk.atUs : undefined, chunk.atUs);
+          this.#feed(c, chunk.bytes, c.timed && !Number.isNaN(chunk.atUs) ? chunk.atUs : undefined, chunk.atUs);
           c.next++;
           continue;
         }
@@ -225,7 +231,7 @@ export class ReplaySource {
         let end = c.nextByte;
         while (end < limit && !((times[end] ?? Number.POSITIVE_INFINITY) > clockUs)) end++;
         if (end > c.nextByte)
-          this.#feed(c.port, chunk.bytes.subarray(c.nextByte, end), times.subarray(c.nextByte, end), times[end - 1] ?? Number.NaN);
+          this.#feed(c, chunk.bytes.subarray(c.nextByte, end), times.subarray(c.nextByte, end), times[end - 1] ?? Number.NaN);
         c.nextByte = end;
         if (end === times.length) {
           c.next++;
@@ -261,6 +267,7 @@ export class ReplaySource {
 
   /** The end: the clock stops at the capture's last recorded time, never past it. */
   #finish(): void {
+    for (const c of this.#chunks) for (const t of c.takeStops(c.length)) this.#onStop(c.port, t);
     this.#clockUs = this.endUs;
     this.#ended = true;
     this.pause();
