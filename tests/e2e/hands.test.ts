@@ -142,6 +142,22 @@ describe.skipIf(skip !== null)('channel traces', () => {
     expect(spikyGlitches).toBe(3);
     // A 3.2 s capture: the 10 s window, the smallest that holds it.
     await expect(page.getByRole('radio', { name: '10 s' }).getAttribute('aria-checked')).resolves.toBe('true');
+    // A radio group keyed as one: Tab reaches the chosen window only, the arrows move the choice.
+    const windows = page.getByRole('radiogroup', { name: 'Window' });
+    await expect(windows.locator('[tabindex="0"]').textContent()).resolves.toBe('10 s');
+    await windows.getByRole('radio', { name: '10 s' }).focus();
+    await page.keyboard.press('ArrowRight');
+    await expect(page.getByRole('radio', { name: '1 min' }).getAttribute('aria-checked')).resolves.toBe('true');
+    await expect(page.evaluate(() => document.activeElement?.textContent)).resolves.toBe('1 min');
+    await page.keyboard.press('ArrowLeft');
+    await page.keyboard.press('ArrowLeft');
+    await expect(page.getByRole('radio', { name: '1 s' }).getAttribute('aria-checked')).resolves.toBe('true');
+    await page.keyboard.press('End');
+    await expect(page.getByRole('radio', { name: '10 min' }).getAttribute('aria-checked')).resolves.toBe('true');
+    await page.keyboard.press('ArrowRight'); // wraps
+    await expect(page.getByRole('radio', { name: '1 s' }).getAttribute('aria-checked')).resolves.toBe('true');
+    await page.keyboard.press('ArrowRight');
+    await expect(page.getByRole('radio', { name: '10 s' }).getAttribute('aria-checked')).resolves.toBe('true');
     await page.locator('.trace-picker').getByRole('button', { name: 'All sent' }).click();
     await expect.poll(() => page.getByTestId('glitch-count').textContent()).toBe(`${spikyGlitches} glitches in view`);
     mkdirSync(SHOTS, { recursive: true });
@@ -224,6 +240,27 @@ describe.skipIf(skip !== null)('a phone at 390 px', () => {
     expect(small).toEqual([]);
     expect(await page.getByRole('radio', { name: '4×' }).count()).toBe(1);
     expect(await page.getByRole('radio', { name: '1 s' }).count()).toBe(1);
+    // The bind modes: each row is its radio's target (a tap anywhere on it chooses).
+    await page.getByRole('button', { name: 'Bind…' }).first().click();
+    await page.getByRole('region', { name: 'Bind a satellite' }).locator('.modes tbody tr').first().waitFor();
+    const smallInBind = await page.$$eval('.bind button, .bind select, .bind summary', (els) =>
+      els
+        .filter((e) => (e as HTMLElement).offsetParent !== null)
+        .map((e) => ({
+          what: `${e.tagName.toLowerCase()} ${e.textContent?.trim().slice(0, 30) ?? ''}`,
+          h: e.getBoundingClientRect().height,
+        }))
+        .filter((x) => x.h < 40),
+    );
+    expect(smallInBind).toEqual([]);
+    const rows = await page.$$eval('.bind .modes tbody tr', (els) => els.map((e) => e.getBoundingClientRect().height));
+    expect(rows.length).toBeGreaterThan(5);
+    expect(Math.min(...rows)).toBeGreaterThanOrEqual(40);
+    await page
+      .locator('.bind .modes tbody tr')
+      .nth(2)
+      .click({ position: { x: 200, y: 10 } });
+    await expect(page.locator('.bind .modes tbody tr').nth(2).locator('input').isChecked()).resolves.toBe(true);
     expect(errors).toEqual([]);
     await page.context().close();
   });

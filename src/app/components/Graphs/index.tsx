@@ -25,6 +25,7 @@ import {
   type ValueScale,
 } from '../../axes.js';
 import { chartColors, theme } from '../../theme.js';
+import { Choice } from '../Choice/index.js';
 import './style.css';
 
 /** The windows offered, shortest first (the first that holds a capture is chosen for it). */
@@ -164,22 +165,14 @@ export function Graphs({ windowUs }: { windowUs: Signal<number> }) {
     <section class="graphs" aria-label="Graphs">
       <div class="graph-head">
         <h2>Link over time</h2>
-        <div class="window" role="radiogroup" aria-label="Window">
-          {WINDOWS.map(([us, label]) => (
-            <button
-              key={label}
-              type="button"
-              role="radio"
-              aria-checked={windowUs.value === us}
-              class={windowUs.value === us ? 'on' : ''}
-              onClick={() => {
-                windowUs.value = us;
-              }}
-            >
-              {label}
-            </button>
-          ))}
-        </div>
+        <Choice
+          label="Window"
+          options={WINDOWS}
+          value={windowUs.value}
+          onChoose={(us) => {
+            windowUs.value = us;
+          }}
+        />
       </div>
       <div class="chart-host" ref={host} />
     </section>

@@ -12,6 +12,7 @@ import { elapsedAxis } from '../../axes.js';
 import { chartColors, theme } from '../../theme.js';
 import { overviewColumns } from './columns.js';
 import { readingPercent } from './reading.js';
+import { Choice } from '../Choice/index.js';
 import './style.css';
 
 /** The timeline's height, px: the plot and its time axis. */
@@ -189,20 +190,7 @@ export function ReplayBar() {
             Play
           </button>
         )}
-        <div class="window" role="radiogroup" aria-label="Speed">
-          {SPEEDS.map(([v, label]) => (
-            <button
-              key={label}
-              type="button"
-              role="radio"
-              aria-checked={speed.value === v}
-              class={speed.value === v ? 'on' : ''}
-              onClick={() => send({ type: 'replay-speed', speed: v })}
-            >
-              {label}
-            </button>
-          ))}
-        </div>
+        <Choice label="Speed" options={SPEEDS} value={speed.value} onChoose={(v) => send({ type: 'replay-speed', speed: v })} />
         <span class="muted" data-testid="replay-reading">
           {readingText}
         </span>
