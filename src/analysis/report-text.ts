@@ -18,12 +18,9 @@ export function formatClock(us: number): string {
     const m = Math.floor((s % 3600) / 60);
     return `${h}:${String(m).padStart(2, '0')}:${String(Math.floor(s % 60)).padStart(2, '0')}`;
   }
-  const m = Math.floor(s / 60);
-  const rest = s - m * 60;
-  let sec = rest.toFixed(1);
-  if (sec === '60.0') return `${m + 1}:00.0`;
-  if (rest < 10) sec = `0${sec}`;
-  return `${m}:${sec}`;
+  // Rounded to a tenth before it is split: 9.96 s is 0:10.0 (not 0:010.0), 59.96 s 1:00.0.
+  const tenths = Math.round(s * 10);
+  return `${Math.floor(tenths / 600)}:${((tenths % 600) / 10).toFixed(1).padStart(4, '0')}`;
 }
 
 /** "2.4 s", "350 ms", "1.20 ms", "6.7 µs". */

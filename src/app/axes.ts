@@ -92,8 +92,16 @@ export function agoSplits(start: number, end: number, step: number): number[] {
   return out;
 }
 
+/**
+ * What the end of a live graph's window is called: "now" live; "0 s" in a replay (store.ts
+ * `windowEnd`), whose window ends at the replay's position, which is not now. A word that
+ * changes only with the source: uPlot does not redraw an axis for a label alone.
+ */
+export type WindowEnd = () => string;
+const NOW: WindowEnd = () => 'now';
+
 /** The x axis of the live graphs: seconds before the window's end, in round steps that stay put. */
-export function agoAxis(): uPlot.Axis {
+export function agoAxis(end: WindowEnd = NOW): uPlot.Axis {
   const c = chartColors();
   return {
     stroke: c.axis,
@@ -101,9 +109,12 @@ export function agoAxis(): uPlot.Axis {
     ticks: { stroke: c.grid, width: 1 },
     splits: (u, _axis, min, max) => agoSplits(min, max, timeStep(max - min, u.bbox.width / devicePixelRatio)),
     values: (u, splits) => {
-      const end = u.scales.x?.max ?? 0;
+      const last = u.scales.x?.max ?? 0;
       const step = stepOf(splits);
-      return splits.map((v) => agoLabel(v - end, step));
+      return splits.map((v) => {
+        const label = agoLabel(v - last, step);
+        return label === 'now' ? end() : label;
+      });
     },
   };
 }
@@ -186,12 +197,13 @@ export function valueAxis(label: string, v: ValueScale = {}): uPlot.Axis {
   };
 }
 
-/** The hover legend's time: seconds before the window's end, to a tenth. */
-export function legendTime(u: uPlot, v: number | null): string {
-  if (v === null || !Number.isFinite(v)) return '—';
-  const end = u.scales.x?.max ?? v;
-  const s = Math.max(0, end - v);
-  return s < 0.05 ? 'now' : `−${s.toFixed(1)} s`;
+/** The hover legend's time: seconds before the window's end, to a tenth; the end as `end` calls it. */
+export function legendTimeAt(end: WindowEnd = NOW): (u: uPlot, v: number | null) => string {
+  return (u, v) => {
+    if (v === null || !Number.isFinite(v)) return '—';
+    const s = Math.max(0, (u.scales.x?.max ?? v) - v);
+    return s < 0.05 ? end() : `−${s.toFixed(1)} s`;
+  };
 }
 
 /** A legend value with its unit, or a dash where the series has no value. */

@@ -7,6 +7,7 @@
 import { batch, computed, signal } from '@preact/signals';
 import type { InspectEntry } from '../worker/inspector.js';
 import type { BindProgress, FromWorker, Overview, RecordingStatus, ReplayStatus, SourceStatus, ToWorker } from '../worker/protocol.js';
+import type { WindowEnd } from './axes.js';
 import { onFrame, wake } from './frame-loop.js';
 import { Live } from './live.js';
 import type { DiagnosisStatus } from '../worker/protocol.js';
@@ -27,6 +28,8 @@ export const overview = signal<Overview | null>(null);
 /** The replayed capture's name (null: no replay), and its length, µs: they change per capture, not with every status. */
 export const replayName = computed(() => replay.value?.name ?? null);
 export const replaySpanUs = computed(() => (replay.value === null ? 0 : replay.value.endUs - replay.value.startUs));
+/** The end of the graphs' window: now, or in a replay 0 s before its position (the replay bar's clock). */
+export const windowEnd: WindowEnd = () => (replay.peek() === null ? 'now' : '0 s');
 /** A capture's file is still being read: nothing plays, and there is no link state or finding yet (not a receiver waiting). */
 export const replayReading = computed(() => replay.value?.reading === true);
 export const notices = signal<Notice[]>([]);

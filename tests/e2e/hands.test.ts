@@ -361,7 +361,8 @@ const SIZES = [
   { name: '1280', width: 1280, height: 800 },
   { name: '1920', width: 1920, height: 1080 },
 ] as const;
-const OUT = '/tmp/shots-pageB';
+/** Where the screenshots go, beside the other browser tests' (opened and looked at, not compared). */
+const OUT = join(SHOTS, 'hands');
 
 describe.skipIf(skip !== null)('screenshots', () => {
   it('of the live demo, a replay, the inspector and the traces at 390, 1280 and 1920 px, light and dark', async () => {
@@ -380,6 +381,9 @@ describe.skipIf(skip !== null)('screenshots', () => {
           await demo.page.waitForTimeout(500);
           await demo.page.screenshot({ path: join(OUT, `demo-unfolded-${size.name}-${scheme}.png`), fullPage: true });
         }
+        // The traces draw while on screen: shot once drawn (their glitch count is then shown).
+        await demo.page.locator('.traces').scrollIntoViewIfNeeded();
+        await demo.page.getByTestId('glitch-count').waitFor();
         await demo.page.locator('.traces').screenshot({ path: join(OUT, `traces-${size.name}-${scheme}.png`) });
         await demo.page.getByRole('button', { name: 'Inspect frames…' }).click();
         await demo.page.locator('.insp-table').waitFor();
@@ -388,7 +392,10 @@ describe.skipIf(skip !== null)('screenshots', () => {
         await demo.page.context().close();
         const rep = await open({ width: size.width, height: size.height, scheme, query: '?demo=0' });
         await replayed(rep.page, spiky);
-        await rep.page.waitForTimeout(500);
+        if (size.width < 600) await rep.page.locator('.p-traces .fold-toggle').click();
+        await rep.page.locator('.traces').scrollIntoViewIfNeeded();
+        await rep.page.getByTestId('glitch-count').waitFor();
+        await rep.page.evaluate(() => window.scrollTo(0, 0));
         await rep.page.screenshot({ path: join(OUT, `replay-${size.name}-${scheme}.png`), fullPage: true });
         await rep.page.context().close();
       }

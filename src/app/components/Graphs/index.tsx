@@ -12,12 +12,12 @@ import 'uplot/dist/uPlot.min.css';
 import { layeredChart } from '../../axes-layer.js';
 import { chartTurn, onFrame } from '../../frame-loop.js';
 import type { Live, SeriesBuffer } from '../../live.js';
-import { current, status } from '../../store.js';
+import { current, status, windowEnd } from '../../store.js';
 import {
   agoAxis,
   hoverCursor,
   keyboardCursor,
-  legendTime,
+  legendTimeAt,
   legendValue,
   showNewest,
   valueAxis,
@@ -68,9 +68,9 @@ function makeChart(el: HTMLElement, spec: ChartSpec, width: number, sync: uPlot.
     cursor: hoverCursor(sync.key),
     legend: { show: true, live: true },
     scales: { x: { time: false }, y: valueScale(spec.scale) },
-    axes: [agoAxis(), valueAxis(`${spec.title} ${spec.unit}`, spec.scale)],
+    axes: [agoAxis(windowEnd), valueAxis(`${spec.title} ${spec.unit}`, spec.scale)],
     series: [
-      { label: 'Time', value: legendTime },
+      { label: 'Time', value: legendTimeAt(windowEnd) },
       {
         label: spec.title,
         stroke: spec.color,

@@ -11,11 +11,11 @@ import { REMOTE_LABELS, type SourceStatus } from '../../../worker/protocol.js';
 import { layeredChart } from '../../axes-layer.js';
 import { chartTurn, onFrame } from '../../frame-loop.js';
 import type { Live } from '../../live.js';
-import { allLives, select, selected, send, sources } from '../../store.js';
+import { allLives, select, selected, send, sources, windowEnd } from '../../store.js';
 import { setText } from '../../text.js';
 import { drawEpisodes } from '../../timeline.js';
 import { AlignedColumns } from './columns.js';
-import { agoAxis, hoverCursor, keyboardCursor, legendTime, legendValue, showNewest, valueAxis, valueScale } from '../../axes.js';
+import { agoAxis, hoverCursor, keyboardCursor, legendTimeAt, legendValue, showNewest, valueAxis, valueScale } from '../../axes.js';
 import { chartColors, theme } from '../../theme.js';
 import './style.css';
 
@@ -122,9 +122,9 @@ export function Remotes({ windowUs }: { windowUs: Signal<number> }) {
         legend: { show: true, live: true },
         cursor: hoverCursor(),
         scales: { x: { time: false }, y: valueScale(FADE_SCALE) },
-        axes: [agoAxis(), valueAxis('Fades /s', FADE_SCALE)],
+        axes: [agoAxis(windowEnd), valueAxis('Fades /s', FADE_SCALE)],
         series: [
-          { label: 'Time', value: legendTime },
+          { label: 'Time', value: legendTimeAt(windowEnd) },
           ...order.map((id, i) => ({
             label: list[i]?.label ?? String(id),
             stroke: colors[i % colors.length],

@@ -8,6 +8,7 @@ import { computed, useComputed, useSignal } from '@preact/signals';
 import { useEffect, useRef } from 'preact/hooks';
 import uPlot from 'uplot';
 import { overview, replay, replayName, replayReading, replaySpanUs, send } from '../../store.js';
+import { formatClock } from '../../../analysis/report-text.js';
 import { elapsedAxis } from '../../axes.js';
 import { chartColors, theme } from '../../theme.js';
 import { overviewColumns } from './columns.js';
@@ -25,12 +26,6 @@ const SPEEDS = [
   [4, '4×'],
   [0, 'max'],
 ] as const;
-
-/** m:ss.s, rounded to a tenth before it is split, so 59.96 s reads 1:00.0, never 0:60.0. */
-function clock(us: number): string {
-  const tenths = Math.round(Math.max(0, us / 1e5));
-  return `${Math.floor(tenths / 600)}:${((tenths % 600) / 10).toFixed(1).padStart(4, '0')}`;
-}
 
 // The replay status comes five times a second and mostly only its position moves: the bar
 // renders from the parts that change rarely, and the clock text and the slider's position are
@@ -55,7 +50,7 @@ const readingText = computed(() => {
 });
 const clockText = computed(() => {
   const r = replay.value;
-  return r === null ? '' : `${clock(r.positionUs - r.startUs)} / ${clock(Math.max(1, r.endUs - r.startUs))}`;
+  return r === null ? '' : `${formatClock(r.positionUs - r.startUs)} / ${formatClock(Math.max(1, r.endUs - r.startUs))}`;
 });
 
 export function ReplayBar() {

@@ -13,10 +13,10 @@ import type uPlot from 'uplot';
 import { SPIKE_MIN_JUMP_PERCENT, SPIKE_RETURN_PERCENT } from '../../../analysis/report-thresholds.js';
 import { CHANNEL_COUNT, channelName } from '../../../decoder/index.js';
 import { layeredChart } from '../../axes-layer.js';
-import { agoAxis, hoverCursor, keyboardCursor, legendTime, showNewest } from '../../axes.js';
+import { agoAxis, hoverCursor, keyboardCursor, legendTimeAt, showNewest } from '../../axes.js';
 import { chartTurn, onFrame, wake } from '../../frame-loop.js';
 import type { Live } from '../../live.js';
-import { current } from '../../store.js';
+import { current, windowEnd } from '../../store.js';
 import { setText } from '../../text.js';
 import { chartColors, theme } from '../../theme.js';
 import { laneUs, laneY, traceView } from '../../traces.js';
@@ -63,9 +63,9 @@ function makeChart(el: HTMLElement, channels: readonly number[], width: number, 
       cursor: hoverCursor('satscope'),
       legend: { show: true, live: true },
       scales: { x: { time: false }, y: { range: () => [0, lanes] } },
-      axes: [agoAxis(), laneAxis(channels)],
+      axes: [agoAxis(windowEnd), laneAxis(channels)],
       series: [
-        { label: 'Time', value: legendTime },
+        { label: 'Time', value: legendTimeAt(windowEnd) },
         ...channels.map((id, k) => ({
           label: channelName(id),
           stroke: c.traces[k % c.traces.length],
