@@ -5,7 +5,7 @@
  * (in order, with their formats), the same counters after every frame and every push, and the
  * same format at the end with the fast path on and off (`fastPath: false`: the general path
  * only), under every option and however the bytes come (tests/lockstep.ts compares them).
- * Streams of over a megabyte: tests/decoder.fastpath-long.test.ts.
+ * Streams of over a megabyte: tests/slow/decoder.fastpath-long.test.ts (npm run test:slow).
  */
 import { readdirSync, readFileSync, statSync } from 'node:fs';
 import { join, relative, resolve } from 'node:path';

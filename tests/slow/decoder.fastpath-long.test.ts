@@ -6,8 +6,8 @@
  * running for thousands of frames at a time; the damage sends it back to the general path.
  */
 import { describe, expect, it } from 'vitest';
-import type { DecoderOptions } from '../src/decoder/index.js';
-import { damagedStream, expectSame, FEEDS, feed, OPTIONS } from './lockstep.js';
+import type { DecoderOptions } from '../../src/decoder/index.js';
+import { damagedStream, expectSame, FEEDS, feed, OPTIONS } from '../lockstep.js';
 
 /** About 1.1 MB each: 12 min at 11 ms, 24 min at 22 ms; the options each runs under. */
 const LONG: readonly [string, number, readonly DecoderOptions[]][] = [
