@@ -104,8 +104,8 @@ interface Run {
 function satscope(args: string[]): Promise<Run> {
   const rssFile = join(dir, `rss-${Math.random().toString(36).slice(2)}`);
   return new Promise((done) => {
-    // In a process group of its own, so that a run over time is stopped whole (GNU time, the
-    // command and the process it relaunches itself in), not only its first process.
+    // In a process group of its own, so that a run over time is stopped whole (GNU time and the
+    // command), not only its first process.
     const child = spawn('/usr/bin/time', ['-f', '%M', '-o', rssFile, process.execPath, CLI, ...args], { detached: true });
     let killed = false;
     const timer = setTimeout(() => {

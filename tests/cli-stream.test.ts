@@ -10,7 +10,6 @@ import { join } from 'node:path';
 import { pathToFileURL } from 'node:url';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { preset, simulate } from '../src/simulator/index.js';
-import { COMMAND_NODE_FLAGS } from '../src/cli/relaunch.js';
 import { CLI as cli, CLI_TIMEOUT_MS, satscopeWith } from './built-cli.js';
 
 let dir = '';
@@ -45,7 +44,7 @@ const sleep = (ms: number): Promise<void> => new Promise((r) => setTimeout(r, ms
 
 describe('satscope decode into a pipe', () => {
   it('keeps its memory flat when the reader is slow, and still delivers every frame', async () => {
-    const child = spawn(process.execPath, [...COMMAND_NODE_FLAGS, join(dir, 'peak.mjs'), 'decode', big], {
+    const child = spawn(process.execPath, [join(dir, 'peak.mjs'), 'decode', big], {
       stdio: ['ignore', 'pipe', 'pipe'],
     });
     let err = '';
@@ -93,7 +92,7 @@ describe('satscope decode into a pipe', () => {
       'sh',
       [
         '-c',
-        `("${process.execPath}" ${COMMAND_NODE_FLAGS.join(' ')} "${join(dir, 'peak.mjs')}" decode "${big}" 2>"${dir}/err"; echo $? >"${dir}/rc") | head -n 3; cat "${dir}/rc" "${dir}/err"`,
+        `("${process.execPath}" "${join(dir, 'peak.mjs')}" decode "${big}" 2>"${dir}/err"; echo $? >"${dir}/rc") | head -n 3; cat "${dir}/rc" "${dir}/err"`,
       ],
       { encoding: 'utf8', timeout: CLI_TIMEOUT_MS },
     );
