@@ -367,38 +367,49 @@ const OUT = join(SHOTS, 'hands');
 describe.skipIf(skip !== null)('screenshots', () => {
   it('of the live demo, a replay, the inspector and the traces at 390, 1280 and 1920 px, light and dark', async () => {
     mkdirSync(OUT, { recursive: true });
-    for (const size of SIZES) {
-      for (const scheme of ['light', 'dark'] as const) {
-        const demo = await open({ width: size.width, height: size.height, scheme });
-        await demo.page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor({ timeout: 10_000 });
-        await demo.page.waitForTimeout(3000);
+    // One page a theme and state, resized to each width (the layout follows the width alone):
+    // the demo's 3 s of history is waited for once a theme, not once a shot.
+    for (const scheme of ['light', 'dark'] as const) {
+      const demo = await open({ width: 1920, height: 1080, scheme });
+      await demo.page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor({ timeout: 10_000 });
+      // 3 s of the demo's history (270 frames at 11 ms) in the graphs and traces.
+      await demo.page.waitForFunction(() => Number(document.querySelector('[data-testid="count-frames"]')?.textContent) >= 270);
+      for (const size of SIZES) {
+        await demo.page.setViewportSize({ width: size.width, height: size.height });
+        await demo.page.evaluate(() => window.scrollTo(0, 0));
         await demo.page.screenshot({ path: join(OUT, `demo-first-screen-${size.name}-${scheme}.png`) });
         await demo.page.screenshot({ path: join(OUT, `demo-${size.name}-${scheme}.png`), fullPage: true });
         if (size.width < 600) {
-          await demo.page.locator('.p-graphs .fold-toggle').click();
-          await demo.page.locator('.p-traces .fold-toggle').click();
+          for (const name of ['graphs', 'traces']) {
+            const toggle = demo.page.locator(`.p-${name} .fold-toggle`);
+            if ((await toggle.getAttribute('aria-expanded')) !== 'true') await toggle.click();
+          }
           await demo.page.locator('.traces canvas').waitFor();
-          await demo.page.waitForTimeout(500);
           await demo.page.screenshot({ path: join(OUT, `demo-unfolded-${size.name}-${scheme}.png`), fullPage: true });
         }
         // The traces draw while on screen: shot once drawn (their glitch count is then shown).
         await demo.page.locator('.traces').scrollIntoViewIfNeeded();
         await demo.page.getByTestId('glitch-count').waitFor();
         await demo.page.locator('.traces').screenshot({ path: join(OUT, `traces-${size.name}-${scheme}.png`) });
-        await demo.page.getByRole('button', { name: 'Inspect frames…' }).click();
-        await demo.page.locator('.insp-table').waitFor();
-        await demo.page.waitForTimeout(600);
+      }
+      await demo.page.getByRole('button', { name: 'Inspect frames…' }).click();
+      await demo.page.locator('.insp-body .row.frame').first().waitFor();
+      for (const size of SIZES) {
+        await demo.page.setViewportSize({ width: size.width, height: size.height });
         await demo.page.locator('.p-inspector').screenshot({ path: join(OUT, `inspector-${size.name}-${scheme}.png`) });
-        await demo.page.context().close();
-        const rep = await open({ width: size.width, height: size.height, scheme, query: '?demo=0' });
-        await replayed(rep.page, spiky);
-        if (size.width < 600) await rep.page.locator('.p-traces .fold-toggle').click();
+      }
+      await demo.page.context().close();
+      const rep = await open({ width: 390, height: 844, scheme, query: '?demo=0' });
+      await replayed(rep.page, spiky);
+      await rep.page.locator('.p-traces .fold-toggle').click();
+      for (const size of SIZES) {
+        await rep.page.setViewportSize({ width: size.width, height: size.height });
         await rep.page.locator('.traces').scrollIntoViewIfNeeded();
         await rep.page.getByTestId('glitch-count').waitFor();
         await rep.page.evaluate(() => window.scrollTo(0, 0));
         await rep.page.screenshot({ path: join(OUT, `replay-${size.name}-${scheme}.png`), fullPage: true });
-        await rep.page.context().close();
       }
+      await rep.page.context().close();
     }
   }, 240_000);
 });
