@@ -497,9 +497,11 @@ describe.skipIf(skip !== null)('the page on any screen', () => {
 
   it('takes screenshots of the demo, a replay and the empty state at three sizes in both themes, none wider than its viewport', async () => {
     const report: string[] = [];
-    for (const size of SIZES) {
-      for (const scheme of THEMES) {
-        const shoot = async (page: Page, state: string) => {
+    // One page a theme and state, resized to each width (the layout follows the width alone).
+    for (const scheme of THEMES) {
+      const shootAll = async (page: Page, state: string) => {
+        for (const size of SIZES) {
+          await page.setViewportSize({ width: size.width, height: size.height });
           const w = await widths(page);
           report.push(`${size.name} ${scheme} ${state}: document ${w.document} / viewport ${w.viewport}`);
           expect(w.document, `${state} ${size.name} ${scheme}`).toBe(w.viewport);
@@ -508,24 +510,24 @@ describe.skipIf(skip !== null)('the page on any screen', () => {
             expect(h, `toolbar at ${size.name} (${state})`).toBeLessThan(56);
           }
           await shot(page, `ui-${state}-${size.name}-${scheme}`);
-        };
-        const empty = await open({ width: size.width, height: size.height, scheme, query: '?demo=0' });
-        await empty.page.getByTestId('empty-state').waitFor();
-        await shoot(empty.page, 'empty');
-        await empty.page.context().close();
+        }
+      };
+      const empty = await open({ width: 390, height: 844, scheme, query: '?demo=0' });
+      await empty.page.getByTestId('empty-state').waitFor();
+      await shootAll(empty.page, 'empty');
+      await empty.page.context().close();
 
-        const demo = await open({ width: size.width, height: size.height, scheme });
-        await demoRunning(demo.page);
-        await demo.page.waitForTimeout(4000);
-        await shoot(demo.page, 'demo');
-        await demo.page.context().close();
+      const demo = await open({ width: 390, height: 844, scheme });
+      await demoRunning(demo.page);
+      // 4 s of the demo's history (360 frames at 11 ms) in the graphs.
+      await demo.page.waitForFunction(() => Number(document.querySelector('[data-testid="count-frames"]')?.textContent) >= 360);
+      await shootAll(demo.page, 'demo');
+      await demo.page.context().close();
 
-        const rep = await open({ width: size.width, height: size.height, scheme, query: '?demo=0' });
-        await replayed(rep.page, capture);
-        await rep.page.waitForTimeout(500);
-        await shoot(rep.page, 'replay');
-        await rep.page.context().close();
-      }
+      const rep = await open({ width: 390, height: 844, scheme, query: '?demo=0' });
+      await replayed(rep.page, capture);
+      await shootAll(rep.page, 'replay');
+      await rep.page.context().close();
     }
     console.log(report.join('\n'));
   }, 240_000);
