@@ -55,7 +55,9 @@ describe('the overview in the timeline’s columns', () => {
       const byColumn = new Map<number, number[]>();
       for (let b = 0; b < n; b++) {
         const c = Math.floor((b / n) * columns);
-        byColumn.set(c, [...(byColumn.get(c) ?? []), b]);
+        const bins = byColumn.get(c);
+        if (bins === undefined) byColumn.set(c, [b]);
+        else bins.push(b);
       }
       const want = [...byColumn.values()];
       expect(got.x).toEqual(want.map((bins) => (o.t[bins[0] ?? 0] ?? 0) / 1e6));
@@ -63,7 +65,8 @@ describe('the overview in the timeline’s columns', () => {
       expect(got.fadeRate).toEqual(want.map((bins) => most(bins.map((b) => o.fadeRate[b] ?? 0))));
       // Nothing drawn that no second had, and the worst second of all still there.
       expect(Math.max(...got.lost)).toBe(Math.max(...o.lost));
-      for (const v of got.fadeRate) if (!Number.isNaN(v)) expect(o.fadeRate).toContain(v);
+      const rates = new Set(o.fadeRate);
+      expect(got.fadeRate.filter((v) => !Number.isNaN(v) && !rates.has(v))).toEqual([]);
     }
   });
 
