@@ -3,6 +3,7 @@
  * from the simulator, checked against its ground truth; and on the real PX4 captures when they
  * are beside the repository. The CLI tests need `npm run build:lib` first (`npm test` does it).
  */
+import { DATA_COLORS } from '../src/analysis/palette.js';
 import { existsSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
@@ -506,7 +507,7 @@ describe('healthReport: several ports on one clock', () => {
     expect(html).toContain('tail &lt;b&gt;: lost frames /s');
     expect(html).not.toContain('tail <b>');
     // Red failsafe bands in each of a remote's panels (lost frames and fades).
-    const bands = (html.match(/fill="rgba\(214, 40, 40, 0.28\)"/g) ?? []).length;
+    const bands = html.split(`fill="${DATA_COLORS.light.failsafeBand}"`).length - 1;
     expect(bands).toBe(2 * (r1.failsafes.length + r2.failsafes.length) + 1); // + the legend swatch
   });
 });
@@ -544,7 +545,7 @@ describe('reportHtml', () => {
     for (const f of report.verdict) expect(html).toContain(escapeHtml(f.text));
     expect(html).toContain('lost frames /s');
     expect(html).toContain('fades /s');
-    expect(html).toMatch(/fill="rgba\(214, 40, 40, 0.28\)"/);
+    expect(html).toContain(`fill="${DATA_COLORS.light.failsafeBand}"`);
     expect(html).toMatch(/<h3>Failsafe episodes<\/h3>/);
     expect(html).toMatch(/Throttle/);
     expect(html).toMatch(/@page/);

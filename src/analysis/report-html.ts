@@ -3,6 +3,7 @@
  * fetched, one printed page. Rendering only: the figures come from `healthReport`.
  */
 import { XPLUS_FIRST, channelName, type ResolutionReason } from '../decoder/index.js';
+import { DATA_COLORS } from './palette.js';
 import { RSSI_LOW_DBM } from './report-thresholds.js';
 import { formatClock, formatDuration, pctText, plural, rate } from './report-text.js';
 import type { FindingLevel, HealthReport, RemoteReport, ReportStatus } from './report-types.js';
@@ -12,14 +13,11 @@ export function escapeHtml(text: string): string {
   return text.replace(/[&<>"']/g, (c) => (c === '&' ? '&amp;' : c === '<' ? '&lt;' : c === '>' ? '&gt;' : c === '"' ? '&quot;' : '&#39;'));
 }
 
+/** The page's light palette (palette.ts), and what only the printed report draws. */
 const COLORS = {
-  fades: '#2f6fb7',
-  lost: '#d9822b',
-  rssi: '#2e8b57',
-  rssiMin: '#9ccfb1',
+  ...DATA_COLORS.light,
   hold: 'rgba(230, 170, 30, 0.45)',
-  failsafe: 'rgba(214, 40, 40, 0.28)',
-  failsafeEdge: '#d62828',
+  failsafe: DATA_COLORS.light.failsafeBand,
   grid: '#e3e3e3',
   axis: '#777',
   text: '#333',

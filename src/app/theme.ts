@@ -5,6 +5,7 @@
  * their colours from `chartColors()` and are rebuilt when `theme` changes.
  */
 import { computed, signal } from '@preact/signals';
+import { type DataColors, DATA_COLORS } from '../analysis/palette.js';
 
 export type Theme = 'light' | 'dark';
 
@@ -47,50 +48,35 @@ export function setTheme(choice: Theme | null): void {
   }
 }
 
-export interface ChartColors {
+/** The graphs' colours: the data's (palette.ts, shared with the report) and the chart's own. */
+export interface ChartColors extends DataColors {
   axis: string;
   grid: string;
   cursor: string;
-  fades: string;
-  rssi: string;
-  period: string;
-  lost: string;
-  failsafeBand: string;
   remotes: string[];
-  /** The channel traces, one a lane (cycled), and the glitch marks over them. */
+  /** The channel traces, one a lane (cycled); the glitch marks over them are the palette's. */
   traces: string[];
-  glitch: string;
   /** The shade of every other lane of the traces. */
   lane: string;
 }
 
 const DARK: ChartColors = {
+  ...DATA_COLORS.dark,
   axis: '#8a97a8',
   grid: '#1e2835',
   cursor: '#8a97a8',
-  fades: '#f0b429',
-  rssi: '#7cc4ff',
-  period: '#4fd1a5',
-  lost: '#ff6b6b',
-  failsafeBand: 'rgba(255,60,60,0.25)',
   remotes: ['#4fd1a5', '#f0b429', '#7cc4ff', '#ff8fab', '#c3a6ff'],
   traces: ['#7cc4ff', '#4fd1a5', '#f0b429', '#c3a6ff'],
-  glitch: '#ff4d4f',
   lane: 'rgba(140,160,190,0.07)',
 };
 
 const LIGHT: ChartColors = {
+  ...DATA_COLORS.light,
   axis: '#4f5b6b',
   grid: '#e3e8ee',
   cursor: '#4f5b6b',
-  fades: '#b7791f',
-  rssi: '#1f6fd1',
-  period: '#0a7d5a',
-  lost: '#d1343a',
-  failsafeBand: 'rgba(209,52,58,0.16)',
   remotes: ['#0a7d5a', '#b7791f', '#1f6fd1', '#c2185b', '#7048e8'],
   traces: ['#1f6fd1', '#0a7d5a', '#a0660f', '#7048e8'],
-  glitch: '#d1343a',
   lane: 'rgba(60,80,110,0.05)',
 };
 
