@@ -77,6 +77,12 @@ export interface WalkOptions {
   /** Whether event records have their CRC-32 checked. Default: they are skipped unread. */
   eventsChecked?: boolean;
   /**
+   * Gets each event record in the file's order among the data records (its text is
+   * `bytes[start, end)`, UTF-8; its time `recordTimeUs`), after its CRC-32 was checked: set, it
+   * makes `eventsChecked` true (an event from a damaged record is never told).
+   */
+  events?: RecordSink;
+  /**
    * Gets each run of whole records walked, events too: `bytes[from, to)` of a slice, records one
    * after the other, their headers checked (and their CRCs, as asked), after `sink` has had them.
    */
@@ -93,7 +99,8 @@ export interface WalkOptions {
  *   checked fails its CRC (the file is not intact: parseCapture salvages it)
  */
 export async function walkDataRecords(file: SlicedFile, sink: RecordSink, options: WalkOptions = {}): Promise<WalkedRecords | null> {
-  const { goOn = () => true, checked = () => false, eventsChecked = false, runs, sliceBytes = SLICE_BYTES } = options;
+  const { goOn = () => true, checked = () => false, events, runs, sliceBytes = SLICE_BYTES } = options;
+  const eventsChecked = options.eventsChecked === true || events !== undefined;
   const size = file.size;
   const read = async (from: number, length: number): Promise<Uint8Array> => {
     const to = Math.min(size, from + length);
@@ -130,7 +137,7 @@ export async function walkDataRecords(file: SlicedFile, sink: RecordSink, option
   for (;;) {
     const n = bytes.length;
     const run = p;
-    p = walkRun(bytes, view, p, at, sink, checked, eventsChecked, count);
+    p = walkRun(bytes, view, p, at, sink, checked, eventsChecked, count, events);
     if (p > run) runs?.(bytes, view, run, p);
     if (queued !== null) {
       if (p !== n) throw new CaptureFormatError(`no intact record at offset ${at + p}`);
@@ -200,6 +207,7 @@ function walkRun(
   checked: (port: number) => boolean,
   eventsChecked: boolean,
   count: WalkCount,
+  events: RecordSink | undefined,
 ): number {
   const n = bytes.length;
   let p = from;
@@ -216,7 +224,7 @@ function walkRun(
       sink(bytes, view, p + RECORD_HEADER_SIZE, end, port);
       count.chunks++;
       count.dataBytes += total - RECORD_OVERHEAD;
-    }
+    } else events?.(bytes, view, p + RECORD_HEADER_SIZE, end, port);
     p += total;
   }
   return p;

@@ -5,7 +5,16 @@
  * report, then the same at the end with the count of chunks and bytes it walked, which the
  * worker checks against the capture it reads.
  */
-import { CaptureBuilder, type ChunkFacts, type ParsedCapture, RecordTally, type SlicedFile, walkDataRecords } from '../../capture/index.js';
+import {
+  CaptureBuilder,
+  type ChunkFacts,
+  type ParsedCapture,
+  RecordTally,
+  recordTimeUs,
+  type SlicedFile,
+  walkDataRecords,
+} from '../../capture/index.js';
+import { stopsPort } from '../../analysis/doctor-events.js';
 import { type CaptureSpan, spanBetween } from '../../analysis/index.js';
 import { BYTE_TIME_US } from '../../decoder/index.js';
 import type { Overview } from '../protocol.js';
@@ -67,6 +76,8 @@ export type FilePassReport =
 /** The capture's chunk facts and span, as a file pass found them walking its records. */
 export type WalkedFacts = ChunkFacts & { span: CaptureSpan };
 
+const utf8 = new TextDecoder();
+
 /** A report at most this often: the worker draws the overview about once a second. */
 const PROGRESS_MS = 250;
 
@@ -121,7 +132,10 @@ export async function passOverFile(
     const walked = await walkDataRecords(file, (bytes, view, start, end, port) => pass.feedRecord(bytes, view, start, end, port), {
       goOn,
       checked,
-      ...(kept === null ? {} : { eventsChecked: true }),
+      // A recorded stop ("device lost") is the adapter's absence, not the link's (LinkMonitor.stopped).
+      events: (bytes, view, start, end, port) => {
+        if (stopsPort(utf8.decode(bytes.subarray(start, end)))) pass.stopped(port, recordTimeUs(view, start));
+      },
       ...(kept === null && tally === null
         ? {}
         : {

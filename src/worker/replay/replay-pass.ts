@@ -214,6 +214,14 @@ export class ReplayPass implements OverviewPass {
     this.#chunk++;
   }
 
+  /**
+   * A recorded stop ("device lost") of `port` at `atUs`, in a file walked record by record
+   * (`feedRecord`): told to its link before the next chunk, as `step` tells a capture's.
+   */
+  stopped(port: number, atUs: number): void {
+    this.#byPort[port]?.link.stopped(atUs);
+  }
+
   /** Tells each link its recorded stops before the capture's chunk `chunk` (`LinkMonitor.stopped`). */
   #stopsBefore(chunk: number): void {
     for (let e = this.#stops[this.#nextStop]; e !== undefined && e.chunkIndex <= chunk; e = this.#stops[++this.#nextStop])
