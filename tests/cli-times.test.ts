@@ -167,11 +167,10 @@ describe('a file of 2 GiB or more', () => {
     } finally {
       closeSync(fd);
     }
-    const child = spawnSync(
-      'sh',
-      ['-c', `"${process.execPath}" "${join(dir, 'peak.mjs')}" decode "${file}" | head -n 3`],
-      { encoding: 'utf8', timeout: RUN_MS },
-    );
+    const child = spawnSync('sh', ['-c', `"${process.execPath}" "${join(dir, 'peak.mjs')}" decode "${file}" | head -n 3`], {
+      encoding: 'utf8',
+      timeout: RUN_MS,
+    });
     expect(child.status).toBe(0);
     expect(child.stdout.trim().split('\n')).toHaveLength(3);
     expect(child.stdout).toMatch(/^\{"t": null, "remote": "internal"/);
