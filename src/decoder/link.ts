@@ -336,7 +336,7 @@ export class LinkMonitor {
       if (info) {
         this.#settleStats(); // the period owed is the one measured with the nominal period before
         this.#systemByte = frame.system;
-        this.#systemPeriod = info.periodMs === 11 ? FRAME_PERIOD_11MS_US : FRAME_PERIOD_22MS_US;
+        this.#systemPeriod = info.periodUs;
         s.nominalPeriodUs = this.#systemPeriod;
       }
     }

@@ -66,16 +66,46 @@ export interface SystemInfo {
   readonly value: number;
   readonly protocol: 'DSM2' | 'DSMX';
   readonly periodMs: 11 | 22;
+  /** The same frame period in µs (FRAME_PERIOD_11MS_US or FRAME_PERIOD_22MS_US): the one place a system byte gives it. */
+  readonly periodUs: number;
   readonly resolution: Resolution;
   /** e.g. "DSMX 11 ms 2048". */
   readonly name: string;
 }
 
 const SYSTEMS: readonly SystemInfo[] = [
-  { value: SYSTEM_DSM2_22MS_1024, protocol: 'DSM2', periodMs: 22, resolution: 1024, name: 'DSM2 22 ms 1024' },
-  { value: SYSTEM_DSM2_11MS_2048, protocol: 'DSM2', periodMs: 11, resolution: 2048, name: 'DSM2 11 ms 2048' },
-  { value: SYSTEM_DSMX_22MS_2048, protocol: 'DSMX', periodMs: 22, resolution: 2048, name: 'DSMX 22 ms 2048' },
-  { value: SYSTEM_DSMX_11MS_2048, protocol: 'DSMX', periodMs: 11, resolution: 2048, name: 'DSMX 11 ms 2048' },
+  {
+    value: SYSTEM_DSM2_22MS_1024,
+    protocol: 'DSM2',
+    periodMs: 22,
+    periodUs: FRAME_PERIOD_22MS_US,
+    resolution: 1024,
+    name: 'DSM2 22 ms 1024',
+  },
+  {
+    value: SYSTEM_DSM2_11MS_2048,
+    protocol: 'DSM2',
+    periodMs: 11,
+    periodUs: FRAME_PERIOD_11MS_US,
+    resolution: 2048,
+    name: 'DSM2 11 ms 2048',
+  },
+  {
+    value: SYSTEM_DSMX_22MS_2048,
+    protocol: 'DSMX',
+    periodMs: 22,
+    periodUs: FRAME_PERIOD_22MS_US,
+    resolution: 2048,
+    name: 'DSMX 22 ms 2048',
+  },
+  {
+    value: SYSTEM_DSMX_11MS_2048,
+    protocol: 'DSMX',
+    periodMs: 11,
+    periodUs: FRAME_PERIOD_11MS_US,
+    resolution: 2048,
+    name: 'DSMX 11 ms 2048',
+  },
 ];
 
 /** §8.3: the protocol a system byte names, or `undefined` for any other value. */

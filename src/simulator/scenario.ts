@@ -292,7 +292,7 @@ export function resolveScenario(s: Scenario): ResolvedScenario {
     frameJitterUs: finite('timing.frameJitterUs', name, to.frameJitterUs ?? 8, 0, 500),
     byteJitterUs: finite('timing.byteJitterUs', name, to.byteJitterUs ?? 0.02, 0, 5),
   };
-  const periodUs = info.periodMs * 1000;
+  const periodUs = info.periodUs;
   // Frame, jitter and a noise burst must fit in one period so byte times stay in order.
   if (FRAME_SIZE * timing.byteTimeUs + 2 * timing.frameJitterUs + 2000 > periodUs) {
     fail(name, 'byteTimeUs and frameJitterUs leave no idle gap between frames');

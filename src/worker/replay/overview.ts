@@ -39,7 +39,7 @@ export function overviewBinUs(spanUs: number): number {
 /** The frame period a decoder's format implies (its system byte, or 1024 resolution: 22 ms), NaN when it implies none. */
 function periodOf(format: FormatInfo): number {
   const info = format.system === null ? undefined : systemInfo(format.system);
-  if (info !== undefined) return info.periodMs === 11 ? FRAME_PERIOD_11MS_US : FRAME_PERIOD_22MS_US;
+  if (info !== undefined) return info.periodUs;
   return format.resolution === 1024 ? FRAME_PERIOD_22MS_US : Number.NaN;
 }
 
