@@ -521,6 +521,17 @@ describe('a recorded unplug', () => {
     expect([silent.holds, silent.failsafes]).toEqual([1, 1]);
     expect(silent.missedFrames).toBeGreaterThan(150);
   });
+
+  it('is said in the report, where and for how long, and nothing is said without it', () => {
+    const said = (c: Capture) =>
+      healthReport(c)
+        .verdict.filter((f) => f.code === 'adapter-away')
+        .map((f) => f.text);
+    const [text, ...more] = said(unplugged(11, 2e6, 4e6));
+    expect(more).toEqual([]);
+    expect(text).toMatch(/^Port 0: the adapter was unplugged 1 time \(2\.0 s in all, from 0:02\.0\); nothing is counted for that time$/);
+    expect(said(unplugged(11, 2e6, 4e6, false))).toEqual([]);
+  });
 });
 
 describe('the doctor states what info and the report state', () => {

@@ -37,6 +37,35 @@ export function recordedStops(capture: Capture): RecordedStop[] {
     .sort((a, b) => a.chunkIndex - b.chunkIndex);
 }
 
+/** A time the adapter was away: from a recorded stop to the port's next recorded data (or the capture's last), µs. */
+export interface Absence {
+  readonly port: number;
+  readonly fromUs: number;
+  readonly toUs: number;
+}
+
+/**
+ * The capture's recorded stops as absences, each until the port's next data chunk recorded
+ * after it, or `endUs` (the capture's end) when none came; stops without a time are left out.
+ */
+export function recordedAbsences(capture: Capture, endUs: number): Absence[] {
+  const { chunkPorts, chunkTimesUs } = capture;
+  const out: Absence[] = [];
+  for (const stop of recordedStops(capture)) {
+    if (!Number.isFinite(stop.timeUs)) continue;
+    let toUs = endUs;
+    for (let i = stop.chunkIndex; i < chunkPorts.length; i++) {
+      const t = chunkTimesUs[i] ?? Number.NaN;
+      if (chunkPorts[i] === stop.port && Number.isFinite(t)) {
+        toUs = t;
+        break;
+      }
+    }
+    out.push({ port: stop.port, fromUs: stop.timeUs, toUs: Math.max(stop.timeUs, toUs) });
+  }
+  return out;
+}
+
 /**
  * Feeds one recorded event to a doctor: "port opened" / "device reconnected" (optionally
  * "… at 420000 baud") opens the port, "device lost" / "port closed" closes it, and a text that

@@ -27,7 +27,8 @@ export type FindingCode =
   | 'chunk-timing'
   | 'restarts'
   | 'delivery'
-  | 'file-issues';
+  | 'file-issues'
+  | 'adapter-away';
 
 /** One plain-English finding. */
 export interface ReportFinding {

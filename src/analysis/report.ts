@@ -18,7 +18,8 @@ import { decodePort, type PortPass } from './report-port.js';
 import { adoptPortMessage, type PortReadingMessage } from './report-port-message.js';
 import { LEVEL_ORDER, remoteFindings, statusOf } from './report-findings.js';
 import { fadesPerMinute, MAX_LISTED_HOLDS, REPORT_BIN_US, REPORT_THRESHOLDS } from './report-thresholds.js';
-import { finite, plural, r1, r1n, r3 } from './report-text.js';
+import { finite, formatClock, formatDuration, plural, r1, r1n, r3 } from './report-text.js';
+import { recordedAbsences } from './doctor-events.js';
 import type {
   HealthReport,
   HealthReportOptions,
@@ -258,6 +259,19 @@ export function healthReportFeeding(
       code: 'file-issues',
       port: null,
       text: `The file is damaged: ${plural(capture.issues.length, 'part')} skipped (${capture.issues[0]?.message ?? ''})`,
+    });
+  }
+  // A recorded unplug: the link counts nothing for it (LinkMonitor.stopped); the report says where it was.
+  const away = hasClock ? recordedAbsences(capture, span.endUs) : [];
+  for (const port of [...new Set(away.map((a) => a.port))]) {
+    const mine = away.filter((a) => a.port === port);
+    const total = mine.reduce((sum, a) => sum + (a.toUs - a.fromUs), 0);
+    const label = remotes.find((r) => r.port === port)?.label ?? `Port ${port}`;
+    verdict.push({
+      level: 'info',
+      code: 'adapter-away',
+      port,
+      text: `${label}: the adapter was unplugged ${plural(mine.length, 'time')} (${formatDuration(total)} in all, from ${formatClock((mine[0]?.fromUs ?? origin) - origin)}); nothing is counted for that time`,
     });
   }
   if (ports.length === 0) {
