@@ -4,6 +4,7 @@
  * rebinds, restarts).
  */
 import { systemInfo, type FormatInfo, type LinkStats, type Resolution } from '../decoder/index.js';
+import { becameFailsafe } from '../decoder/link.js';
 import { fadesPerMinute, REPORT_THRESHOLDS } from './report-thresholds.js';
 import { formatDuration, plural, rate as rateText } from './report-text.js';
 import { ARDUPILOT_GUESS_FRAMES, bindPulses, channelSetText, satelliteSettings } from './doctor-stacks.js';
@@ -186,7 +187,7 @@ export function satelliteFindings(p: PortState, now: number, ctx: RuleContext, a
   const restarts = link.restarts.filter((r) => r.timeUs >= memoryStart);
   const byRestart = (e: { lastFrameUs: number }) => restarts.some((r) => r.timeUs - r.gapUs === e.lastFrameUs);
   const linkFailsafes = failsafes.filter((e) => !byRestart(e));
-  const linkHolds = holds.filter((e) => !failsafes.some((f) => f.lastFrameUs === e.lastFrameUs) && !byLine(e) && !byRestart(e));
+  const linkHolds = holds.filter((e) => !becameFailsafe(e.lastFrameUs, failsafes) && !byLine(e) && !byRestart(e));
   const rate = fadeRateOf(p, s, now, ctx);
   const fadeHigh = format.headerMode === 'fades' && rate !== null && rate.perMinute > REPORT_THRESHOLDS.fadeRateHighPerMin && rate.enough;
   const rssiLow = Number.isFinite(s.minRssi) && s.minRssi < REPORT_THRESHOLDS.rssiLowDbm;
@@ -199,8 +200,8 @@ export function satelliteFindings(p: PortState, now: number, ctx: RuleContext, a
       });
     if (holds.length > 0) {
       const last = holds[holds.length - 1] as (typeof holds)[number];
-      const became = holds.filter((e) => failsafes.some((f) => f.lastFrameUs === e.lastFrameUs)).length;
-      const restarted = holds.filter((e) => byRestart(e) && !failsafes.some((f) => f.lastFrameUs === e.lastFrameUs)).length;
+      const became = holds.filter((e) => becameFailsafe(e.lastFrameUs, failsafes)).length;
+      const restarted = holds.filter((e) => byRestart(e) && !becameFailsafe(e.lastFrameUs, failsafes)).length;
       const line = holds.length - became - restarted - linkHolds.length;
       const parts = [
         became > 0 ? `${became} of them became ${became === 1 ? 'a failsafe' : 'failsafes'}` : '',
@@ -259,7 +260,7 @@ export function satelliteFindings(p: PortState, now: number, ctx: RuleContext, a
   }
   if (restarts.length > 0) {
     const r = restarts[restarts.length - 1] as (typeof restarts)[number];
-    const failsafe = restarts.some((x) => failsafes.some((f) => f.lastFrameUs === x.timeUs - x.gapUs));
+    const failsafe = restarts.some((x) => becameFailsafe(x.timeUs - x.gapUs, failsafes));
     add({
       code: 'receiver-restart',
       ports: [p.port],

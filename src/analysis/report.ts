@@ -11,6 +11,7 @@
 import type { Capture } from '../capture/index.js';
 import { capturePorts } from '../capture/index.js';
 import { CHANNEL_COUNT, channelName, systemInfo, type LinkEpisode, type Resolution } from '../decoder/index.js';
+import { becameFailsafe } from '../decoder/link.js';
 import { captureSpan } from './capture-span.js';
 import type { Doctor } from './doctor.js';
 import { looksInternal, readPorts } from './resolution-key.js';
@@ -142,7 +143,7 @@ export function healthReportFeeding(
     const holdEpisodes = hasClock ? episodes.filter((e) => e.kind === 'hold').map((e) => episodeOf(e, origin, end)) : [];
     // A hold that became a failsafe ends where the failsafe starts, after the same last frame;
     // one still open at the end of the capture did not recover either.
-    const recovered = holdEpisodes.filter((h) => !h.ongoing && !failsafes.some((f) => f.lastFrameUs === h.lastFrameUs));
+    const recovered = holdEpisodes.filter((h) => !h.ongoing && !becameFailsafe(h.lastFrameUs, failsafes));
     let longestHold: ReportEpisode | null = null;
     for (const e of recovered) if (longestHold === null || e.durationUs > longestHold.durationUs) longestHold = e;
 

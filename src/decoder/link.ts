@@ -157,6 +157,15 @@ export function isFrameInterval(intervalUs: number, nominalPeriodUs: number, jit
   return intervalUs <= 1.5 * nominalPeriodUs + jitterUs;
 }
 
+/**
+ * Whether a hold (or any silence, given by the frame before it) became a failsafe: one of
+ * `failsafes` follows the same last frame, as the monitor opens one when a hold passes
+ * FAILSAFE_TIMEOUT_US. Every surface that tells holds from failsafes asks this.
+ */
+export function becameFailsafe(lastFrameUs: number, failsafes: readonly { readonly lastFrameUs: number }[]): boolean {
+  return failsafes.some((f) => f.lastFrameUs === lastFrameUs);
+}
+
 /** The gap after which the link is in hold: `HOLD_MIN_US` or 2.5 periods, whichever is longer, plus the delivery jitter. */
 export function holdThresholdUs(nominalPeriodUs: number, jitterUs: number): number {
   const base = Number.isFinite(nominalPeriodUs) ? Math.max(HOLD_MIN_US, 2.5 * nominalPeriodUs) : HOLD_MIN_US;
