@@ -534,6 +534,17 @@ describe('a recorded unplug', () => {
   });
 });
 
+/** A truth: nothing was lost (no hold, failsafe or missed frame in info, no weak link from the doctor). */
+function nothingLost(capture: Capture): string[] {
+  const { link } = summarizeCapture(capture);
+  const codes = doctorCapture(capture).findings.map((f) => f.code);
+  const wrong = [];
+  if (link.holds + link.failsafes + link.missedFrames > 0)
+    wrong.push(`${link.holds} holds, ${link.failsafes} failsafes, ${link.missedFrames} missed`);
+  if (codes.includes('weak-link')) wrong.push(`doctor: ${codes.join(', ')}`);
+  return wrong;
+}
+
 describe('the doctor states what info and the report state', () => {
   /** What the truth of a class says besides the surfaces agreeing: every disagreement in words. */
   type Truth = (capture: Capture) => string[];
@@ -609,17 +620,9 @@ describe('the doctor states what info and the report state', () => {
       name: 'recordings with the adapter unplugged ("device lost"), 0.3 to 3 s',
       captures: () =>
         [0.3e6, 1.2e6, 3e6].map((us, i) => ({ name: `unplugged ${us / 1e3} ms`, capture: unplugged(20 + i, 1.5e6, 1.5e6 + us) })),
-      // The adapter was away: no hold, failsafe or missed frame, no weak link; the same chunks
-      // without the events (a silence the recording does not explain) are a hold.
-      truth: (capture) => {
-        const { link } = summarizeCapture(capture);
-        const codes = doctorCapture(capture).findings.map((f) => f.code);
-        const wrong = [];
-        if (link.holds + link.failsafes + link.missedFrames > 0)
-          wrong.push(`${link.holds} holds, ${link.failsafes} failsafes, ${link.missedFrames} missed`);
-        if (codes.includes('weak-link')) wrong.push(`doctor: ${codes.join(', ')}`);
-        return wrong;
-      },
+      // The adapter was away: nothing lost (the same chunks without the events are a failsafe:
+      // 'a recorded unplug' below).
+      truth: nothingLost,
     },
     {
       name: 'USB stalls: frames held back and delivered at once, on receivers with and without a counter',
@@ -631,16 +634,7 @@ describe('the doctor states what info and the report state', () => {
             capture: sscap(heldBack(s, c.stallUs, 2e6, 1e6 + ((c.seed * 123_457) % 500_000))),
           };
         }),
-      // Nothing was lost: no hold, no failsafe, no missed frame, no weak link.
-      truth: (capture) => {
-        const { link } = summarizeCapture(capture);
-        const codes = doctorCapture(capture).findings.map((f) => f.code);
-        const wrong = [];
-        if (link.holds + link.failsafes + link.missedFrames > 0)
-          wrong.push(`${link.holds} holds, ${link.failsafes} failsafes, ${link.missedFrames} missed`);
-        if (codes.includes('weak-link')) wrong.push(`doctor: ${codes.join(', ')}`);
-        return wrong;
-      },
+      truth: nothingLost,
     },
   );
   if (present)
