@@ -7,9 +7,10 @@
  * only), under every option and however the bytes come (tests/lockstep.ts compares them).
  * Streams of over a megabyte: tests/slow/decoder.fastpath-long.test.ts (npm run test:slow).
  */
-import { readdirSync, readFileSync, statSync } from 'node:fs';
-import { join, relative, resolve } from 'node:path';
+import { readdirSync, readFileSync } from 'node:fs';
+import { join, relative } from 'node:path';
 import { describe, expect, it } from 'vitest';
+import { CAPTURE_DIR, filesUnder } from './shared-captures.js';
 import { CaptureFormatError, captureChunks, capturePorts, readCapture } from '../src/capture/index.js';
 import { CLEAN_PRESETS } from './damage.js';
 import { damagedStream, expectSame, FEEDS, feed, OPTIONS } from './lockstep.js';
@@ -19,21 +20,7 @@ const fixtures = readdirSync(fixtureDir)
   .filter((f) => f.endsWith('.bin'))
   .map((f) => f.replace('.bin', ''));
 
-/** Every file under `dir`, recursively, relative to it. */
-function filesUnder(dir: string): string[] {
-  let entries: string[];
-  try {
-    entries = readdirSync(dir);
-  } catch {
-    return [];
-  }
-  return entries.flatMap((name) => {
-    const path = join(dir, name);
-    return statSync(path).isDirectory() ? filesUnder(path).map((f) => join(name, f)) : [name];
-  });
-}
-
-const captureDir = resolve(import.meta.dirname, '../../shared/captures');
+const captureDir = CAPTURE_DIR;
 const captureFiles = filesUnder(captureDir);
 
 describe('the fast path gives what the general path gives', () => {

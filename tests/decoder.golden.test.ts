@@ -9,9 +9,10 @@
  * again: only for a change of output that is meant, said in its commit.
  */
 import { createHash } from 'node:crypto';
-import { readdirSync, readFileSync, statSync } from 'node:fs';
-import { join, resolve } from 'node:path';
+import { readdirSync, readFileSync } from 'node:fs';
+import { join } from 'node:path';
 import { describe, expect, it } from 'vitest';
+import { CAPTURE_DIR, filesUnder } from './shared-captures.js';
 import { captureChunks, capturePorts, readCapture } from '../src/capture/index.js';
 import { type DecodedFrame, type DecoderEvent, type DecoderOptions, SpektrumDecoder } from '../src/decoder/index.js';
 import { CLEAN_PRESETS } from './damage.js';
@@ -93,19 +94,7 @@ const fixtures = readdirSync(fixtureDir)
   .filter((f) => f.endsWith('.bin'))
   .map((f) => f.replace('.bin', ''));
 
-function filesUnder(dir: string): string[] {
-  let entries: string[];
-  try {
-    entries = readdirSync(dir);
-  } catch {
-    return [];
-  }
-  return entries.flatMap((name) => {
-    const path = join(dir, name);
-    return statSync(path).isDirectory() ? filesUnder(path).map((f) => join(name, f)) : [name];
-  });
-}
-const captureDir = resolve(import.meta.dirname, '../../shared/captures');
+const captureDir = CAPTURE_DIR;
 const captures = filesUnder(captureDir).filter((f) => !/\.md$/i.test(f) && !/readme/i.test(f));
 
 describe("the decoder's output is what tests/golden/ holds", () => {
