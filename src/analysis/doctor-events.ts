@@ -37,6 +37,30 @@ export function recordedStops(capture: Capture): RecordedStop[] {
     .sort((a, b) => a.chunkIndex - b.chunkIndex);
 }
 
+/**
+ * A cursor over recorded stops by the capture's chunk they came before: a pass over the chunks
+ * takes those before each chunk once (nothing allocated: it runs for every chunk fed), and a
+ * seek puts it back.
+ */
+export class StopCursor {
+  #next = 0;
+  constructor(readonly stops: readonly RecordedStop[]) {}
+
+  /** The next stop recorded before the capture's chunk `chunk` (Infinity: all left), taken; undefined when none. */
+  take(chunk: number): RecordedStop | undefined {
+    const e = this.stops[this.#next];
+    if (e === undefined || e.chunkIndex > chunk) return undefined;
+    this.#next++;
+    return e;
+  }
+
+  /** Puts the cursor on the first stop recorded before chunk `chunk` or later (a seek feeds from there). */
+  seek(chunk: number): void {
+    this.#next = 0;
+    while ((this.stops[this.#next]?.chunkIndex ?? Number.POSITIVE_INFINITY) < chunk) this.#next++;
+  }
+}
+
 /** A time the adapter was away: from a recorded stop to the port's next recorded data (or the capture's last), µs. */
 export interface Absence {
   readonly port: number;

@@ -9,7 +9,7 @@
 import { type DecoderCheckpoint, type LinkCheckpoint, type LinkMonitor, SpektrumDecoder } from '../../decoder/index.js';
 import { type Capture, recordTimeUs } from '../../capture/index.js';
 import { LinkSeries, monitorWithSeries, timingJitterUs } from '../../analysis/index.js';
-import { type RecordedStop, recordedStops } from '../../analysis/doctor-events.js';
+import { recordedStops, StopCursor } from '../../analysis/doctor-events.js';
 import { failsafeAsRead, failsafesOf, overviewBinUs, sumOverview } from './overview.js';
 import type { Overview } from '../protocol.js';
 
@@ -82,9 +82,8 @@ export class ReplayPass implements OverviewPass {
   readonly #at = new Float64Array(1);
   #nextCheckpointUs: number;
   #done = false;
-  /** The capture's recorded stops ("device lost"), and the next to tell its port's link. */
-  #stops: RecordedStop[];
-  #nextStop = 0;
+  /** The capture's recorded stops ("device lost"), each told to its port's link before the chunk after it. */
+  #stops: StopCursor;
 
   /**
    * @param originUs, endUs the capture's span (`captureSpan`): bin 0 starts at the first, the links are judged at the last
@@ -102,7 +101,7 @@ export class ReplayPass implements OverviewPass {
   ) {
     this.#capture = capture;
     this.#prefix = prefix;
-    this.#stops = capture === null ? [] : recordedStops(capture);
+    this.#stops = new StopCursor(capture === null ? [] : recordedStops(capture));
     this.#binUs = overviewBinUs(endUs - originUs);
     this.#ports = ports.map((port) => {
       const series = new LinkSeries(this.#binUs, originUs);
@@ -147,8 +146,9 @@ export class ReplayPass implements OverviewPass {
     }
     this.#capture = capture;
     this.#prefix = false;
-    this.#stops = recordedStops(capture);
-    while ((this.#stops[this.#nextStop]?.chunkIndex ?? Infinity) < n) this.#nextStop++; // told already, if the head had them
+    // The stops before chunk n were told from the head, which holds the same chunks.
+    this.#stops = new StopCursor(recordedStops(capture));
+    this.#stops.seek(n);
     return true;
   }
 
@@ -224,8 +224,7 @@ export class ReplayPass implements OverviewPass {
 
   /** Tells each link its recorded stops before the capture's chunk `chunk` (`LinkMonitor.stopped`). */
   #stopsBefore(chunk: number): void {
-    for (let e = this.#stops[this.#nextStop]; e !== undefined && e.chunkIndex <= chunk; e = this.#stops[++this.#nextStop])
-      this.#byPort[e.port]?.link.stopped(e.timeUs);
+    for (let e = this.#stops.take(chunk); e !== undefined; e = this.#stops.take(chunk)) this.#byPort[e.port]?.link.stopped(e.timeUs);
   }
 
   /** The end of the stream: every decoder flushed, every link judged at the capture's end. */

@@ -4,7 +4,7 @@
  */
 import { BYTE_TIME_US } from '../../decoder/index.js';
 import { captureTimesInOrder, chunkFirstByteUs, type Capture } from '../../capture/index.js';
-import { type RecordedStop, recordedStops } from '../../analysis/doctor-events.js';
+import { recordedStops, StopCursor } from '../../analysis/doctor-events.js';
 
 /** One chunk's bytes with their times. */
 export interface Chunk {
@@ -34,9 +34,8 @@ export class PortChunks {
   readonly #ordered: boolean;
   /** Whether the per-byte times inside each chunk never go back: a seek then bisects for its byte. */
   readonly #bytesOrdered: boolean;
-  /** This port's recorded stops ("device lost"), and the next one not told since the last seek. */
-  readonly #stops: RecordedStop[];
-  #nextStop = 0;
+  /** This port's recorded stops ("device lost"): each told once since the cursor was last put. */
+  readonly #stops: StopCursor;
 
   /**
    * @param index the capture's chunk number of each of this port's chunks, in order (`capturePortIndex`)
@@ -80,26 +79,20 @@ export class PortChunks {
         bytesOrdered = (times[j] ?? Number.NaN) >= (times[j - 1] ?? Number.NaN);
     }
     this.#bytesOrdered = bytesOrdered;
-    this.#stops = recordedStops(capture).filter((e) => e.port === port);
+    this.#stops = new StopCursor(recordedStops(capture).filter((e) => e.port === port));
   }
 
   /**
-   * The times of this port's recorded stops before its chunk k (all that are left: k = length),
-   * each once since the cursor was last put (a seek tells again those from its first chunk on).
+   * The time of this port's next recorded stop before its chunk k (all that are left: k =
+   * length), taken; undefined when none. A seek tells again those from its first chunk on.
    */
-  takeStops(k: number): number[] {
-    const before = k < this.length ? this.#chunk(k) : Number.POSITIVE_INFINITY;
-    const out: number[] = [];
-    for (let e = this.#stops[this.#nextStop]; e !== undefined && e.chunkIndex <= before; e = this.#stops[++this.#nextStop])
-      out.push(e.timeUs);
-    return out;
+  takeStop(k: number): number | undefined {
+    return this.#stops.take(k < this.length ? this.#chunk(k) : Number.POSITIVE_INFINITY)?.timeUs;
   }
 
   /** The stops not told yet are those from the cursor's chunk on. */
   #seekStops(): void {
-    const from = this.done ? Number.POSITIVE_INFINITY : this.#chunk(this.next);
-    this.#nextStop = 0;
-    while ((this.#stops[this.#nextStop]?.chunkIndex ?? Number.POSITIVE_INFINITY) < from) this.#nextStop++;
+    this.#stops.seek(this.done ? Number.POSITIVE_INFINITY : this.#chunk(this.next));
   }
 
   /** The capture's chunk number of this port's chunk k. */

@@ -182,7 +182,7 @@ export class ReplaySource {
 
   #feed(c: PortChunks, bytes: Uint8Array, time: number | Float64Array | undefined, atUs: number): void {
     const port = c.port;
-    if (c.nextByte === 0) for (const t of c.takeStops(c.next)) this.#onStop(port, t);
+    if (c.nextByte === 0) for (let t = c.takeStop(c.next); t !== undefined; t = c.takeStop(c.next)) this.#onStop(port, t);
     if (Number.isFinite(atUs) && !(atUs <= this.#lastFedUs)) this.#lastFedUs = atUs;
     this.sink(port, bytes, time, atUs, this.#fedAtMs);
   }
@@ -267,7 +267,7 @@ export class ReplaySource {
 
   /** The end: the clock stops at the capture's last recorded time, never past it. */
   #finish(): void {
-    for (const c of this.#chunks) for (const t of c.takeStops(c.length)) this.#onStop(c.port, t);
+    for (const c of this.#chunks) for (let t = c.takeStop(c.length); t !== undefined; t = c.takeStop(c.length)) this.#onStop(c.port, t);
     this.#clockUs = this.endUs;
     this.#ended = true;
     this.pause();
