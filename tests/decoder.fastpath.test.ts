@@ -20,8 +20,7 @@ const fixtures = readdirSync(fixtureDir)
   .filter((f) => f.endsWith('.bin'))
   .map((f) => f.replace('.bin', ''));
 
-const captureDir = CAPTURE_DIR;
-const captureFiles = filesUnder(captureDir);
+const captureFiles = filesUnder(CAPTURE_DIR);
 
 describe('the fast path gives what the general path gives', () => {
   it.each(fixtures)('fixture %s, every option, every feed', (name) => {
@@ -31,30 +30,30 @@ describe('the fast path gives what the general path gives', () => {
     for (const options of OPTIONS) for (const how of FEEDS) expectSame(feed(bytes, times, how), options, `${name}, ${how}`);
   });
 
-  if (captureFiles.length === 0) console.warn(`skipping the real captures in the fast-path test: ${captureDir} is not here`);
+  if (captureFiles.length === 0) console.warn(`skipping the real captures in the fast-path test: ${CAPTURE_DIR} is not here`);
   it.skipIf(captureFiles.length === 0)('reads every file in ../shared/captures that is a capture (the rest are notes)', () => {
     for (const file of captureFiles) {
       try {
-        readCapture(new Uint8Array(readFileSync(join(captureDir, file))), file);
+        readCapture(new Uint8Array(readFileSync(join(CAPTURE_DIR, file))), file);
       } catch (e) {
         expect(e, file).toBeInstanceOf(CaptureFormatError);
         expect(file, 'a file readCapture rejects').toMatch(/\.(md|txt)$/i);
-        expect(readFileSync(join(captureDir, file), 'utf8'), file).not.toMatch(/^Time \[s\]/);
+        expect(readFileSync(join(CAPTURE_DIR, file), 'utf8'), file).not.toMatch(/^Time \[s\]/);
       }
     }
   });
 
   const captures = captureFiles.filter((file) => {
     try {
-      readCapture(new Uint8Array(readFileSync(join(captureDir, file))), file);
+      readCapture(new Uint8Array(readFileSync(join(CAPTURE_DIR, file))), file);
       return true;
     } catch {
       return false;
     }
   });
   it.skipIf(captures.length === 0).each(captures)('real capture %s, every port, every option, as recorded and every feed', (file) => {
-    const capture = readCapture(new Uint8Array(readFileSync(join(captureDir, file))), file);
-    const rel = relative(captureDir, join(captureDir, file));
+    const capture = readCapture(new Uint8Array(readFileSync(join(CAPTURE_DIR, file))), file);
+    const rel = relative(CAPTURE_DIR, join(CAPTURE_DIR, file));
     let frames = 0;
     for (const port of capturePorts(capture)) {
       for (const options of OPTIONS) {

@@ -94,8 +94,7 @@ const fixtures = readdirSync(fixtureDir)
   .filter((f) => f.endsWith('.bin'))
   .map((f) => f.replace('.bin', ''));
 
-const captureDir = CAPTURE_DIR;
-const captures = filesUnder(captureDir).filter((f) => !/\.md$/i.test(f) && !/readme/i.test(f));
+const captures = filesUnder(CAPTURE_DIR).filter((f) => !/\.md$/i.test(f) && !/readme/i.test(f));
 
 describe("the decoder's output is what tests/golden/ holds", () => {
   it.each(fixtures)('fixture %s, every option, every feed', async (name) => {
@@ -107,11 +106,11 @@ describe("the decoder's output is what tests/golden/ holds", () => {
     );
   });
 
-  if (captures.length === 0) console.warn(`skipping the real captures in the golden test: ${captureDir} is not here`);
+  if (captures.length === 0) console.warn(`skipping the real captures in the golden test: ${CAPTURE_DIR} is not here`);
   it.skipIf(captures.length === 0).each(captures)('real capture %s, every port, every option, as recorded', async (name) => {
     let capture: ReturnType<typeof readCapture>;
     try {
-      capture = readCapture(new Uint8Array(readFileSync(join(captureDir, name))), name);
+      capture = readCapture(new Uint8Array(readFileSync(join(CAPTURE_DIR, name))), name);
     } catch {
       return; // a note, not a capture (the fast-path test checks which)
     }

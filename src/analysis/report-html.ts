@@ -17,7 +17,6 @@ export function escapeHtml(text: string): string {
 const COLORS = {
   ...DATA_COLORS.light,
   hold: 'rgba(230, 170, 30, 0.45)',
-  failsafe: DATA_COLORS.light.failsafeBand,
   grid: '#e3e3e3',
   axis: '#777',
   text: '#333',
@@ -125,7 +124,7 @@ function graphsSvg(report: HealthReport): string {
   const legend: [string, string][] = [['Lost frames', COLORS.lost]];
   if (panels.some((p) => p.color === COLORS.fades)) legend.push(['Fades', COLORS.fades]);
   if (panels.some((p) => p.kind === 'rssi')) legend.push(['RSSI mean', COLORS.rssi], ['RSSI lowest', COLORS.rssiMin]);
-  legend.push(['Hold', COLORS.hold], ['Failsafe', COLORS.failsafe]);
+  legend.push(['Hold', COLORS.hold], ['Failsafe', COLORS.failsafeBand]);
   let lx = left;
   for (const [name, color] of legend) {
     parts.push(
@@ -149,7 +148,7 @@ function graphsSvg(report: HealthReport): string {
     for (const e of p.remote.failsafes) {
       const x0 = x(e.startUs);
       const x1 = x(e.endUs);
-      parts.push(`<rect x="${f1(x0)}" y="${top}" width="${f1(Math.max(1.5, x1 - x0))}" height="${panelH}" fill="${COLORS.failsafe}"/>`);
+      parts.push(`<rect x="${f1(x0)}" y="${top}" width="${f1(Math.max(1.5, x1 - x0))}" height="${panelH}" fill="${COLORS.failsafeBand}"/>`);
       parts.push(`<line x1="${f1(x0)}" y1="${top}" x2="${f1(x0)}" y2="${bottom}" stroke="${COLORS.failsafeEdge}" stroke-width="1"/>`);
     }
     const pad = 12; // room for the title

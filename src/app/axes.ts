@@ -98,10 +98,9 @@ export function agoSplits(start: number, end: number, step: number): number[] {
  * changes only with the source: uPlot does not redraw an axis for a label alone.
  */
 export type WindowEnd = () => string;
-const NOW: WindowEnd = () => 'now';
 
 /** The x axis of the live graphs: seconds before the window's end, in round steps that stay put. */
-export function agoAxis(end: WindowEnd = NOW): uPlot.Axis {
+export function agoAxis(end: WindowEnd): uPlot.Axis {
   const c = chartColors();
   return {
     stroke: c.axis,
@@ -198,7 +197,7 @@ export function valueAxis(label: string, v: ValueScale = {}): uPlot.Axis {
 }
 
 /** The hover legend's time: seconds before the window's end, to a tenth; the end as `end` calls it. */
-export function legendTimeAt(end: WindowEnd = NOW): (u: uPlot, v: number | null) => string {
+export function legendTimeAt(end: WindowEnd): (u: uPlot, v: number | null) => string {
   return (u, v) => {
     if (v === null || !Number.isFinite(v)) return '—';
     const s = Math.max(0, (u.scales.x?.max ?? v) - v);

@@ -73,39 +73,17 @@ export interface SystemInfo {
   readonly name: string;
 }
 
+/** A system byte's entry: its name and period in µs follow from what it says (§8.3). */
+function system(value: number, protocol: SystemInfo['protocol'], periodMs: 11 | 22, resolution: Resolution): SystemInfo {
+  const periodUs = periodMs === 11 ? FRAME_PERIOD_11MS_US : FRAME_PERIOD_22MS_US;
+  return { value, protocol, periodMs, periodUs, resolution, name: `${protocol} ${periodMs} ms ${resolution}` };
+}
+
 const SYSTEMS: readonly SystemInfo[] = [
-  {
-    value: SYSTEM_DSM2_22MS_1024,
-    protocol: 'DSM2',
-    periodMs: 22,
-    periodUs: FRAME_PERIOD_22MS_US,
-    resolution: 1024,
-    name: 'DSM2 22 ms 1024',
-  },
-  {
-    value: SYSTEM_DSM2_11MS_2048,
-    protocol: 'DSM2',
-    periodMs: 11,
-    periodUs: FRAME_PERIOD_11MS_US,
-    resolution: 2048,
-    name: 'DSM2 11 ms 2048',
-  },
-  {
-    value: SYSTEM_DSMX_22MS_2048,
-    protocol: 'DSMX',
-    periodMs: 22,
-    periodUs: FRAME_PERIOD_22MS_US,
-    resolution: 2048,
-    name: 'DSMX 22 ms 2048',
-  },
-  {
-    value: SYSTEM_DSMX_11MS_2048,
-    protocol: 'DSMX',
-    periodMs: 11,
-    periodUs: FRAME_PERIOD_11MS_US,
-    resolution: 2048,
-    name: 'DSMX 11 ms 2048',
-  },
+  system(SYSTEM_DSM2_22MS_1024, 'DSM2', 22, 1024),
+  system(SYSTEM_DSM2_11MS_2048, 'DSM2', 11, 2048),
+  system(SYSTEM_DSMX_22MS_2048, 'DSMX', 22, 2048),
+  system(SYSTEM_DSMX_11MS_2048, 'DSMX', 11, 2048),
 ];
 
 /** §8.3: the protocol a system byte names, or `undefined` for any other value. */
