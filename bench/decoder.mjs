@@ -262,12 +262,6 @@ const CASES = [
   { name: 'whole buffer, no times', stream: '2048', run: whole, base: 'baseline JS loop, 2048 internal' },
   { name: CHUNK_CASE, stream: '2048', run: chunkTimes, base: 'baseline JS loop, 2048 internal' },
   { name: '64-byte chunks, per-byte times', stream: '2048', run: perByteTimes, base: 'baseline JS loop, 2048 internal', vs: CHUNK_CASE },
-  {
-    name: '64-byte chunks, chunk times, general path',
-    stream: '2048',
-    run: (s) => chunkTimes(s, { fastPath: false }),
-    base: 'baseline JS loop, 2048 internal',
-  },
   { name: 'baseline JS loop, 1024 internal', stream: '1024', run: (s) => baseline(s.bytes, s.resolution), base: null },
   {
     name: '1024 mode, 64-byte chunks, chunk times',

@@ -11,7 +11,7 @@ import { SpektrumDecoder, type DecoderEvent, type DecoderOptions } from '../src/
 import { encodeExternalFrame, encodeInternalFrame, preset, simulate } from '../src/simulator/index.js';
 import { concatBytes } from './bytes.js';
 import { dsmxSlots } from './frames.js';
-import { OPTIONS } from './lockstep.js';
+import { OPTIONS } from './decoder-streams.js';
 
 function decode(bytes: Uint8Array, options: DecoderOptions = {}) {
   const events: DecoderEvent[] = [];

@@ -16,7 +16,7 @@ import { CAPTURE_DIR, filesUnder } from './shared-captures.js';
 import { captureChunks, capturePorts, readCapture } from '../src/capture/index.js';
 import { type DecodedFrame, type DecoderEvent, type DecoderOptions, SpektrumDecoder } from '../src/decoder/index.js';
 import { CLEAN_PRESETS } from './damage.js';
-import { damagedStream, FEEDS, feed, OPTIONS, type Push } from './lockstep.js';
+import { damagedStream, FEEDS, feed, OPTIONS, type Push } from './decoder-streams.js';
 
 /** A frame as one line of text: every field a caller may read. */
 function frameLine(f: DecodedFrame): string {

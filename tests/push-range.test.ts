@@ -10,7 +10,7 @@ import { Doctor } from '../src/analysis/index.js';
 import { type DecoderEvent, SpektrumDecoder } from '../src/decoder/index.js';
 import { ibusStream, receiveAs } from '../src/simulator/index.js';
 import { concatBytes } from './bytes.js';
-import { damagedStream } from './lockstep.js';
+import { damagedStream } from './decoder-streams.js';
 
 /** Chunk bounds of every size from 0 to 300 bytes, repeatable. */
 function cuts(length: number, seed: number): [number, number][] {

@@ -11,8 +11,6 @@
  * restores keeps its own.
  */
 import { FrameSlots } from './frame.js';
-import type { Resolution } from './spec.js';
-import type { DecoderStats, RemoteKind, ResolutionReason, Withheld } from './types.js';
 import type { LinkEpisode, LinkRestart, LinkState, LinkStats } from './link.js';
 
 /** A copy of `from`'s slot arrays and counts in `into` (a fresh set when none is given). */
@@ -28,51 +26,14 @@ export function copySlots(from: FrameSlots, into: FrameSlots = new FrameSlots())
   return into;
 }
 
-/** `SpektrumDecoder.checkpoint()`. */
+declare const opaque: unique symbol;
+
+/**
+ * `SpektrumDecoder.checkpoint()`: opaque. What it holds is the decoder's own and changes between
+ * versions (a decoder refuses one of another version); it survives `structuredClone`.
+ */
 export interface DecoderCheckpoint {
-  readonly resolutionOption: 'auto' | Resolution;
-  readonly remoteOption: 'auto' | RemoteKind;
-  readonly headerModeOption: 'auto' | 'fades' | 'rssi';
-  readonly fixedBy: 'user' | 'internal-remote';
-  /** The bytes not yet decided, from stream offset `base`, and their per-byte times (null when none came). */
-  readonly bytes: Uint8Array;
-  readonly byteTimes: Float64Array | null;
-  readonly base: number;
-  /** The records of the chunks those bytes came in (their ends are stream offsets). */
-  readonly chunkEnds: Float64Array;
-  readonly chunkTimes: Float64Array;
-  readonly chunkPerByte: Uint8Array;
-  readonly ended: boolean;
-  readonly locked: boolean;
-  readonly everLocked: boolean;
-  readonly confirmedUntil: number;
-  readonly resolution: Resolution;
-  readonly reason: ResolutionReason;
-  readonly remote: RemoteKind;
-  readonly system: number | null;
-  readonly b0Mode: number;
-  readonly forcedMismatch: Resolution | null;
-  readonly withheld: Withheld | null;
-  readonly ambiguous: boolean;
-  readonly last0: number;
-  readonly last1: number;
-  readonly haveLast: boolean;
-  readonly jumpTrusted: boolean;
-  readonly nextAt: number;
-  readonly nextLayout: number;
-  readonly layouts: Int32Array;
-  readonly layoutCount: number;
-  readonly layoutNext: number;
-  readonly shown: FrameSlots;
-  readonly staged: FrameSlots;
-  readonly stagedAt: number;
-  readonly frameIndex: number;
-  readonly stats: Readonly<DecoderStats>;
-  readonly candInternal: boolean;
-  readonly candSystem: number;
-  readonly candB0: number;
-  readonly candFrames: number;
-  readonly candSkipped: number;
+  readonly [opaque]: 'DecoderCheckpoint';
 }
 
 /** `FrameLedger.checkpoint()`. */

@@ -275,9 +275,6 @@ export class LinkMonitor {
     this.#maxEpisodes = options.maxEpisodes ?? Infinity;
     this.#onMissed = options.onMissed;
     this.#ledger = new FrameLedger(this.#jitterPrior);
-    // Written again, not only declared: finish() writing a field written once threw away the
-    // compiled code that read it (decoder.ts, #ended).
-    this.#finished = false;
   }
 
   get state(): LinkState {

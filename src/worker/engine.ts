@@ -125,7 +125,7 @@ export class Engine {
     this.link.restore(link);
     this.#ranges = new ChannelRanges();
     this.#rangesSinceUs = this.link.lastFrameUs;
-    this.#forced = decoder.resolutionOption !== 'auto';
+    this.#forced = this.decoder.resolutionSetting !== 'auto';
     // Frames found missing from here on are placed from the checkpoint's last frame.
     this.#currentUs = this.link.lastFrameUs;
     this.#changed = true;
