@@ -17,19 +17,22 @@
 import { existsSync, readdirSync, readFileSync, statSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 import { describe, expect, it } from 'vitest';
-import type { FormatInfo, LinkEpisode, LinkStats } from '../src/decoder/index.js';
-import { encodeCapture, importRaw, readCapture, type Capture, type CaptureRecordInput } from '../src/capture/index.js';
-import {
-  captureSpan,
-  diagnosedHealthReport,
-  doctorCapture,
-  type DoctorFinding,
-  formatClock,
-  healthReport,
-  summarizeCapture,
-  timingJitterUs,
-} from '../src/analysis/index.js';
-import { preset, simulate } from '../src/simulator/index.js';
+import type { FormatInfo } from '../src/decoder/types.js';
+import type { LinkEpisode, LinkStats } from '../src/decoder/link.js';
+import { encodeCapture, type CaptureRecordInput } from '../src/capture/writer.js';
+import { importRaw } from '../src/capture/raw.js';
+import { readCapture } from '../src/capture/sniff.js';
+import type { Capture } from '../src/capture/model.js';
+import { captureSpan } from '../src/analysis/capture-span.js';
+import { diagnosedHealthReport } from '../src/analysis/doctor-report.js';
+import { doctorCapture } from '../src/analysis/doctor-capture.js';
+import type { DoctorFinding } from '../src/analysis/doctor-types.js';
+import { formatClock } from '../src/analysis/report-text.js';
+import { healthReport } from '../src/analysis/report.js';
+import { summarizeCapture } from '../src/analysis/summary.js';
+import { timingJitterUs } from '../src/analysis/capture-pass.js';
+import { preset } from '../src/simulator/presets.js';
+import { simulate } from '../src/simulator/simulator.js';
 import { Diagnosis } from '../src/worker/diagnosis.js';
 import { Engine } from '../src/worker/engine.js';
 import type { Clock } from '../src/worker/host.js';

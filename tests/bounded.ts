@@ -5,7 +5,7 @@
  */
 import { Worker } from 'node:worker_threads';
 import { fileURLToPath } from 'node:url';
-import type { DecoderOptions } from '../src/decoder/index.js';
+import type { DecoderOptions } from '../src/decoder/decoder.js';
 
 export interface BoundedInput {
   bytes: Uint8Array;

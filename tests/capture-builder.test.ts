@@ -4,7 +4,11 @@
  * however well the columns' size was guessed.
  */
 import { describe, expect, it } from 'vitest';
-import { CaptureBuilder, type ParsedCapture, encodeCapture, parseCapture, walkDataRecords } from '../src/capture/index.js';
+import { CaptureBuilder } from '../src/capture/capture-builder.js';
+import type { ParsedCapture } from '../src/capture/model.js';
+import { encodeCapture } from '../src/capture/writer.js';
+import { parseCapture } from '../src/capture/reader.js';
+import { walkDataRecords } from '../src/capture/record-walk.js';
 import { longCapture } from './long-capture.js';
 
 /** Data records of 1–300 bytes on two ports, events among them (two before the first chunk), untimed when `timed` is false. */

@@ -4,7 +4,7 @@
  * came from.
  */
 import { describe, expect, it } from 'vitest';
-import { captureSpan, seedCaptureSpan } from '../src/analysis/index.js';
+import { captureSpan, seedCaptureSpan } from '../src/analysis/capture-span.js';
 import {
   captureChunksByPort,
   captureFact,
@@ -12,8 +12,8 @@ import {
   capturePorts,
   captureTimesInOrder,
   seedCaptureFact,
-  type Capture,
-} from '../src/capture/index.js';
+} from '../src/capture/facts.js';
+import type { Capture } from '../src/capture/model.js';
 
 function capture(ports: number[], times: number[]): Capture {
   return {

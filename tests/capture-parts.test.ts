@@ -4,8 +4,11 @@
  * parts (the plan or a part says so), so its salvage stays `parseCapture`'s.
  */
 import { describe, expect, it } from 'vitest';
-import { assembleParts, CaptureWriter, parseCapture, partColumns, planParts, readPart } from '../src/capture/index.js';
-import { preset, simulate } from '../src/simulator/index.js';
+import { assembleParts, partColumns, planParts, readPart } from '../src/capture/parts.js';
+import { CaptureWriter } from '../src/capture/writer.js';
+import { parseCapture } from '../src/capture/reader.js';
+import { preset } from '../src/simulator/presets.js';
+import { simulate } from '../src/simulator/simulator.js';
 import { concatBytes } from './bytes.js';
 import { usbChunks } from './feeds.js';
 

@@ -5,11 +5,15 @@
 import { existsSync, readFileSync } from 'node:fs';
 import { fileURLToPath } from 'node:url';
 import { describe, expect, it } from 'vitest';
-import { CaptureFormatError, CaptureWriter, captureChunks, parseCapture, readCapture } from '../src/capture/index.js';
-import type { Capture, ParsedCapture } from '../src/capture/index.js';
+import { CaptureFormatError, captureChunks } from '../src/capture/model.js';
+import { CaptureWriter } from '../src/capture/writer.js';
+import { parseCapture } from '../src/capture/reader.js';
+import { readCapture } from '../src/capture/sniff.js';
+import type { Capture, ParsedCapture } from '../src/capture/model.js';
 // A test hook, not part of the package: what the reader did, counted.
 import { parseCaptureCounting } from '../src/capture/reader.js';
-import { preset, simulate } from '../src/simulator/index.js';
+import { preset } from '../src/simulator/presets.js';
+import { simulate } from '../src/simulator/simulator.js';
 import { concatBytes } from './bytes.js';
 
 const PX4 = fileURLToPath(new URL('../../shared/captures/px4/', import.meta.url));

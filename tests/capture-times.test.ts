@@ -4,21 +4,18 @@
  * as the same capture without it, on every surface.
  */
 import { describe, expect, it } from 'vitest';
-import {
-  assembleParts,
-  type Capture,
-  CaptureWriter,
-  crc32,
-  parseCapture,
-  RECORD_OVERHEAD,
-  partColumns,
-  planParts,
-  readCapture,
-  readPart,
-} from '../src/capture/index.js';
-import { LinkSeries, monitorWithSeries, summarizeCapture } from '../src/analysis/index.js';
+import { assembleParts, partColumns, planParts, readPart } from '../src/capture/parts.js';
+import type { Capture } from '../src/capture/model.js';
+import { CaptureWriter } from '../src/capture/writer.js';
+import { crc32 } from '../src/capture/crc32.js';
+import { parseCapture } from '../src/capture/reader.js';
+import { RECORD_OVERHEAD } from '../src/capture/layout.js';
+import { readCapture } from '../src/capture/sniff.js';
+import { LinkSeries, monitorWithSeries } from '../src/analysis/series.js';
+import { summarizeCapture } from '../src/analysis/summary.js';
 import { MAX_SERIES_BINS } from '../src/analysis/series.js';
-import { preset, simulate } from '../src/simulator/index.js';
+import { preset } from '../src/simulator/presets.js';
+import { simulate } from '../src/simulator/simulator.js';
 import { concatBytes } from './bytes.js';
 import { usbChunks } from './feeds.js';
 

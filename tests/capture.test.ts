@@ -1,20 +1,17 @@
 import { existsSync, readFileSync } from 'node:fs';
 import { fileURLToPath } from 'node:url';
 import { describe, expect, it } from 'vitest';
-import {
-  CaptureFormatError,
-  CaptureWriter,
-  RECORD_OVERHEAD,
-  captureChunks,
-  capturePorts,
-  crc32,
-  encodeCapture,
-  importRaw,
-  importSaleaeCsv,
-  parseCapture,
-  readCapture,
-} from '../src/capture/index.js';
-import type { Capture, CaptureMeta, CaptureRecordInput } from '../src/capture/index.js';
+import { CaptureFormatError, captureChunks } from '../src/capture/model.js';
+import { CaptureWriter, encodeCapture } from '../src/capture/writer.js';
+import { RECORD_OVERHEAD } from '../src/capture/layout.js';
+import { capturePorts } from '../src/capture/facts.js';
+import { crc32 } from '../src/capture/crc32.js';
+import { importRaw } from '../src/capture/raw.js';
+import { importSaleaeCsv } from '../src/capture/saleae.js';
+import { parseCapture } from '../src/capture/reader.js';
+import { readCapture } from '../src/capture/sniff.js';
+import type { Capture, CaptureMeta } from '../src/capture/model.js';
+import type { CaptureRecordInput } from '../src/capture/writer.js';
 import { crcFollows } from '../src/capture/crc32.js';
 import { concatBytes } from './bytes.js';
 

@@ -9,16 +9,12 @@
 import { existsSync, readFileSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 import { describe, expect, it } from 'vitest';
-import {
-  type DecodedFrame,
-  type DecoderEvent,
-  type DecoderOptions,
-  LinkMonitor,
-  type LinkOptions,
-  SpektrumDecoder,
-} from '../src/decoder/index.js';
-import { importSaleaeCsv } from '../src/capture/index.js';
-import { preset, simulate } from '../src/simulator/index.js';
+import type { DecodedFrame, DecoderEvent } from '../src/decoder/types.js';
+import { type DecoderOptions, SpektrumDecoder } from '../src/decoder/decoder.js';
+import { LinkMonitor, type LinkOptions } from '../src/decoder/link.js';
+import { importSaleaeCsv } from '../src/capture/saleae.js';
+import { preset } from '../src/simulator/presets.js';
+import { simulate } from '../src/simulator/simulator.js';
 import { damagedStream, type Feed, feed, type Push } from './decoder-streams.js';
 
 /** One call on the pair: a push, a next() (with the link fed its frame), a resolution set, the end. */

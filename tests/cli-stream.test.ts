@@ -9,7 +9,8 @@ import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { pathToFileURL } from 'node:url';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
-import { preset, simulate } from '../src/simulator/index.js';
+import { preset } from '../src/simulator/presets.js';
+import { simulate } from '../src/simulator/simulator.js';
 import { CLI as cli, CLI_TIMEOUT_MS, satscopeWith } from './built-cli.js';
 
 let dir = '';

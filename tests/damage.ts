@@ -2,7 +2,8 @@
  * Damage for decoder tests: lost and stray bytes applied to a clean stream, with the map back to
  * the clean stream's offsets, and the clean stream's frames as the oracle of what was sent.
  */
-import { SpektrumDecoder, type DecodedFrame, type DecoderOptions } from '../src/decoder/index.js';
+import { SpektrumDecoder, type DecoderOptions } from '../src/decoder/decoder.js';
+import type { DecodedFrame } from '../src/decoder/types.js';
 
 export interface SentFrame {
   offset: number;

@@ -2,8 +2,9 @@
  * Streams for the decoder's tests: every way bytes reach it (`feed`), every option
  * combination, and simulated streams with damage of every kind.
  */
-import type { DecoderOptions } from '../src/decoder/index.js';
-import { preset, simulate } from '../src/simulator/index.js';
+import type { DecoderOptions } from '../src/decoder/decoder.js';
+import { preset } from '../src/simulator/presets.js';
+import { simulate } from '../src/simulator/simulator.js';
 import { damage, type Edit } from './damage.js';
 import { usbChunks } from './feeds.js';
 

@@ -10,8 +10,9 @@ import { existsSync, readFileSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 import fc from 'fast-check';
 import { describe, expect, it } from 'vitest';
-import { importSaleaeCsv } from '../src/capture/index.js';
-import { preset, simulate } from '../src/simulator/index.js';
+import { importSaleaeCsv } from '../src/capture/saleae.js';
+import { preset } from '../src/simulator/presets.js';
+import { simulate } from '../src/simulator/simulator.js';
 import { CLEAN_PRESETS, damage, framesOf, judge, sameReading, type Edit } from './damage.js';
 
 const captureDir = resolve(import.meta.dirname, '../../shared/captures/px4');

@@ -3,8 +3,11 @@
  * offset (by the rule a frame's time follows) and, for a discard, the discarded bytes.
  */
 import { describe, expect, it } from 'vitest';
-import { BYTE_TIME_US, SpektrumDecoder, type DecoderEvent } from '../src/decoder/index.js';
-import { preset, simulate } from '../src/simulator/index.js';
+import { BYTE_TIME_US } from '../src/decoder/spec.js';
+import { SpektrumDecoder } from '../src/decoder/decoder.js';
+import type { DecoderEvent } from '../src/decoder/types.js';
+import { preset } from '../src/simulator/presets.js';
+import { simulate } from '../src/simulator/simulator.js';
 
 /** An event as plain data, its bytes copied while they were valid. */
 type Seen =

@@ -4,10 +4,14 @@
  */
 import { existsSync, readFileSync } from 'node:fs';
 import { describe, expect, it } from 'vitest';
-import { SpektrumDecoder, copyFrame, type DecoderEvent, type DecoderOptions, type FrameSnapshot } from '../src/decoder/index.js';
-import { importRaw, importSaleaeCsv } from '../src/capture/index.js';
-import { healthReport, summarizeCapture } from '../src/analysis/index.js';
-import { encodeExternalFrame, encodeInternalFrame } from '../src/simulator/index.js';
+import { SpektrumDecoder, type DecoderOptions } from '../src/decoder/decoder.js';
+import { copyFrame, type FrameSnapshot } from '../src/decoder/snapshot.js';
+import type { DecoderEvent } from '../src/decoder/types.js';
+import { importRaw } from '../src/capture/raw.js';
+import { importSaleaeCsv } from '../src/capture/saleae.js';
+import { healthReport } from '../src/analysis/report.js';
+import { summarizeCapture } from '../src/analysis/summary.js';
+import { encodeExternalFrame, encodeInternalFrame } from '../src/simulator/encode.js';
 import { concatBytes as join } from './bytes.js';
 import { dsmxSlots } from './frames.js';
 import { runBounded } from './bounded.js';

@@ -7,8 +7,11 @@
 import { readFileSync } from 'node:fs';
 import fc from 'fast-check';
 import { describe, expect, it } from 'vitest';
-import { SpektrumDecoder, type DecoderEvent, type DecoderOptions } from '../src/decoder/index.js';
-import { encodeExternalFrame, encodeInternalFrame, preset, simulate } from '../src/simulator/index.js';
+import { SpektrumDecoder, type DecoderOptions } from '../src/decoder/decoder.js';
+import type { DecoderEvent } from '../src/decoder/types.js';
+import { encodeExternalFrame, encodeInternalFrame } from '../src/simulator/encode.js';
+import { preset } from '../src/simulator/presets.js';
+import { simulate } from '../src/simulator/simulator.js';
 import { concatBytes } from './bytes.js';
 import { dsmxSlots } from './frames.js';
 import { OPTIONS } from './decoder-streams.js';

@@ -4,8 +4,10 @@
  * than frames read at a shifted offset that match nothing that was sent.
  */
 import { describe, expect, it } from 'vitest';
-import { SpektrumDecoder, systemInfo, type DecoderEvent, type DecoderOptions } from '../src/decoder/index.js';
-import { simulate } from '../src/simulator/index.js';
+import { SpektrumDecoder, type DecoderOptions } from '../src/decoder/decoder.js';
+import { systemInfo } from '../src/decoder/spec.js';
+import type { DecoderEvent } from '../src/decoder/types.js';
+import { simulate } from '../src/simulator/simulator.js';
 
 const SYSTEMS = [0x01, 0x12, 0xa2, 0xb2];
 const FORCED: DecoderOptions[] = [

@@ -13,8 +13,11 @@ import { readdirSync, readFileSync } from 'node:fs';
 import { join } from 'node:path';
 import { describe, expect, it } from 'vitest';
 import { CAPTURE_DIR, filesUnder } from './shared-captures.js';
-import { captureChunks, capturePorts, readCapture } from '../src/capture/index.js';
-import { type DecodedFrame, type DecoderEvent, type DecoderOptions, SpektrumDecoder } from '../src/decoder/index.js';
+import { captureChunks } from '../src/capture/model.js';
+import { capturePorts } from '../src/capture/facts.js';
+import { readCapture } from '../src/capture/sniff.js';
+import type { DecodedFrame, DecoderEvent } from '../src/decoder/types.js';
+import { type DecoderOptions, SpektrumDecoder } from '../src/decoder/decoder.js';
 import { CLEAN_PRESETS } from './damage.js';
 import { damagedStream, FEEDS, feed, OPTIONS, type Push } from './decoder-streams.js';
 

@@ -3,8 +3,11 @@
  * the header mode the remote had shown, and its fades after the jump are counted.
  */
 import { describe, expect, it } from 'vitest';
-import { SpektrumDecoder, copyFrame, systemInfo, type DecoderEvent } from '../src/decoder/index.js';
-import { simulate } from '../src/simulator/index.js';
+import { SpektrumDecoder } from '../src/decoder/decoder.js';
+import { copyFrame } from '../src/decoder/snapshot.js';
+import { systemInfo } from '../src/decoder/spec.js';
+import type { DecoderEvent } from '../src/decoder/types.js';
+import { simulate } from '../src/simulator/simulator.js';
 
 const SYSTEMS = [0x01, 0x12, 0xa2, 0xb2];
 

@@ -4,8 +4,10 @@
  */
 import fc from 'fast-check';
 import { describe, expect, it } from 'vitest';
-import { SpektrumDecoder, type DecodedFrame } from '../src/decoder/index.js';
-import { preset, simulate } from '../src/simulator/index.js';
+import { SpektrumDecoder } from '../src/decoder/decoder.js';
+import type { DecodedFrame } from '../src/decoder/types.js';
+import { preset } from '../src/simulator/presets.js';
+import { simulate } from '../src/simulator/simulator.js';
 
 const PRESETS = [
   'dsm2-22ms-1024-internal',

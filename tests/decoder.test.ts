@@ -1,14 +1,9 @@
 import { describe, expect, it } from 'vitest';
-import {
-  SpektrumDecoder,
-  copyFrame,
-  decodeStream,
-  servoToMicros,
-  servoToPercent,
-  channelName,
-  type DecoderEvent,
-  type FrameSnapshot,
-} from '../src/decoder/index.js';
+import { SpektrumDecoder } from '../src/decoder/decoder.js';
+import { copyFrame, type FrameSnapshot } from '../src/decoder/snapshot.js';
+import { decodeStream } from '../src/decoder/stream.js';
+import { servoToMicros, servoToPercent, channelName } from '../src/decoder/spec.js';
+import type { DecoderEvent } from '../src/decoder/types.js';
 import {
   encodeExternalFrame,
   encodeInternalFrame,
@@ -16,7 +11,7 @@ import {
   encodeServo2048,
   encodeXPlus,
   vtxWords,
-} from '../src/simulator/index.js';
+} from '../src/simulator/encode.js';
 import { readFileSync } from 'node:fs';
 import { join as joinPath } from 'node:path';
 import { concatBytes as join } from './bytes.js';

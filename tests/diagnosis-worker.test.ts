@@ -5,9 +5,10 @@
  * hears there, and returns to 115200. The port is a stand-in with WebSerial's shape.
  */
 import { describe, expect, it } from 'vitest';
-import type { DoctorFinding } from '../src/analysis/index.js';
-import { importRaw } from '../src/capture/index.js';
-import { crsfStream, receiveAs } from '../src/simulator/index.js';
+import type { DoctorFinding } from '../src/analysis/doctor-types.js';
+import { importRaw } from '../src/capture/raw.js';
+import { crsfStream } from '../src/simulator/protocols.js';
+import { receiveAs } from '../src/simulator/line.js';
 import { Diagnosis, type ProbeHooks } from '../src/worker/diagnosis.js';
 import { Engine } from '../src/worker/engine.js';
 import type { FromWorker } from '../src/worker/protocol.js';

@@ -4,8 +4,9 @@
  * never "certain", and when the count moves it re-reads the remote, which is not a rebind.
  */
 import { describe, expect, it } from 'vitest';
-import { doctorCapture } from '../src/analysis/index.js';
-import { preset, simulate } from '../src/simulator/index.js';
+import { doctorCapture } from '../src/analysis/doctor-capture.js';
+import { preset } from '../src/simulator/presets.js';
+import { simulate } from '../src/simulator/simulator.js';
 import { recording } from './feeds.js';
 
 const SYSTEMS = [0x01, 0x12, 0xa2, 0xb2];

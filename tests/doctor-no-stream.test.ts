@@ -9,21 +9,18 @@ import { mkdtempSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { describe, expect, it } from 'vitest';
-import { Doctor, diagnosedHealthReport, doctorCapture, type DoctorReport } from '../src/analysis/index.js';
-import { importRaw, type Capture } from '../src/capture/index.js';
-import { LinkMonitor, SpektrumDecoder } from '../src/decoder/index.js';
+import { Doctor } from '../src/analysis/doctor.js';
+import { diagnosedHealthReport } from '../src/analysis/doctor-report.js';
+import { doctorCapture, type DoctorReport } from '../src/analysis/doctor-capture.js';
+import { importRaw } from '../src/capture/raw.js';
+import type { Capture } from '../src/capture/model.js';
+import { LinkMonitor } from '../src/decoder/link.js';
+import { SpektrumDecoder } from '../src/decoder/decoder.js';
 import { doctorCommand } from '../src/cli/doctor.js';
-import {
-  crsfStream,
-  ibusStream,
-  PRESET_NAMES,
-  preset,
-  sbusStream,
-  simulate,
-  srxl2Stream,
-  srxlV1Stream,
-  type Transmission,
-} from '../src/simulator/index.js';
+import { crsfStream, ibusStream, sbusStream, srxl2Stream, srxlV1Stream } from '../src/simulator/protocols.js';
+import { PRESET_NAMES, preset } from '../src/simulator/presets.js';
+import { simulate } from '../src/simulator/simulator.js';
+import type { Transmission } from '../src/simulator/line.js';
 import { perByteCapture, recording } from './feeds.js';
 
 const SECOND = 1_000_000;

@@ -6,9 +6,11 @@
  * rests on its resolution is as certain in one as in the other.
  */
 import { describe, expect, it } from 'vitest';
-import { diagnosedHealthReport, doctorCapture } from '../src/analysis/index.js';
-import type { Capture } from '../src/capture/index.js';
-import { preset, simulate } from '../src/simulator/index.js';
+import { diagnosedHealthReport } from '../src/analysis/doctor-report.js';
+import { doctorCapture } from '../src/analysis/doctor-capture.js';
+import type { Capture } from '../src/capture/model.js';
+import { preset } from '../src/simulator/presets.js';
+import { simulate } from '../src/simulator/simulator.js';
 import { recording } from './feeds.js';
 
 const SECOND = 1_000_000;

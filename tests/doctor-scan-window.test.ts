@@ -5,11 +5,19 @@
  * a long capture.
  */
 import { describe, expect, it } from 'vitest';
-import { captureSpan, decodeCapture, Doctor, type DoctorFinding } from '../src/analysis/index.js';
+import { captureSpan } from '../src/analysis/capture-span.js';
+import { decodeCapture } from '../src/analysis/capture-pass.js';
+import { Doctor } from '../src/analysis/doctor.js';
+import type { DoctorFinding } from '../src/analysis/doctor-types.js';
 // Not part of the package's surface: where the scan starts, to check it does leave bytes out.
 import { firstScanned } from '../src/analysis/capture-pass.js';
-import { CaptureWriter, readCapture, type Capture } from '../src/capture/index.js';
-import { crsfStream, ibusStream, preset, receiveAs, simulate, srxl2Stream, srxlV1Stream } from '../src/simulator/index.js';
+import { CaptureWriter } from '../src/capture/writer.js';
+import { readCapture } from '../src/capture/sniff.js';
+import type { Capture } from '../src/capture/model.js';
+import { crsfStream, ibusStream, srxl2Stream, srxlV1Stream } from '../src/simulator/protocols.js';
+import { preset } from '../src/simulator/presets.js';
+import { receiveAs } from '../src/simulator/line.js';
+import { simulate } from '../src/simulator/simulator.js';
 import { concatBytes } from './bytes.js';
 import { usbChunks } from './feeds.js';
 

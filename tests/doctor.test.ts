@@ -6,32 +6,23 @@
 import { existsSync, readFileSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 import { describe, expect, it } from 'vitest';
-import {
-  diagnosedHealthReport,
-  Doctor,
-  doctorCapture,
-  doctorEvent,
-  reportHtml,
-  type DoctorFinding,
-  type DoctorOptions,
-} from '../src/analysis/index.js';
-import { LinkMonitor, SpektrumDecoder, USB_CHUNK_JITTER_US } from '../src/decoder/index.js';
-import { CaptureWriter, importSaleaeCsv, readCapture } from '../src/capture/index.js';
-import {
-  crsfStream,
-  ibusStream,
-  noiseSignal,
-  preset,
-  receiveAs,
-  sbusStream,
-  simulate,
-  spektrumTransmission,
-  srxl2Stream,
-  srxlV1Stream,
-  uartReceive,
-  type Scenario,
-  type UartResult,
-} from '../src/simulator/index.js';
+import { diagnosedHealthReport } from '../src/analysis/doctor-report.js';
+import { Doctor } from '../src/analysis/doctor.js';
+import { doctorCapture } from '../src/analysis/doctor-capture.js';
+import { doctorEvent } from '../src/analysis/doctor-events.js';
+import { reportHtml } from '../src/analysis/report-html.js';
+import type { DoctorFinding, DoctorOptions } from '../src/analysis/doctor-types.js';
+import { LinkMonitor } from '../src/decoder/link.js';
+import { SpektrumDecoder } from '../src/decoder/decoder.js';
+import { USB_CHUNK_JITTER_US } from '../src/decoder/spec.js';
+import { CaptureWriter } from '../src/capture/writer.js';
+import { importSaleaeCsv } from '../src/capture/saleae.js';
+import { readCapture } from '../src/capture/sniff.js';
+import { crsfStream, ibusStream, sbusStream, spektrumTransmission, srxl2Stream, srxlV1Stream } from '../src/simulator/protocols.js';
+import { noiseSignal, receiveAs, uartReceive, type UartResult } from '../src/simulator/line.js';
+import { preset } from '../src/simulator/presets.js';
+import { simulate } from '../src/simulator/simulator.js';
+import type { Scenario } from '../src/simulator/scenario.js';
 import { concatBytes } from './bytes.js';
 
 const SECOND = 1_000_000;

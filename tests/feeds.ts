@@ -1,5 +1,7 @@
 /** How the tests' bytes reach a decoder: as a USB adapter batches them, or with every byte's time. */
-import { CaptureWriter, readCapture, type Capture } from '../src/capture/index.js';
+import { CaptureWriter } from '../src/capture/writer.js';
+import { readCapture } from '../src/capture/sniff.js';
+import type { Capture } from '../src/capture/model.js';
 import { concatBytes } from './bytes.js';
 
 /** A stream with every byte's time, as the simulator makes it. */

@@ -4,8 +4,12 @@
  * preset; and names what is wrong with a slot the decoder rejects.
  */
 import { describe, expect, it } from 'vitest';
-import { SpektrumDecoder, readFrameFields, type DecodedFrame } from '../src/decoder/index.js';
-import { encodeInternalFrame, encodeServo2048, preset, simulate } from '../src/simulator/index.js';
+import { SpektrumDecoder } from '../src/decoder/decoder.js';
+import { readFrameFields } from '../src/decoder/fields.js';
+import type { DecodedFrame } from '../src/decoder/types.js';
+import { encodeInternalFrame, encodeServo2048 } from '../src/simulator/encode.js';
+import { preset } from '../src/simulator/presets.js';
+import { simulate } from '../src/simulator/simulator.js';
 import { CLEAN_PRESETS } from './damage.js';
 
 function frames(bytes: Uint8Array): { frame: DecodedFrame; fields: ReturnType<typeof readFrameFields> }[] {

@@ -5,7 +5,8 @@
 import { readdirSync, readFileSync } from 'node:fs';
 import { join } from 'node:path';
 import { describe, expect, it } from 'vitest';
-import { SpektrumDecoder, type DecodedFrame } from '../src/decoder/index.js';
+import { SpektrumDecoder } from '../src/decoder/decoder.js';
+import type { DecodedFrame } from '../src/decoder/types.js';
 import { usbChunks } from './feeds.js';
 
 const dir = join(import.meta.dirname, 'fixtures');

@@ -1,5 +1,5 @@
 /** Frames the decoder tests build by hand: a DSMX 2048 frame pair, as a DX-series transmitter sends 10 channels. */
-import { encodeInternalFrame, encodeServo2048 } from '../src/simulator/index.js';
+import { encodeInternalFrame, encodeServo2048 } from '../src/simulator/encode.js';
 
 /** The slots of frame `i % 2` of a DSMX pair (10 channels; the first slot's phase bit marks frame 0), positions drifting with `t`. */
 export function dsmxSlots(i: number, t: number): number[] {

@@ -1,6 +1,8 @@
 import { describe, expect, it } from 'vitest';
 import { describeFrame } from '../src/app/inspect.js';
-import { SpektrumDecoder, copyFrame, servoToMicros, type FrameSnapshot } from '../src/decoder/index.js';
+import { SpektrumDecoder } from '../src/decoder/decoder.js';
+import { copyFrame, type FrameSnapshot } from '../src/decoder/snapshot.js';
+import { servoToMicros } from '../src/decoder/spec.js';
 import {
   encodeExternalFrame,
   encodeInternalFrame,
@@ -8,7 +10,7 @@ import {
   encodeServo2048,
   encodeXPlus,
   vtxWords,
-} from '../src/simulator/index.js';
+} from '../src/simulator/encode.js';
 import { DISCARD_BYTES_CAP, InspectorLog, type InspectEntry } from '../src/worker/inspector.js';
 import { concatBytes as join } from './bytes.js';
 import { dsmxPair } from './frames.js';

@@ -6,21 +6,23 @@ import { describe, expect, it } from 'vitest';
 import {
   CRSF_FORMAT,
   SBUS_FORMAT,
-  UART_115200_8N1,
-  characterTimeUs,
   crsfStream,
   ibusStream,
-  lineSignal,
-  noiseSignal,
-  preset,
-  receiveAs,
   sbusStream,
-  simulate,
   spektrumTransmission,
   srxl2Stream,
+} from '../src/simulator/protocols.js';
+import {
+  UART_115200_8N1,
+  characterTimeUs,
+  lineSignal,
+  noiseSignal,
+  receiveAs,
   uartReceive,
   type Transmission,
-} from '../src/simulator/index.js';
+} from '../src/simulator/line.js';
+import { preset } from '../src/simulator/presets.js';
+import { simulate } from '../src/simulator/simulator.js';
 
 const count = (r: ReturnType<typeof uartReceive>, kind: string): number => r.errors.filter((e) => e.kind === kind).length;
 

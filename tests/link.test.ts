@@ -1,7 +1,9 @@
 /** The link monitor: the failsafe state machine of spec §7.1, episodes, period, missed frames, delivery. */
 import { describe, expect, it } from 'vitest';
-import { BYTE_TIME_US, HOLD_MIN_US, LinkMonitor, type DecodedFrame } from '../src/decoder/index.js';
-import { LinkSeries, monitorWithSeries } from '../src/analysis/index.js';
+import { BYTE_TIME_US } from '../src/decoder/spec.js';
+import { HOLD_MIN_US, LinkMonitor } from '../src/decoder/link.js';
+import type { DecodedFrame } from '../src/decoder/types.js';
+import { LinkSeries, monitorWithSeries } from '../src/analysis/series.js';
 
 /** A stand-in frame: only what the monitor reads. `fades: null` is a receiver without a counter. */
 function frame(timeUs: number, fadesDelta = 0, system: number | null = 0xb2, fades: number | null = 0): DecodedFrame {

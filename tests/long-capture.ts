@@ -1,7 +1,11 @@
 /** A long capture of two remotes for the replay tests, and what the library says about it up to a time. */
-import { type Capture, encodeCapture } from '../src/capture/index.js';
-import { LinkMonitor, SpektrumDecoder, USB_CHUNK_JITTER_US } from '../src/decoder/index.js';
-import { preset, simulate } from '../src/simulator/index.js';
+import type { Capture } from '../src/capture/model.js';
+import { encodeCapture } from '../src/capture/writer.js';
+import { LinkMonitor } from '../src/decoder/link.js';
+import { SpektrumDecoder } from '../src/decoder/decoder.js';
+import { USB_CHUNK_JITTER_US } from '../src/decoder/spec.js';
+import { preset } from '../src/simulator/presets.js';
+import { simulate } from '../src/simulator/simulator.js';
 import { usbChunks } from './feeds.js';
 
 export const MINUTE = 60e6;

@@ -10,21 +10,25 @@
 import { readdirSync, readFileSync } from 'node:fs';
 import { join } from 'node:path';
 import { describe, expect, it } from 'vitest';
-import { LinkMonitor, SpektrumDecoder, type LinkEpisode, type Resolution } from '../src/decoder/index.js';
-import { captureChunks, capturePorts, encodeCapture, readCapture, type Capture, type CaptureRecordInput } from '../src/capture/index.js';
-import {
-  Doctor,
-  captureSpan,
-  diagnosedHealthReport,
-  doctorCapture,
-  doctorEvent,
-  healthReport,
-  resolutionKey,
-  summarizeCapture,
-  timingJitterUs,
-} from '../src/analysis/index.js';
+import { LinkMonitor, type LinkEpisode } from '../src/decoder/link.js';
+import { SpektrumDecoder } from '../src/decoder/decoder.js';
+import type { Resolution } from '../src/decoder/spec.js';
+import { captureChunks, type Capture } from '../src/capture/model.js';
+import { capturePorts } from '../src/capture/facts.js';
+import { encodeCapture, type CaptureRecordInput } from '../src/capture/writer.js';
+import { readCapture } from '../src/capture/sniff.js';
+import { Doctor } from '../src/analysis/doctor.js';
+import { captureSpan } from '../src/analysis/capture-span.js';
+import { diagnosedHealthReport } from '../src/analysis/doctor-report.js';
+import { doctorCapture } from '../src/analysis/doctor-capture.js';
+import { doctorEvent } from '../src/analysis/doctor-events.js';
+import { healthReport } from '../src/analysis/report.js';
+import { resolutionKey } from '../src/analysis/resolution-key.js';
+import { summarizeCapture } from '../src/analysis/summary.js';
+import { timingJitterUs } from '../src/analysis/capture-pass.js';
 import { SLICE_BYTES } from '../src/analysis/capture-pass.js';
-import { preset, simulate } from '../src/simulator/index.js';
+import { preset } from '../src/simulator/presets.js';
+import { simulate } from '../src/simulator/simulator.js';
 import { perByteCapture, usbChunks } from './feeds.js';
 
 /** One port decoded alone with `resolution`: its decoder and its link monitor, finished at the capture's end. */

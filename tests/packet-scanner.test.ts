@@ -5,8 +5,11 @@
  */
 import fc from 'fast-check';
 import { describe, expect, it } from 'vitest';
-import { PacketScanner, type PacketKind } from '../src/analysis/index.js';
-import { crsfStream, ibusStream, preset, receiveAs, sbusStream, simulate, srxl2Stream, srxlV1Stream } from '../src/simulator/index.js';
+import { PacketScanner, type PacketKind } from '../src/analysis/doctor-line.js';
+import { crsfStream, ibusStream, sbusStream, srxl2Stream, srxlV1Stream } from '../src/simulator/protocols.js';
+import { preset } from '../src/simulator/presets.js';
+import { receiveAs } from '../src/simulator/line.js';
+import { simulate } from '../src/simulator/simulator.js';
 
 const SECOND = 1_000_000;
 

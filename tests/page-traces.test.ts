@@ -4,7 +4,7 @@
  * one-frame glitch visible when frames outnumber pixels, at a cost that follows the width.
  */
 import { describe, expect, it } from 'vitest';
-import { CHANNEL_COUNT, PULSE_MAX_US, PULSE_MIN_US } from '../src/decoder/index.js';
+import { CHANNEL_COUNT, PULSE_MAX_US, PULSE_MIN_US } from '../src/decoder/spec.js';
 import { TRACE_ROWS, TraceBuffer, laneUs, laneY, traceView } from '../src/app/traces.js';
 import type { TraceBatch } from '../src/worker/protocol.js';
 

@@ -4,7 +4,8 @@
  * than the engine waits for, and must change nothing.
  */
 import { describe, expect, it, vi } from 'vitest';
-import { CaptureBuilder, RecordTally } from '../src/capture/index.js';
+import { CaptureBuilder } from '../src/capture/capture-builder.js';
+import { RecordTally } from '../src/capture/record-tally.js';
 import { primeRuns } from '../src/capture/prime-runs.js';
 
 describe('primeRuns', () => {

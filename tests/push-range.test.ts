@@ -6,9 +6,11 @@
  * same state. A range that is not one of the bytes is refused.
  */
 import { describe, expect, it } from 'vitest';
-import { Doctor } from '../src/analysis/index.js';
-import { type DecoderEvent, SpektrumDecoder } from '../src/decoder/index.js';
-import { ibusStream, receiveAs } from '../src/simulator/index.js';
+import { Doctor } from '../src/analysis/doctor.js';
+import type { DecoderEvent } from '../src/decoder/types.js';
+import { SpektrumDecoder } from '../src/decoder/decoder.js';
+import { ibusStream } from '../src/simulator/protocols.js';
+import { receiveAs } from '../src/simulator/line.js';
 import { concatBytes } from './bytes.js';
 import { damagedStream } from './decoder-streams.js';
 

@@ -8,8 +8,9 @@
 import { existsSync, readFileSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 import { describe, expect, it } from 'vitest';
-import { SpektrumDecoder, type DecodedFrame } from '../src/decoder/index.js';
-import { importSaleaeCsv } from '../src/capture/index.js';
+import { SpektrumDecoder } from '../src/decoder/decoder.js';
+import type { DecodedFrame } from '../src/decoder/types.js';
+import { importSaleaeCsv } from '../src/capture/saleae.js';
 import { usbChunks } from './feeds.js';
 
 const dir = resolve(import.meta.dirname, '../../shared/captures/px4');

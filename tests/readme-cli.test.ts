@@ -9,8 +9,9 @@ import { copyFileSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from '
 import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
-import { CaptureWriter } from '../src/capture/index.js';
-import { preset, simulate } from '../src/simulator/index.js';
+import { CaptureWriter } from '../src/capture/writer.js';
+import { preset } from '../src/simulator/presets.js';
+import { simulate } from '../src/simulator/simulator.js';
 import { concatBytes } from './bytes.js';
 import { usbChunks } from './feeds.js';
 

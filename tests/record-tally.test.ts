@@ -5,18 +5,13 @@
  * chunk counts and chunk numbers, whether the times never go back, and the span with its events.
  */
 import { describe, expect, it } from 'vitest';
-import { captureSpan, spanBetween } from '../src/analysis/index.js';
-import { BYTE_TIME_US } from '../src/decoder/index.js';
-import {
-  RecordTally,
-  captureChunksByPort,
-  capturePortIndex,
-  capturePorts,
-  captureTimesInOrder,
-  encodeCapture,
-  parseCapture,
-  walkDataRecords,
-} from '../src/capture/index.js';
+import { captureSpan, spanBetween } from '../src/analysis/capture-span.js';
+import { BYTE_TIME_US } from '../src/decoder/spec.js';
+import { RecordTally } from '../src/capture/record-tally.js';
+import { captureChunksByPort, capturePortIndex, capturePorts, captureTimesInOrder } from '../src/capture/facts.js';
+import { encodeCapture } from '../src/capture/writer.js';
+import { parseCapture } from '../src/capture/reader.js';
+import { walkDataRecords } from '../src/capture/record-walk.js';
 import { longCapture } from './long-capture.js';
 
 /**

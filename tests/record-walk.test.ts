@@ -3,7 +3,9 @@
  * same chunks parseCapture reads, whatever the slice size; a file that is not intact is refused.
  */
 import { describe, expect, it } from 'vitest';
-import { encodeCapture, parseCapture, recordTimeUs, walkDataRecords } from '../src/capture/index.js';
+import { encodeCapture } from '../src/capture/writer.js';
+import { parseCapture } from '../src/capture/reader.js';
+import { recordTimeUs, walkDataRecords } from '../src/capture/record-walk.js';
 
 /** Data records of 1–40 bytes (one of 3000) on three ports, an event every 50, one record far bigger than a slice. */
 function file(): Uint8Array {

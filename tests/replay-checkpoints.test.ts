@@ -5,16 +5,21 @@
  * capture up to the target, as a decode fed every chunk up to there has them.
  */
 import { describe, expect, it } from 'vitest';
-import { type Capture, capturePorts, encodeCapture, readCapture } from '../src/capture/index.js';
+import type { Capture } from '../src/capture/model.js';
+import { capturePorts } from '../src/capture/facts.js';
+import { encodeCapture } from '../src/capture/writer.js';
+import { readCapture } from '../src/capture/sniff.js';
 import { Dispatcher } from '../src/worker/dispatcher.js';
 import { addOverviews, overviewOf } from '../src/worker/replay/overview.js';
-import { preset, simulate } from '../src/simulator/index.js';
+import { preset } from '../src/simulator/presets.js';
+import { simulate } from '../src/simulator/simulator.js';
 import { usbChunks } from './feeds.js';
 import { CHECKPOINT_US, ReplayPass, checkpointDue } from '../src/worker/replay/replay-pass.js';
 import { checkpointChunks } from '../src/worker/replay/replay-split.js';
 import { passOverFile } from '../src/worker/replay/replay-file-pass.js';
 import { type PreviewSizes, previewOf } from '../src/worker/replay/replay-preview.js';
-import { captureSpan, healthReport } from '../src/analysis/index.js';
+import { captureSpan } from '../src/analysis/capture-span.js';
+import { healthReport } from '../src/analysis/report.js';
 import type { Overview } from '../src/worker/protocol.js';
 import { MINUTE, libraryUpTo, longCapture, longCaptureWithSeed } from './long-capture.js';
 import { FakeClock, ReadingClock, fakeHost } from './worker-fakes.js';

@@ -6,7 +6,11 @@
  * fails, disagrees, or read a damaged file counts for nothing: the worker decodes its ports.
  */
 import { describe, expect, it } from 'vitest';
-import { type Capture, capturePortIndex, capturePorts, parseCapture, readCapture, type SlicedFile } from '../src/capture/index.js';
+import type { Capture } from '../src/capture/model.js';
+import { capturePortIndex, capturePorts } from '../src/capture/facts.js';
+import { parseCapture } from '../src/capture/reader.js';
+import { readCapture } from '../src/capture/sniff.js';
+import type { SlicedFile } from '../src/capture/record-walk.js';
 import { Dispatcher } from '../src/worker/dispatcher.js';
 import { overviewOf } from '../src/worker/replay/overview.js';
 import type { Overview } from '../src/worker/protocol.js';

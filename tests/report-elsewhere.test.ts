@@ -5,11 +5,15 @@
  * together. Readings guessed wrong (another resolution than the report asks for) are not used.
  */
 import { describe, expect, it } from 'vitest';
-import { diagnosedHealthReport, Doctor } from '../src/analysis/index.js';
+import { diagnosedHealthReport } from '../src/analysis/doctor-report.js';
+import { Doctor } from '../src/analysis/doctor.js';
 import { diagnosedReportJobs } from '../src/analysis/doctor-report.js';
 import { readPortMessage, sameReading, type PortReadingMessage } from '../src/analysis/report-port-message.js';
-import type { Capture } from '../src/capture/index.js';
-import { crsfStream, ibusStream, preset, receiveAs, simulate, srxlV1Stream } from '../src/simulator/index.js';
+import type { Capture } from '../src/capture/model.js';
+import { crsfStream, ibusStream, srxlV1Stream } from '../src/simulator/protocols.js';
+import { preset } from '../src/simulator/presets.js';
+import { receiveAs } from '../src/simulator/line.js';
+import { simulate } from '../src/simulator/simulator.js';
 import { concatBytes } from './bytes.js';
 import { oneAfterAnother, recording, type Stream } from './feeds.js';
 

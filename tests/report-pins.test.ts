@@ -8,9 +8,15 @@
 import { existsSync, readFileSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 import { describe, expect, it } from 'vitest';
-import { diagnosedHealthReport, doctorCapture, summarizeCapture } from '../src/analysis/index.js';
-import { importSaleaeCsv, type Capture } from '../src/capture/index.js';
-import { ibusStream, preset, receiveAs, simulate, srxlV1Stream } from '../src/simulator/index.js';
+import { diagnosedHealthReport } from '../src/analysis/doctor-report.js';
+import { doctorCapture } from '../src/analysis/doctor-capture.js';
+import { summarizeCapture } from '../src/analysis/summary.js';
+import { importSaleaeCsv } from '../src/capture/saleae.js';
+import type { Capture } from '../src/capture/model.js';
+import { ibusStream, srxlV1Stream } from '../src/simulator/protocols.js';
+import { preset } from '../src/simulator/presets.js';
+import { receiveAs } from '../src/simulator/line.js';
+import { simulate } from '../src/simulator/simulator.js';
 import { oneAfterAnother, perByteCapture, recording } from './feeds.js';
 
 const SECOND = 1_000_000;

@@ -11,9 +11,12 @@ import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
 import { pathToFileURL } from 'node:url';
 import { afterAll, describe, expect, it } from 'vitest';
-import { diagnosedHealthReport, diagnosedReportJobs } from '../src/analysis/index.js';
-import { parseCapture, readCapture, type Capture } from '../src/capture/index.js';
-import { preset, simulate } from '../src/simulator/index.js';
+import { diagnosedHealthReport, diagnosedReportJobs } from '../src/analysis/doctor-report.js';
+import { parseCapture } from '../src/capture/reader.js';
+import { readCapture } from '../src/capture/sniff.js';
+import type { Capture } from '../src/capture/model.js';
+import { preset } from '../src/simulator/presets.js';
+import { simulate } from '../src/simulator/simulator.js';
 import { recordingFile } from './feeds.js';
 
 const SECOND = 1_000_000;

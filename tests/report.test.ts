@@ -8,26 +8,21 @@ import { existsSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'no
 import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
-import { servoToMicros } from '../src/decoder/index.js';
-import {
-  CaptureWriter,
-  encodeCapture,
-  importRaw,
-  importSaleaeCsv,
-  readCapture,
-  type Capture,
-  type CaptureMeta,
-  type CaptureRecordInput,
-} from '../src/capture/index.js';
-import {
-  diagnosedHealthReport,
-  escapeHtml,
-  healthReport,
-  reportHtml,
-  SPIKE_MIN_JUMP_PERCENT,
-  type HealthReport,
-} from '../src/analysis/index.js';
-import { encodeServo2048, preset, simulate, type Scenario, type SimChunk } from '../src/simulator/index.js';
+import { servoToMicros } from '../src/decoder/spec.js';
+import { CaptureWriter, encodeCapture, type CaptureRecordInput } from '../src/capture/writer.js';
+import { importRaw } from '../src/capture/raw.js';
+import { importSaleaeCsv } from '../src/capture/saleae.js';
+import { readCapture } from '../src/capture/sniff.js';
+import type { Capture, CaptureMeta } from '../src/capture/model.js';
+import { diagnosedHealthReport } from '../src/analysis/doctor-report.js';
+import { escapeHtml, reportHtml } from '../src/analysis/report-html.js';
+import { healthReport } from '../src/analysis/report.js';
+import { SPIKE_MIN_JUMP_PERCENT } from '../src/analysis/report-thresholds.js';
+import type { HealthReport } from '../src/analysis/report-types.js';
+import { encodeServo2048 } from '../src/simulator/encode.js';
+import { preset } from '../src/simulator/presets.js';
+import { simulate, type SimChunk } from '../src/simulator/simulator.js';
+import type { Scenario } from '../src/simulator/scenario.js';
 import { perByteCapture } from './feeds.js';
 import { satscope } from './built-cli.js';
 

@@ -5,9 +5,12 @@
  * of a bin too) and in its checkpoint.
  */
 import { describe, expect, it } from 'vitest';
-import { LinkSeries, monitorWithSeries } from '../src/analysis/index.js';
-import { type DecodedFrame, LinkMonitor, SpektrumDecoder } from '../src/decoder/index.js';
-import { preset, simulate } from '../src/simulator/index.js';
+import { LinkSeries, monitorWithSeries } from '../src/analysis/series.js';
+import type { DecodedFrame } from '../src/decoder/types.js';
+import { LinkMonitor } from '../src/decoder/link.js';
+import { SpektrumDecoder } from '../src/decoder/decoder.js';
+import { preset } from '../src/simulator/presets.js';
+import { simulate } from '../src/simulator/simulator.js';
 
 type Sums = { frames: number; fades: number; lost: number; rssi: number[]; intervals: number[] };
 

@@ -6,30 +6,22 @@
 import { readFileSync, readdirSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 import { describe, expect, it } from 'vitest';
+import { PRESET_NAMES, demoScenario, preset, presets } from '../src/simulator/presets.js';
+import { Simulator, simulate, type SimChunk } from '../src/simulator/simulator.js';
+import { channelLayout, describeLayout } from '../src/simulator/layouts.js';
 import {
-  PRESET_NAMES,
-  Simulator,
-  channelLayout,
-  demoScenario,
-  describeLayout,
   encodeExternalFrame,
   encodeInternalFrame,
   encodeServo1024,
   encodeServo2048,
   encodeVtx,
   encodeXPlus,
-  preset,
-  presets,
-  resolveScenario,
-  simulate,
-  toFixtureFrame,
   vtxControl,
   vtxWords,
   xplusPosition,
-  type Scenario,
-  type SimChunk,
-  type TruthFrame,
-} from '../src/simulator/index.js';
+} from '../src/simulator/encode.js';
+import { resolveScenario, type Scenario } from '../src/simulator/scenario.js';
+import { toFixtureFrame, type TruthFrame } from '../src/simulator/truth.js';
 
 // ---------------------------------------------------------------------------------------------
 // Reference decoding, straight from the spec.

@@ -3,8 +3,9 @@
  * often bytes come, the last change always delivered, idle ticks while live sources are quiet.
  */
 import { describe, expect, it } from 'vitest';
-import { SpektrumDecoder } from '../src/decoder/index.js';
-import { preset, simulate } from '../src/simulator/index.js';
+import { SpektrumDecoder } from '../src/decoder/decoder.js';
+import { preset } from '../src/simulator/presets.js';
+import { simulate } from '../src/simulator/simulator.js';
 import { Batcher, IDLE_TICK_MS, MIN_BATCH_MS } from '../src/worker/batcher.js';
 import { Diagnosis } from '../src/worker/diagnosis.js';
 import type { FromWorker } from '../src/worker/protocol.js';

@@ -3,8 +3,10 @@
  * ports, commands through its queue in order, sources closed while their data is on the way.
  */
 import { describe, expect, it } from 'vitest';
-import { encodeCapture, parseCapture } from '../src/capture/index.js';
-import { preset, simulate } from '../src/simulator/index.js';
+import { encodeCapture } from '../src/capture/writer.js';
+import { parseCapture } from '../src/capture/reader.js';
+import { preset } from '../src/simulator/presets.js';
+import { simulate } from '../src/simulator/simulator.js';
 import { Dispatcher } from '../src/worker/dispatcher.js';
 import { framesFile } from '../src/worker/frames-export.js';
 import type { ToWorker } from '../src/worker/protocol.js';

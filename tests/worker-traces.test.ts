@@ -4,9 +4,11 @@
  * own rule finds, the same ones `satscope report` lists.
  */
 import { describe, expect, it } from 'vitest';
-import { healthReport } from '../src/analysis/index.js';
-import { CHANNEL_COUNT, SpektrumDecoder, channelResolution, servoToMicros } from '../src/decoder/index.js';
-import { preset, simulate, type SimChunk } from '../src/simulator/index.js';
+import { healthReport } from '../src/analysis/report.js';
+import { CHANNEL_COUNT, channelResolution, servoToMicros } from '../src/decoder/spec.js';
+import { SpektrumDecoder } from '../src/decoder/decoder.js';
+import { preset } from '../src/simulator/presets.js';
+import { simulate, type SimChunk } from '../src/simulator/simulator.js';
 import { Engine } from '../src/worker/engine.js';
 import type { TraceBatch } from '../src/worker/protocol.js';
 import { MAX_TRACE_ROWS, TraceLog } from '../src/worker/traces.js';

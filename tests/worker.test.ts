@@ -4,10 +4,14 @@
  * of port errors.
  */
 import { describe, expect, it } from 'vitest';
-import { encodeCapture, importRaw, readCapture, type Capture } from '../src/capture/index.js';
-import { captureSpan } from '../src/analysis/index.js';
+import { encodeCapture } from '../src/capture/writer.js';
+import { importRaw } from '../src/capture/raw.js';
+import { readCapture } from '../src/capture/sniff.js';
+import type { Capture } from '../src/capture/model.js';
+import { captureSpan } from '../src/analysis/capture-span.js';
 import type { Batch } from '../src/worker/protocol.js';
-import { preset, simulate } from '../src/simulator/index.js';
+import { preset } from '../src/simulator/presets.js';
+import { simulate } from '../src/simulator/simulator.js';
 import { Engine, SETTLE_US } from '../src/worker/engine.js';
 import { SeriesBuffer } from '../src/app/live.js';
 import { ReplaySource } from '../src/worker/sources/replay.js';

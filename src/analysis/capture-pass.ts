@@ -9,9 +9,11 @@
  * Chunks are read straight from the capture's columns (no object per chunk), and the capture's
  * span (`captureSpan`) is one pass over its chunk times, taken once by the caller.
  */
-import type { Capture, CaptureEvent, CaptureTiming } from '../capture/index.js';
-import { SpektrumDecoder, USB_CHUNK_JITTER_US, type DecodedFrame, type DecoderOptions } from '../decoder/index.js';
-import type { LinkMonitor } from '../decoder/index.js';
+import type { Capture, CaptureEvent, CaptureTiming } from '../capture/model.js';
+import { SpektrumDecoder, type DecoderOptions } from '../decoder/decoder.js';
+import { USB_CHUNK_JITTER_US } from '../decoder/spec.js';
+import type { DecodedFrame } from '../decoder/types.js';
+import type { LinkMonitor } from '../decoder/link.js';
 import type { Doctor } from './doctor.js';
 import { doctorEvent, stopsPort } from './doctor-events.js';
 import { SCAN_MEMORY, startsCandidate } from './doctor-line.js';
@@ -19,6 +21,7 @@ import { lineWindow } from './doctor-state.js';
 import { LinkSeries, monitorWithSeries } from './series.js';
 import { captureSpan } from './capture-span.js';
 
+/** How `decodeCapture` reads a port: decoder options, the port, the series' bins, where the span starts and ends, and a doctor to listen. */
 export interface DecodeCaptureOptions extends DecoderOptions {
   /** Which serial port of a multi-port capture to decode. Default 0. */
   port?: number;

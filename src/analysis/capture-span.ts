@@ -6,8 +6,9 @@
  * time found as its records are walked (a long capture's replay: the capture's RecordTally),
  * by the same rule (`SpanTally`).
  */
-import { type Capture, captureFact, chunkFirstByteUs, seedCaptureFact } from '../capture/index.js';
-import { BYTE_TIME_US } from '../decoder/index.js';
+import { type Capture, chunkFirstByteUs } from '../capture/model.js';
+import { captureFact, seedCaptureFact } from '../capture/facts.js';
+import { BYTE_TIME_US } from '../decoder/spec.js';
 
 export interface CaptureSpan {
   startUs: number;

@@ -4,8 +4,11 @@
  * arrive, with the capture's events ("port opened", line errors) fed in where they happened.
  * Pure: same capture, same findings.
  */
-import { BYTE_TIME_US, LinkMonitor, SpektrumDecoder, type Resolution } from '../decoder/index.js';
-import { capturePorts, chunkFirstByteUs, type Capture, type CaptureKind, type CaptureTiming } from '../capture/index.js';
+import { BYTE_TIME_US, type Resolution } from '../decoder/spec.js';
+import { LinkMonitor } from '../decoder/link.js';
+import { SpektrumDecoder } from '../decoder/decoder.js';
+import { capturePorts } from '../capture/facts.js';
+import { chunkFirstByteUs, type Capture, type CaptureKind, type CaptureTiming } from '../capture/model.js';
 import { Doctor } from './doctor.js';
 import type { DoctorCode, DoctorFinding, Severity } from './doctor-types.js';
 import { doctorEvent, stopsPort } from './doctor-events.js';
@@ -13,6 +16,7 @@ import { SLICE_BYTES, timingJitterUs } from './capture-pass.js';
 import { captureSpan } from './capture-span.js';
 import { portResolutions } from './resolution-key.js';
 
+/** How `doctorCapture` reads a capture: the resolution, and the step its timeline is judged at. */
 export interface DoctorCaptureOptions {
   /** Resolution override for every port's decoder. Default 'auto'. */
   resolution?: 'auto' | Resolution;

@@ -4,7 +4,7 @@
  * makes. The live worker, `doctorCapture` and the report's one pass all go through here, so a
  * recording says what was seen.
  */
-import type { Capture } from '../capture/index.js';
+import type { Capture } from '../capture/model.js';
 import type { Doctor } from './doctor.js';
 
 /** A capture event's text names a WebSerial read error, e.g. "line error: FramingError". */

@@ -8,8 +8,8 @@
  * rest on one reading. A capture without timing is the exception: the doctor reads it on a clock
  * of its own (bytes back to back at 115200, `doctorCapture`), which the report does not use.
  */
-import type { Capture } from '../capture/index.js';
-import { capturePorts } from '../capture/index.js';
+import type { Capture } from '../capture/model.js';
+import { capturePorts } from '../capture/facts.js';
 import { healthReportFeeding, type ReadingsElsewhere } from './report.js';
 import type { PortReadingJob } from './report-port-message.js';
 import { likelyReadings } from './resolution-key.js';

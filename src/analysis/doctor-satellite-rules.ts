@@ -3,7 +3,9 @@
  * bound in, what its frames carry, and how weak its link is (failsafes, holds, fades, RSSI,
  * rebinds, restarts).
  */
-import { systemInfo, type FormatInfo, type LinkStats, type Resolution } from '../decoder/index.js';
+import { systemInfo, type Resolution } from '../decoder/spec.js';
+import type { FormatInfo } from '../decoder/types.js';
+import type { LinkStats } from '../decoder/link.js';
 import { becameFailsafe } from '../decoder/link.js';
 import { fadesPerMinute, REPORT_THRESHOLDS } from './report-thresholds.js';
 import { formatDuration, plural, rate as rateText } from './report-text.js';

@@ -5,7 +5,7 @@
  * documentation (read 2026-11-23); the source is cited beside each entry. Settings change
  * between releases: the citations say which file to re-read when they do.
  */
-import { systemInfo, type Resolution } from '../decoder/index.js';
+import { systemInfo, type Resolution } from '../decoder/spec.js';
 
 export type FlightStack = 'Betaflight' | 'iNav' | 'ArduPilot' | 'PX4';
 

@@ -2,7 +2,7 @@
  * What the doctor keeps per port: its thresholds, one-second bins of counters over the last
  * 64 seconds, and the state its rules read (activity, packets, frames, formats, restarts).
  */
-import type { Resolution } from '../decoder/index.js';
+import type { Resolution } from '../decoder/spec.js';
 import {
   type BurstClock,
   type BurstClockCheckpoint,

@@ -2,7 +2,8 @@
  * What the doctor says and how it is set up: finding codes, severities, confidence, evidence,
  * the probe that would confirm a finding, the options and what a port gives it to read.
  */
-import type { LinkMonitor, SpektrumDecoder } from '../decoder/index.js';
+import type { LinkMonitor } from '../decoder/link.js';
+import type { SpektrumDecoder } from '../decoder/decoder.js';
 import type { StackSetting } from './doctor-stacks.js';
 
 /** Stable codes, for programs and tests; titles are for people. */
@@ -42,6 +43,7 @@ export type DoctorCode =
   | 'delivery-stall'
   | 'rssi-receiver';
 
+/** How much a finding matters: a problem to fix, a warning to check, or information. */
 export type Severity = 'problem' | 'warning' | 'info';
 /** How sure: 'certain' (the bytes prove it), 'likely' (the numbers fit it and nothing else known), 'possible' (one of several explanations). */
 export type Confidence = 'possible' | 'likely' | 'certain';
@@ -63,6 +65,7 @@ export interface ConfirmProbe {
   note: string;
 }
 
+/** One thing the doctor found: what, on which ports, how bad, how sure, the evidence, and what to do. */
 export interface DoctorFinding {
   code: DoctorCode;
   /** The ports it is about, in increasing order (several for a finding about the whole system). */
@@ -81,6 +84,7 @@ export interface DoctorFinding {
   sinceUs: number;
 }
 
+/** How a `Doctor` reads its sources: their timing, how far back it remembers, and where its clock starts. */
 export interface DoctorOptions {
   /**
    * How byte and error times were taken: 'per-byte' (a logic analyser, the line model), where

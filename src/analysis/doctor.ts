@@ -12,7 +12,8 @@
  * Feeding costs a few operations per byte and per frame and allocates nothing; `findings()`
  * builds its answer (call it a few times a second at most).
  */
-import { FRAME_SIZE, type DecodedFrame } from '../decoder/index.js';
+import { FRAME_SIZE } from '../decoder/spec.js';
+import type { DecodedFrame } from '../decoder/types.js';
 import { BurstClock, PACKET_KINDS, PacketScanner, type PacketKind } from './doctor-line.js';
 import { ArduPilotGuess } from './doctor-stacks.js';
 import { lineFindings, lineVerdict, noSatelliteFinding, nothingFindings } from './doctor-line-rules.js';

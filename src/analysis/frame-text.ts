@@ -23,6 +23,7 @@ export function formatJsonLine(f: DecodedFrame): string {
 
 const CHANNEL_COLUMNS = Array.from({ length: CHANNEL_COUNT }, (_, id) => `ch${id}_us`);
 
+/** The header row of `satscope decode --format csv`, matching `formatCsvLine`. */
 export function formatCsvHeader(): string {
   return ['t', 'remote', 'system', 'resolution', 'fades', 'rssi', ...CHANNEL_COLUMNS].join(',');
 }

@@ -23,58 +23,20 @@
  * `diagnosedHealthReport(capture)`.
  */
 export { Doctor } from './doctor.js';
-export { LINE_WINDOW_BINS, NOTHING_AFTER_US, NOTHING_CERTAIN_US } from './doctor-state.js';
-export type {
-  Confidence,
-  ConfirmProbe,
-  DoctorCode,
-  DoctorFinding,
-  DoctorOptions,
-  DoctorPortSource,
-  Evidence,
-  Severity,
-} from './doctor-types.js';
-export { diagnosedHealthReport, diagnosedReportJobs } from './doctor-report.js';
-export { readPortMessage, sameReading, type PortReadingJob, type PortReadingMessage } from './report-port-message.js';
-export { doctorCapture, type DoctorCaptureOptions, type DoctorReport, type DoctorTimelineEntry } from './doctor-capture.js';
-export { doctorEvent } from './doctor-events.js';
-export {
-  ArduPilotGuess,
-  ARDUPILOT_GUESS_FRAMES,
-  bindPulses,
-  channelSetText,
-  foreignSettings,
-  PROTOCOL_SETTINGS,
-  satelliteSettings,
-  type FlightStack,
-  type ForeignProtocol,
-  type GuessTally,
-  type StackSetting,
-  type StreamFacts,
-} from './doctor-stacks.js';
-export { classifyLine, PacketScanner, PACKET_KINDS, type LineCounts, type LineVerdict, type PacketKind } from './doctor-line.js';
-export { decodeCapture, timingJitterUs, type DecodeCaptureOptions } from './capture-pass.js';
-export { type CaptureSpan, SpanTally, captureSpan, seedCaptureSpan, spanBetween } from './capture-span.js';
-export { resolutionKey } from './resolution-key.js';
+export type { Confidence, DoctorCode, DoctorFinding, DoctorOptions, Evidence, Severity } from './doctor-types.js';
+export { diagnosedHealthReport } from './doctor-report.js';
+export { doctorCapture, type DoctorCaptureOptions, type DoctorReport } from './doctor-capture.js';
+export { decodeCapture, type DecodeCaptureOptions } from './capture-pass.js';
 export { summarizeCapture, type CaptureSummary, type ChannelSummary } from './summary.js';
 export { formatCsvHeader, formatCsvLine, formatJsonLine } from './frame-text.js';
-export { LinkSeries, monitorWithSeries } from './series.js';
-export { healthReport, type ReadingsElsewhere } from './report.js';
-export { formatClock, formatDuration } from './report-text.js';
-export { REPORT_BIN_US, REPORT_THRESHOLDS, SPIKE_MIN_JUMP_PERCENT, type ReportThresholds } from './report-thresholds.js';
+export { LinkSeries } from './series.js';
+export { healthReport } from './report.js';
 export type {
-  FindingCode,
-  FindingLevel,
   HealthReport,
   HealthReportOptions,
   RemoteReport,
   ReportChannel,
   ReportEpisode,
   ReportFinding,
-  ReportGlitch,
-  ReportPeriodStats,
-  ReportSeries,
-  ReportStatus,
-  ReportDiagnosis,
 } from './report-types.js';
-export { escapeHtml, reportHtml } from './report-html.js';
+export { reportHtml } from './report-html.js';

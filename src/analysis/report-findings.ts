@@ -2,7 +2,7 @@
  * The health report's plain-English findings for one remote, from its figures, judged by the
  * report's thresholds; and the status they add up to.
  */
-import type { CaptureTiming } from '../capture/index.js';
+import type { CaptureTiming } from '../capture/model.js';
 import {
   BAD_FRAME_WARN_RATIO,
   FADE_RATE_HIGH_PER_MIN,

@@ -2,7 +2,8 @@
  * The health report as one self-contained HTML page: inline SVG graphs, no scripts, nothing
  * fetched, one printed page. Rendering only: the figures come from `healthReport`.
  */
-import { XPLUS_FIRST, channelName, type ResolutionReason } from '../decoder/index.js';
+import { XPLUS_FIRST, channelName } from '../decoder/spec.js';
+import type { ResolutionReason } from '../decoder/types.js';
 import { DATA_COLORS } from './palette.js';
 import { RSSI_LOW_DBM } from './report-thresholds.js';
 import { formatClock, formatDuration, pctText, plural, rate } from './report-text.js';

@@ -10,8 +10,10 @@
  * Which readings to make elsewhere is `likelyReadings`: a guess that costs nothing when wrong,
  * since the report decodes on its own thread whatever it asks for and nobody made.
  */
-import type { Capture } from '../capture/index.js';
-import { SpektrumDecoder, type DecoderCheckpoint, type LinkCheckpoint, type Resolution } from '../decoder/index.js';
+import type { Capture } from '../capture/model.js';
+import { SpektrumDecoder } from '../decoder/decoder.js';
+import type { DecoderCheckpoint, LinkCheckpoint } from '../decoder/checkpoint.js';
+import type { Resolution } from '../decoder/spec.js';
 import { timingJitterUs } from './capture-pass.js';
 import { Doctor } from './doctor.js';
 import type { PortCheckpoint } from './doctor-state.js';

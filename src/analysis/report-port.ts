@@ -5,19 +5,10 @@
  * `SPIKE_MIN_JUMP_PERCENT`). Sums, not a record per frame, so a day-long capture costs the same
  * memory as a minute.
  */
-import type { Capture } from '../capture/index.js';
-import {
-  CHANNEL_COUNT,
-  channelName,
-  channelResolution,
-  servoToMicros,
-  servoToPercent,
-  type DecodedFrame,
-  type DecoderStats,
-  type FormatInfo,
-  type LinkMonitor,
-  type Resolution,
-} from '../decoder/index.js';
+import type { Capture } from '../capture/model.js';
+import { CHANNEL_COUNT, channelName, channelResolution, servoToMicros, servoToPercent, type Resolution } from '../decoder/spec.js';
+import type { DecodedFrame, DecoderStats, FormatInfo } from '../decoder/types.js';
+import type { LinkMonitor } from '../decoder/link.js';
 import { decodeCapture } from './capture-pass.js';
 import type { Doctor } from './doctor.js';
 import { MAX_LISTED_GLITCHES, REPORT_BIN_US, SPIKE_MIN_JUMP_PERCENT } from './report-thresholds.js';

@@ -2,7 +2,7 @@
  * Every threshold the health report judges a link by, each with where it comes from, and the
  * record of them a report carries (`REPORT_THRESHOLDS`). The doctor judges by the same ones.
  */
-import { USB_CHUNK_JITTER_US } from '../decoder/index.js';
+import { USB_CHUNK_JITTER_US } from '../decoder/spec.js';
 
 /** Width of one bin of the per-second series, µs. */
 export const REPORT_BIN_US = 1_000_000;

@@ -3,8 +3,10 @@
  * that `healthReport` makes, `reportHtml` renders and `satscope report --json` prints. Times are
  * µs relative to the report's time zero (`timeline.originUs`).
  */
-import type { CaptureKind, CaptureTiming } from '../capture/index.js';
-import type { HeaderReading, MissedBasis, RemoteKind, Resolution, ResolutionReason } from '../decoder/index.js';
+import type { CaptureKind, CaptureTiming } from '../capture/model.js';
+import type { HeaderReading, RemoteKind, ResolutionReason } from '../decoder/types.js';
+import type { MissedBasis } from '../decoder/link.js';
+import type { Resolution } from '../decoder/spec.js';
 import type { ReportThresholds } from './report-thresholds.js';
 
 /** How bad a finding is. */
@@ -255,6 +257,7 @@ export interface ReportDiagnosis {
   settings: readonly { stack: string; lines: readonly string[]; note: string }[];
 }
 
+/** How `healthReport` reads a capture (the resolution) and names it; every field is optional. */
 export interface HealthReportOptions {
   /** Resolution override for the decoder (default 'auto'). */
   resolution?: 'auto' | Resolution;

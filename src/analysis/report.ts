@@ -8,9 +8,10 @@
  * report's time zero (`timeline.originUs`, the earliest time recorded in the capture on any
  * port), so that the ports of a multi-port capture share one time axis.
  */
-import type { Capture } from '../capture/index.js';
-import { capturePorts } from '../capture/index.js';
-import { CHANNEL_COUNT, channelName, systemInfo, type LinkEpisode, type Resolution } from '../decoder/index.js';
+import type { Capture } from '../capture/model.js';
+import { capturePorts } from '../capture/facts.js';
+import { CHANNEL_COUNT, channelName, systemInfo, type Resolution } from '../decoder/spec.js';
+import type { LinkEpisode } from '../decoder/link.js';
 import { becameFailsafe } from '../decoder/link.js';
 import { captureSpan } from './capture-span.js';
 import type { Doctor } from './doctor.js';

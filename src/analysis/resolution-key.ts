@@ -3,9 +3,12 @@
  * remote takes from the internal one, and the order a whole capture's ports are decoded in so
  * that each is decoded once: the internal remote's port first, then the others with its key.
  */
-import { capturePorts, type Capture } from '../capture/index.js';
+import { capturePorts } from '../capture/facts.js';
+import type { Capture } from '../capture/model.js';
 import { decodeCapture } from './capture-pass.js';
-import { SpektrumDecoder, systemInfo, type DecoderStats, type FormatInfo, type Resolution } from '../decoder/index.js';
+import { SpektrumDecoder } from '../decoder/decoder.js';
+import { systemInfo, type Resolution } from '../decoder/spec.js';
+import type { DecoderStats, FormatInfo } from '../decoder/types.js';
 
 /**
  * The resolution an external remote takes: that of an internal remote whose system byte is one

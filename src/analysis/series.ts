@@ -4,8 +4,8 @@
  * missed frames placed where they were due). The live page (100 ms bins), the replay overview
  * and the health report (1 s bins) all fill it the same way.
  */
-import { LinkMonitor, type LinkOptions } from '../decoder/index.js';
-import type { DecodedFrame } from '../decoder/index.js';
+import { LinkMonitor, type LinkOptions } from '../decoder/link.js';
+import type { DecodedFrame } from '../decoder/types.js';
 
 /**
  * The most bins a series holds: 12 days of 1 s bins, 29 h of 100 ms ones. Times are whatever a

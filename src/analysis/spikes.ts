@@ -4,7 +4,8 @@
  * tally (report-port.ts) judges its candidates with `isSpike`, and the page's channel traces
  * mark what `SpikeFinder` finds frame by frame, so the report and the page name the same glitches.
  */
-import { CHANNEL_COUNT, channelResolution, servoToMicros, servoToPercent, type DecodedFrame } from '../decoder/index.js';
+import { CHANNEL_COUNT, channelResolution, servoToMicros, servoToPercent } from '../decoder/spec.js';
+import type { DecodedFrame } from '../decoder/types.js';
 import { SPIKE_MIN_JUMP_PERCENT, SPIKE_RETURN_PERCENT, SPIKE_WINDOW_FRAMES, SPIKE_WINDOW_US } from './report-thresholds.js';
 
 /**

@@ -2,12 +2,13 @@
  * The summary `satscope info` prints: one port of a capture decoded (`decodeCapture`) and summed
  * up. Pure: the capture is already in memory, and the caller chooses how to show the result.
  */
-import type { Capture, CaptureIssue } from '../capture/index.js';
-import type { LinkEpisode, LinkStats } from '../decoder/index.js';
-import { channelName, channelResolution, CHANNEL_COUNT, servoToMicros } from '../decoder/index.js';
-import type { DecodedFrame, DecoderStats, FormatInfo } from '../decoder/index.js';
+import type { Capture, CaptureIssue } from '../capture/model.js';
+import type { LinkEpisode, LinkStats } from '../decoder/link.js';
+import { channelName, channelResolution, CHANNEL_COUNT, servoToMicros } from '../decoder/spec.js';
+import type { DecodedFrame, DecoderStats, FormatInfo } from '../decoder/types.js';
 import { decodeCapture, type DecodeCaptureOptions } from './capture-pass.js';
 
+/** One channel over a capture: its name, how many frames carried it, its range and last value in µs. */
 export interface ChannelSummary {
   id: number;
   name: string;
@@ -17,6 +18,7 @@ export interface ChannelSummary {
   lastUs: number;
 }
 
+/** One port of a capture decoded (`summarizeCapture`): what `satscope info` prints. */
 export interface CaptureSummary {
   kind: Capture['kind'];
   timing: Capture['timing'];

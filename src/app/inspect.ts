@@ -5,19 +5,9 @@
  * `readFrameFields`, made with the decoder's own tables, so the inspector shows a frame
  * exactly as the decoder read it; this file only says it.
  */
-import {
-  FRAME_SIZE,
-  channelName,
-  readFrameFields,
-  systemInfo,
-  type FrameFields,
-  type HeaderMode,
-  type RemoteKind,
-  type Resolution,
-  type SlotFields,
-  type SlotKind,
-  type VtxControl,
-} from '../decoder/index.js';
+import { FRAME_SIZE, channelName, systemInfo, type Resolution } from '../decoder/spec.js';
+import { readFrameFields, type FrameFields, type SlotFields, type SlotKind } from '../decoder/fields.js';
+import type { HeaderMode, RemoteKind, VtxControl } from '../decoder/types.js';
 
 export type { SlotKind };
 

@@ -3,7 +3,7 @@
  * in growing columns, outside the virtual DOM. Renderers read it once per animation frame
  * (frame-loop.ts) and redraw only what changed.
  */
-import { CHANNEL_COUNT } from '../decoder/index.js';
+import { CHANNEL_COUNT } from '../decoder/spec.js';
 import type { Batch } from '../worker/protocol.js';
 import { TraceBuffer } from './traces.js';
 

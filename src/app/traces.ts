@@ -8,7 +8,7 @@
  * never across a break: after a silence the link monitor calls a hold, a channel has no value
  * until it appears again, and the line stops there rather than join what came before.
  */
-import { CHANNEL_COUNT, PULSE_MAX_US, PULSE_MIN_US } from '../decoder/index.js';
+import { CHANNEL_COUNT, PULSE_MAX_US, PULSE_MIN_US } from '../decoder/spec.js';
 import type { TraceBatch } from '../worker/protocol.js';
 
 /** Frames kept: ten minutes (the longest window) at 11 ms, with room (the worker sends no more between two batches). */

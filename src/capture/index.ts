@@ -6,7 +6,6 @@
 export {
   CaptureFormatError,
   captureChunks,
-  chunkFirstByteUs,
   type Capture,
   type CaptureChunk,
   type CaptureEvent,
@@ -19,49 +18,10 @@ export {
   type MetaScalar,
   type ParsedCapture,
 } from './model.js';
-export { crc32 } from './crc32.js';
-export {
-  type ChunkFacts,
-  captureChunksByPort,
-  captureFact,
-  capturePortIndex,
-  capturePorts,
-  captureTimesInOrder,
-  seedCaptureFact,
-  seedChunkFacts,
-} from './facts.js';
-export { RecordTally } from './record-tally.js';
-export {
-  CAPTURE_FILE_EXTENSION,
-  CAPTURE_FORMAT_VERSION,
-  MAX_META_BYTES,
-  MAX_RECORD_PAYLOAD,
-  RECORD_OVERHEAD,
-  RECORD_TYPE_DATA,
-  RECORD_TYPE_EVENT,
-  hasCaptureMagic,
-} from './layout.js';
+export { capturePorts } from './facts.js';
+export { CAPTURE_FILE_EXTENSION, CAPTURE_FORMAT_VERSION } from './layout.js';
 export { CaptureWriter, encodeCapture, type CaptureRecordInput } from './writer.js';
 export { parseCapture, type ReadOptions } from './reader.js';
-export {
-  assembleParts,
-  partColumns,
-  planParts,
-  readPart,
-  type CaptureColumns,
-  type CapturePart,
-  type CapturePlan,
-  type PartRead,
-} from './parts.js';
-export {
-  type RecordSink,
-  type SlicedFile,
-  type WalkedRecords,
-  type WalkOptions,
-  recordTimeUs,
-  walkDataRecords,
-} from './record-walk.js';
-export { CaptureBuilder } from './capture-builder.js';
 export { importRaw } from './raw.js';
 export { importSaleaeCsv } from './saleae.js';
 export { readCapture } from './sniff.js';

@@ -37,6 +37,7 @@ export interface CaptureMeta {
   [key: string]: MetaScalar | CapturePortInfo[] | undefined;
 }
 
+/** The file a capture came from: a SatScope .sscap, raw serial bytes, or a Saleae async-serial CSV export. */
 export type CaptureKind = 'sscap' | 'raw' | 'saleae-csv';
 
 /**
@@ -47,6 +48,7 @@ export type CaptureKind = 'sscap' | 'raw' | 'saleae-csv';
  */
 export type CaptureTiming = 'per-byte' | 'per-chunk' | 'none';
 
+/** What kind of damage a reader found in a capture file (docs/capture-format.md, "Reading damaged files"). */
 export type CaptureIssueKind =
   /** .sscap: the file ends inside a record (the usual end of a recording that was cut off). */
   | 'truncated-record'

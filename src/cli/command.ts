@@ -7,9 +7,12 @@
  */
 import { closeSync, readFileSync, writeFileSync } from 'node:fs';
 import { basename } from 'node:path';
-import { captureChunks, capturePorts, type Capture } from '../capture/index.js';
-import { SpektrumDecoder } from '../decoder/index.js';
-import { captureSpan, reportHtml, summarizeCapture } from '../analysis/index.js';
+import { captureChunks, type Capture } from '../capture/model.js';
+import { capturePorts } from '../capture/facts.js';
+import { SpektrumDecoder } from '../decoder/decoder.js';
+import { captureSpan } from '../analysis/capture-span.js';
+import { reportHtml } from '../analysis/report-html.js';
+import { summarizeCapture } from '../analysis/summary.js';
 import { threadedReport } from './report-threads.js';
 import { parseCommandLine, UsageError, type Args } from './args.js';
 import { fileProblem } from './file-problem.js';

@@ -7,7 +7,9 @@
  */
 import { basename } from 'node:path';
 import { parseArgs } from 'node:util';
-import { doctorCapture, formatClock, type DoctorFinding, type DoctorReport } from '../analysis/index.js';
+import { doctorCapture, type DoctorReport } from '../analysis/doctor-capture.js';
+import { formatClock } from '../analysis/report-text.js';
+import type { DoctorFinding } from '../analysis/doctor-types.js';
 import { loadCapture } from './input.js';
 import { TIMING_WORDS } from './format.js';
 import { plural } from '../analysis/report-text.js';

@@ -1,8 +1,8 @@
 /** Text forms of frames and summaries for the CLI. */
-import type { HealthReport, ReportFinding } from '../analysis/index.js';
-import type { CaptureSummary } from '../analysis/index.js';
+import type { HealthReport, ReportFinding } from '../analysis/report-types.js';
+import type { CaptureSummary } from '../analysis/summary.js';
 import { formatClock, plural } from '../analysis/report-text.js';
-import type { CaptureTiming } from '../capture/index.js';
+import type { CaptureTiming } from '../capture/model.js';
 import { systemInfo } from '../decoder/spec.js';
 
 // One frame a line, as `satscope decode` prints it: the library's, which the page's export uses too.

@@ -10,18 +10,10 @@
  */
 import { closeSync, fstatSync, openSync } from 'node:fs';
 import { basename } from 'node:path';
-import {
-  assembleParts,
-  CaptureFormatError,
-  type CapturePart,
-  partColumns,
-  planParts,
-  readCapture,
-  readPart,
-  type Capture,
-  type PartRead,
-  type ReadOptions,
-} from '../capture/index.js';
+import { assembleParts, type CapturePart, partColumns, planParts, readPart, type PartRead } from '../capture/parts.js';
+import { CaptureFormatError, type Capture } from '../capture/model.js';
+import { readCapture } from '../capture/sniff.js';
+import type { ReadOptions } from '../capture/reader.js';
 import { readFileRange } from './file-range.js';
 import { fileProblem } from './file-problem.js';
 import type { ReadThreadData, ReadThreadParts, ReadThreadResult } from './read-thread.js';

@@ -7,7 +7,7 @@
  * left or one is not intact. A file that is not one is never sent: this thread is stopped.
  */
 import { closeSync, openSync } from 'node:fs';
-import type { CaptureColumns, CapturePart, PartRead } from '../capture/index.js';
+import type { CaptureColumns, CapturePart, PartRead } from '../capture/parts.js';
 import { readFileRange } from './file-range.js';
 import { workerSide } from './waited-worker.js';
 
@@ -41,7 +41,7 @@ try {
     closeSync(fd);
   }
   post({ read } satisfies ReadThreadResult);
-  const { readPart } = await import('../capture/index.js');
+  const { readPart } = await import('../capture/parts.js');
   const { parts, columns, taken } = (await next()) as ReadThreadParts;
   for (let k = Atomics.add(taken, 0, 1); k < parts.length; k = Atomics.add(taken, 0, 1)) {
     const part = parts[k] as CapturePart;

@@ -19,6 +19,7 @@ import type { Resolution } from './spec.js';
 import { type Core, copyState, createChain, type DecoderState, initialState, unlock } from './state.js';
 import type { DecodedFrame, DecoderEvent, DecoderStats, FormatInfo, HeaderMode, RemoteKind } from './types.js';
 
+/** How a `SpektrumDecoder` reads a stream; every field is optional and 'auto' decides on evidence. */
 export interface DecoderOptions {
   /** Fix the servo resolution instead of inferring it (e.g. from the internal remote). Default 'auto'. */
   resolution?: 'auto' | Resolution;
@@ -48,6 +49,11 @@ function checkResolution(resolution: unknown): asserts resolution is 'auto' | Re
   }
 }
 
+/**
+ * A push decoder for one satellite's byte stream: `push` bytes as they arrive, take frames with
+ * `next` until it returns undefined. It never throws on bytes, and gives the same frames however
+ * the bytes are chunked (see the file's comment for what it claims and when).
+ */
 export class SpektrumDecoder {
   readonly #d: Core;
   /** The counters `stats` hands out: one object for the decoder's life, whatever state is restored. */

@@ -9,6 +9,7 @@ import { EMPTY_SLOT, FRAME_SIZE, MASK_2048_PHASE, SLOTS_PER_FRAME, XPLUS_FIRST, 
 import type { Resolution } from './spec.js';
 import type { HeaderMode, RemoteKind, VtxControl } from './types.js';
 
+/** What one slot of a frame holds (`readFrameFields`). */
 export type SlotKind = 'channel' | 'xplus' | 'empty' | 'vtx' | 'invalid';
 
 /** One of the seven 16-bit slots (§8.1, §8.2, §8.6). */

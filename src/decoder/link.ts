@@ -37,6 +37,7 @@ import { EpisodeLog } from './episode-log.js';
 import { FrameLedger } from './ledger.js';
 import { copyEpisodes, type LinkCheckpoint } from './checkpoint.js';
 
+/** The link as the receiver's failsafe rule (§7.1) sees it: no frame yet, frames arriving, a silence (hold), or failsafe after 1 s of it. */
 export type LinkState = 'waiting' | 'live' | 'hold' | 'failsafe';
 
 /** A receiver that started again: its fade counter fell from `from` to `to` after a silence of `gapUs`, at `timeUs` (the first frame after). */
@@ -68,6 +69,7 @@ export type MissedBasis =
   /** Neither yet: no timing, or no period known. */
   | 'none';
 
+/** How a `LinkMonitor` judges silences (hold and failsafe thresholds, delivery jitter) and what it keeps; every field is optional. */
 export interface LinkOptions {
   /** Gap after the last frame before the link counts as "hold", µs. Default: see `holdThresholdUs`. */
   holdAfterUs?: number;
@@ -90,6 +92,7 @@ export interface LinkOptions {
   onMissed?: (fromUs: number, toUs: number, count: number, periodUs: number) => void;
 }
 
+/** What a `LinkMonitor` has measured so far (`stats`). */
 export interface LinkStats {
   frames: number;
   /** Sum of the receiver's fade deltas (frames it reported missing). */
@@ -177,6 +180,12 @@ const PERIOD_WINDOW = 33;
 const BURST_MEAN_US = 0.8 * FRAME_PERIOD_11MS_US;
 const RATE_WINDOW = 512;
 
+/**
+ * The link's health from the frames and the clock: the failsafe state machine of spec §7.1,
+ * the frame period, missed frames, fades, holds, stalls and restarts. Time is always passed
+ * in (`frame(f)` uses the frame's time, `update(nowUs)` the caller's, `finish(endUs)` ends a
+ * capture), so live use and replay give the same figures.
+ */
 export class LinkMonitor {
   readonly #holdOption: number | undefined;
   readonly #failsafeAfterUs: number;

@@ -59,8 +59,10 @@ export const SYSTEM_DSM2_11MS_2048 = 0x12;
 export const SYSTEM_DSMX_22MS_2048 = 0xa2;
 export const SYSTEM_DSMX_11MS_2048 = 0xb2;
 
+/** Servo resolution: 10-bit (1024) or 11-bit (2048) channel words (§9). */
 export type Resolution = 1024 | 2048;
 
+/** What a §8.3 system byte says: its name, resolution and frame period (`systemInfo`). */
 export interface SystemInfo {
   /** The system byte value. */
   readonly value: number;

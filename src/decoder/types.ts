@@ -1,5 +1,6 @@
 import type { Resolution } from './spec.js';
 
+/** Which header a remote sends (spec §8.2, §8.3): internal (fades or RSSI, then a system byte) or external (a UINT16 fade count). */
 export type RemoteKind = 'internal' | 'external';
 
 /** What byte 0 of an internal remote's frame carries (§8.3, §8.3.1). */

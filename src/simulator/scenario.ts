@@ -29,6 +29,7 @@ export interface Window {
   durationUs: number;
 }
 
+/** How the simulated receiver's fade counter starts and counts lost frames. */
 export interface FadeOptions {
   /** The counter's first value (e.g. 250 internal or 65530 external to see it wrap). Default 0. */
   start?: number;
@@ -66,6 +67,7 @@ export interface VtxOptions {
   settings: readonly VtxSettings[];
 }
 
+/** When the simulated receiver sends its bytes: the start, the byte time, and frame and byte jitter. */
 export interface TimingOptions {
   /** Time of the first frame slot. Default 1000. */
   startUs?: number;
@@ -77,6 +79,7 @@ export interface TimingOptions {
   byteJitterUs?: number;
 }
 
+/** Line damage the simulator adds: truncated frames, noise bytes, flipped bits, a start in mid-frame. */
 export interface DamageOptions {
   /** Probability per frame of losing `1…truncateMaxBytes` random bytes (the rest keep their times). */
   truncateRate?: number;

@@ -26,6 +26,7 @@ import { resolveScenario } from './scenario.js';
 import type { ResolvedScenario, Scenario } from './scenario.js';
 import type { FrameDamage, SimTruth, TruthChannel, TruthFrame, TruthGap, TruthNoise } from './truth.js';
 
+/** How a `Simulator` runs beyond its scenario: whether it keeps the ground truth. */
 export interface SimulatorOptions {
   /** Record ground truth (`takeTruth()`, `SimChunk.truth`). Default false: costs objects per frame. */
   truth?: boolean;
@@ -56,6 +57,10 @@ const STREAM_DAMAGE = 4;
 const STREAM_NOISE = 5;
 const STREAM_RSSI = 6;
 
+/**
+ * A simulated remote receiver: generates its serial bytes chunk by chunk with per-byte times and
+ * the ground truth (`SimTruth`) a decoder must recover. Deterministic from the scenario's seed.
+ */
 export class Simulator {
   /** The scenario with defaults filled in. */
   readonly scenario: ResolvedScenario;

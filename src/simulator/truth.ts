@@ -84,6 +84,7 @@ export interface TruthGap {
   failsafe: boolean;
 }
 
+/** What the simulator sent: every frame, every stretch of noise and every gap, with times. */
 export interface SimTruth {
   frames: TruthFrame[];
   noise: TruthNoise[];

@@ -9,8 +9,10 @@
  * decoders. Live ports can be asked to listen briefly at another line setting to confirm a
  * finding (`confirm`), and return to 115200.
  */
-import { Doctor, doctorEvent, type ConfirmProbe, type DoctorFinding } from '../analysis/index.js';
-import type { Capture } from '../capture/index.js';
+import { Doctor } from '../analysis/doctor.js';
+import { doctorEvent } from '../analysis/doctor-events.js';
+import type { ConfirmProbe, DoctorFinding } from '../analysis/doctor-types.js';
+import type { Capture } from '../capture/model.js';
 import type { Engine } from './engine.js';
 import { BROWSER_CLOCK, type Clock } from './host.js';
 import type { DiagnosisStatus, FromWorker } from './protocol.js';

@@ -4,8 +4,8 @@
  * Built with a `Host` (post and clock), so the whole worker runs in Node with fakes; worker.ts
  * gives it the browser's.
  */
-import { USB_CHUNK_JITTER_US } from '../decoder/index.js';
-import type { Capture } from '../capture/index.js';
+import { USB_CHUNK_JITTER_US } from '../decoder/spec.js';
+import type { Capture } from '../capture/model.js';
 import { Batcher } from './batcher.js';
 import { bind } from './binding.js';
 import { Diagnosis } from './diagnosis.js';

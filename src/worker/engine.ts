@@ -4,18 +4,12 @@
  * channel, and 100 ms graph buckets. `batch()` hands the page what changed since the last call.
  * Time is always passed in: the arrival clock live, the capture's own clock in replay.
  */
-import {
-  BYTE_TIME_US,
-  CHANNEL_COUNT,
-  LinkMonitor,
-  SpektrumDecoder,
-  type DecodedFrame,
-  type DecoderCheckpoint,
-  type LinkCheckpoint,
-  type LinkEpisode,
-  type Resolution,
-} from '../decoder/index.js';
-import { LinkSeries } from '../analysis/index.js';
+import { BYTE_TIME_US, CHANNEL_COUNT, type Resolution } from '../decoder/spec.js';
+import { LinkMonitor, type LinkEpisode } from '../decoder/link.js';
+import { SpektrumDecoder } from '../decoder/decoder.js';
+import type { DecodedFrame } from '../decoder/types.js';
+import type { DecoderCheckpoint, LinkCheckpoint } from '../decoder/checkpoint.js';
+import { LinkSeries } from '../analysis/series.js';
 import { ChannelRanges } from '../analysis/summary.js';
 import { InspectorLog } from './inspector.js';
 import { TraceLog } from './traces.js';

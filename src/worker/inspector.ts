@@ -11,7 +11,8 @@
  * Stream offsets are the decoder's: 0 is the first byte pushed since the decoder was created or
  * reset. `reset()` the log together with the decoder.
  */
-import { FRAME_SIZE, type DecodedFrame, type DecoderEvent } from '../decoder/index.js';
+import { FRAME_SIZE } from '../decoder/spec.js';
+import type { DecodedFrame, DecoderEvent } from '../decoder/types.js';
 
 export type InspectKind = 'frame' | 'discarded' | 'resync' | 'locked' | 'format-changed';
 

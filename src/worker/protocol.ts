@@ -4,9 +4,10 @@
  * gesture (requestPort) and the display. High-rate data crosses as typed arrays in batches, a
  * few per animation frame at most, transferred, never one message per Spektrum frame.
  */
-import type { FormatInfo, LinkState, MissedBasis } from '../decoder/index.js';
+import type { FormatInfo } from '../decoder/types.js';
+import type { LinkState, MissedBasis } from '../decoder/link.js';
 import type { InspectEntry } from './inspector.js';
-import type { ConfirmProbe, DoctorFinding } from '../analysis/index.js';
+import type { ConfirmProbe, DoctorFinding } from '../analysis/doctor-types.js';
 
 /** How the page names a port it was granted: its place in getPorts() and its USB IDs. */
 export interface PortIdentity {

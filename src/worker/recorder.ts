@@ -5,7 +5,10 @@
  * carries a CRC, so an unfinished file is simply a capture that ends early: a marker file names
  * the recording in progress, and on the next start it is offered back.
  */
-import { CaptureWriter, captureChunks, capturePorts, parseCapture, type Capture, type CaptureMeta } from '../capture/index.js';
+import { CaptureWriter } from '../capture/writer.js';
+import { captureChunks, type Capture, type CaptureMeta } from '../capture/model.js';
+import { capturePorts } from '../capture/facts.js';
+import { parseCapture } from '../capture/reader.js';
 import type { RecordingStatus } from './protocol.js';
 
 const DIR = 'recordings';

@@ -4,8 +4,10 @@
  * reading the ports never stalls on it (a long capture's frames take seconds).
  */
 /// <reference lib="webworker" />
-import { type Capture, readCapture } from '../capture/index.js';
-import { diagnosedHealthReport, reportHtml } from '../analysis/index.js';
+import type { Capture } from '../capture/model.js';
+import { readCapture } from '../capture/sniff.js';
+import { diagnosedHealthReport } from '../analysis/doctor-report.js';
+import { reportHtml } from '../analysis/report-html.js';
 import { type FramesExport, framesFile } from './frames-export.js';
 
 export interface ReportRequest {

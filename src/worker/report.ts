@@ -4,7 +4,7 @@
  * capture takes a good part of a second, and this worker must keep reading ports meanwhile (a
  * stall shows as a gap in the data and in the recording).
  */
-import type { Capture } from '../capture/index.js';
+import type { Capture } from '../capture/model.js';
 import { type Host, notice } from './host.js';
 import type { ReportReply, ReportRequest } from './report-worker.js';
 

@@ -6,7 +6,8 @@
  * MAX_TRACE_ROWS frames wait: what the page keeps at most; older ones, never shown, are dropped.
  */
 import { SpikeFinder } from '../analysis/spikes.js';
-import { CHANNEL_COUNT, channelResolution, servoToMicros, type DecodedFrame } from '../decoder/index.js';
+import { CHANNEL_COUNT, channelResolution, servoToMicros } from '../decoder/spec.js';
+import type { DecodedFrame } from '../decoder/types.js';
 import type { TraceBatch } from './protocol.js';
 
 /** Frames the page keeps per remote for the traces (ten minutes at 11 ms is 54 546). */

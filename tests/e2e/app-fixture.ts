@@ -5,8 +5,9 @@
 import { closeSync, existsSync, mkdirSync, openSync, writeFileSync, writeSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 import type { Browser, Page } from 'playwright-core';
-import { CaptureWriter } from '../../src/capture/index.js';
-import { Simulator, preset } from '../../src/simulator/index.js';
+import { CaptureWriter } from '../../src/capture/writer.js';
+import { Simulator } from '../../src/simulator/simulator.js';
+import { preset } from '../../src/simulator/presets.js';
 import { concatBytes } from '../bytes.js';
 import { usbChunks } from '../feeds.js';
 import { chromiumAvailable, launchChromium, startStaticServer, type LaunchChromiumOptions, type StaticServer } from './harness/browser.js';

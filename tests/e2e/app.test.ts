@@ -10,10 +10,17 @@ import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import type { Download, Page } from 'playwright-core';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
-import { channelName } from '../../src/decoder/index.js';
-import { CaptureWriter, captureChunks, capturePorts, parseCapture, readCapture } from '../../src/capture/index.js';
-import { captureSpan, decodeCapture, summarizeCapture } from '../../src/analysis/index.js';
-import { preset, simulate } from '../../src/simulator/index.js';
+import { channelName } from '../../src/decoder/spec.js';
+import { CaptureWriter } from '../../src/capture/writer.js';
+import { captureChunks } from '../../src/capture/model.js';
+import { capturePorts } from '../../src/capture/facts.js';
+import { parseCapture } from '../../src/capture/reader.js';
+import { readCapture } from '../../src/capture/sniff.js';
+import { captureSpan } from '../../src/analysis/capture-span.js';
+import { decodeCapture } from '../../src/analysis/capture-pass.js';
+import { summarizeCapture } from '../../src/analysis/summary.js';
+import { preset } from '../../src/simulator/presets.js';
+import { simulate } from '../../src/simulator/simulator.js';
 import {
   SHARED_CAPTURES,
   SHOTS as SHOTS_DIR,

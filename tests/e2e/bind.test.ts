@@ -7,7 +7,8 @@
 import type { Browser } from 'playwright-core';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { planPulses } from '../../src/bind/index.js';
-import { preset, simulate } from '../../src/simulator/index.js';
+import { preset } from '../../src/simulator/presets.js';
+import { simulate } from '../../src/simulator/simulator.js';
 import { browserUnavailable, shot, startSerialApp, type SerialAppSession } from './app-fixture.js';
 import type { StaticServer } from './harness/browser.js';
 import { buildSignalShim, fakeSerialUnsupportedReason, type FakeSerialPort } from './harness/pty-serial.js';

@@ -9,7 +9,8 @@ import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { mkdtempSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { preset, simulate } from '../../src/simulator/index.js';
+import { preset } from '../../src/simulator/presets.js';
+import { simulate } from '../../src/simulator/simulator.js';
 import { browserUnavailable, shot, startApp, usbChunks, writeCapture, type AppSession } from './app-fixture.js';
 
 const skip = browserUnavailable();

@@ -13,10 +13,15 @@ import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import type { Page } from 'playwright-core';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
-import { importSaleaeCsv, readCapture, type Capture } from '../../src/capture/index.js';
-import { LinkMonitor, SpektrumDecoder, USB_CHUNK_JITTER_US } from '../../src/decoder/index.js';
-import { summarizeCapture } from '../../src/analysis/index.js';
-import { preset, simulate } from '../../src/simulator/index.js';
+import { importSaleaeCsv } from '../../src/capture/saleae.js';
+import { readCapture } from '../../src/capture/sniff.js';
+import type { Capture } from '../../src/capture/model.js';
+import { LinkMonitor } from '../../src/decoder/link.js';
+import { SpektrumDecoder } from '../../src/decoder/decoder.js';
+import { USB_CHUNK_JITTER_US } from '../../src/decoder/spec.js';
+import { summarizeCapture } from '../../src/analysis/summary.js';
+import { preset } from '../../src/simulator/presets.js';
+import { simulate } from '../../src/simulator/simulator.js';
 import { resolutionSource } from '../../src/app/components/SystemBadge/words.js';
 import {
   ROOT,

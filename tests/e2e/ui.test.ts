@@ -11,9 +11,10 @@ import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import type { Page } from 'playwright-core';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
-import { readCapture } from '../../src/capture/index.js';
-import { summarizeCapture } from '../../src/analysis/index.js';
-import { preset, simulate } from '../../src/simulator/index.js';
+import { readCapture } from '../../src/capture/sniff.js';
+import { summarizeCapture } from '../../src/analysis/summary.js';
+import { preset } from '../../src/simulator/presets.js';
+import { simulate } from '../../src/simulator/simulator.js';
 import { agoLabel, agoSplits, decimals, niceSplits, niceTop, timeStep } from '../../src/app/axes.js';
 import { SHOTS, browserUnavailable, shot, startApp, usbChunks, writeCapture, type AppSession } from './app-fixture.js';
 

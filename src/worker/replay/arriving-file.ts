@@ -4,7 +4,7 @@
  * walk it with walkDataRecords as they would a File. Reading a File again costs as much as the
  * first time (the browser copies it across processes); a piece posted to a helper does not.
  */
-import type { SlicedFile } from '../../capture/index.js';
+import type { SlicedFile } from '../../capture/record-walk.js';
 
 export class ArrivingFile implements SlicedFile {
   /**

@@ -4,16 +4,13 @@
  * ports, and the failsafe episodes; also the frame period to pace a capture without timing at.
  * Each port's bytes are decoded once, when the capture opens.
  */
-import {
-  FRAME_PERIOD_11MS_US,
-  FRAME_PERIOD_22MS_US,
-  FRAME_SIZE,
-  type FormatInfo,
-  type LinkEpisode,
-  systemInfo,
-} from '../../decoder/index.js';
-import type { Capture } from '../../capture/index.js';
-import { type LinkSeries, captureSpan, decodeCapture } from '../../analysis/index.js';
+import { FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US, FRAME_SIZE, systemInfo } from '../../decoder/spec.js';
+import type { FormatInfo } from '../../decoder/types.js';
+import type { LinkEpisode } from '../../decoder/link.js';
+import type { Capture } from '../../capture/model.js';
+import type { LinkSeries } from '../../analysis/series.js';
+import { captureSpan } from '../../analysis/capture-span.js';
+import { decodeCapture } from '../../analysis/capture-pass.js';
 import type { Overview } from '../protocol.js';
 
 /** The overview's widest bins: one second (a long capture's). */

@@ -5,18 +5,14 @@
  * report, then the same at the end with the count of chunks and bytes it walked, which the
  * worker checks against the capture it reads.
  */
-import {
-  CaptureBuilder,
-  type ChunkFacts,
-  type ParsedCapture,
-  RecordTally,
-  recordTimeUs,
-  type SlicedFile,
-  walkDataRecords,
-} from '../../capture/index.js';
+import { CaptureBuilder } from '../../capture/capture-builder.js';
+import type { ChunkFacts } from '../../capture/facts.js';
+import type { ParsedCapture } from '../../capture/model.js';
+import { RecordTally } from '../../capture/record-tally.js';
+import { recordTimeUs, type SlicedFile, walkDataRecords } from '../../capture/record-walk.js';
 import { stopsPort } from '../../analysis/doctor-events.js';
-import { type CaptureSpan, spanBetween } from '../../analysis/index.js';
-import { BYTE_TIME_US } from '../../decoder/index.js';
+import { type CaptureSpan, spanBetween } from '../../analysis/capture-span.js';
+import { BYTE_TIME_US } from '../../decoder/spec.js';
 import type { Overview } from '../protocol.js';
 import { ArrivingFile } from './arriving-file.js';
 import { type Checkpoint, ReplayPass } from './replay-pass.js';

@@ -3,7 +3,7 @@
  * or in this one, fed the file's pieces as they are read, and what it has reported so far: the
  * halves of a split replay pass (replay-split.ts).
  */
-import type { ParsedCapture } from '../../capture/index.js';
+import type { ParsedCapture } from '../../capture/model.js';
 import { ArrivingFile } from './arriving-file.js';
 import type { Clock } from '../host.js';
 import type { Overview } from '../protocol.js';

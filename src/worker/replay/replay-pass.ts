@@ -6,9 +6,13 @@
  * each CHECKPOINT_US of capture time: a seek restores the nearest one and feeds only from there,
  * with the counters, episodes and link state of the whole capture up to the target.
  */
-import { type DecoderCheckpoint, type LinkCheckpoint, type LinkMonitor, SpektrumDecoder } from '../../decoder/index.js';
-import { type Capture, recordTimeUs } from '../../capture/index.js';
-import { LinkSeries, monitorWithSeries, timingJitterUs } from '../../analysis/index.js';
+import type { DecoderCheckpoint, LinkCheckpoint } from '../../decoder/checkpoint.js';
+import type { LinkMonitor } from '../../decoder/link.js';
+import { SpektrumDecoder } from '../../decoder/decoder.js';
+import type { Capture } from '../../capture/model.js';
+import { recordTimeUs } from '../../capture/record-walk.js';
+import { LinkSeries, monitorWithSeries } from '../../analysis/series.js';
+import { timingJitterUs } from '../../analysis/capture-pass.js';
 import { recordedStops, StopCursor } from '../../analysis/doctor-events.js';
 import { failsafeAsRead, failsafesOf, overviewBinUs, sumOverview } from './overview.js';
 import type { Overview } from '../protocol.js';

@@ -5,8 +5,12 @@
  * a record a cut leaves). The start gives the records to decode first; the end gives where the
  * capture ends, so that the page can place the part read on the whole span at once.
  */
-import { type Capture, type SlicedFile, captureChunksByPort, capturePorts, hasCaptureMagic, parseCapture } from '../../capture/index.js';
-import { captureSpan } from '../../analysis/index.js';
+import type { Capture } from '../../capture/model.js';
+import type { SlicedFile } from '../../capture/record-walk.js';
+import { captureChunksByPort, capturePorts } from '../../capture/facts.js';
+import { hasCaptureMagic } from '../../capture/layout.js';
+import { parseCapture } from '../../capture/reader.js';
+import { captureSpan } from '../../analysis/capture-span.js';
 
 /** A file this large gets a preview: under it, reading it whole is as quick. */
 const PREVIEW_MIN_BYTES = 32 << 20;

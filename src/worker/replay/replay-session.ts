@@ -7,9 +7,12 @@
  * once (overview.ts) and seek with fresh decodes.
  */
 import { plural } from '../../analysis/report-text.js';
-import { CaptureFormatError, capturePorts, readCapture, type Capture } from '../../capture/index.js';
-import { FRAME_PERIOD_11MS_US } from '../../decoder/index.js';
-import { captureSpan, timingJitterUs } from '../../analysis/index.js';
+import { CaptureFormatError, type Capture } from '../../capture/model.js';
+import { capturePorts } from '../../capture/facts.js';
+import { readCapture } from '../../capture/sniff.js';
+import { FRAME_PERIOD_11MS_US } from '../../decoder/spec.js';
+import { captureSpan } from '../../analysis/capture-span.js';
+import { timingJitterUs } from '../../analysis/capture-pass.js';
 import type { Batcher } from '../batcher.js';
 import type { Diagnosis } from '../diagnosis.js';
 import { type Host, notice } from '../host.js';

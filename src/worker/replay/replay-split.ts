@@ -14,8 +14,9 @@
  * counts. A half that fails or disagrees is decoded again from the capture, here; the overview
  * and seeks are then exactly the one-worker pass's.
  */
-import { type Capture, type ParsedCapture, captureTimesInOrder, seedChunkFacts } from '../../capture/index.js';
-import { seedCaptureSpan } from '../../analysis/index.js';
+import type { Capture, ParsedCapture } from '../../capture/model.js';
+import { captureTimesInOrder, seedChunkFacts } from '../../capture/facts.js';
+import { seedCaptureSpan } from '../../analysis/capture-span.js';
 import type { Clock } from '../host.js';
 import { addOverviews } from './overview.js';
 import { PieceReader, type ReadableFile } from './piece-reader.js';

@@ -9,7 +9,9 @@
  * that fires late (a busy machine, a starved worker) delivers the chunks it owes, each at its own
  * time, so a late timer is never link loss; the demo's failsafes are the scenario's dropouts.
  */
-import { Simulator, demoScenario, type Scenario } from '../../simulator/index.js';
+import { Simulator } from '../../simulator/simulator.js';
+import { demoScenario } from '../../simulator/presets.js';
+import type { Scenario } from '../../simulator/scenario.js';
 import type { Clock } from '../host.js';
 import type { Driver } from '../registry.js';
 

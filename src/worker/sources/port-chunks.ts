@@ -2,8 +2,9 @@
  * A capture's chunks of one port, read from its columns by index (replay.ts plays them): where a
  * seek starts, what each chunk holds and when it arrived, recorded or on a paced clock.
  */
-import { BYTE_TIME_US } from '../../decoder/index.js';
-import { captureTimesInOrder, chunkFirstByteUs, type Capture } from '../../capture/index.js';
+import { BYTE_TIME_US } from '../../decoder/spec.js';
+import { captureTimesInOrder } from '../../capture/facts.js';
+import { chunkFirstByteUs, type Capture } from '../../capture/model.js';
 import { recordedStops, StopCursor } from '../../analysis/doctor-events.js';
 
 /** One chunk's bytes with their times. */

@@ -4,9 +4,10 @@
  * several ports (remotes) with one common clock: each port feeds its own decode, and all of
  * them advance with the one replay clock.
  */
-import { FRAME_PERIOD_11MS_US, FRAME_SIZE } from '../../decoder/index.js';
-import { capturePortIndex, capturePorts, type Capture } from '../../capture/index.js';
-import { captureSpan } from '../../analysis/index.js';
+import { FRAME_PERIOD_11MS_US, FRAME_SIZE } from '../../decoder/spec.js';
+import { capturePortIndex, capturePorts } from '../../capture/facts.js';
+import type { Capture } from '../../capture/model.js';
+import { captureSpan } from '../../analysis/capture-span.js';
 import { BROWSER_CLOCK, type Clock } from '../host.js';
 import { PortChunks } from './port-chunks.js';
 

@@ -4,7 +4,7 @@
  * every RECONNECT_MS and on the browser's 'connect' event, so a replugged adapter comes back as
  * the same remote (same label, same port in the recording) without a prompt.
  */
-import { USB_CHUNK_JITTER_US } from '../../decoder/index.js';
+import { USB_CHUNK_JITTER_US } from '../../decoder/spec.js';
 import type { Batcher } from '../batcher.js';
 import type { Diagnosis } from '../diagnosis.js';
 import { type Host, notice, nowUs } from '../host.js';

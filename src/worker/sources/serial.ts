@@ -4,7 +4,7 @@
  * the device goes away. Line errors (buffer overrun, framing, break, parity) cost a reader, not
  * the session: a fresh reader is taken from the new `port.readable`.
  */
-import { BAUD_RATE } from '../../decoder/index.js';
+import { BAUD_RATE } from '../../decoder/spec.js';
 import { portName } from '../../bind/index.js';
 import type { PortIdentity } from '../protocol.js';
 

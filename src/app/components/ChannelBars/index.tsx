@@ -8,7 +8,7 @@
  * channel's min / max / last as `satscope info` prints them.
  */
 import { useEffect, useRef } from 'preact/hooks';
-import { channelName, channelResolution, PULSE_MAX_US, PULSE_MIN_US, servoToMicros, servoToPercent } from '../../../decoder/index.js';
+import { channelName, channelResolution, PULSE_MAX_US, PULSE_MIN_US, servoToMicros, servoToPercent } from '../../../decoder/spec.js';
 import { onFrame } from '../../frame-loop.js';
 import { current } from '../../store.js';
 import { setText } from '../../text.js';

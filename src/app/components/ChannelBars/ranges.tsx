@@ -5,7 +5,7 @@
  */
 import { useEffect, useRef, useState } from 'preact/hooks';
 import { formatClock } from '../../../analysis/report-text.js';
-import { channelName } from '../../../decoder/index.js';
+import { channelName } from '../../../decoder/spec.js';
 import { onFrame } from '../../frame-loop.js';
 import type { Live } from '../../live.js';
 import { current, replay } from '../../store.js';

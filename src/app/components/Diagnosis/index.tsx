@@ -9,7 +9,8 @@
  */
 import { computed, signal } from '@preact/signals';
 import { useState } from 'preact/hooks';
-import type { DoctorFinding, FlightStack } from '../../../analysis/index.js';
+import type { DoctorFinding } from '../../../analysis/doctor-types.js';
+import type { FlightStack } from '../../../analysis/doctor-stacks.js';
 import { diagnosis, replayReading, send, sources } from '../../store.js';
 import { plural } from '../../../analysis/report-text.js';
 import { splitFindings } from './current.js';

@@ -3,7 +3,7 @@
  * RSSI-capable, and whether the resolution was read from the system byte or inferred.
  */
 import { computed } from '@preact/signals';
-import { systemInfo } from '../../../decoder/index.js';
+import { systemInfo } from '../../../decoder/spec.js';
 import { nominalPeriodUs, status } from '../../store.js';
 import { resolutionSource } from './words.js';
 import './style.css';
