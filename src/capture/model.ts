@@ -2,6 +2,7 @@
  * The in-memory capture model every importer returns and every consumer reads: bytes with their
  * arrival times, chunk by chunk, per port, plus the events and issues found on the way.
  */
+import { byteInChunkUs } from '../decoder/spec.js';
 
 /** A metadata value that is not a list: what the free-form metadata fields may hold. */
 export type MetaScalar = string | number | boolean | null;
@@ -206,11 +207,9 @@ export function* captureChunks(capture: Capture, port?: number): Generator<Captu
 
 /**
  * When the first of a chunk's `count` bytes arrived, for a chunk timed by its last byte's arrival
- * (`chunkTimesUs`), its bytes `byteTimeUs` apart on the line: as the decoder dates a chunk-timed
- * chunk's bytes (its own hot path writes it out), the span its start, the doctor its earliest
- * frame and a replay its next byte. (An empty chunk gets a byte time after its arrival: it has
- * no byte to date.)
+ * (`chunkTimesUs`), its bytes `byteTimeUs` apart on the line (`byteInChunkUs`). An empty chunk
+ * gets a byte time after its arrival: it has no byte to date.
  */
 export function chunkFirstByteUs(arrivalUs: number, count: number, byteTimeUs: number): number {
-  return arrivalUs - (count - 1) * byteTimeUs;
+  return byteInChunkUs(arrivalUs, count - 1, byteTimeUs);
 }

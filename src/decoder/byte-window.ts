@@ -5,9 +5,9 @@
  * kept (`base + index`). Times are kept per pushed chunk, not per byte: each chunk's end offset
  * and its time (or NaN), and per-byte times only for chunks pushed with them. A byte's time is
  * its own, or its chunk's time less one byte time (86.8 µs at 115200 baud) for each byte after
- * it in the chunk: the one rule for when a byte arrived (`dateByte`).
+ * it in the chunk (`byteInChunkUs`, the one rule for when a byte arrived).
  */
-import { BYTE_TIME_US } from './spec.js';
+import { byteInChunkUs } from './spec.js';
 
 const INITIAL_CAPACITY = 4096;
 const INITIAL_CHUNKS = 64;
@@ -42,7 +42,7 @@ export class ByteWindow {
   /**
    * Doubles handed between calls go in typed-array slots, never as arguments or results: a
    * double passed to or returned from a call that is not inlined is boxed (an allocation).
-   * `at[0]`: the time of the chunk being pushed; `when[0]`: what `dateByte` dated.
+   * `at[0]`: the time of the chunk being pushed; `when[0]`: what `dateNext` or `dateAny` dated.
    */
   readonly at = new Float64Array(1);
   readonly when = new Float64Array(1);
@@ -189,7 +189,7 @@ export class ByteWindow {
     this.when[0] =
       this.#chunkPerByte[i] === 1 && byteTimes !== null
         ? byteTimes[x - this.base]!
-        : this.#chunkTimes[i]! - (this.#chunkEnds[i]! - 1 - x) * BYTE_TIME_US;
+        : byteInChunkUs(this.#chunkTimes[i]!, this.#chunkEnds[i]! - 1 - x);
   }
 
   /**

@@ -166,6 +166,17 @@ export class SpektrumDecoder {
     return this.#d.s.opts.resolution;
   }
 
+  /**
+   * When the oldest byte the decoder still holds arrived (dated as a frame's first byte is): a
+   * frame it will hand out once the next one confirms it. NaN when it holds none or has no times.
+   */
+  get pendingSinceUs(): number {
+    const w = this.#d.w;
+    if (w.head === w.tail) return Number.NaN;
+    w.dateAny(w.base + w.head);
+    return w.when[0] ?? Number.NaN;
+  }
+
   /** What the decoder has decided about the format, and why (a new object each call). */
   get format(): FormatInfo {
     return formatOf(this.#d.s);

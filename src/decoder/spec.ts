@@ -9,6 +9,15 @@ export const FRAME_SIZE = 16;
 export const BAUD_RATE = 115_200;
 /** Time one byte occupies on the wire at 115200 8N1, in µs (≈ 86.8). */
 export const BYTE_TIME_US = 10_000_000 / BAUD_RATE;
+
+/**
+ * When a byte of a chunk arrived, for a chunk timed by its last byte's arrival: `bytesAfter`
+ * bytes (each `byteTimeUs` on the line) before it. The one rule for dating a byte that came
+ * without a time of its own: the decoder's frames and events, the span, the doctor and replay.
+ */
+export function byteInChunkUs(chunkTimeUs: number, bytesAfter: number, byteTimeUs = BYTE_TIME_US): number {
+  return chunkTimeUs - bytesAfter * byteTimeUs;
+}
 /** §7.1: a frame every 11 or 22 ms. */
 export const FRAME_PERIOD_11MS_US = 11_000;
 export const FRAME_PERIOD_22MS_US = 22_000;

@@ -4,7 +4,7 @@
  * channel, and 100 ms graph buckets. `batch()` hands the page what changed since the last call.
  * Time is always passed in: the arrival clock live, the capture's own clock in replay.
  */
-import { BYTE_TIME_US, CHANNEL_COUNT, type Resolution } from '../decoder/spec.js';
+import { CHANNEL_COUNT, type Resolution } from '../decoder/spec.js';
 import { LinkMonitor, type LinkEpisode } from '../decoder/link.js';
 import { SpektrumDecoder } from '../decoder/decoder.js';
 import type { DecodedFrame } from '../decoder/types.js';
@@ -31,7 +31,6 @@ export interface EngineOptions {
 export const SETTLE_US = 500_000;
 
 /** Pushes remembered to date the bytes the decoder still holds. */
-const PUSHES_KEPT = 32;
 
 /** What an engine hands a listener (the doctor): each chunk as it arrives, each frame after the link monitor counted it. */
 export interface EngineTap {
@@ -85,15 +84,6 @@ export class Engine {
     });
   }
 
-  /**
-   * The last PUSHES_KEPT pushes, a ring (for `#pendingUs`): the stream offset after each, and its
-   * time argument: a chunk time (NaN for none), or per-byte times.
-   */
-  readonly #pushEnd = new Float64Array(PUSHES_KEPT);
-  readonly #pushTime = new Float64Array(PUSHES_KEPT);
-  readonly #pushTimes = new Array<Float64Array | undefined>(PUSHES_KEPT).fill(undefined);
-  /** Pushes so far. */
-  #pushCount = 0;
   /** Whether the resolution is forced (only then can it match no frame). */
   #forced: boolean;
 
@@ -101,10 +91,6 @@ export class Engine {
   push(bytes: Uint8Array, time: number | Float64Array | undefined, arrivedMs: number): void {
     this.tap?.bytes(bytes, time);
     this.decoder.push(bytes, time);
-    const k = this.#pushCount++ % PUSHES_KEPT;
-    this.#pushEnd[k] = this.decoder.stats.bytes;
-    this.#pushTime[k] = typeof time === 'number' ? time : Number.NaN;
-    this.#pushTimes[k] = typeof time === 'number' ? undefined : time;
     this.#arrivedMs = arrivedMs;
     this.#drain();
   }
@@ -206,29 +192,6 @@ export class Engine {
   }
 
   /**
-   * The time of the oldest byte the decoder still holds (a frame it will hand out once the next
-   * one confirms it), dated as the decoder dates frames; NaN when it holds none or it is unknown.
-   */
-  #pendingUs(): number {
-    const s = this.decoder.stats;
-    if (s.pendingBytes === 0) return Number.NaN;
-    const b = s.bytes - s.pendingBytes;
-    const kept = Math.min(this.#pushCount, PUSHES_KEPT);
-    // Newest first; the oldest kept push is taken when no newer one holds the byte.
-    for (let n = 0; n < kept; n++) {
-      const c = this.#pushCount - 1 - n;
-      const k = c % PUSHES_KEPT;
-      const end = this.#pushEnd[k] ?? Number.NaN;
-      if (n + 1 < kept && b < (this.#pushEnd[(c - 1) % PUSHES_KEPT] ?? Number.NaN)) continue;
-      const times = this.#pushTimes[k];
-      if (times === undefined) return (this.#pushTime[k] ?? Number.NaN) - (end - 1 - b) * BYTE_TIME_US;
-      const j = b - (end - times.length);
-      return j >= 0 ? (times[j] ?? Number.NaN) : Number.NaN;
-    }
-    return Number.NaN;
-  }
-
-  /**
    * The buckets not handed out yet, up to the one holding `untilUs`: first those that have
    * settled (final), then the open ones as counted so far (provisional: the page shows them and
    * replaces them with the next batch's), so the graphs hold every fade and missed frame the
@@ -275,7 +238,7 @@ export class Engine {
     const before = this.link.state;
     const ended = this.#ended;
     const now = ended && Number.isFinite(this.#endUs) ? this.#endUs : nowUs;
-    if (!ended && this.#mismatch === null) this.link.update(now, this.#pendingUs());
+    if (!ended && this.#mismatch === null) this.link.update(now, this.decoder.pendingSinceUs);
     const episodes = this.#newEpisodes();
     const retracted = this.link.takeRetracted();
     for (const id of retracted) this.#sent.delete(id);
