@@ -460,3 +460,14 @@ describe('LinkMonitor: breaks the receiver explains', () => {
     expect(link.stats).toMatchObject({ holds: 1, failsafes: 1, stalls: 0 });
   });
 });
+
+describe('episodeEndAt: an episode as read at a time', () => {
+  it('ends where it ended, or at that time while still on, never before it began', async () => {
+    const { episodeEndAt } = await import('../src/decoder/episode.js');
+    expect(episodeEndAt({ startUs: 100, endUs: 300 }, 1_000)).toBe(300);
+    expect(episodeEndAt({ startUs: 100, endUs: null }, 1_000)).toBe(1_000);
+    // Read only up to 200: a longer episode shows as far as that.
+    expect(episodeEndAt({ startUs: 100, endUs: 300 }, 200)).toBe(200);
+    expect(episodeEndAt({ startUs: 100, endUs: null }, 50)).toBe(100);
+  });
+});

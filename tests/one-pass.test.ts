@@ -10,7 +10,8 @@
 import { readdirSync, readFileSync } from 'node:fs';
 import { join } from 'node:path';
 import { describe, expect, it } from 'vitest';
-import { LinkMonitor, type LinkEpisode } from '../src/decoder/link.js';
+import type { LinkEpisode } from '../src/decoder/episode.js';
+import { LinkMonitor } from '../src/decoder/link.js';
 import { SpektrumDecoder } from '../src/decoder/decoder.js';
 import type { Resolution } from '../src/decoder/spec.js';
 import { captureChunks, type Capture } from '../src/capture/model.js';

@@ -11,7 +11,7 @@
 import type { Capture } from '../capture/model.js';
 import { capturePorts } from '../capture/facts.js';
 import { CHANNEL_COUNT, channelName, systemInfo, type Resolution } from '../decoder/spec.js';
-import type { LinkEpisode } from '../decoder/link.js';
+import { episodeEndAt, type LinkEpisode } from '../decoder/episode.js';
 import { becameFailsafe } from '../decoder/link.js';
 import { captureSpan } from './capture-span.js';
 import type { Doctor } from './doctor.js';
@@ -33,7 +33,7 @@ import type {
 } from './report-types.js';
 
 function episodeOf(e: LinkEpisode, origin: number, end: number): ReportEpisode {
-  const endAbs = e.endUs ?? end;
+  const endAbs = episodeEndAt(e, end);
   return {
     startUs: r1(e.startUs - origin),
     endUs: r1(endAbs - origin),

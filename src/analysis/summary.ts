@@ -3,7 +3,8 @@
  * up. Pure: the capture is already in memory, and the caller chooses how to show the result.
  */
 import type { Capture, CaptureIssue } from '../capture/model.js';
-import type { LinkEpisode, LinkStats } from '../decoder/link.js';
+import type { LinkEpisode } from '../decoder/episode.js';
+import type { LinkStats } from '../decoder/link.js';
 import { channelName, channelResolution, CHANNEL_COUNT, servoToMicros } from '../decoder/spec.js';
 import type { DecodedFrame, DecoderStats, FormatInfo } from '../decoder/types.js';
 import { decodeCapture, type DecodeCaptureOptions } from './capture-pass.js';

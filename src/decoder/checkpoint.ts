@@ -11,7 +11,8 @@
  * restores keeps its own.
  */
 import { FrameSlots } from './frame.js';
-import type { LinkEpisode, LinkRestart, LinkState, LinkStats } from './link.js';
+import type { LinkEpisode } from './episode.js';
+import type { LinkRestart, LinkState, LinkStats } from './link.js';
 
 /** A copy of `from`'s slot arrays and counts in `into` (a fresh set when none is given). */
 export function copySlots(from: FrameSlots, into: FrameSlots = new FrameSlots()): FrameSlots {

@@ -5,7 +5,7 @@
  * made a day of a flaky link quadratic: a hold every 40 s is 2 154 episodes, 1.5 million copies
  * over a day's 1 440 checkpoints, 3 s to send them between workers (node 20).
  */
-import type { LinkEpisode } from './link.js';
+import type { LinkEpisode } from './episode.js';
 
 /** Episodes a block: a checkpoint copies at most this many references of the last one. */
 const BLOCK = 256;

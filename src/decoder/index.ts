@@ -17,9 +17,9 @@ export type {
   ResolutionReason,
   VtxControl,
 } from './types.js';
+export type { LinkEpisode } from './episode.js';
 export {
   LinkMonitor,
-  type LinkEpisode,
   type LinkOptions,
   type LinkRestart,
   type LinkState,

@@ -34,6 +34,7 @@
 import { FAILSAFE_TIMEOUT_US, FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US, systemInfo } from './spec.js';
 import type { DecodedFrame } from './types.js';
 import { EpisodeLog } from './episode-log.js';
+import type { LinkEpisode } from './episode.js';
 import { FrameLedger } from './ledger.js';
 import { copyEpisodes, type LinkCheckpoint } from './checkpoint.js';
 
@@ -46,18 +47,6 @@ export interface LinkRestart {
   from: number;
   to: number;
   gapUs: number;
-}
-
-/** A stretch without frames. `endUs` is null while it lasts. */
-export interface LinkEpisode {
-  /** 0, 1, 2, … in the order the episodes began (stays with an episode when older ones are dropped). */
-  id: number;
-  kind: 'hold' | 'failsafe';
-  /** When the hold (the last frame + one period: the next frame was due) or the failsafe (last frame + 1 s) began, µs. */
-  startUs: number;
-  endUs: number | null;
-  /** Time of the last frame before the gap, µs. */
-  lastFrameUs: number;
 }
 
 /** Where the missed-frame count comes from. */

@@ -5,7 +5,8 @@
  * Time is always passed in: the arrival clock live, the capture's own clock in replay.
  */
 import { CHANNEL_COUNT, type Resolution } from '../decoder/spec.js';
-import { LinkMonitor, type LinkEpisode } from '../decoder/link.js';
+import type { LinkEpisode } from '../decoder/episode.js';
+import { LinkMonitor } from '../decoder/link.js';
 import { SpektrumDecoder } from '../decoder/decoder.js';
 import type { DecodedFrame } from '../decoder/types.js';
 import type { DecoderCheckpoint, LinkCheckpoint } from '../decoder/checkpoint.js';

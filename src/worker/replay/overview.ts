@@ -6,7 +6,7 @@
  */
 import { FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US, FRAME_SIZE, systemInfo } from '../../decoder/spec.js';
 import type { FormatInfo } from '../../decoder/types.js';
-import type { LinkEpisode } from '../../decoder/link.js';
+import { episodeEndAt, type LinkEpisode } from '../../decoder/episode.js';
 import type { Capture } from '../../capture/model.js';
 import type { LinkSeries } from '../../analysis/series.js';
 import { captureSpan } from '../../analysis/capture-span.js';
@@ -141,9 +141,7 @@ export function failsafeAsRead(
   complete: boolean,
 ): Overview['failsafe'] {
   const out: Overview['failsafe'] = [];
-  for (const e of failsafes)
-    if (complete || e.startUs < readUntilUs)
-      out.push({ startUs: e.startUs, endUs: Math.max(e.startUs, Math.min(e.endUs ?? readUntilUs, readUntilUs)) });
+  for (const e of failsafes) if (complete || e.startUs < readUntilUs) out.push({ startUs: e.startUs, endUs: episodeEndAt(e, readUntilUs) });
   return out;
 }
 
