@@ -1,7 +1,8 @@
 /** The link monitor: the failsafe state machine of spec §7.1, episodes, period, missed frames, delivery. */
 import { describe, expect, it } from 'vitest';
 import { BYTE_TIME_US } from '../src/decoder/spec.js';
-import { HOLD_MIN_US, LinkMonitor } from '../src/decoder/link.js';
+import { LinkMonitor } from '../src/decoder/link.js';
+import { HOLD_MIN_US } from '../src/decoder/link-rules.js';
 import type { DecodedFrame } from '../src/decoder/types.js';
 import { LinkSeries, monitorWithSeries } from '../src/analysis/series.js';
 

@@ -6,7 +6,7 @@
 import { systemInfo, type Resolution } from '../decoder/spec.js';
 import type { FormatInfo } from '../decoder/types.js';
 import type { LinkStats } from '../decoder/link.js';
-import { becameFailsafe } from '../decoder/link.js';
+import { becameFailsafe } from '../decoder/episode.js';
 import { fadesPerMinute, REPORT_THRESHOLDS } from './report-thresholds.js';
 import { formatDuration, plural, rate as rateText } from './report-text.js';
 import { ARDUPILOT_GUESS_FRAMES, bindPulses, channelSetText, satelliteSettings } from './doctor-stacks.js';

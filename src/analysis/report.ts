@@ -11,8 +11,7 @@
 import type { Capture } from '../capture/model.js';
 import { capturePorts } from '../capture/facts.js';
 import { CHANNEL_COUNT, channelName, systemInfo, type Resolution } from '../decoder/spec.js';
-import { episodeEndAt, type LinkEpisode } from '../decoder/episode.js';
-import { becameFailsafe } from '../decoder/link.js';
+import { becameFailsafe, episodeEndAt, type LinkEpisode } from '../decoder/episode.js';
 import { captureSpan } from './capture-span.js';
 import type { Doctor } from './doctor.js';
 import { looksInternal, readPorts } from './resolution-key.js';

@@ -23,3 +23,12 @@ export interface LinkEpisode {
 export function episodeEndAt(e: Pick<LinkEpisode, 'startUs' | 'endUs'>, atUs: number): number {
   return Math.max(e.startUs, Math.min(e.endUs ?? atUs, atUs));
 }
+
+/**
+ * Whether a hold (or any silence, given by the frame before it) became a failsafe: one of
+ * `failsafes` follows the same last frame, as the monitor opens one when a hold passes
+ * FAILSAFE_TIMEOUT_US. Every surface that tells holds from failsafes asks this.
+ */
+export function becameFailsafe(lastFrameUs: number, failsafes: readonly { readonly lastFrameUs: number }[]): boolean {
+  return failsafes.some((f) => f.lastFrameUs === lastFrameUs);
+}

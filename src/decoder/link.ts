@@ -35,6 +35,7 @@ import { FAILSAFE_TIMEOUT_US, FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US, system
 import type { DecodedFrame } from './types.js';
 import { EpisodeLog } from './episode-log.js';
 import type { LinkEpisode } from './episode.js';
+import { HOLD_MIN_US, holdThresholdUs, isFrameInterval, nominalPeriodOf } from './link-rules.js';
 import { FrameLedger } from './ledger.js';
 import { copyEpisodes, type LinkCheckpoint } from './checkpoint.js';
 
@@ -132,38 +133,6 @@ export const RESTART_MIN_GAP_US = 100_000;
 /** Restarts kept in `restarts` (the count in `stats` keeps counting). */
 const RESTARTS_KEPT = 64;
 
-/** §7.1 has no hold threshold: a gap shorter than this (and 2.5 periods) is never a hold. */
-export const HOLD_MIN_US = 40_000;
-/** Mean intervals below this are an 11 ms system, above a 22 ms one. */
-export const PERIOD_SNAP_US = 16_500;
-/** 11 or 22 ms: the system period a mean frame interval belongs to. */
-export function nominalPeriodOf(meanIntervalUs: number): number {
-  return meanIntervalUs < PERIOD_SNAP_US ? FRAME_PERIOD_11MS_US : FRAME_PERIOD_22MS_US;
-}
-
-/**
- * Whether an interval between two frames is an ordinary one (no frame missing in it as far as
- * timing can tell): at most 1.5 periods plus the delivery jitter. Period statistics use only these.
- */
-export function isFrameInterval(intervalUs: number, nominalPeriodUs: number, jitterUs: number): boolean {
-  return intervalUs <= 1.5 * nominalPeriodUs + jitterUs;
-}
-
-/**
- * Whether a hold (or any silence, given by the frame before it) became a failsafe: one of
- * `failsafes` follows the same last frame, as the monitor opens one when a hold passes
- * FAILSAFE_TIMEOUT_US. Every surface that tells holds from failsafes asks this.
- */
-export function becameFailsafe(lastFrameUs: number, failsafes: readonly { readonly lastFrameUs: number }[]): boolean {
-  return failsafes.some((f) => f.lastFrameUs === lastFrameUs);
-}
-
-/** The gap after which the link is in hold: `HOLD_MIN_US` or 2.5 periods, whichever is longer, plus the delivery jitter. */
-export function holdThresholdUs(nominalPeriodUs: number, jitterUs: number): number {
-  const base = Number.isFinite(nominalPeriodUs) ? Math.max(HOLD_MIN_US, 2.5 * nominalPeriodUs) : HOLD_MIN_US;
-  return base + (Number.isFinite(jitterUs) ? jitterUs : 0);
-}
-
 const PERIOD_WINDOW = 33;
 /** A mean frame interval below this (0.8 × 11 ms) is no system's period: frames a delivery burst brought together. */
 const BURST_MEAN_US = 0.8 * FRAME_PERIOD_11MS_US;
@@ -198,15 +167,6 @@ export class LinkMonitor {
   readonly #rateFades = new Float64Array(RATE_WINDOW);
   #rateCount = 0;
   #rateNext = 0;
-  /**
-   * `periodUs` and `fadeRate` are owed to the stats: #measure keeps only the windows, and they
-   * are worked out from them when the stats are read (#settleStats), not at every frame (two
-   * divisions and a rounding: frame() took 53 ns a frame instead of 63-73 in Node). Settled
-   * before anything but #measure changes a window or the nominal period, so every read is what
-   * working them out at every frame left.
-   */
-  #periodOwed = false;
-  #rateOwed = false;
   readonly #episodes: LinkEpisode[] = [];
   /** The episodes that can no longer change, for checkpoints (unless `maxEpisodes`: then they are few). */
   #log = new EpisodeLog();
@@ -281,7 +241,6 @@ export class LinkMonitor {
 
   /** Live counters (the same object each time; read it again after more frames). */
   get stats(): Readonly<LinkStats> {
-    this.#settleStats();
     return this.#stats;
   }
 
@@ -338,7 +297,6 @@ export class LinkMonitor {
     if (frame.system !== null && frame.system !== this.#systemByte) {
       const info = systemInfo(frame.system);
       if (info) {
-        this.#settleStats(); // the period owed is the one measured with the nominal period before
         this.#systemByte = frame.system;
         this.#systemPeriod = info.periodUs;
         s.nominalPeriodUs = this.#systemPeriod;
@@ -371,13 +329,10 @@ export class LinkMonitor {
         if (gap > s.longestGapUs) s.longestGapUs = gap;
         const p = s.nominalPeriodUs;
         if (Number.isFinite(p) && isFrameInterval(gap, p, this.jitterUs)) this.#lastInterval = gap;
-        if (gap > 3 * (Number.isFinite(p) ? p : FRAME_PERIOD_22MS_US)) {
-          this.#settleStats(); // the period owed is that of the window about to be emptied
-          this.#periodCount = 0;
-        }
+        if (gap > 3 * (Number.isFinite(p) ? p : FRAME_PERIOD_22MS_US)) this.#periodCount = 0;
       }
       this.#lastUs = t;
-      this.#measure(fades); // at #lastUs: a double handed to a call that is not inlined is boxed, 16 bytes a frame
+      this.#measure(fades); // at #lastUs
       this.#ledger.frame(t, s.nominalPeriodUs, this.#missed);
       this.#confirmHolds();
       s.deliveryDelayUs = this.#ledger.delayUs;
@@ -625,7 +580,6 @@ export class LinkMonitor {
       this.#open.endUs = Number.isFinite(atUs) ? Math.max(atUs, this.#open.startUs) : this.#open.startUs;
       this.#open = null;
     }
-    this.#settleStats();
     this.#lastUs = NaN;
     this.#periodCount = 0;
     this.#ledger.reset();
@@ -649,7 +603,6 @@ export class LinkMonitor {
    * fade-rate windows, the ledger, the holds not yet judged and the counters.
    */
   checkpoint(): LinkCheckpoint {
-    this.#settleStats();
     // Kept whole otherwise: a monitor that drops old episodes has only a few to copy.
     const logged = this.#maxEpisodes === Infinity ? this.#log.take(this.#episodes, this.#settled) : null;
     return {
@@ -727,9 +680,6 @@ export class LinkMonitor {
     this.#finished = cp.finished;
     this.#stoppedUs = cp.stoppedUs;
     Object.assign(this.#stats, cp.stats);
-    // Its stats were settled when it was taken.
-    this.#periodOwed = false;
-    this.#rateOwed = false;
   }
 
   /**
@@ -768,9 +718,7 @@ export class LinkMonitor {
 
   /**
    * The period and fade-rate windows take the frame at #lastUs (and, without a system byte, the
-   * nominal period is snapped, which the frame's own rules read); the figures are owed
-   * (#settleStats). The rings step by comparison, not by a remainder (twice a frame: about 4 ns
-   * a frame less in a Chromium micro-harness, near its noise).
+   * nominal period is snapped, which the frame's own rules read), and the figures follow.
    */
   #measure(fadesDelta: number): void {
     const t = this.#lastUs;
@@ -796,7 +744,12 @@ export class LinkMonitor {
         const mean = (t - (times[this.#periodOldest] ?? NaN)) / (this.#periodCount - 1);
         if (!(mean < BURST_MEAN_US)) s.nominalPeriodUs = nominalPeriodOf(mean);
       }
-      this.#periodOwed = true;
+      // Whole periods in the span, so that a missed frame (one interval two periods long) does
+      // not bias it, and chunk-time jitter averages out.
+      const newest =
+        this.#periodCount < PERIOD_WINDOW ? this.#periodCount - 1 : this.#periodOldest === 0 ? PERIOD_WINDOW - 1 : this.#periodOldest - 1;
+      const span = (times[newest] ?? NaN) - (times[this.#periodOldest] ?? NaN);
+      s.periodUs = span / Math.max(1, Math.round(span / s.nominalPeriodUs));
     }
     // Fade rate over a window of recent frames.
     const i = this.#rateNext;
@@ -806,33 +759,8 @@ export class LinkMonitor {
     fades[i] = prev + fadesDelta;
     this.#rateNext = i === RATE_WINDOW - 1 ? 0 : i + 1;
     if (this.#rateCount < RATE_WINDOW) this.#rateCount++;
-    this.#rateOwed = true;
-  }
-
-  /**
-   * Works out what #measure left owed, from its windows as the last frame left them: the period
-   * (whole periods in the span, so a missed frame, one interval two periods long, does not bias
-   * it, and chunk-time jitter averages out) and the fade rate.
-   */
-  #settleStats(): void {
-    const s = this.#stats;
-    if (this.#periodOwed === true) {
-      this.#periodOwed = false;
-      const times = this.#periodTimes;
-      const oldest = this.#periodOldest;
-      const newest = this.#periodCount < PERIOD_WINDOW ? this.#periodCount - 1 : oldest === 0 ? PERIOD_WINDOW - 1 : oldest - 1;
-      const span = (times[newest] ?? NaN) - (times[oldest] ?? NaN);
-      const periods = Math.max(1, Math.round(span / s.nominalPeriodUs));
-      s.periodUs = span / periods;
-    }
-    if (this.#rateOwed === true) {
-      this.#rateOwed = false;
-      const next = this.#rateNext;
-      const i = next === 0 ? RATE_WINDOW - 1 : next - 1;
-      const oldest = this.#rateCount < RATE_WINDOW ? 0 : next;
-      const fades = this.#rateFades;
-      const span = (this.#rateTimes[i] ?? NaN) - (this.#rateTimes[oldest] ?? NaN);
-      s.fadeRate = span > 0 ? (((fades[i] ?? 0) - (fades[oldest] ?? 0)) / span) * 1e6 : 0;
-    }
+    const oldest = this.#rateCount < RATE_WINDOW ? 0 : this.#rateNext;
+    const span = t - (this.#rateTimes[oldest] ?? NaN);
+    this.#stats.fadeRate = span > 0 ? (((fades[i] ?? 0) - (fades[oldest] ?? 0)) / span) * 1e6 : 0;
   }
 }
