@@ -7,10 +7,8 @@
  * latest time of any byte or event, the span's makings (the analysis's spanBetween says what they
  * make; the line rate chunks are dated by is the caller's).
  *
- * The walk's loop makes no call a record and keeps each branch's times apart. In Chromium 150,
- * one double variable set in both branches (or to NaN) made a heap number a record (316 MB of
- * garbage in the worker over the day capture, by the page bench's figure), and the span tally's
- * methods, called a chunk, were not inlined (46 ms of the worker's CPU profile).
+ * The walk's loop makes no call a record and keeps each branch's times apart: one double
+ * variable set in both branches (or to NaN) is boxed, an allocation a record (bench/README.md).
  */
 import type { ChunkFacts } from './facts.js';
 import { RECORD_OVERHEAD, RECORD_TYPE_DATA, REC_OFF_LENGTH, REC_OFF_PORT, REC_OFF_TIME, REC_OFF_TYPE } from './layout.js';
@@ -64,8 +62,7 @@ export class RecordTally {
       const len = view.getUint32(p + REC_OFF_LENGTH, true);
       const timeUs = view.getFloat64(p + REC_OFF_TIME, true);
       // An event is at its time; a chunk from its first byte to its last (an empty one nowhere).
-      // Each branch keeps its own times: one double variable set in both (or to NaN) was a heap
-      // number a record in Chromium 150.
+      // Each branch keeps its own times (see the file's comment).
       if (bytes[p + REC_OFF_TYPE] === RECORD_TYPE_DATA) {
         const port = bytes[p + REC_OFF_PORT] ?? 0;
         const n = counts[port] ?? 0;

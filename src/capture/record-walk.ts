@@ -44,8 +44,7 @@ export interface SlicedFile {
 /**
  * One data record: its payload is `bytes[start, end)` (`view` over `bytes`), recorded on `port` at
  * `recordTimeUs(view, start)`. The time is read where it is used, not handed over: a double handed
- * to a call that is not inlined is boxed (a heap number a record), and a walk's loop, with the
- * decoding inlined into it, runs out of the compiler's budget for inlining (seen in Chromium 150).
+ * to a call that is not inlined is boxed (an allocation a record).
  */
 export type RecordSink = (bytes: Uint8Array, view: DataView, start: number, end: number, port: number) => void;
 

@@ -2,15 +2,11 @@
  * A worker's first act: one small ArrayBuffer with two views detached, so that the JavaScript
  * engine drops, before it has optimized anything, an assumption this worker breaks anyway.
  *
- * V8 (Chromium 156) compiles typed-array code without detach checks for as long as no buffer
- * with more than one view has been detached in the worker. A replay breaks that within its first
- * second: a piece of the file handed back to be read into again, a byte-stream read into a
- * recycled piece. The engine then throws away every optimized function that reads typed arrays
- * and compiles them again. On the day capture's open (--trace-deopt): 45–48 functions of the
- * helper's walk and decode dropped about 0.5 s in, 24 more with its first report, and 8 of the
- * worker's preview; with this, none. With prime-runs.ts (a compiled loop nothing throws away
- * must be compiled right), 600–820 ms of optimizing compile an open against 920–1010, in three
- * opens each.
+ * The engine compiles typed-array code without detach checks for as long as no buffer with more
+ * than one view has been detached in the worker, and throws every such function away the first
+ * time one is. A replay does detach such buffers (pieces of the file handed back to be read
+ * into again), so it is done first, before anything is compiled, instead of in the middle of a
+ * long open (figures: bench/README.md, "Why the hot paths are written as they are").
  *
  * Returns whether the buffer was detached (false where structuredClone is missing).
  */

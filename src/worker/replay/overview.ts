@@ -116,10 +116,9 @@ export function sumOverview(
   const fades = new Float32Array(t.length);
   const lost = new Float32Array(t.length);
   for (let b = 0; b < t.length; b++) t[b] = origin + b * binUs;
-  // Port by port, each over every bin: with the ports' short loop inside the bins' one, optimised
-  // code entered in the middle of it left it at every bin (a deoptimisation each, 14 000 in one
-  // open of the day capture, Chromium 150's --trace-deopt). The sums are whole counts, exact in
-  // the 32-bit floats they are added up in.
+  // Port by port, each over every bin (the long loop inside: optimised code entered in the middle
+  // of a short inner loop left it at every bin). The sums are whole counts, exact in the 32-bit
+  // floats they are added up in.
   for (const x of all) {
     for (let b = 0; b < t.length; b++) {
       fades[b] = (fades[b] ?? 0) + x.fades(b);

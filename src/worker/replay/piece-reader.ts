@@ -12,10 +12,9 @@ export type ReadableFile = Pick<Blob, 'size' | 'slice' | 'stream'>;
 
 /**
  * A read of the byte stream that has brought nothing for this long is given up: the stream is
- * cancelled and the file read a slice at a time from the piece that stalled. Chromium 156's
- * stream of a File in a worker sometimes never answers a read: the day capture's open waited
- * for ever in 3 of 29 opens (at 96, 100 and 285 MB), where reads take 5-200 ms; a slice at a
- * time never stalled (24 opens). Not seen in a page that only reads the file.
+ * cancelled and the file read a slice at a time from the piece that stalled: a browser's stream
+ * of a File in a worker has been seen never to answer a read, where slices always did
+ * (bench/README.md).
  */
 const STALL_MS = 500;
 

@@ -199,8 +199,7 @@ export class ReplayPass implements OverviewPass {
 
   /**
    * `feed()` at #at[0]. The time goes on in a typed-array slot, not as an argument: a double
-   * handed to a call that is not inlined is boxed, a heap number a chunk, and which calls a
-   * compiler inlines into a walk's loop is its own choice (seen in Chromium 150).
+   * handed to a call that is not inlined is boxed (an allocation a chunk).
    */
   #feed(bytes: Uint8Array, start: number, end: number, port: number): void {
     const atUs = this.#at[0] ?? Number.NaN;
@@ -208,8 +207,7 @@ export class ReplayPass implements OverviewPass {
     const p = this.#byPort[port];
     if (p !== undefined) {
       // A NaN time is none: the chunk goes in untimed. Two calls, not one with `undefined` or the
-      // time: a call given only doubles gets pushRange inlined in the walk's loop, where the other
-      // boxed the time, 60 MB a port-day (the page's heap profile, Chromium 150).
+      // time: a call given only doubles can have pushRange inlined, where the other boxes the time.
       if (Number.isNaN(atUs)) p.decoder.pushRange(bytes, start, end);
       else p.decoder.pushRange(bytes, start, end, atUs);
       drain(p);
