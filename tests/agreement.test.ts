@@ -19,7 +19,7 @@ import { join, resolve } from 'node:path';
 import { describe, expect, it } from 'vitest';
 import type { FormatInfo } from '../src/decoder/types.js';
 import type { LinkEpisode } from '../src/decoder/episode.js';
-import type { LinkStats } from '../src/decoder/link.js';
+import type { LinkStats } from '../src/decoder/link-types.js';
 import { encodeCapture, type CaptureRecordInput } from '../src/capture/writer.js';
 import { importRaw } from '../src/capture/raw.js';
 import { readCapture } from '../src/capture/sniff.js';

@@ -5,7 +5,7 @@
  */
 import { systemInfo, type Resolution } from '../decoder/spec.js';
 import type { FormatInfo } from '../decoder/types.js';
-import type { LinkStats } from '../decoder/link.js';
+import type { LinkStats } from '../decoder/link-types.js';
 import { becameFailsafe } from '../decoder/episode.js';
 import { fadesPerMinute, REPORT_THRESHOLDS } from './report-thresholds.js';
 import { formatDuration, plural, rate as rateText } from './report-text.js';

@@ -5,7 +5,7 @@
  */
 import type { CaptureKind, CaptureTiming } from '../capture/model.js';
 import type { HeaderReading, RemoteKind, ResolutionReason } from '../decoder/types.js';
-import type { MissedBasis } from '../decoder/link.js';
+import type { MissedBasis } from '../decoder/link-types.js';
 import type { Resolution } from '../decoder/spec.js';
 import type { ReportThresholds } from './report-thresholds.js';
 

@@ -4,7 +4,8 @@
  * missed frames placed where they were due). The live page (100 ms bins), the replay overview
  * and the health report (1 s bins) all fill it the same way.
  */
-import { LinkMonitor, type LinkOptions } from '../decoder/link.js';
+import { LinkMonitor } from '../decoder/link.js';
+import type { LinkOptions } from '../decoder/link-types.js';
 import type { DecodedFrame } from '../decoder/types.js';
 
 /**

@@ -4,7 +4,7 @@
  */
 import type { Capture, CaptureIssue } from '../capture/model.js';
 import type { LinkEpisode } from '../decoder/episode.js';
-import type { LinkStats } from '../decoder/link.js';
+import type { LinkStats } from '../decoder/link-types.js';
 import { channelName, channelResolution, CHANNEL_COUNT, servoToMicros } from '../decoder/spec.js';
 import type { DecodedFrame, DecoderStats, FormatInfo } from '../decoder/types.js';
 import { decodeCapture, type DecodeCaptureOptions } from './capture-pass.js';

@@ -10,22 +10,8 @@
  * What an instance was constructed with (options, callbacks) is not state: the instance that
  * restores keeps its own.
  */
-import { FrameSlots } from './frame.js';
 import type { LinkEpisode } from './episode.js';
-import type { LinkRestart, LinkState, LinkStats } from './link.js';
-
-/** A copy of `from`'s slot arrays and counts in `into` (a fresh set when none is given). */
-export function copySlots(from: FrameSlots, into: FrameSlots = new FrameSlots()): FrameSlots {
-  into.ids.set(from.ids);
-  into.positions.set(from.positions);
-  into.words.set(from.words);
-  into.bytes.set(from.bytes);
-  Object.assign(into.vtx, from.vtx);
-  into.count = from.count;
-  into.empty = from.empty;
-  into.hasVtx = from.hasVtx;
-  return into;
-}
+import type { LinkRestart, LinkState, LinkStats } from './link-types.js';
 
 declare const opaque: unique symbol;
 

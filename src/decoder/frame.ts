@@ -180,6 +180,19 @@ export class FrameSlots {
   hasVtx = false;
 }
 
+/** A copy of `from`'s slot arrays and counts in `into` (a fresh set when none is given). */
+export function copySlots(from: FrameSlots, into: FrameSlots = new FrameSlots()): FrameSlots {
+  into.ids.set(from.ids);
+  into.positions.set(from.positions);
+  into.words.set(from.words);
+  into.bytes.set(from.bytes);
+  Object.assign(into.vtx, from.vtx);
+  into.count = from.count;
+  into.empty = from.empty;
+  into.hasVtx = from.hasVtx;
+  return into;
+}
+
 /** A fresh, empty `DecodedFrame` showing `slots`' arrays. */
 export function createFrame(slots: FrameSlots): DecodedFrame {
   return {

@@ -18,14 +18,8 @@ export type {
   VtxControl,
 } from './types.js';
 export type { LinkEpisode } from './episode.js';
-export {
-  LinkMonitor,
-  type LinkOptions,
-  type LinkRestart,
-  type LinkState,
-  type LinkStats,
-  type MissedBasis,
-} from './link.js';
+export { LinkMonitor } from './link.js';
+export type { LinkOptions, LinkRestart, LinkState, LinkStats, MissedBasis } from './link-types.js';
 export { readFrameFields, type FrameFields, type SlotFields, type SlotKind } from './fields.js';
 export { copyFrame, type ChannelValue, type FrameSnapshot } from './snapshot.js';
 export { decodeStream, type TimedChunk } from './stream.js';

@@ -5,9 +5,8 @@
  * bytes are and when they came is the window's (byte-window.ts); the two make the `Core` the
  * acquisition and the locked path work on.
  */
-import { FrameSlots, INVALID } from './frame.js';
+import { copySlots, FrameSlots, INVALID } from './frame.js';
 import type { ByteWindow } from './byte-window.js';
-import { copySlots } from './checkpoint.js';
 import { B0_FADES } from './header.js';
 import type { Resolution } from './spec.js';
 import type { DecodedFrame, DecoderEvent, DecoderStats, RemoteKind, ResolutionReason, Withheld } from './types.js';

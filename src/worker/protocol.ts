@@ -5,7 +5,7 @@
  * few per animation frame at most, transferred, never one message per Spektrum frame.
  */
 import type { FormatInfo } from '../decoder/types.js';
-import type { LinkState, MissedBasis } from '../decoder/link.js';
+import type { LinkState, MissedBasis } from '../decoder/link-types.js';
 import type { InspectEntry } from './inspector.js';
 import type { ConfirmProbe, DoctorFinding } from '../analysis/doctor-types.js';
 

@@ -5,7 +5,7 @@
  * link's state is unknown), never "Live" or "Failsafe" of a link nobody can see.
  */
 import { formatClock } from '../../../analysis/report-text.js';
-import type { LinkState } from '../../../decoder/link.js';
+import type { LinkState } from '../../../decoder/link-types.js';
 
 export type LinkViewKey = LinkState | 'reading' | 'paused' | 'ended' | 'lost';
 
