@@ -35,3 +35,8 @@ export function formatDuration(us: number): string {
 export const plural = (n: number, one: string, many = `${one}s`): string => `${n} ${n === 1 ? one : many}`;
 export const pctText = (ratio: number): string => `${(ratio * 100).toFixed(ratio < 0.001 && ratio > 0 ? 3 : ratio < 0.1 ? 2 : 1)} %`;
 export const rate = (x: number): string => (x === 0 ? '0' : x >= 10 ? x.toFixed(0) : x.toFixed(1));
+
+/** Escapes text for HTML content and attribute values. */
+export function escapeHtml(text: string): string {
+  return text.replace(/[&<>"']/g, (c) => (c === '&' ? '&amp;' : c === '<' ? '&lt;' : c === '>' ? '&gt;' : c === '"' ? '&quot;' : '&#39;'));
+}
