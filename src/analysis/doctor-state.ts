@@ -3,14 +3,8 @@
  * 64 seconds, and the state its rules read (activity, packets, frames, formats, restarts).
  */
 import type { Resolution } from '../decoder/spec.js';
-import {
-  type BurstClock,
-  type BurstClockCheckpoint,
-  PACKET_KINDS,
-  type PacketKind,
-  type PacketScanner,
-  type PacketScannerCheckpoint,
-} from './doctor-line.js';
+import type { BurstClock, BurstClockCheckpoint } from './burst-clock.js';
+import { PACKET_KINDS, type PacketKind, type PacketScanner, type PacketScannerCheckpoint } from './doctor-line.js';
 import type { ArduPilotGuess, ArduPilotGuessCheckpoint, ForeignProtocol } from './doctor-stacks.js';
 import type { DoctorPortSource } from './doctor-types.js';
 

@@ -14,7 +14,8 @@
  */
 import { FRAME_SIZE } from '../decoder/spec.js';
 import type { DecodedFrame } from '../decoder/types.js';
-import { BurstClock, PACKET_KINDS, PacketScanner, type PacketKind } from './doctor-line.js';
+import { BurstClock } from './burst-clock.js';
+import { PACKET_KINDS, PacketScanner, type PacketKind } from './doctor-line.js';
 import { ArduPilotGuess } from './doctor-stacks.js';
 import { lineFindings, lineVerdict, noSatelliteFinding, nothingFindings } from './doctor-line-rules.js';
 import { formatClock } from './report-text.js';
