@@ -29,9 +29,12 @@ import { FRAME_SIZE, type Resolution, systemInfo } from './spec.js';
 import { type Core, discard, event, knownLayout } from './state.js';
 import type { Withheld } from './types.js';
 
-/** Frames looked at before a lock. */
+/** Frames looked at before a lock. Pinned by the golden output (3 or 5 change it). */
 export const ACQUIRE_FRAMES = 4;
-/** Fewest of them that must chain for a lock: two frames that happen to parse are common. */
+/**
+ * Fewest of them that must chain for a lock: two frames that happen to parse are common. 4 fails
+ * decoder.damage.test.ts (frames lost beside damage in the real PX4 captures); 2 changes no test.
+ */
 const MIN_CHAIN = 3;
 /**
  * Start offsets compared before locking. A damaged frame can hide the real alignment's first
@@ -46,7 +49,7 @@ const ACQUIRE_COMMIT = 2 * FRAME_SIZE;
  * Frames read, at most, to decide whether an internal remote's byte 0 is a fade count or
  * SPM4649T RSSI when every value so far could be either (a fade count of 156…226 reads as
  * -100…-30 dBm). RSSI wanders both ways; fades only rise. Without a fall or a value no RSSI
- * takes in this many frames the decoder says it does not know.
+ * takes in this many frames the decoder says it does not know. Unpinned: 7 or 9 change no test.
  */
 const HEADER_EVIDENCE_FRAMES = 8;
 /**
@@ -54,7 +57,8 @@ const HEADER_EVIDENCE_FRAMES = 8;
  * must carry for a lock: more than a header's two, which is all a shifted reading of frames of
  * filler slots finds. A transmitter sends four channels or more, and every frame it sends
  * carries four or more (a pair of 8 to 12 channels, 5 to 7 in each), one such byte each at
- * least (a centred channel's low byte is 0x00).
+ * least (a centred channel's low byte is 0x00). 2 fails decoder.filler.test.ts (a channel
+ * invented from filler); 4 changes no test.
  */
 const EVIDENCE_BYTES = 3;
 
@@ -419,17 +423,31 @@ function scoreChain(d: Core, o: number, resolution: Resolution, frames: number, 
   // Transmitters repeat their layouts (a pair of frames, mostly): a first frame whose layout
   // comes nowhere else in the chain may be damage (a stray byte that made a slot), not a frame.
   if (length >= MIN_CHAIN && !layoutInChain(d, slotLayout(buf, o, resolution), o + FRAME_SIZE, length - 1, resolution)) return -1;
-  let score = 10 * length + recurring - zeroWords - (skipped >= 0 ? 5 : 0);
+  // The weights rank readings that all chain (bestStart keeps the highest). What pins each was
+  // measured by removing it alone and running the decoder's tests (2026-11-29): the chain
+  // length and the system-byte bonus change the golden output (tests/golden: the SPM4649T
+  // fixture); the others change no test's result, golden included. They order candidates that
+  // the tests never put side by side: a test that does is owed before any of them changes.
+  // Chain length dominates: a longer chain of valid frames is the likelier reading.
+  let score = 10 * length;
+  // Layouts that recur every other frame (a transmitter's pair): the right alignment. Unpinned.
+  score += recurring;
+  // Zero words (0x0000) in slots are rarer in real frames than in a shifted reading. Unpinned.
+  score -= zeroWords;
+  // A frame skipped over for a damaged header makes the chain weaker. Unpinned.
+  if (skipped >= 0) score -= 5;
   if (internal) {
-    // A §8.3 system byte in every frame is strong evidence of an internal remote.
+    // A §8.3 system byte in every frame is strong evidence of an internal remote. Pinned by golden.
     if (info !== undefined) score += 8;
+    // ... and more so when its resolution is the one read. Unpinned.
     if (info?.resolution === resolution) score += 2;
   } else if (((byteAt(buf, o) << 8) | s) < 256) {
+    // An external count below 256 (`00 xx`): most external remotes and clones. Unpinned.
     score += 1;
   }
-  // A header of 0xFFFF is an empty slot's filler more often than a fade count at its limit.
+  // A header of 0xFFFF is an empty slot's filler more often than a fade count at its limit. Unpinned.
   if (((byteAt(buf, o) << 8) | s) === 0xffff) score -= 3;
-  // Transmitters send channels 0…N-1: a contiguous set is the signature of the right reading.
+  // Transmitters send channels 0…N-1: a contiguous set is the signature of the right reading. Unpinned.
   if ((channels & (channels + 1)) === 0) score += 2;
   // A chain whose first frame carries no channel is filler that happens to parse (or
   // filler whose chain runs into the frames after it): never a lock, but bestStart weighs it
