@@ -30,7 +30,7 @@ import { type Core, discard, event, knownLayout } from './state.js';
 import type { Withheld } from './types.js';
 
 /** Frames looked at before a lock. Pinned by the golden output (3 or 5 change it). */
-export const ACQUIRE_FRAMES = 4;
+const ACQUIRE_FRAMES = 4;
 /**
  * Fewest of them that must chain for a lock: two frames that happen to parse are common. 4 fails
  * decoder.damage.test.ts (frames lost beside damage in the real PX4 captures); 2 changes no test.
@@ -72,6 +72,9 @@ interface Best {
   resolution: Resolution;
   filler: boolean;
 }
+
+/** Both resolutions, in the order a tie goes to. */
+const RESOLUTIONS = [2048, 1024] as const;
 
 /** The options scoreChain reads with no option forced. */
 const FREE = { remote: 'auto', headerMode: 'auto' } as const;
@@ -224,20 +227,13 @@ function bestStart(d: Core, p: number, avail: number, only: 0 | Resolution, free
     if (!canLead && d.chain.fillerScore > -1) break;
     const frames = Math.min(ACQUIRE_FRAMES, Math.floor((avail - s) / FRAME_SIZE));
     if (frames < 1) break;
-    if (only !== 1024) {
-      const v = scoreChain(d, p + s, 2048, frames, free);
+    for (const r of RESOLUTIONS) {
+      if (only !== 0 && only !== r) continue;
+      const v = scoreChain(d, p + s, r, frames, free);
       if (v > score) {
         score = v;
         shift = s;
-        resolution = 2048;
-      }
-    }
-    if (only !== 2048) {
-      const v = scoreChain(d, p + s, 1024, frames, free);
-      if (v > score) {
-        score = v;
-        shift = s;
-        resolution = 1024;
+        resolution = r;
       }
     }
   }
@@ -287,7 +283,7 @@ function matchForced(d: Core, p: number, avail: number, best: Best): Best {
   const forced = d.s.opts.resolution;
   let score = -1;
   let resolution: Resolution = free.resolution;
-  for (const r of forced === 'auto' ? ([2048, 1024] as const) : [forced]) {
+  for (const r of forced === 'auto' ? RESOLUTIONS : [forced]) {
     const v = scoreChain(d, p + free.shift, r, frames);
     if (v > score) {
       score = v;

@@ -26,7 +26,7 @@ export const FADE_STEP = 8;
  * two (a foreign byte read as its fade count) moves them anywhere. 2 fails decoder.header.test.ts
  * (a fade count that jumps across a dropout); 4 changes no test.
  */
-export const ACQUIRE_FADE_STEP = 3;
+const ACQUIRE_FADE_STEP = 3;
 
 /**
  * §8.3.1: SPM4649T RSSI is -42 (strong) … -92 dBm (weak), -128 on loss. A byte 0 ≥ 0x80 outside

@@ -46,56 +46,54 @@ export function nextFrame(d: Core): DecodedFrame | undefined {
 /** One step of the locked path: a frame, undefined when more bytes are needed, null to go round again. */
 function lockedStep(d: Core): DecodedFrame | null | undefined {
   const { s, w } = d;
-  {
-    const o = w.head;
-    const avail = w.tail - o;
-    if (avail < FRAME_SIZE) {
-      if (w.ended && avail > 0) discard(d, o, avail, 'end-of-stream');
-      return undefined;
-    }
-    const at = w.base + o;
-    const layout = at === s.stagedAt ? s.stagedLayout : slotLayout(w.buf, o, s.resolution);
-    if (at < s.confirmedUntil && layout !== INVALID) return emit(d, o, layout);
-    if (layout !== INVALID && countMoved(d, o, layout)) rereadExternal(d, o);
-    // A staged frame is known to continue the last one: it was checked when it was staged.
-    const fits = layout !== INVALID && (at === s.stagedAt || fitsLast(d, o));
-    if (fits) {
-      // The whole next frame must be in: a header alone is too weak (`00 00` read one byte
-      // late is `00 0c`, a count that rose by 12).
-      if (avail < 2 * FRAME_SIZE) {
-        if (!w.ended) return undefined;
-        // The stream's last frame: whole when the stream ends with it, or when what is left
-        // after it starts with a header that continues it (a truncated last frame).
-        if (knownLayout(s, layout) && (avail === FRAME_SIZE || (avail >= FRAME_SIZE + 2 && standsAlone(d, o, layout, o + FRAME_SIZE)))) {
-          return emit(d, o, layout);
-        }
-        discard(d, o, avail, 'end-of-stream');
-        return undefined;
-      }
-      const next = follows(d, o, o + FRAME_SIZE) ? stageNext(d, o, layout) : INVALID;
-      if (next !== INVALID) {
-        if (knownLayout(s, layout)) return emitStaged(d, o, layout, next);
-        // A new layout: make sure no frame that continues the stream starts inside this one.
-        const q = search(d, o + 1, o + FRAME_SIZE - 1);
-        if (q === NEED_MORE) return undefined;
-        if (q === NOT_FOUND) return emitStaged(d, o, layout, next);
-        resync(d, o, q);
-        return null;
-      }
-    }
-    if (!fits && layout !== INVALID && countJumped(d, o, layout)) {
-      // The same remote goes on after lost frames (its fade count jumped): no frame that
-      // continues the old count starts inside this one.
-      const q = search(d, o + 1, o + FRAME_SIZE - 1);
-      if (q === NEED_MORE) return undefined;
-      if (q === NOT_FOUND) {
-        s.jumpTrusted = true;
+  const o = w.head;
+  const avail = w.tail - o;
+  if (avail < FRAME_SIZE) {
+    if (w.ended && avail > 0) discard(d, o, avail, 'end-of-stream');
+    return undefined;
+  }
+  const at = w.base + o;
+  const layout = at === s.stagedAt ? s.stagedLayout : slotLayout(w.buf, o, s.resolution);
+  if (at < s.confirmedUntil && layout !== INVALID) return emit(d, o, layout);
+  if (layout !== INVALID && countMoved(d, o, layout)) rereadExternal(d, o);
+  // A staged frame is known to continue the last one: it was checked when it was staged.
+  const fits = layout !== INVALID && (at === s.stagedAt || fitsLast(d, o));
+  if (fits) {
+    // The whole next frame must be in: a header alone is too weak (`00 00` read one byte
+    // late is `00 0c`, a count that rose by 12).
+    if (avail < 2 * FRAME_SIZE) {
+      if (!w.ended) return undefined;
+      // The stream's last frame: whole when the stream ends with it, or when what is left
+      // after it starts with a header that continues it (a truncated last frame).
+      if (knownLayout(s, layout) && (avail === FRAME_SIZE || (avail >= FRAME_SIZE + 2 && standsAlone(d, o, layout, o + FRAME_SIZE)))) {
         return emit(d, o, layout);
       }
+      discard(d, o, avail, 'end-of-stream');
+      return undefined;
     }
-    // The frame at o does not continue the stream (or the next one does not continue it).
-    return findContinuation(d, o, layout, fits);
+    const next = follows(d, o, o + FRAME_SIZE) ? stageNext(d, o, layout) : INVALID;
+    if (next !== INVALID) {
+      if (knownLayout(s, layout)) return emitStaged(d, o, layout, next);
+      // A new layout: make sure no frame that continues the stream starts inside this one.
+      const q = search(d, o + 1, o + FRAME_SIZE - 1);
+      if (q === NEED_MORE) return undefined;
+      if (q === NOT_FOUND) return emitStaged(d, o, layout, next);
+      resync(d, o, q);
+      return null;
+    }
   }
+  if (!fits && layout !== INVALID && countJumped(d, o, layout)) {
+    // The same remote goes on after lost frames (its fade count jumped): no frame that
+    // continues the old count starts inside this one.
+    const q = search(d, o + 1, o + FRAME_SIZE - 1);
+    if (q === NEED_MORE) return undefined;
+    if (q === NOT_FOUND) {
+      s.jumpTrusted = true;
+      return emit(d, o, layout);
+    }
+  }
+  // The frame at o does not continue the stream (or the next one does not continue it).
+  return findContinuation(d, o, layout, fits);
 }
 
 /**

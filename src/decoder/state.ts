@@ -12,7 +12,7 @@ import type { Resolution } from './spec.js';
 import type { DecodedFrame, DecoderEvent, DecoderStats, RemoteKind, ResolutionReason, Withheld } from './types.js';
 
 /** Slot layouts remembered (a transmitter uses two to four). */
-export const LAYOUT_MEMORY = 16;
+const LAYOUT_MEMORY = 16;
 
 export interface DecoderState {
   /** The options in force (`setResolution` changes the resolution) and who fixed the resolution. */
@@ -141,7 +141,7 @@ export function createChain(): Chain {
   return { internal: false, system: 0, b0: B0_FADES, frames: 0, skipped: -1, fillerScore: -1 };
 }
 
-export type EventBody = DecoderEvent extends infer E ? (E extends DecoderEvent ? Omit<E, 'timeUs' | 'bytes'> : never) : never;
+type EventBody = DecoderEvent extends infer E ? (E extends DecoderEvent ? Omit<E, 'timeUs' | 'bytes'> : never) : never;
 
 /**
  * Hands `event` to `onEvent` with its time (that of the byte at its offset, dated as a frame's

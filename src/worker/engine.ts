@@ -72,7 +72,6 @@ export class Engine {
 
   constructor(readonly options: EngineOptions) {
     this.decoder = new SpektrumDecoder({ resolution: options.resolution, onEvent: (e) => this.inspector.onEvent(e) });
-    this.#forced = options.resolution !== 'auto';
     // A live view may run for days: keep the newest episodes (the page shows ten minutes).
     this.link = new LinkMonitor({
       jitterUs: options.jitterUs,
@@ -84,9 +83,6 @@ export class Engine {
       },
     });
   }
-
-  /** Whether the resolution is forced (only then can it match no frame). */
-  #forced: boolean;
 
   /** Bytes as they arrived: `time` is the chunk's arrival (or per-byte times). */
   push(bytes: Uint8Array, time: number | Float64Array | undefined, arrivedMs: number): void {
@@ -106,7 +102,6 @@ export class Engine {
     this.link.restore(link);
     this.#ranges = new ChannelRanges();
     this.#rangesSinceUs = this.link.lastFrameUs;
-    this.#forced = this.decoder.resolutionSetting !== 'auto';
     // Frames found missing from here on are placed from the checkpoint's last frame.
     this.#currentUs = this.link.lastFrameUs;
     this.#changed = true;
@@ -142,7 +137,6 @@ export class Engine {
    */
   setResolution(resolution: 'auto' | 1024 | 2048, nowUs: number, by: 'user' | 'internal-remote' = 'user'): void {
     this.decoder.setResolution(resolution, by);
-    this.#forced = resolution !== 'auto';
     this.link.interrupt(nowUs);
     this.#mismatch = null;
     this.#changed = true;
@@ -158,7 +152,7 @@ export class Engine {
 
   #checkMismatch(): void {
     // Only a forced resolution can match no frame (and the decoder's format is made afresh on each read).
-    if (!this.#forced && this.#mismatch === null) return;
+    if (this.decoder.resolutionSetting === 'auto' && this.#mismatch === null) return;
     // The decoder's word: the forced resolution fits no frame, the other one does.
     const mismatch = this.decoder.format.forcedMismatch;
     if (mismatch !== this.#mismatch) {
