@@ -20,9 +20,9 @@
  * (emitted unconditionally): so it always returns after bounded work.
  */
 import { acquire, chainStartsAt, NEED_MORE } from './acquire.js';
-import { byteAt, INVALID, readFrame, showSlots, slotLayout } from './frame.js';
+import { byteAt, type FrameSlots, INVALID, readFrame, showSlots, slotLayout } from './frame.js';
 import { formatOf, setReason } from './format.js';
-import { B0_FADES, B0_RSSI, B0_RSSI_FORCED, B0_UNKNOWN, byte0Follows, countFollows, FADE_STEP, plausibleRssi } from './header.js';
+import { B0_FADES, B0_RSSI, B0_UNKNOWN, byte0Follows, countFollows, FADE_STEP, plausibleRssi } from './header.js';
 import { FRAME_SIZE } from './spec.js';
 import { type Core, type DecoderState, discard, event, knownLayout, learnLayout, unlock } from './state.js';
 import type { DecodedFrame } from './types.js';
@@ -43,8 +43,39 @@ export function nextFrame(d: Core): DecodedFrame | undefined {
   }
 }
 
+/**
+ * The locked path's common case, decided in one pass: the frame at the head is the staged one
+ * (it continues the last frame: checked when it was staged), its layout is known, byte 0's
+ * reading is settled, and the whole next frame is in, valid and continues it (`continues`).
+ * Then it is shown (`show`) exactly as the rest of `lockedStep` would emit it, and the next
+ * frame is staged in turn. Anything else returns null and the rest of `lockedStep` decides.
+ * A hot function (bench/README.md, "Why the hot paths are written as they are").
+ */
+function steadyStep(d: Core): DecodedFrame | null {
+  const { s, w } = d;
+  const o = w.head;
+  const n = o + FRAME_SIZE;
+  const at = w.base + o;
+  if (at !== s.stagedAt || n + FRAME_SIZE > w.tail || at < s.confirmedUntil || !s.haveLast || s.ambiguous || s.b0Mode === B0_UNKNOWN) {
+    return null;
+  }
+  const layout = s.stagedLayout;
+  const buf = w.buf;
+  if (!knownLayout(s, layout) || !continues(s, byteAt(buf, o), byteAt(buf, o + 1), byteAt(buf, n), byteAt(buf, n + 1))) return null;
+  const next = readFrame(buf, w.buf32, n, s.resolution, s.shown);
+  if (next === INVALID) return null;
+  const slots = s.staged;
+  s.staged = s.shown;
+  s.shown = slots;
+  s.stagedAt = at + FRAME_SIZE;
+  s.stagedLayout = next;
+  return show(d, o, slots);
+}
+
 /** One step of the locked path: a frame, undefined when more bytes are needed, null to go round again. */
 function lockedStep(d: Core): DecodedFrame | null | undefined {
+  const steady = steadyStep(d);
+  if (steady !== null) return steady;
   const { s, w } = d;
   const o = w.head;
   const avail = w.tail - o;
@@ -311,10 +342,29 @@ function resync(d: Core, o: number, q: number): void {
   discard(d, o, q - o, q - o < FRAME_SIZE ? 'truncated-frame' : 'noise');
 }
 
-/** Emits the frame at `o`: its header read under the lock's model, its slots, its time; counted. */
+/** Emits the frame at `o`, its layout `layout`. */
 function emit(d: Core, o: number, layout: number): DecodedFrame {
-  const { s, w, frame } = d;
+  const { s, w } = d;
   learnLayout(s, layout);
+  if (s.remote === 'internal' && s.haveLast) settleByte0(d, o);
+  // The slots: read while confirming the frame before (staged), or now.
+  if (s.stagedAt === w.base + o) {
+    const staged = s.staged;
+    s.staged = s.shown;
+    s.shown = staged;
+    s.stagedAt = -1;
+  } else readFrame(w.buf, w.buf32, o, s.resolution, s.shown);
+  return show(d, o, s.shown);
+}
+
+/**
+ * Shows the frame at `o` with its slots `slots`: its time, its header read under the lock's
+ * model (byte 0's reading settled), its slots; and counts it. The one place a frame is written.
+ * Kept whole rather than split into helpers: the JIT then compiles it as one unit wherever it
+ * is called from (bench/README.md, "Why the hot paths are written as they are").
+ */
+function show(d: Core, o: number, slots: FrameSlots): DecodedFrame {
+  const { s, w, frame } = d;
   const buf = w.buf;
   const at = w.base + o;
   frame.index = s.stats.frames;
@@ -325,26 +375,34 @@ function emit(d: Core, o: number, layout: number): DecodedFrame {
   frame.remote = s.remote;
   const b0 = byteAt(buf, o);
   const b1 = byteAt(buf, o + 1);
-  if (s.remote === 'internal') readInternalHeader(d, o, b0, b1);
-  else {
+  // The header under the lock's model.
+  if (s.remote !== 'internal') {
     const count = (b0 << 8) | b1;
     frame.system = null;
     frame.rssi = null;
     frame.fades = count;
     frame.fadesDelta = s.haveLast ? fadeDelta(d, o, (s.last0 << 8) | s.last1, count, 0xffff) : 0;
+  } else {
+    frame.system = b1;
+    const mode = s.b0Mode;
+    if (mode === B0_FADES) {
+      frame.rssi = null;
+      frame.fades = b0;
+      frame.fadesDelta = s.haveLast ? fadeDelta(d, o, s.last0, b0, 0xff) : 0;
+    } else if (mode === B0_UNKNOWN) {
+      frame.rssi = null;
+      frame.fades = null;
+      frame.fadesDelta = 0;
+    } else {
+      frame.rssi = b0 >= 0x80 ? b0 - 0x100 : b0;
+      frame.fades = null;
+      frame.fadesDelta = 0;
+    }
   }
   s.last0 = b0;
   s.last1 = b1;
   s.haveLast = true;
   s.jumpTrusted = false;
-  // The slots: read while confirming the frame before (staged), or now.
-  if (s.stagedAt === at) {
-    const staged = s.staged;
-    s.staged = s.shown;
-    s.shown = staged;
-    s.stagedAt = -1;
-  } else readFrame(buf, w.buf32, o, s.resolution, s.shown);
-  const slots = s.shown;
   showSlots(frame, slots);
   const stats = s.stats;
   stats.frames++;
@@ -356,26 +414,21 @@ function emit(d: Core, o: number, layout: number): DecodedFrame {
   return frame;
 }
 
-/** The header fields of an internal remote's frame at `o` (system byte `b1`), deciding byte 0 where the frames tell. */
-function readInternalHeader(d: Core, o: number, b0: number, b1: number): void {
-  const { s, frame } = d;
-  frame.system = b1;
-  frame.fadesDelta = 0;
-  // Byte 0 moved under a still byte 1: an internal remote (an external count moves its low
-  // byte first). The reading stands, only surer: no event.
-  if (s.ambiguous && s.haveLast && b0 !== s.last0) s.ambiguous = false;
-  if (s.b0Mode === B0_UNKNOWN && s.haveLast) decideByte0(d, o, b0);
-  if (s.b0Mode === B0_RSSI || s.b0Mode === B0_RSSI_FORCED) {
-    frame.rssi = b0 >= 0x80 ? b0 - 0x100 : b0;
-    frame.fades = null;
-  } else if (s.b0Mode === B0_UNKNOWN) {
-    frame.rssi = null;
-    frame.fades = null;
-  } else {
-    frame.rssi = null;
-    frame.fades = b0;
-    if (s.haveLast) frame.fadesDelta = fadeDelta(d, o, s.last0, b0, 0xff);
-  }
+/**
+ * What an internal remote's frame at `o` tells about byte 0, before it is shown. Byte 0 moved
+ * under a still byte 1: an internal remote (an external count moves its low byte first), the
+ * reading stands, only surer (no event). Undecided: a value no RSSI takes says fades, a fall
+ * says RSSI.
+ */
+function settleByte0(d: Core, o: number): void {
+  const { s } = d;
+  const b0 = byteAt(d.w.buf, o);
+  if (s.ambiguous && b0 !== s.last0) s.ambiguous = false;
+  if (s.b0Mode !== B0_UNKNOWN) return;
+  if (!plausibleRssi(b0)) s.b0Mode = B0_FADES;
+  else if (b0 < s.last0) s.b0Mode = B0_RSSI;
+  else return;
+  event(d, { type: 'format-changed', offset: d.w.base + o, format: formatOf(s) });
 }
 
 /**
@@ -391,13 +444,4 @@ function fadeDelta(d: Core, o: number, from: number, to: number, mask: number): 
   if (!counted) d.s.stats.fadeJumps++;
   event(d, { type: 'fade-jump', offset: d.w.base + o, from, to, counted });
   return counted ? delta : 0;
-}
-
-/** An internal remote whose byte 0 was undecided: a value no RSSI takes says fades, a fall says RSSI. */
-function decideByte0(d: Core, o: number, b0: number): void {
-  const { s } = d;
-  if (!plausibleRssi(b0)) s.b0Mode = B0_FADES;
-  else if (b0 < s.last0) s.b0Mode = B0_RSSI;
-  else return;
-  event(d, { type: 'format-changed', offset: d.w.base + o, format: formatOf(s) });
 }
