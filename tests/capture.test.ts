@@ -218,13 +218,20 @@ describe('.sscap round trip', () => {
     expect(chunksOf(parseCapture(padded.subarray(7, 7 + file.length)))).toEqual(chunksOf(parsed));
   });
 
-  it('costs RECORD_OVERHEAD bytes per record on top of the payload', () => {
-    const header = new CaptureWriter(META).header();
+  it('costs RECORD_OVERHEAD bytes per record on top of the payload, and the index after them', () => {
+    const w = new CaptureWriter(META);
+    const header = w.header();
+    const records = RECORDS.map((r) => (r.type === 'data' ? w.data(r.bytes, r.timeUs, r.port) : w.event(r.text, r.timeUs, r.port)));
     const payload =
       DATA_RECORDS.reduce((n, r) => n + r.bytes.length, 0) +
       new TextEncoder().encode('port opened').length +
       new TextEncoder().encode('device lost 🔌').length;
-    expect(file.length).toBe(header.length + payload + RECORDS.length * RECORD_OVERHEAD);
+    const recorded = records.reduce((n, r) => n + r.length, 0);
+    expect(recorded).toBe(payload + RECORDS.length * RECORD_OVERHEAD);
+    // The final index: 20 bytes of record, 56 of its own, 32 an entry (one a port here: the stretches are short).
+    const ports = new Set(DATA_RECORDS.map((r) => r.port ?? 0)).size;
+    expect(w.close().length).toBe(RECORD_OVERHEAD + 56 + 32 * ports);
+    expect(file.length).toBe(header.length + recorded + RECORD_OVERHEAD + 56 + 32 * ports);
   });
 });
 
@@ -233,14 +240,17 @@ describe('CaptureWriter', () => {
     const w = new CaptureWriter(META);
     const parts = [w.header()];
     for (const r of RECORDS) parts.push(r.type === 'data' ? w.data(r.bytes, r.timeUs, r.port) : w.event(r.text, r.timeUs, r.port));
+    parts.push(w.close());
     expect(concat(...parts)).toEqual(encodeCapture(META, RECORDS));
+    expect(() => w.data(FRAME, 0)).toThrow(/closed/);
+    expect(() => w.close()).toThrow(/closed/);
   });
 
   it('hands out a header copy that callers cannot use to change later headers', () => {
     const w = new CaptureWriter(META);
     const first = w.header();
     first.fill(0);
-    expect(w.header()).toEqual(encodeCapture(META, []));
+    expect(w.header()).toEqual(encodeCapture(META, []).subarray(0, first.length));
   });
 
   it('rejects bad arguments with a TypeError', () => {
@@ -552,7 +562,7 @@ describe('.sscap header errors', () => {
   });
 
   it('repairs the metadata length of a capture without records from where its metadata ends', () => {
-    const file = encodeCapture({ note: 'nothing recorded' }, []);
+    const file = new CaptureWriter({ note: 'nothing recorded' }).header();
     new DataView(file.buffer).setUint32(12, 0x7fffffff, true);
     const parsed = parseCapture(file);
     expect(parsed.meta).toEqual({ note: 'nothing recorded' });
@@ -560,7 +570,7 @@ describe('.sscap header errors', () => {
   });
 
   it('refuses a header with an impossible metadata length and damaged metadata when no record follows', () => {
-    const file = encodeCapture({ note: 'nothing recorded' }, []);
+    const file = new CaptureWriter({ note: 'nothing recorded' }).header();
     new DataView(file.buffer).setUint32(12, 0x7fffffff, true);
     file[20]! ^= 0x01;
     expectFormatError(() => parseCapture(file), /damaged SatScope capture header.*no intact record/);

@@ -102,10 +102,12 @@ describe('walking the data records of an intact capture', () => {
   });
 
   it('says where a file cut off inside a record ends, having walked every record before it', async () => {
-    // The last record (a data record) cut in its CRC, in its header, and after its first byte.
+    // The last data record (the final index follows it: its payload length is 12 bytes from
+    // the end) cut in its CRC, in its header, and after its first byte.
+    const indexAt = bytes.length - 20 - new DataView(bytes.buffer, bytes.byteOffset).getUint32(bytes.length - 12, true);
     const last = capture.chunkEnds.length - 1;
-    const lastStart = bytes.length - (20 + (capture.chunkEnds[last] ?? 0) - (capture.chunkEnds[last - 1] ?? 0));
-    for (const end of [bytes.length - 3, lastStart + 9, lastStart + 1]) {
+    const lastStart = indexAt - (20 + (capture.chunkEnds[last] ?? 0) - (capture.chunkEnds[last - 1] ?? 0));
+    for (const end of [indexAt - 3, lastStart + 9, lastStart + 1]) {
       const cut = bytes.subarray(0, end);
       const parsed = parseCapture(cut);
       expect(parsed.issues.map((i) => [i.kind, i.offset])).toEqual([['truncated-record', lastStart]]);

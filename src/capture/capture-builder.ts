@@ -10,6 +10,7 @@ import {
   RECORD_HEADER_SIZE,
   RECORD_OVERHEAD,
   RECORD_TYPE_DATA,
+  RECORD_TYPE_EVENT,
   REC_OFF_LENGTH,
   REC_OFF_PORT,
   REC_OFF_TIME,
@@ -103,7 +104,9 @@ export class CaptureBuilder {
         ports[i] = port;
         i++;
         if (!Number.isNaN(timeUs)) anyTime = true;
-      } else this.#events.push({ timeUs, port, text: utf8Decode(bytes, payload, payload + len), chunkIndex: i });
+      } else if (bytes[p + REC_OFF_TYPE] === RECORD_TYPE_EVENT) {
+        this.#events.push({ timeUs, port, text: utf8Decode(bytes, payload, payload + len), chunkIndex: i });
+      }
       p += RECORD_OVERHEAD + len;
     }
     this.#dataLength = at;

@@ -38,6 +38,13 @@ export const MAX_RECORD_PAYLOAD = 1 << 24;
 
 export const RECORD_TYPE_DATA = 1;
 export const RECORD_TYPE_EVENT = 2;
+/** Where records start (capture-index.ts); readers that do not use it step over it. */
+export const RECORD_TYPE_INDEX = 3;
+
+/** Whether `type` is a record type this code knows (another is a damaged record). */
+export function isRecordType(type: number | undefined): boolean {
+  return type === RECORD_TYPE_DATA || type === RECORD_TYPE_EVENT || type === RECORD_TYPE_INDEX;
+}
 
 /** True when `bytes` starts with the .sscap signature. */
 export function hasCaptureMagic(bytes: Uint8Array): boolean {

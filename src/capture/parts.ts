@@ -7,7 +7,15 @@
  * CRC fails, bytes between records) makes the plan or a part say so, and the file goes to
  * `parseCapture`, which salvages.
  */
-import { RECORD_HEADER_SIZE, RECORD_OVERHEAD, RECORD_TYPE_DATA, REC_OFF_PORT, REC_OFF_TIME, REC_OFF_TYPE } from './layout.js';
+import {
+  RECORD_HEADER_SIZE,
+  RECORD_OVERHEAD,
+  RECORD_TYPE_DATA,
+  RECORD_TYPE_EVENT,
+  REC_OFF_PORT,
+  REC_OFF_TIME,
+  REC_OFF_TYPE,
+} from './layout.js';
 import type { CaptureEvent, CaptureMeta, ParsedCapture } from './model.js';
 import { readHeader } from './header.js';
 import { RecordProbe } from './record-probe.js';
@@ -126,7 +134,9 @@ export function readPart(bytes: Uint8Array, part: CapturePart, columns: CaptureC
       chunkPorts[chunks] = port;
       chunks++;
       if (!Number.isNaN(timeUs)) anyTime = true;
-    } else events.push({ timeUs, port, text: utf8Decode(bytes, payload, payload + len), chunkIndex: chunks });
+    } else if (bytes[p + REC_OFF_TYPE] === RECORD_TYPE_EVENT) {
+      events.push({ timeUs, port, text: utf8Decode(bytes, payload, payload + len), chunkIndex: chunks });
+    }
     p += result;
   }
   return { intact: true, events, anyTime };

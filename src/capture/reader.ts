@@ -3,6 +3,7 @@
  */
 import { utf8Decode } from './text.js';
 import {
+  isRecordType,
   MAX_RECORD_PAYLOAD,
   RECORD_HEADER_SIZE,
   RECORD_OVERHEAD,
@@ -148,7 +149,7 @@ function readSscap(bytes: Uint8Array, work: CaptureReaderWork, shared: boolean):
         chunkPorts[chunks] = port;
         chunks++;
         if (!Number.isNaN(timeUs)) anyTime = true;
-      } else {
+      } else if (bytes[p + REC_OFF_TYPE] === RECORD_TYPE_EVENT) {
         events.push({ timeUs, port, text: utf8Decode(bytes, payload, payload + len), chunkIndex: chunks });
       }
       p += result;
@@ -198,5 +199,5 @@ function readSscap(bytes: Uint8Array, work: CaptureReaderWork, shared: boolean):
 function plausibleHeader(bytes: Uint8Array, view: DataView, p: number, n: number): boolean {
   if (n - p < RECORD_HEADER_SIZE) return false;
   const type = bytes[p + REC_OFF_TYPE];
-  return (type === RECORD_TYPE_DATA || type === RECORD_TYPE_EVENT) && view.getUint32(p + REC_OFF_LENGTH, true) <= MAX_RECORD_PAYLOAD;
+  return isRecordType(type) && view.getUint32(p + REC_OFF_LENGTH, true) <= MAX_RECORD_PAYLOAD;
 }

@@ -6,11 +6,10 @@
  */
 import { crc32, crcRun, crcShift, mulModPoly } from './crc32.js';
 import {
+  isRecordType,
   MAX_RECORD_PAYLOAD,
   RECORD_HEADER_SIZE,
   RECORD_OVERHEAD,
-  RECORD_TYPE_DATA,
-  RECORD_TYPE_EVENT,
   REC_OFF_LENGTH,
   REC_OFF_TYPE,
   SYNC0,
@@ -77,7 +76,7 @@ export class RecordProbe {
     if (avail >= 2 && bytes[p + 1] !== SYNC1) return NOT_RECORD;
     if (avail >= 3) {
       const type = bytes[p + REC_OFF_TYPE];
-      if (type !== RECORD_TYPE_DATA && type !== RECORD_TYPE_EVENT) return DAMAGED;
+      if (!isRecordType(type)) return DAMAGED;
     }
     if (avail < RECORD_HEADER_SIZE) {
       if (avail >= REC_OFF_LENGTH + 4 && view.getUint32(p + REC_OFF_LENGTH, true) > MAX_RECORD_PAYLOAD) return DAMAGED;

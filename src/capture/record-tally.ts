@@ -11,7 +11,15 @@
  * variable set in both branches (or to NaN) is boxed, an allocation a record (bench/README.md).
  */
 import type { ChunkFacts } from './facts.js';
-import { RECORD_OVERHEAD, RECORD_TYPE_DATA, REC_OFF_LENGTH, REC_OFF_PORT, REC_OFF_TIME, REC_OFF_TYPE } from './layout.js';
+import {
+  RECORD_OVERHEAD,
+  RECORD_TYPE_DATA,
+  RECORD_TYPE_EVENT,
+  REC_OFF_LENGTH,
+  REC_OFF_PORT,
+  REC_OFF_TIME,
+  REC_OFF_TYPE,
+} from './layout.js';
 import { chunkFirstByteUs } from './model.js';
 import { primeRuns } from './prime-runs.js';
 
@@ -79,7 +87,7 @@ export class RecordTally {
           if (firstUs < (times[1] ?? Number.NaN)) times[1] = firstUs;
           if (timeUs > (times[2] ?? Number.NaN)) times[2] = timeUs;
         }
-      } else {
+      } else if (bytes[p + REC_OFF_TYPE] === RECORD_TYPE_EVENT) {
         if (timeUs < (times[1] ?? Number.NaN)) times[1] = timeUs;
         if (timeUs > (times[2] ?? Number.NaN)) times[2] = timeUs;
       }

@@ -15,6 +15,7 @@ import {
   RECORD_HEADER_SIZE,
   RECORD_OVERHEAD,
   RECORD_TYPE_DATA,
+  RECORD_TYPE_EVENT,
   REC_OFF_LENGTH,
   REC_OFF_PORT,
   REC_OFF_TIME,
@@ -214,7 +215,8 @@ function walkRun(
     const total = recordSize(bytes, view, p);
     if (total < 0) throw new CaptureFormatError(`no intact record header at offset ${at + p}`);
     if (p + total > n) return p;
-    const data = bytes[p + REC_OFF_TYPE] === RECORD_TYPE_DATA;
+    const type = bytes[p + REC_OFF_TYPE];
+    const data = type === RECORD_TYPE_DATA;
     const port = bytes[p + REC_OFF_PORT] ?? 0;
     const end = p + total - CRC_SIZE;
     if ((data ? checked(port) : eventsChecked) && !crcFollows(bytes, p + REC_OFF_TYPE, end, view))
@@ -223,7 +225,7 @@ function walkRun(
       sink(bytes, view, p + RECORD_HEADER_SIZE, end, port);
       count.chunks++;
       count.dataBytes += total - RECORD_OVERHEAD;
-    } else events?.(bytes, view, p + RECORD_HEADER_SIZE, end, port);
+    } else if (type === RECORD_TYPE_EVENT) events?.(bytes, view, p + RECORD_HEADER_SIZE, end, port);
     p += total;
   }
   return p;

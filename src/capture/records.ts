@@ -6,10 +6,10 @@
  * (record-walk.ts) and the capture kept from it (capture-builder.ts) all read records so.
  */
 import {
+  isRecordType,
   MAX_RECORD_PAYLOAD,
   RECORD_OVERHEAD,
   RECORD_TYPE_DATA,
-  RECORD_TYPE_EVENT,
   REC_OFF_LENGTH,
   REC_OFF_TYPE,
   SYNC0,
@@ -37,12 +37,7 @@ export function grown<T extends Uint8Array | Uint32Array | Float64Array>(to: T, 
 export function recordSize(bytes: Uint8Array, view: DataView, p: number): number {
   const type = bytes[p + REC_OFF_TYPE];
   const len = view.getUint32(p + REC_OFF_LENGTH, true);
-  return bytes[p] === SYNC0 &&
-    bytes[p + 1] === SYNC1 &&
-    (type === RECORD_TYPE_DATA || type === RECORD_TYPE_EVENT) &&
-    len <= MAX_RECORD_PAYLOAD
-    ? RECORD_OVERHEAD + len
-    : -1;
+  return bytes[p] === SYNC0 && bytes[p + 1] === SYNC1 && isRecordType(type) && len <= MAX_RECORD_PAYLOAD ? RECORD_OVERHEAD + len : -1;
 }
 
 /** Where a run of records starts: its file offset, and the chunk index and data offset it fills from. */

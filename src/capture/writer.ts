@@ -23,6 +23,7 @@ import {
   SYNC0,
   SYNC1,
 } from './layout.js';
+import { IndexBuilder } from './capture-index.js';
 import { cleanMeta, isPlainObject } from './meta.js';
 import type { CaptureMeta } from './model.js';
 
@@ -83,18 +84,25 @@ function encodeHeader(meta: CaptureMeta): Uint8Array {
 /**
  * Encodes a capture a piece at a time, so a recorder can append to a file (or OPFS) as bytes
  * arrive without keeping the capture in memory. Write `header()` first, then the bytes each
- * `data()` / `event()` call returns, in order.
+ * `data()` / `event()` call returns, in order, and those of `close()` last. The writer indexes
+ * the records as it goes (docs/capture-format.md, "Index"): now and then a call returns an
+ * index segment after its record, and `close()` returns the final one.
  *
  * ```ts
  * const w = new CaptureWriter({ createdAt: new Date().toISOString(), baudRate: 115200, source: 'webserial' });
  * await file.write(w.header());
  * await file.write(w.data(chunk, performance.now() * 1000));
+ * await file.write(w.close());
  * ```
  */
 export class CaptureWriter {
   /** The metadata as stored (a validated copy). */
   readonly meta: CaptureMeta;
   readonly #header: Uint8Array;
+  readonly #index = new IndexBuilder();
+  /** File offset of the next record: the bytes handed out so far. */
+  #at: number;
+  #closed = false;
 
   /** @throws {TypeError} when `meta` has a field of the wrong type or is larger than 1 MiB as JSON. */
   constructor(meta: CaptureMeta = {}) {
@@ -102,6 +110,7 @@ export class CaptureWriter {
     this.meta = cleanMeta(meta, problems);
     if (problems.length > 0) throw new TypeError(`invalid capture metadata: ${problems.join('; ')}`);
     this.#header = encodeHeader(this.meta);
+    this.#at = this.#header.length;
   }
 
   /** The file header: the first bytes of the file. A fresh copy on each call. */
@@ -117,9 +126,11 @@ export class CaptureWriter {
   data(bytes: Uint8Array, timeUs: number, port = 0): Uint8Array {
     if (!(bytes instanceof Uint8Array)) throw new TypeError('bytes must be a Uint8Array');
     checkPayload(bytes.length);
-    const out = new Uint8Array(RECORD_OVERHEAD + bytes.length);
-    writeRecord(out, 0, RECORD_TYPE_DATA, checkPort(port), checkTime(timeUs), bytes);
-    return out;
+    this.#open();
+    const record = new Uint8Array(RECORD_OVERHEAD + bytes.length);
+    writeRecord(record, 0, RECORD_TYPE_DATA, checkPort(port), checkTime(timeUs), bytes);
+    this.#index.data(this.#at, timeUs, port, bytes.length);
+    return this.#out(record);
   }
 
   /**
@@ -130,8 +141,38 @@ export class CaptureWriter {
     if (typeof text !== 'string') throw new TypeError('event text must be a string');
     const payload = utf8Encode(text);
     checkPayload(payload.length);
-    const out = new Uint8Array(RECORD_OVERHEAD + payload.length);
-    writeRecord(out, 0, RECORD_TYPE_EVENT, checkPort(port), checkTime(timeUs), payload);
+    this.#open();
+    const record = new Uint8Array(RECORD_OVERHEAD + payload.length);
+    writeRecord(record, 0, RECORD_TYPE_EVENT, checkPort(port), checkTime(timeUs), payload);
+    this.#index.event();
+    return this.#out(record);
+  }
+
+  /**
+   * The last bytes of the file: the final index segment (the capture's span and counts, and
+   * where each stretch of it starts). A file without them is read as before, by a plain scan
+   * of what the segments written so far do not cover.
+   * @throws {TypeError} when called twice.
+   */
+  close(): Uint8Array {
+    this.#open();
+    this.#closed = true;
+    return this.#index.segment(this.#at, true);
+  }
+
+  #open(): void {
+    if (this.#closed) throw new TypeError('the capture is closed: nothing can follow its final index');
+  }
+
+  /** `record`, with an index segment after it when one is due. */
+  #out(record: Uint8Array): Uint8Array {
+    this.#at += record.length;
+    if (!this.#index.due(this.#at)) return record;
+    const segment = this.#index.segment(this.#at, false);
+    const out = new Uint8Array(record.length + segment.length);
+    out.set(record, 0);
+    out.set(segment, record.length);
+    this.#at += segment.length;
     return out;
   }
 }
@@ -142,39 +183,31 @@ export type CaptureRecordInput =
   | { type: 'event'; text: string; timeUs: number; port?: number };
 
 /**
- * A whole .sscap file in one buffer: the same bytes as `CaptureWriter`'s header followed by one
- * record per input, in order.
+ * A whole .sscap file in one buffer: the same bytes as a `CaptureWriter` given the records in
+ * order and then closed (header, records, index).
  * @throws {TypeError} on invalid metadata or records (see `CaptureWriter`).
  */
 export function encodeCapture(meta: CaptureMeta, records: readonly CaptureRecordInput[]): Uint8Array {
-  const header = new CaptureWriter(meta).header();
-  // Validate and encode payloads first, so the output is allocated once at its final size.
-  const payloads: Uint8Array[] = [];
-  let size = header.length;
+  const writer = new CaptureWriter(meta);
+  const parts = [writer.header()];
   for (const [i, r] of records.entries()) {
     if (!isPlainObject(r)) throw new TypeError(`records[${i}] must be an object`);
-    let payload: Uint8Array;
     if (r.type === 'data') {
       if (!(r.bytes instanceof Uint8Array)) throw new TypeError(`records[${i}].bytes must be a Uint8Array`);
-      payload = r.bytes;
+      parts.push(writer.data(r.bytes, r.timeUs, r.port ?? 0));
     } else if (r.type === 'event') {
       if (typeof r.text !== 'string') throw new TypeError(`records[${i}].text must be a string`);
-      payload = utf8Encode(r.text);
+      parts.push(writer.event(r.text, r.timeUs, r.port ?? 0));
     } else {
       throw new TypeError(`records[${i}].type must be 'data' or 'event'`);
     }
-    checkTime(r.timeUs);
-    checkPort(r.port ?? 0);
-    checkPayload(payload.length);
-    payloads.push(payload);
-    size += RECORD_OVERHEAD + payload.length;
   }
-  const out = new Uint8Array(size);
-  out.set(header, 0);
-  let offset = header.length;
-  records.forEach((r, i) => {
-    const type = r.type === 'data' ? RECORD_TYPE_DATA : RECORD_TYPE_EVENT;
-    offset += writeRecord(out, offset, type, r.port ?? 0, r.timeUs, payloads[i] as Uint8Array);
-  });
+  parts.push(writer.close());
+  const out = new Uint8Array(parts.reduce((n, part) => n + part.length, 0));
+  let at = 0;
+  for (const part of parts) {
+    out.set(part, at);
+    at += part.length;
+  }
   return out;
 }

@@ -229,6 +229,12 @@ export class Recorder {
   async stop(): Promise<void> {
     const handle = this.#handle;
     if (handle === undefined) return;
+    try {
+      // The final index, unless writing already failed (the file then ends with what was written).
+      if (this.#error === null && this.#writer !== undefined) this.#write(this.#writer.close());
+    } catch (error) {
+      this.#error = `The recording's index could not be written (${String(error)}): the file is read by a plain scan instead.`;
+    }
     this.#handle = undefined;
     try {
       handle.flush();
