@@ -5,8 +5,10 @@
  * `frame()` uses the frame's own time and `update(now)` advances the clock between frames;
  * nothing here reads a clock.
  *
- * This file is the one home of the link rules every surface shares (live page, replay,
- * `satscope info`, `satscope report`):
+ * This file and the parts the monitor owns (the frame ledger, ledger.ts; the period and
+ * fade-rate windows, link-rates.ts; the stall judge, link-stalls.ts; the restart watch,
+ * link-restarts.ts; the plain timing rules, link-rules.ts) are the one home of the link rules
+ * every surface shares (live page, replay, `satscope info`, `satscope report`):
  *
  * - **Missed frames** rest on the receiver's own evidence where it gives some: the fade counter
  *   (UINT8 of an internal remote, UINT16 of an external one, §8.3/§8.4: "missed frames for this
@@ -36,19 +38,12 @@ import type { DecodedFrame } from './types.js';
 import { EpisodeLog } from './episode-log.js';
 import type { LinkEpisode } from './episode.js';
 import type { LinkOptions, LinkRestart, LinkState, LinkStats } from './link-types.js';
-import { HOLD_MIN_US, holdThresholdUs, isFrameInterval, nominalPeriodOf } from './link-rules.js';
+import { HOLD_MIN_US, holdThresholdUs, isFrameInterval } from './link-rules.js';
+import { LinkRates } from './link-rates.js';
+import { RestartWatch } from './link-restarts.js';
+import { StallJudge } from './link-stalls.js';
 import { FrameLedger } from './ledger.js';
 import { copyEpisodes, type LinkCheckpoint } from './checkpoint.js';
-
-/** A fade counter that falls after a silence at least this long is a restart, not line damage (a restart takes a satellite longer). */
-export const RESTART_MIN_GAP_US = 100_000;
-/** Restarts kept in `restarts` (the count in `stats` keeps counting). */
-const RESTARTS_KEPT = 64;
-
-const PERIOD_WINDOW = 33;
-/** A mean frame interval below this (0.8 × 11 ms) is no system's period: frames a delivery burst brought together. */
-const BURST_MEAN_US = 0.8 * FRAME_PERIOD_11MS_US;
-const RATE_WINDOW = 512;
 
 /**
  * The link's health from the frames and the clock: the failsafe state machine of spec §7.1,
@@ -69,16 +64,10 @@ export class LinkMonitor {
   #state: LinkState = 'waiting';
   #lastUs = NaN;
   #systemPeriod = NaN;
-  /** The last frame times without a gap, a ring: `#periodCount` of them, the oldest at `#periodOldest` once it is full. */
-  readonly #periodTimes = new Float64Array(PERIOD_WINDOW);
-  #periodCount = 0;
-  #periodOldest = 0;
+  /** The period and fade-rate windows. */
+  readonly #rates = new LinkRates();
   /** The last system byte seen, and whether `systemInfo` knew it (one lookup per change, not per frame). */
   #systemByte = -1;
-  readonly #rateTimes = new Float64Array(RATE_WINDOW);
-  readonly #rateFades = new Float64Array(RATE_WINDOW);
-  #rateCount = 0;
-  #rateNext = 0;
   readonly #episodes: LinkEpisode[] = [];
   /** The episodes that can no longer change, for checkpoints (unless `maxEpisodes`: then they are few). */
   #log = new EpisodeLog();
@@ -88,25 +77,10 @@ export class LinkMonitor {
   readonly #ledger: FrameLedger;
   /** `#missedByCount` bound once, for the ledger (no closure made per frame). */
   readonly #missed = (fromUs: number, toUs: number, count: number): void => this.#missedByCount(fromUs, toUs, count);
-  /**
-   * Holds not yet confirmed, with the receiver's fade count when each began: a hold whose
-   * silence the next punctual frame shows held no missing frame was the adapter holding bytes
-   * back (a delivery stall), not the link: it is withdrawn (`retracted`).
-   */
-  readonly #unconfirmed: { episode: LinkEpisode; endFades: number }[] = [];
-  readonly #retracted: number[] = [];
-  /**
-   * A hold that just ended with no counter to judge it, and the frames that came right after
-   * it closer together than half a period: a stall delivers the frames it held all at once,
-   * while a link that lost them resumes at its pace.
-   */
-  #burst: { episode: LinkEpisode; frames: number } | null = null;
-  #closesSeen = 0;
   /** The fade counter has shown that it counts (a value other than 0, or a rise). */
   #counting = false;
-  /** The last frame's fade count (NaN: none yet), and the last restarts. */
-  #prevCount = NaN;
-  readonly #restarts: LinkRestart[] = [];
+  /** The fade counter from frame to frame, and the receiver restarts it showed. */
+  readonly #restarts = new RestartWatch();
   #lastFades = 0;
   #lastInterval = NaN;
   #finished = false;
@@ -132,6 +106,8 @@ export class LinkMonitor {
     deliveryDelayUs: NaN,
     deliveryJitterUs: NaN,
   };
+  /** The holds that wait to be judged, and the delivery stalls they turn out to be. */
+  readonly #stalls = new StallJudge(this.#episodes, this.#stats);
 
   /** @throws {TypeError} when a duration is not a positive finite number. */
   constructor(options: LinkOptions = {}) {
@@ -163,7 +139,7 @@ export class LinkMonitor {
 
   /** The last receiver restarts (up to 64), oldest first. */
   get restarts(): readonly LinkRestart[] {
-    return this.#restarts;
+    return this.#restarts.restarts;
   }
 
   /** Time of the last frame, µs (NaN before the first, without timing, or after `interrupt()`). */
@@ -222,13 +198,8 @@ export class LinkMonitor {
       this.#redate(open.lastFrameUs, last);
     }
     const gap = Number.isFinite(t) && Number.isFinite(last) && t >= last ? t - last : NaN;
-    if (this.#burst !== null) {
-      // Within a burst, frames of chunks delivered together may even be dated out of order.
-      const p = s.nominalPeriodUs;
-      if (Number.isFinite(t) && !(t - last >= (Number.isFinite(p) ? p : FRAME_PERIOD_11MS_US) / 2)) this.#burst.frames++;
-      else this.#endBurst();
-    }
-    const restartDue = this.#restarted(frame, gap);
+    this.#stalls.frame(t, last);
+    const restartDue = this.#restarts.frame(frame, gap, s);
     const fades = frame.fadesDelta;
     s.fades += fades;
     this.#lastFades = fades;
@@ -241,12 +212,12 @@ export class LinkMonitor {
         if (gap > s.longestGapUs) s.longestGapUs = gap;
         const p = s.nominalPeriodUs;
         if (Number.isFinite(p) && isFrameInterval(gap, p, this.jitterUs)) this.#lastInterval = gap;
-        if (gap > 3 * (Number.isFinite(p) ? p : FRAME_PERIOD_22MS_US)) this.#periodCount = 0;
+        if (gap > 3 * (Number.isFinite(p) ? p : FRAME_PERIOD_22MS_US)) this.#rates.clearPeriod();
       }
       this.#lastUs = t;
-      this.#measure(fades); // at #lastUs
+      this.#rates.measure(t, fades, s, !Number.isFinite(this.#systemPeriod));
       this.#ledger.frame(t, s.nominalPeriodUs, this.#missed);
-      this.#confirmHolds();
+      this.#stalls.confirm(this.#ledger);
       s.deliveryDelayUs = this.#ledger.delayUs;
       s.deliveryJitterUs = this.#ledger.jitterUs;
     }
@@ -276,44 +247,11 @@ export class LinkMonitor {
     }
     if (this.#open !== null) {
       this.#open.endUs = Number.isFinite(t) ? t : this.#open.startUs;
-      // What the receiver says it missed in the silence. Where its counter counts, that is the
-      // evidence, and the hold is judged now (a stall's frames arrive late, none missed);
-      // otherwise it waits for the frame count of the ledger window that closes over it.
-      const at = this.#unconfirmed.findIndex((x) => x.episode === this.#open);
-      const u = this.#unconfirmed[at];
-      if (u !== undefined && this.#counting) {
-        this.#unconfirmed.splice(at, 1);
-        this.#judge(u.episode, restartDue > 0 ? restartDue : fades);
-      } else if (u !== undefined) {
-        u.endFades = fades;
-        this.#burst = { episode: u.episode, frames: 1 };
-      }
+      // What the receiver says it missed in the silence: the evidence where its counter counts.
+      this.#stalls.ended(this.#open, this.#counting, restartDue > 0 ? restartDue : fades, fades);
       this.#open = null;
     }
     this.#state = 'live';
-  }
-
-  /**
-   * Whether `frame` ends a silence of `gapUs` with a restarted counter (recorded, and counted in
-   * `stats.restarts`); returns the frames due in the silence (0: no restart). A wrap in the
-   * silence adds about as many as were due: a fall further from that than 8 frames, or half of
-   * them, is no wrap.
-   */
-  #restarted(frame: DecodedFrame, gapUs: number): number {
-    const count = frame.fades;
-    if (count === null) return 0;
-    const prev = this.#prevCount;
-    this.#prevCount = count;
-    const p = this.#stats.nominalPeriodUs;
-    if (!(count < prev) || !(gapUs >= RESTART_MIN_GAP_US) || !Number.isFinite(p)) return 0;
-    const modulus = frame.remote === 'internal' ? 256 : 65536;
-    const due = Math.max(0, Math.round(gapUs / p) - 1);
-    const wrapped = (count - prev + modulus) % modulus;
-    if (Math.abs(wrapped - due) <= Math.max(8, 0.5 * due)) return 0;
-    this.#stats.restarts++;
-    this.#restarts.push({ timeUs: frame.timeUs, from: prev, to: count, gapUs });
-    if (this.#restarts.length > RESTARTS_KEPT) this.#restarts.shift();
-    return Math.max(1, due);
   }
 
   /**
@@ -322,80 +260,7 @@ export class LinkMonitor {
    * from the count of holds.
    */
   takeRetracted(): number[] {
-    return this.#retracted.splice(0, this.#retracted.length);
-  }
-
-  /** After a ledger window: holds before its most punctual frame are confirmed or withdrawn. */
-  #confirmHolds(): void {
-    const l = this.#ledger;
-    if (l.closes === this.#closesSeen) return;
-    this.#closesSeen = l.closes;
-    for (let i = 0; i < this.#unconfirmed.length; ) {
-      const u = this.#unconfirmed[i];
-      // A hold whose burst is still arriving is judged by the burst first.
-      const waiting = u === undefined || u.episode === this.#burst?.episode;
-      if (waiting || !(u.episode.lastFrameUs < l.closedPunctualUs) || u.episode.endUs === null) {
-        i++;
-        continue;
-      }
-      this.#unconfirmed.splice(i, 1);
-      this.#judge(u.episode, Math.max(l.closedMissing, u.endFades));
-    }
-  }
-
-  /** The burst after a hold is over: a hold whose frames came in it is withdrawn now; any other waits for its ledger window. */
-  #endBurst(): void {
-    const b = this.#burst;
-    this.#burst = null;
-    if (b === null) return;
-    // The burst brought the silence's frames, and the frame due when it came.
-    const missed = Math.max(0, this.#dueIn(b.episode) + 1 - b.frames);
-    const at = this.#unconfirmed.findIndex((x) => x.episode === b.episode);
-    if (at >= 0 && this.#judge(b.episode, missed)) this.#unconfirmed.splice(at, 1);
-  }
-
-  /** Frames a hold's silence (through its failsafe, if it became one) would have held had the link lost them (0 while it is open or no period is known). */
-  #dueIn(e: LinkEpisode): number {
-    const p = this.#stats.nominalPeriodUs;
-    const end = this.#silenceEndUs(e);
-    return Number.isFinite(p) && end !== null ? Math.round((end - e.lastFrameUs) / p) - 1 : 0;
-  }
-
-  /** Where the silence a hold began ended: the hold's end, or its failsafe's (null while it lasts). */
-  #silenceEndUs(e: LinkEpisode): number | null {
-    for (let i = this.#episodes.length - 1; i >= 0; i--) {
-      const f = this.#episodes[i] as LinkEpisode;
-      if (f.kind === 'failsafe' && f.lastFrameUs === e.lastFrameUs) return f.endUs;
-      if (f.lastFrameUs < e.lastFrameUs) break;
-    }
-    return e.endUs;
-  }
-
-  /**
-   * Keeps a hold that ended, or withdraws it (and says so): `missed` is how many frames the
-   * evidence says were lost in its silence. A stall delivers the frames it held after it, so a
-   * hold that lost under half of them was the adapter's: a delivery stall, and so is the
-   * failsafe it became (the flight controller, on the receiver's own line, had its frames).
-   */
-  #judge(e: LinkEpisode, missed: number): boolean {
-    const due = this.#dueIn(e);
-    if (due < 2 || missed >= due / 2) return false;
-    const s = this.#stats;
-    const silence = (this.#silenceEndUs(e) ?? e.lastFrameUs) - e.lastFrameUs;
-    for (let i = this.#episodes.length - 1; i >= 0; i--) {
-      const x = this.#episodes[i] as LinkEpisode;
-      if (x.lastFrameUs !== e.lastFrameUs) {
-        if (x.lastFrameUs < e.lastFrameUs) break;
-        continue;
-      }
-      this.#episodes.splice(i, 1);
-      if (x.kind === 'hold') s.holds--;
-      else s.failsafes--;
-      this.#retracted.push(x.id);
-    }
-    s.stalls++;
-    if (silence > s.longestStallUs) s.longestStallUs = silence;
-    return true;
+    return this.#stalls.takeRetracted();
   }
 
   /** Frames the ledger found missing: they count while the receiver has given no counter to go by. */
@@ -428,8 +293,7 @@ export class LinkMonitor {
       // The hold began when the next frame was due, whenever it was noticed.
       const p = s.nominalPeriodUs;
       this.#openEpisode('hold', last + (Number.isFinite(p) ? p : this.holdAfterUs), last);
-      if (this.#open !== null) this.#unconfirmed.push({ episode: this.#open, endFades: 0 });
-      if (this.#unconfirmed.length > 64) this.#unconfirmed.shift();
+      if (this.#open !== null) this.#stalls.held(this.#open);
     }
     if (gap >= this.#failsafeAfterUs && this.#state === 'hold') {
       this.#state = 'failsafe';
@@ -453,7 +317,7 @@ export class LinkMonitor {
       this.interrupt(this.#stoppedUs);
       this.#stoppedUs = NaN;
     }
-    if (this.#burst !== null) this.#endBurst();
+    this.#stalls.endBurst();
     const state = this.update(endUs);
     const s = this.#stats;
     if (!Number.isFinite(endUs) || !Number.isFinite(this.#lastUs) || !Number.isFinite(s.nominalPeriodUs)) return state;
@@ -463,7 +327,7 @@ export class LinkMonitor {
     if (this.#counting) {
       // The receiver never got to report these: frames due in a silence longer than a hold.
       this.#ledger.finish(endUs, Infinity, this.#missed);
-      this.#confirmHolds();
+      this.#stalls.confirm(this.#ledger);
       if (silence > grace) {
         const p = s.nominalPeriodUs;
         const k = Math.max(0, Math.floor((silence - this.jitterUs) / p));
@@ -475,7 +339,7 @@ export class LinkMonitor {
       }
     } else {
       this.#ledger.finish(endUs, silence > grace ? this.jitterUs : Infinity, this.#missed);
-      this.#confirmHolds();
+      this.#stalls.confirm(this.#ledger);
     }
     return state;
   }
@@ -487,13 +351,13 @@ export class LinkMonitor {
    * for the time in between.
    */
   interrupt(atUs: number): void {
-    this.#burst = null;
+    this.#stalls.interrupt();
     if (this.#open !== null) {
       this.#open.endUs = Number.isFinite(atUs) ? Math.max(atUs, this.#open.startUs) : this.#open.startUs;
       this.#open = null;
     }
     this.#lastUs = NaN;
-    this.#periodCount = 0;
+    this.#rates.clearPeriod();
     this.#ledger.reset();
     this.#state = 'waiting';
   }
@@ -517,32 +381,26 @@ export class LinkMonitor {
   checkpoint(): LinkCheckpoint {
     // Kept whole otherwise: a monitor that drops old episodes has only a few to copy.
     const logged = this.#maxEpisodes === Infinity ? this.#log.take(this.#episodes, this.#settled) : null;
+    const stalls = this.#stalls;
     return {
       state: this.#state,
       lastUs: this.#lastUs,
       systemPeriod: this.#systemPeriod,
-      periodTimes: this.#periodTimes.slice(),
-      periodCount: this.#periodCount,
-      periodOldest: this.#periodOldest,
       systemByte: this.#systemByte,
-      rateTimes: this.#rateTimes.slice(),
-      rateFades: this.#rateFades.slice(),
-      rateCount: this.#rateCount,
-      rateNext: this.#rateNext,
+      ...this.#rates.checkpoint(),
       settled: logged?.blocks ?? [],
       graph: copyEpisodes({
         episodes: logged?.open ?? this.#episodes,
         open: this.#open,
-        unconfirmed: this.#unconfirmed,
-        burst: this.#burst,
+        unconfirmed: stalls.unconfirmed,
+        burst: stalls.burst,
       }),
       nextEpisode: this.#nextEpisode,
-      retracted: this.#retracted.slice(),
+      retracted: stalls.retracted.slice(),
       ledger: this.#ledger.checkpoint(),
-      closesSeen: this.#closesSeen,
+      closesSeen: stalls.closesSeen,
       counting: this.#counting,
-      prevCount: this.#prevCount,
-      restarts: this.#restarts.map((r) => ({ ...r })),
+      ...this.#restarts.checkpoint(),
       lastFades: this.#lastFades,
       lastInterval: this.#lastInterval,
       finished: this.#finished,
@@ -560,14 +418,8 @@ export class LinkMonitor {
     this.#state = cp.state;
     this.#lastUs = cp.lastUs;
     this.#systemPeriod = cp.systemPeriod;
-    this.#periodTimes.set(cp.periodTimes);
-    this.#periodCount = cp.periodCount;
-    this.#periodOldest = cp.periodOldest;
+    this.#rates.restore(cp);
     this.#systemByte = cp.systemByte;
-    this.#rateTimes.set(cp.rateTimes);
-    this.#rateFades.set(cp.rateFades);
-    this.#rateCount = cp.rateCount;
-    this.#rateNext = cp.rateNext;
     const g = copyEpisodes(cp.graph);
     // Pushed one by one: a long session's thousands of episodes are too many for spread arguments.
     // The settled ones are copied (the monitor's own are written: redated, ended; the log's never),
@@ -578,15 +430,11 @@ export class LinkMonitor {
     if (cp.settled.length > 0) this.#episodes.sort((a, b) => a.id - b.id);
     this.#log = EpisodeLog.of(cp.settled, g.episodes);
     this.#open = g.open;
-    this.#unconfirmed.splice(0, this.#unconfirmed.length, ...g.unconfirmed); // at most 64
-    this.#burst = g.burst;
+    this.#stalls.restore(g.unconfirmed, g.burst, cp.retracted, cp.closesSeen);
     this.#nextEpisode = cp.nextEpisode;
-    this.#retracted.splice(0, this.#retracted.length, ...cp.retracted);
     this.#ledger.restore(cp.ledger);
-    this.#closesSeen = cp.closesSeen;
     this.#counting = cp.counting;
-    this.#prevCount = cp.prevCount;
-    this.#restarts.splice(0, this.#restarts.length, ...cp.restarts.map((r) => ({ ...r })));
+    this.#restarts.restore(cp);
     this.#lastFades = cp.lastFades;
     this.#lastInterval = cp.lastInterval;
     this.#finished = cp.finished;
@@ -599,10 +447,7 @@ export class LinkMonitor {
    * to be judged by it and it is not of the silence still open (`#redate` moves those).
    */
   readonly #settled = (e: LinkEpisode): boolean =>
-    e.endUs !== null &&
-    !(this.#open !== null && e.lastFrameUs === this.#open.lastFrameUs) &&
-    this.#burst?.episode.lastFrameUs !== e.lastFrameUs &&
-    !this.#unconfirmed.some((u) => u.episode.lastFrameUs === e.lastFrameUs);
+    e.endUs !== null && !(this.#open !== null && e.lastFrameUs === this.#open.lastFrameUs) && !this.#stalls.waits(e.lastFrameUs);
 
   /** Re-dates the episodes counted from `fromUs` to count from the frame at `lastUs`. */
   #redate(fromUs: number, lastUs: number): void {
@@ -626,53 +471,5 @@ export class LinkMonitor {
     // Drop the oldest in one go (an amortised splice), never the open one.
     if (this.#episodes.length > this.#maxEpisodes * 1.25) this.#episodes.splice(0, this.#episodes.length - this.#maxEpisodes);
     this.#open = episode;
-  }
-
-  /**
-   * The period and fade-rate windows take the frame at #lastUs (and, without a system byte, the
-   * nominal period is snapped, which the frame's own rules read), and the figures follow.
-   */
-  #measure(fadesDelta: number): void {
-    const t = this.#lastUs;
-    // Period: the span of the last 32 gap-free intervals, which averages out chunk jitter.
-    const times = this.#periodTimes;
-    const count = this.#periodCount;
-    if (count < PERIOD_WINDOW) {
-      if (count === 0) this.#periodOldest = 0;
-      times[count] = t;
-      this.#periodCount = count + 1;
-    } else {
-      const oldest = this.#periodOldest;
-      times[oldest] = t;
-      this.#periodOldest = oldest === PERIOD_WINDOW - 1 ? 0 : oldest + 1;
-    }
-    if (this.#periodCount >= 9) {
-      const s = this.#stats;
-      if (!Number.isFinite(this.#systemPeriod) && (!Number.isFinite(s.nominalPeriodUs) || this.#periodCount === PERIOD_WINDOW)) {
-        // Without a system byte: snap the mean interval to 11 or 22 ms, first over 8 intervals,
-        // then again over every full window, so a few frames missing early do not stick. A
-        // window that a delivery burst crowds (frames a stall held back, dated together) is
-        // faster than any system sends: it says nothing of the period.
-        const mean = (t - (times[this.#periodOldest] ?? NaN)) / (this.#periodCount - 1);
-        if (!(mean < BURST_MEAN_US)) s.nominalPeriodUs = nominalPeriodOf(mean);
-      }
-      // Whole periods in the span, so that a missed frame (one interval two periods long) does
-      // not bias it, and chunk-time jitter averages out.
-      const newest =
-        this.#periodCount < PERIOD_WINDOW ? this.#periodCount - 1 : this.#periodOldest === 0 ? PERIOD_WINDOW - 1 : this.#periodOldest - 1;
-      const span = (times[newest] ?? NaN) - (times[this.#periodOldest] ?? NaN);
-      s.periodUs = span / Math.max(1, Math.round(span / s.nominalPeriodUs));
-    }
-    // Fade rate over a window of recent frames.
-    const i = this.#rateNext;
-    const fades = this.#rateFades;
-    const prev = this.#rateCount === 0 ? 0 : (fades[i === 0 ? RATE_WINDOW - 1 : i - 1] ?? 0);
-    this.#rateTimes[i] = t;
-    fades[i] = prev + fadesDelta;
-    this.#rateNext = i === RATE_WINDOW - 1 ? 0 : i + 1;
-    if (this.#rateCount < RATE_WINDOW) this.#rateCount++;
-    const oldest = this.#rateCount < RATE_WINDOW ? 0 : this.#rateNext;
-    const span = t - (this.#rateTimes[oldest] ?? NaN);
-    this.#stats.fadeRate = span > 0 ? (((fades[i] ?? 0) - (fades[oldest] ?? 0)) / span) * 1e6 : 0;
   }
 }

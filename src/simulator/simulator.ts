@@ -10,21 +10,21 @@ import {
   EMPTY_SLOT,
   FAILSAFE_TIMEOUT_US,
   FRAME_SIZE,
-  MASK_1024_SXPOS,
   MASK_2048_PHASE,
-  MASK_2048_SXPOS,
   SLOTS_PER_FRAME,
   XPLUS_CHANNEL_ID,
   XPLUS_FIRST,
 } from '../decoder/spec.js';
 import type { VtxControl } from '../decoder/types.js';
+import { LineDamage } from './damage.js';
 import { SHIFT_1024_CHANID, SHIFT_2048_CHANID, SHIFT_XPLUS_SUBID, vtxControl } from './encode.js';
 import { channelLayout } from './layouts.js';
 import type { FrameLayout } from './layouts.js';
+import { StickMotion } from './motion.js';
 import { Prng, deriveSeed } from './prng.js';
 import { resolveScenario } from './scenario.js';
 import type { ResolvedScenario, Scenario } from './scenario.js';
-import type { FrameDamage, SimTruth, TruthChannel, TruthFrame, TruthGap, TruthNoise } from './truth.js';
+import type { SimTruth, TruthChannel, TruthFrame, TruthGap, TruthNoise } from './truth.js';
 
 /** How a `Simulator` runs beyond its scenario: whether it keeps the ground truth. */
 export interface SimulatorOptions {
@@ -70,9 +70,9 @@ export class Simulator {
   private readonly truthOn: boolean;
   private readonly codes: Int8Array[];
   private readonly rngTiming: Prng;
-  private readonly rngMotion: Prng;
+  private readonly motion: StickMotion;
   private readonly rngFades: Prng;
-  private readonly rngDamage: Prng;
+  private readonly lineDamage: LineDamage;
   private readonly rngNoise: Prng;
   private readonly rngRssi: Prng;
 
@@ -81,8 +81,6 @@ export class Simulator {
   private readonly fadeMask: number;
   private rssiLevel: number;
   private rssiLost = false;
-  private readonly walk = new Float64Array(20);
-  private readonly walkIds: number[] = [];
   private xplusCursor = 0;
   private vtxKey = -1;
   private vtxRemaining = 0;
@@ -98,7 +96,6 @@ export class Simulator {
   private readonly words = new Uint16Array(SLOTS_PER_FRAME);
   private readonly frame = new Uint8Array(FRAME_SIZE);
   private readonly frameTimes = new Float64Array(FRAME_SIZE);
-  private readonly removed = new Uint8Array(FRAME_SIZE);
 
   private produced = 0;
   private framesSent = 0;
@@ -126,20 +123,14 @@ export class Simulator {
       return c;
     });
     this.rngTiming = new Prng(deriveSeed(s.seed, STREAM_TIMING));
-    this.rngMotion = new Prng(deriveSeed(s.seed, STREAM_MOTION));
+    this.motion = new StickMotion(s.motion, new Prng(deriveSeed(s.seed, STREAM_MOTION)));
     this.rngFades = new Prng(deriveSeed(s.seed, STREAM_FADES));
-    this.rngDamage = new Prng(deriveSeed(s.seed, STREAM_DAMAGE));
+    this.lineDamage = new LineDamage(s.damage, new Prng(deriveSeed(s.seed, STREAM_DAMAGE)), this.truthOn);
     this.rngNoise = new Prng(deriveSeed(s.seed, STREAM_NOISE));
     this.rngRssi = new Prng(deriveSeed(s.seed, STREAM_RSSI));
     this.fades = s.fades.start;
     this.fadeMask = s.remote === 'internal' ? 0xff : 0xffff;
     this.rssiLevel = s.rssi.meanDbm;
-    s.motion.forEach((m, id) => {
-      if (m.kind === 'walk') {
-        this.walkIds.push(id);
-        this.walk[id] = m.start ?? 0;
-      }
-    });
   }
 
   /** Nominal time of the next frame slot, µs: everything before it has been generated. */
@@ -231,43 +222,6 @@ export class Simulator {
 
   // ---------------------------------------------------------------------------------------
 
-  /** Percent travel of channel `id` at time `tau` (µs since the first slot). */
-  private percent(id: number, tau: number): number {
-    const m = this.scenario.motion[id]!;
-    switch (m.kind) {
-      case 'fixed':
-        return m.percent;
-      case 'sine':
-        return (m.centre ?? 0) + m.amplitude * Math.sin((2 * Math.PI * tau) / m.periodUs + (m.phase ?? 0));
-      case 'walk':
-        return this.walk[id]!;
-      case 'steps':
-        return m.levels[Math.floor(tau / m.holdUs) % m.levels.length]!;
-    }
-  }
-
-  /** Position of channel `id` on the link's scale (0–1023 or 0–2047), ±100 % = 341/1707 in 2048. */
-  private position(id: number, tau: number, resolution: number): number {
-    const p = this.percent(id, tau);
-    const max = resolution === 2048 ? MASK_2048_SXPOS : MASK_1024_SXPOS;
-    const v = Math.round(resolution / 2 + (p * resolution) / 300);
-    return v < 0 ? 0 : v > max ? max : v;
-  }
-
-  private advanceMotion(): void {
-    const motion = this.scenario.motion;
-    for (const id of this.walkIds) {
-      const m = motion[id]!;
-      if (m.kind !== 'walk') continue;
-      const lo = m.min ?? -100;
-      const hi = m.max ?? 100;
-      let x = this.walk[id]! + m.step * (2 * this.rngMotion.next() - 1);
-      if (x > hi) x = 2 * hi - x;
-      if (x < lo) x = 2 * lo - x;
-      this.walk[id] = x < lo ? lo : x > hi ? hi : x;
-    }
-  }
-
   private inWindow(atUs: number, durationUs: number, t: number): boolean {
     return t >= atUs && t < atUs + durationUs;
   }
@@ -283,7 +237,7 @@ export class Simulator {
     this.unitLen = 0;
     this.unitPos = 0;
 
-    this.advanceMotion();
+    this.motion.advance();
     if (s.headerMode === 'rssi') {
       // A slow swing (near and far) plus a mean-reverting random walk, clamped to §8.3.1's range.
       const target = s.rssi.meanDbm + s.rssi.swingDb * Math.sin((2 * Math.PI * tau) / s.rssi.swingPeriodUs);
@@ -347,14 +301,14 @@ export class Simulator {
       }
       const code = codes[i]!;
       if (code >= 0) {
-        const pos = this.position(code, tau, res);
+        const pos = this.motion.position(code, tau, res);
         words[i] =
           res === 1024
             ? (code << SHIFT_1024_CHANID) | pos
             : (i === 0 && layout.phase ? MASK_2048_PHASE : 0) | (code << SHIFT_2048_CHANID) | pos;
         channels?.push({ id: code, pos });
       } else if (code === CODE_XPLUS && xplusChannel >= 0) {
-        const v9 = this.position(xplusChannel, tau, 2048) >> 2;
+        const v9 = this.motion.position(xplusChannel, tau, 2048) >> 2;
         const sub = (xplusChannel - XPLUS_FIRST) & 3;
         words[i] =
           (xplusChannel - XPLUS_FIRST >= 4 ? MASK_2048_PHASE : 0) |
@@ -406,35 +360,9 @@ export class Simulator {
     }
 
     // Line damage.
-    const d = s.damage;
-    const removed = this.removed;
-    removed.fill(0);
-    let damage: FrameDamage | null = null;
-    let nRemoved = 0;
-    if (this.framesSent === 0 && d.startMidFrame > 0) {
-      for (let i = 0; i < d.startMidFrame; i++) removed[i] = 1;
-      nRemoved = d.startMidFrame;
-    } else if (this.rngDamage.chance(d.truncateRate)) {
-      const want = 1 + this.rngDamage.int(d.truncateMaxBytes);
-      while (nRemoved < want) {
-        const i = this.rngDamage.int(FRAME_SIZE);
-        if (!removed[i]) {
-          removed[i] = 1;
-          nRemoved++;
-        }
-      }
-    } else if (this.rngDamage.chance(d.bitFlipRate)) {
-      const byte = this.rngDamage.int(FRAME_SIZE);
-      const bit = this.rngDamage.int(8);
-      f[byte] = f[byte]! ^ (1 << bit);
-      if (this.truthOn) damage = { kind: 'bit-flip', byte, bit };
-    }
-    if (nRemoved > 0 && this.truthOn) {
-      const list: number[] = [];
-      for (let i = 0; i < FRAME_SIZE; i++) if (removed[i]) list.push(i);
-      damage = { kind: 'truncated', removed: list };
-    }
-    const damaged = nRemoved > 0 || damage !== null;
+    const damage = this.lineDamage.apply(f, this.framesSent === 0);
+    const removed = this.lineDamage.removed;
+    const damaged = this.lineDamage.removedCount > 0 || damage !== null;
 
     // Emit.
     const offset = this.produced;

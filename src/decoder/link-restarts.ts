@@ -1,0 +1,63 @@
+/**
+ * Receiver restarts: after a silence of `RESTART_MIN_GAP_US` or more, a fade counter that fell
+ * by more than a wrap explains started again from 0 at power-up. Its count then says nothing
+ * about the silence: the link monitor (link.ts), which owns a watch, keeps the hold and counts
+ * the frames due in the silence as missed.
+ */
+import type { LinkCheckpoint } from './checkpoint.js';
+import type { LinkRestart, LinkStats } from './link-types.js';
+import type { DecodedFrame } from './types.js';
+
+/** A fade counter that falls after a silence at least this long is a restart, not line damage (a restart takes a satellite longer). */
+export const RESTART_MIN_GAP_US = 100_000;
+/** Restarts kept in `restarts` (the count in `stats` keeps counting). */
+const RESTARTS_KEPT = 64;
+
+/** What of a `LinkCheckpoint` is the restart watch's. */
+type RestartsCheckpoint = Pick<LinkCheckpoint, 'prevCount' | 'restarts'>;
+
+/** The receiver's fade counter from frame to frame, and the restarts it showed. */
+export class RestartWatch {
+  /** The last frame's fade count (NaN: none yet). */
+  #prevCount = NaN;
+  readonly #restarts: LinkRestart[] = [];
+
+  /** The last receiver restarts (up to 64), oldest first. */
+  get restarts(): readonly LinkRestart[] {
+    return this.#restarts;
+  }
+
+  /**
+   * Whether `frame` ends a silence of `gapUs` with a restarted counter (recorded, and counted in
+   * `s.restarts`); returns the frames due in the silence (0: no restart). A wrap in the
+   * silence adds about as many as were due: a fall further from that than 8 frames, or half of
+   * them, is no wrap.
+   */
+  frame(frame: DecodedFrame, gapUs: number, s: LinkStats): number {
+    const count = frame.fades;
+    if (count === null) return 0;
+    const prev = this.#prevCount;
+    this.#prevCount = count;
+    const p = s.nominalPeriodUs;
+    if (!(count < prev) || !(gapUs >= RESTART_MIN_GAP_US) || !Number.isFinite(p)) return 0;
+    const modulus = frame.remote === 'internal' ? 256 : 65536;
+    const due = Math.max(0, Math.round(gapUs / p) - 1);
+    const wrapped = (count - prev + modulus) % modulus;
+    if (Math.abs(wrapped - due) <= Math.max(8, 0.5 * due)) return 0;
+    s.restarts++;
+    this.#restarts.push({ timeUs: frame.timeUs, from: prev, to: count, gapUs });
+    if (this.#restarts.length > RESTARTS_KEPT) this.#restarts.shift();
+    return Math.max(1, due);
+  }
+
+  /** The last count and the restarts (copies), for `LinkMonitor.checkpoint()`. */
+  checkpoint(): RestartsCheckpoint {
+    return { prevCount: this.#prevCount, restarts: this.#restarts.map((r) => ({ ...r })) };
+  }
+
+  /** Puts the watch back where `checkpoint()` was taken. */
+  restore(cp: RestartsCheckpoint): void {
+    this.#prevCount = cp.prevCount;
+    this.#restarts.splice(0, this.#restarts.length, ...cp.restarts.map((r) => ({ ...r })));
+  }
+}
