@@ -18,7 +18,6 @@ import {
 } from './layout.js';
 import type { CaptureEvent, ParsedCapture } from './model.js';
 import type { HeaderResult } from './header.js';
-import { primeRuns } from './prime-runs.js';
 import { copyPayload, grown, trimTo } from './records.js';
 import { utf8Decode } from './text.js';
 import { stepOverBadTimes } from './time-rule.js';
@@ -38,10 +37,6 @@ export class CaptureBuilder {
   #anyTime = false;
   #expected = false;
   readonly #events: CaptureEvent[] = [];
-
-  constructor() {
-    primeRuns((bytes, view, from, to) => this.records(bytes, view, from, to));
-  }
 
   /**
    * Room for `records` chunks of `dataBytes` in all (a guess from the file's start, before any

@@ -21,7 +21,6 @@ import {
   REC_OFF_TYPE,
 } from './layout.js';
 import { chunkFirstByteUs } from './model.js';
-import { primeRuns } from './prime-runs.js';
 
 /** Room for this many of a port's chunks at first when none was guessed, then grown by half as needed (4 bytes a chunk). */
 const FIRST_ROOM = 1 << 10;
@@ -41,9 +40,7 @@ export class RecordTally {
   #inOrder = true;
 
   /** @param byteTimeUs how far apart a chunk's bytes arrived, for dating its first byte (the line rate's byte time) */
-  constructor(readonly byteTimeUs: number) {
-    primeRuns((bytes, view, from, to) => this.records(bytes, view, from, to));
-  }
+  constructor(readonly byteTimeUs: number) {}
 
   /**
    * Room for `chunksByPort[p]` chunks of each port at once (a guess from the file's start, before
