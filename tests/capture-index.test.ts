@@ -101,6 +101,18 @@ describe('the capture index', () => {
     const times = [...capture.chunkTimesUs].filter(Number.isFinite);
     expect(index.firstUs).toBe(times[0]);
     expect(index.lastUs).toBe(times.at(-1));
+    // Each port's records and bytes, as the capture's columns count them.
+    const ports = [0, 2, 5].map((port) => {
+      let records = 0;
+      let bytes = 0;
+      for (let i = 0, start = 0; i < capture.chunkEnds.length; start = capture.chunkEnds[i]!, i++) {
+        if (capture.chunkPorts[i] !== port) continue;
+        records++;
+        bytes += capture.chunkEnds[i]! - start;
+      }
+      return { port, records, bytes };
+    });
+    expect(index.ports).toEqual(ports);
     checkEntries(file, capture, index.entries);
     // Every port, from its first record, a stretch at least INDEX_STRETCH_US long and no longer
     // than that and a chunk period (port 5 sends every 9.9 s: each of its chunks starts one).

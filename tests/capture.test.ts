@@ -228,10 +228,11 @@ describe('.sscap round trip', () => {
       new TextEncoder().encode('device lost 🔌').length;
     const recorded = records.reduce((n, r) => n + r.length, 0);
     expect(recorded).toBe(payload + RECORDS.length * RECORD_OVERHEAD);
-    // The final index: 20 bytes of record, 56 of its own, 32 an entry (one a port here: the stretches are short).
+    // The final index: 20 bytes of record, 64 of its own, 24 a port and 32 an entry (one a port
+    // here: the stretches are short).
     const ports = new Set(DATA_RECORDS.map((r) => r.port ?? 0)).size;
-    expect(w.close().length).toBe(RECORD_OVERHEAD + 56 + 32 * ports);
-    expect(file.length).toBe(header.length + recorded + RECORD_OVERHEAD + 56 + 32 * ports);
+    expect(w.close().length).toBe(RECORD_OVERHEAD + 64 + (24 + 32) * ports);
+    expect(file.length).toBe(header.length + recorded + RECORD_OVERHEAD + 64 + (24 + 32) * ports);
   });
 });
 

@@ -6,7 +6,7 @@
  */
 import { describe, expect, it } from 'vitest';
 import type { Capture } from '../src/capture/model.js';
-import { capturePorts } from '../src/capture/facts.js';
+import { captureChunksByPort, capturePorts } from '../src/capture/facts.js';
 import { encodeCapture } from '../src/capture/writer.js';
 import { readCapture } from '../src/capture/sniff.js';
 import { Dispatcher } from '../src/worker/dispatcher.js';
@@ -120,6 +120,17 @@ describe('a long capture in the worker', () => {
     if (preview === null) return;
     expect([preview.startUs, preview.endUs]).toEqual([span.startUs, span.endUs]);
     expect(preview.ports).toEqual(ports);
+    // Its size counted by its index, exactly.
+    expect(preview.indexed).toBe(true);
+    expect(preview.expected.records).toBe(capture.chunkEnds.length);
+    expect(preview.expected.dataBytes).toBe(capture.bytes.length);
+    expect(preview.expected.chunksByPort).toEqual(Array.from(captureChunksByPort(capture)));
+    // Without its final index (a recording cut short), guessed from the start: a few percent over.
+    const cut = FILE.subarray(0, FILE.length - 200);
+    const guessed = await previewOf(new Blob([cut.slice()]), { minBytes: 0, headBytes: 400_000, tailBytes: 20_000 });
+    expect(guessed?.indexed).toBe(false);
+    expect(guessed?.expected.records).toBeGreaterThan(capture.chunkEnds.length * 0.97);
+    expect(guessed?.expected.records).toBeLessThan(capture.chunkEnds.length * 1.1);
     // The head is the file's first records: a prefix of the whole capture's chunks.
     const n = preview.head.chunkEnds.length;
     expect(n).toBeGreaterThan(1000);

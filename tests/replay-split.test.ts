@@ -288,20 +288,18 @@ describe('a long capture decoded on two workers', () => {
     // The capture played is the one the worker's half kept as it walked: the file is not read again.
     expect([split.wholeReads, paced.wholeReads]).toEqual([0, 0]);
     expectCaptureAsRead(split, FILE);
-    // The helper made room for it before its walk, as much as the file's start promised (3 % more
-    // than its share), and did not grow it on the way.
+    // The helper made room for it before its walk, as much as the file's index counts, and did
+    // not grow it on the way.
     const played = split.worker.replay?.source.capture as Capture;
     const expected = helper.jobs[0]?.expected ?? { records: 0, dataBytes: 0, chunksByPort: [] };
-    expect(expected.records / played.chunkEnds.length).toBeGreaterThan(1);
-    expect(expected.records / played.chunkEnds.length).toBeLessThan(1.08);
-    expect(expected.dataBytes / played.bytes.length).toBeGreaterThan(1);
-    expect(expected.dataBytes / played.bytes.length).toBeLessThan(1.08);
+    expect(expected.records).toBe(played.chunkEnds.length);
+    expect(expected.dataBytes).toBe(played.bytes.length);
     expect(played.bytes.buffer.byteLength / played.bytes.length).toBeLessThan(1.08);
     // So did this worker's half for each port's chunk numbers (the port index it finds).
     const index = capturePortIndex(played);
     for (const p of capturePorts(played)) {
       const room = (index[p]?.buffer.byteLength ?? 0) / 4;
-      expect(room / (index[p]?.length ?? 0)).toBeGreaterThan(1);
+      expect(room / (index[p]?.length ?? 0)).toBeGreaterThanOrEqual(1);
       expect(room / (index[p]?.length ?? 0)).toBeLessThan(1.08);
       expect(expected.chunksByPort[p]).toBe(room);
     }

@@ -33,8 +33,13 @@ const SEGMENT_BYTES = 1 << 20;
 const SEARCH_BACK_BYTES = 4 * SEGMENT_BYTES;
 
 const FLAG_FINAL = 1;
-/** Payload: u16 version, u16 flags, u32 entries, f64 previous segment, f64 data and event records before, f64 first and last data time. */
-const HEAD_SIZE = 48;
+/**
+ * Payload: u16 version, u16 flags, u32 entries, f64 previous segment, f64 data and event records
+ * before, f64 first and last data time, u32 ports, u32 zero.
+ */
+const HEAD_SIZE = 56;
+/** A port's totals before the segment: f64 data records, f64 data bytes, u8 port, 7 zero bytes. */
+const PORT_SIZE = 24;
 /** An entry: f64 file offset, f64 time, f64 port's data bytes before, u32 port's data records before, u8 port, 3 zero bytes. */
 const ENTRY_SIZE = 32;
 /** Payload end: u32 payload length, then the tag, so that a reader at the end of the file finds the record's start. */
@@ -54,6 +59,13 @@ export interface IndexEntry {
   readonly port: number;
 }
 
+/** A port's data before the last segment. */
+export interface IndexPort {
+  readonly port: number;
+  readonly records: number;
+  readonly bytes: number;
+}
+
 /** A file's index, read and checked. */
 export interface CaptureIndex {
   /** Written at close: the records end where the index ends. Otherwise records after `coversTo` take a plain scan. */
@@ -65,6 +77,8 @@ export interface CaptureIndex {
   readonly eventRecords: number;
   readonly firstUs: number;
   readonly lastUs: number;
+  /** Each port's data records and bytes before the last segment, ports in increasing order. */
+  readonly ports: readonly IndexPort[];
   /** Every entry, in file order. */
   readonly entries: readonly IndexEntry[];
 }
@@ -117,7 +131,8 @@ export class IndexBuilder {
   /** The INDEX record to write at file offset `offset`: the entries since the last one (`final`: at close). */
   segment(offset: number, final: boolean): Uint8Array {
     const entries = this.#pending;
-    const length = HEAD_SIZE + ENTRY_SIZE * entries.length + TAIL_SIZE;
+    const ports = [...this.#ports].sort((a, b) => a[0] - b[0]);
+    const length = HEAD_SIZE + PORT_SIZE * ports.length + ENTRY_SIZE * entries.length + TAIL_SIZE;
     const out = new Uint8Array(RECORD_OVERHEAD + length);
     const view = new DataView(out.buffer);
     out[0] = SYNC0;
@@ -134,7 +149,14 @@ export class IndexBuilder {
     view.setFloat64(h + 24, this.#eventRecords, true);
     view.setFloat64(h + 32, this.#firstUs, true);
     view.setFloat64(h + 40, this.#lastUs, true);
+    view.setUint32(h + 48, ports.length, true);
     let e = h + HEAD_SIZE;
+    for (const [port, p] of ports) {
+      view.setFloat64(e, p.records, true);
+      view.setFloat64(e + 8, p.bytes, true);
+      out[e + 16] = port;
+      e += PORT_SIZE;
+    }
     for (const entry of entries) {
       view.setFloat64(e, entry.offset, true);
       view.setFloat64(e + 8, entry.timeUs, true);
@@ -167,6 +189,7 @@ interface Segment {
   readonly eventRecords: number;
   readonly firstUs: number;
   readonly lastUs: number;
+  readonly ports: IndexPort[];
   readonly entries: IndexEntry[];
 }
 
@@ -192,15 +215,23 @@ export async function readCaptureIndex(size: number, recordsFrom: number, read: 
   const ports = new Map<number, IndexEntry>();
   let from = recordsFrom;
   let counts = { dataRecords: 0, eventRecords: 0 };
+  const totals = new Map<number, IndexPort>();
   for (const s of segments) {
     if (s.dataRecords < counts.dataRecords || s.eventRecords < counts.eventRecords) return null;
     counts = s;
+    // A port's totals only grow, and a port once seen stays.
+    for (const [port, before] of totals) {
+      const now = s.ports.find((p) => p.port === port);
+      if (now === undefined || now.records < before.records || now.bytes < before.bytes) return null;
+    }
+    for (const p of s.ports) totals.set(p.port, p);
     for (const e of s.entries) {
       // Entries lie between the segment before and this one, in file order; a port's go forward.
       const before = ports.get(e.port);
       if (e.offset < from || e.offset + RECORD_OVERHEAD > s.at) return null;
       if (before !== undefined && (e.chunk <= before.chunk || e.streamOffset < before.streamOffset)) return null;
-      if (e.chunk >= s.dataRecords) return null;
+      const total = totals.get(e.port);
+      if (total === undefined || e.chunk >= total.records || e.streamOffset > total.bytes) return null;
       from = e.offset + RECORD_OVERHEAD;
       ports.set(e.port, e);
       entries.push(e);
@@ -214,6 +245,7 @@ export async function readCaptureIndex(size: number, recordsFrom: number, read: 
     eventRecords: last.eventRecords,
     firstUs: last.firstUs,
     lastUs: last.lastUs,
+    ports: last.ports,
     entries,
   };
 }
@@ -253,7 +285,7 @@ async function segmentAt(at: number, recordsFrom: number, read: ReadAt): Promise
   const head = await read(at, RECORD_HEADER_SIZE);
   if (head.length < RECORD_HEADER_SIZE || head[0] !== SYNC0 || head[1] !== SYNC1 || head[REC_OFF_TYPE] !== RECORD_TYPE_INDEX) return null;
   const length = new DataView(head.buffer, head.byteOffset, head.length).getUint32(REC_OFF_LENGTH, true);
-  if (length > MAX_RECORD_PAYLOAD || length < HEAD_SIZE + TAIL_SIZE || (length - HEAD_SIZE - TAIL_SIZE) % ENTRY_SIZE !== 0) return null;
+  if (length > MAX_RECORD_PAYLOAD || length < HEAD_SIZE + TAIL_SIZE) return null;
   const record = await read(at, RECORD_OVERHEAD + length);
   if (record.length < RECORD_OVERHEAD + length) return null;
   const view = new DataView(record.buffer, record.byteOffset, record.length);
@@ -261,15 +293,30 @@ async function segmentAt(at: number, recordsFrom: number, read: ReadAt): Promise
   if (crc32(record, REC_OFF_TYPE, crcAt, view) !== view.getUint32(crcAt, true)) return null;
   const h = RECORD_HEADER_SIZE;
   const count = view.getUint32(h + 4, true);
-  if (view.getUint16(h, true) !== INDEX_VERSION || count !== (length - HEAD_SIZE - TAIL_SIZE) / ENTRY_SIZE) return null;
+  const portCount = view.getUint32(h + 48, true);
+  if (
+    view.getUint16(h, true) !== INDEX_VERSION ||
+    portCount > 256 ||
+    length !== HEAD_SIZE + PORT_SIZE * portCount + ENTRY_SIZE * count + TAIL_SIZE
+  )
+    return null;
   if (view.getUint32(crcAt - TAIL_SIZE, true) !== length || !tagAt(record, crcAt - TAIL_SIZE / 2)) return null;
   const previous = view.getFloat64(h + 8, true);
   const dataRecords = view.getFloat64(h + 16, true);
   const eventRecords = view.getFloat64(h + 24, true);
   if (!(previous === -1 || (Number.isInteger(previous) && previous >= recordsFrom))) return null;
   if (!Number.isInteger(dataRecords) || dataRecords < 0 || !Number.isInteger(eventRecords) || eventRecords < 0) return null;
+  const ports: IndexPort[] = [];
+  let e = h + HEAD_SIZE;
+  for (let k = 0; k < portCount; k++, e += PORT_SIZE) {
+    const port = { port: record[e + 16] ?? 0, records: view.getFloat64(e, true), bytes: view.getFloat64(e + 8, true) };
+    if (!Number.isInteger(port.records) || port.records < 0 || !Number.isInteger(port.bytes) || port.bytes < 0) return null;
+    if (k > 0 && port.port <= (ports[k - 1]?.port ?? 0)) return null;
+    ports.push(port);
+  }
+  if (ports.reduce((n, p) => n + p.records, 0) !== dataRecords) return null;
   const entries: IndexEntry[] = [];
-  for (let e = h + HEAD_SIZE, k = 0; k < count; k++, e += ENTRY_SIZE) {
+  for (let k = 0; k < count; k++, e += ENTRY_SIZE) {
     const offset = view.getFloat64(e, true);
     const streamOffset = view.getFloat64(e + 16, true);
     if (!Number.isInteger(offset) || !Number.isInteger(streamOffset) || streamOffset < 0) return null;
@@ -290,6 +337,7 @@ async function segmentAt(at: number, recordsFrom: number, read: ReadAt): Promise
     eventRecords,
     firstUs: view.getFloat64(h + 32, true),
     lastUs: view.getFloat64(h + 40, true),
+    ports,
     entries,
   };
 }

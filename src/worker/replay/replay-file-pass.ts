@@ -39,7 +39,7 @@ export interface FilePassJob {
    * handed over when done: the other half keeps the capture, and they are seeded into it.
    */
   tally?: boolean | undefined;
-  /** The capture's size, guessed from the file's start (`Preview.expected`): room for what is kept or tallied is made before the walk. */
+  /** The capture's size, from its index or guessed from the file's start (`Preview.expected`): room for what is kept or tallied is made before the walk. */
   expected?: ExpectedSize | undefined;
   resolution: 'auto' | 1024 | 2048;
   originUs: number;

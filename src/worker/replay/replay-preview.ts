@@ -3,7 +3,9 @@
  * takes seconds): its first PREVIEW_BYTES and its last TAIL_BYTES each read as a capture of
  * their own (every record carries its own sync marker and CRC, and the reader skips the part of
  * a record a cut leaves). The start gives the records to decode first; the end gives where the
- * capture ends, so that the page can place the part read on the whole span at once.
+ * capture ends, so that the page can place the part read on the whole span at once. The
+ * capture's size (room for its columns) comes from its index when it has one that checks out
+ * and was closed; else it is guessed from the start's.
  */
 import type { Capture } from '../../capture/model.js';
 import type { SlicedFile } from '../../capture/record-walk.js';
@@ -11,6 +13,7 @@ import { captureChunksByPort, capturePorts } from '../../capture/facts.js';
 import { hasCaptureMagic } from '../../capture/layout.js';
 import { parseCapture } from '../../capture/reader.js';
 import { captureSpan } from '../../analysis/capture-span.js';
+import { type CaptureIndex, readCaptureIndex } from '../../capture/capture-index.js';
 
 /** A file this large gets a preview: under it, reading it whole is as quick. */
 const PREVIEW_MIN_BYTES = 32 << 20;
@@ -26,11 +29,13 @@ export interface Preview {
   /** The first recorded time, and the last (from the file's end). */
   startUs: number;
   endUs: number;
-  /** The whole capture's size, guessed from the start's: room for its columns. */
+  /** The whole capture's size, from its index or guessed from the start's: room for its columns. */
   expected: ExpectedSize;
+  /** Whether `expected` is the index's count rather than a guess. */
+  indexed: boolean;
 }
 
-/** A capture's chunks (in all and of each port, 0–255) and data bytes, guessed from its file's start (3 % more). */
+/** A capture's chunks (in all and of each port, 0–255) and data bytes: counted by its index, or guessed from its file's start (3 % more). */
 export interface ExpectedSize {
   records: number;
   dataBytes: number;
@@ -61,6 +66,7 @@ export async function previewOf(file: SlicedFile, sizes: PreviewSizes = SIZES): 
   let head: Capture;
   let tail: Capture;
   let headerLength = 0;
+  let index: CaptureIndex | null = null;
   try {
     const start = new Uint8Array(await file.slice(0, headBytes).arrayBuffer());
     if (!hasCaptureMagic(start)) return null;
@@ -72,6 +78,11 @@ export async function previewOf(file: SlicedFile, sizes: PreviewSizes = SIZES): 
     end.set(start.subarray(0, headerLength));
     end.set(new Uint8Array(await file.slice(size - tailBytes, size).arrayBuffer()), headerLength);
     tail = parseCapture(end);
+    index = await readCaptureIndex(
+      size,
+      headerLength,
+      async (offset, length) => new Uint8Array(await file.slice(offset, offset + length).arrayBuffer()),
+    );
   } catch {
     // Whatever is wrong (a damaged start, a file that cannot be read), reading the whole file says it.
     return null;
@@ -80,12 +91,30 @@ export async function previewOf(file: SlicedFile, sizes: PreviewSizes = SIZES): 
   const startUs = captureSpan(head).startUs;
   const endUs = captureSpan(tail).endUs;
   if (!Number.isFinite(startUs) || !Number.isFinite(endUs) || endUs < startUs) return null;
-  // The start's share of the file holds its share of the records, give or take.
-  const scale = (1.03 * size) / Math.max(1, headBytes - headerLength);
-  const expected = {
+  const indexed = index?.final === true;
+  return {
+    head,
+    ports: capturePorts(head),
+    startUs,
+    endUs,
+    expected: indexed ? counted(index as CaptureIndex) : guessed(head, size, headBytes - headerLength),
+    indexed,
+  };
+}
+
+/** The sizes a closed index counts. */
+function counted(index: CaptureIndex): ExpectedSize {
+  const chunksByPort = new Array<number>(256).fill(0);
+  for (const p of index.ports) chunksByPort[p.port] = p.records;
+  return { records: index.dataRecords, dataBytes: index.ports.reduce((n, p) => n + p.bytes, 0), chunksByPort };
+}
+
+/** The sizes guessed from the records of the file's first `headRecordBytes`: their share of the file holds their share of the records, give or take. */
+function guessed(head: Capture, size: number, headRecordBytes: number): ExpectedSize {
+  const scale = (1.03 * size) / Math.max(1, headRecordBytes);
+  return {
     records: Math.ceil(head.chunkEnds.length * scale),
     dataBytes: Math.ceil(head.bytes.length * scale),
     chunksByPort: Array.from(captureChunksByPort(head), (n) => Math.ceil(n * scale)),
   };
-  return { head, ports: capturePorts(head), startUs, endUs, expected };
 }
