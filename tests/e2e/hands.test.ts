@@ -120,11 +120,10 @@ describe.skipIf(skip !== null)('channel traces', () => {
     const { page, errors } = await open();
     await page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor({ timeout: 10_000 });
     await page.locator('.traces canvas').waitFor();
-    await page.waitForTimeout(1500);
+    await expect.poll(() => drawnPixels(page), { timeout: 10_000 }).toBeGreaterThan(2000);
     const lanes = await traceSeries(page);
     expect(lanes.map((l) => l.label).slice(0, 4)).toEqual(['Throttle', 'Aileron', 'Elevator', 'Rudder']);
     expect(lanes.length).toBeGreaterThanOrEqual(6);
-    expect(await drawnPixels(page)).toBeGreaterThan(2000);
     // Sticks only, then one more.
     await page.locator('.trace-picker').getByRole('button', { name: 'Sticks' }).click();
     await expect.poll(async () => (await traceSeries(page)).length).toBe(4);

@@ -52,7 +52,8 @@ describe.skipIf(skip !== null)('the page parts', () => {
     await page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor({ timeout: 10_000 });
     await expect(clipped(page, 'source-status')).resolves.toBe(false);
     await page.getByRole('button', { name: '● Record' }).click();
-    await page.waitForTimeout(1200);
+    // The pill and the button as wide as a recording makes them: its progress shown.
+    await page.locator('.rec-info').filter({ hasText: /·.*\d/ }).waitFor({ timeout: 5000 });
     await expect(clipped(page, 'source-status')).resolves.toBe(false);
     await page.getByRole('button', { name: 'Stop recording' }).click();
     await page.getByRole('button', { name: 'Export .sscap' }).waitFor();
