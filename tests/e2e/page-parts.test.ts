@@ -125,8 +125,12 @@ describe.skipIf(skip !== null)('the page parts', () => {
         await page.setInputFiles('input[type=file]', path);
         await page.locator('section.replay').waitFor();
         await page.getByRole('button', { name: 'Pause' }).click();
-        await expect(page.getByTestId('link-state').textContent()).resolves.toBe('Paused');
-        await expect(page.getByTestId('link-hint').textContent()).resolves.toMatch(/^Paused at \d:\d\d\.\d of the capture: there /);
+        // The worker says it paused: wait for its word, then read the hint it came with.
+        await page
+          .getByTestId('link-state')
+          .filter({ hasText: /^Paused$/ })
+          .waitFor({ timeout: 5000 });
+        await expect.poll(() => page.getByTestId('link-hint').textContent()).toMatch(/^Paused at \d:\d\d\.\d of the capture: there /);
         await shot(page, `parts-${width}-${theme}-paused`);
         await page.getByRole('radio', { name: 'max' }).click();
         await page.getByRole('button', { name: 'Play' }).click();
