@@ -189,6 +189,32 @@ describe('the capture index', () => {
     expect(none).toBeGreaterThan(0);
   });
 
+  it('gives up in bounded work on crafted bytes: tags everywhere, each pointing at a large record', async () => {
+    // A header that claims a 4 MiB INDEX record, then "length, SSIX" over and over, each length
+    // reaching back to that header: read and checked in full, each would cost 4 MiB.
+    const size = 4 << 20;
+    const crafted = new Uint8Array(size);
+    const view = new DataView(crafted.buffer);
+    crafted.set([0xa5, 0x5c, 3, 0], 100);
+    view.setUint32(104, size - 200, true);
+    let reads = 0;
+    let readBytes = 0;
+    for (let end = size; end > size - 200_000; end -= 12) {
+      view.setUint32(end - 12, end - 20 - 100, true);
+      crafted.set([0x53, 0x53, 0x49, 0x58], end - 8);
+    }
+    const started = performance.now();
+    const index = await readCaptureIndex(size, 50, (offset, length) => {
+      reads++;
+      readBytes += Math.max(0, Math.min(length, size - offset));
+      return crafted.subarray(offset, offset + length);
+    });
+    expect(index).toBeNull();
+    expect(reads).toBeLessThan(300);
+    expect(readBytes).toBeLessThan(6 << 20);
+    expect(performance.now() - started).toBeLessThan(2000);
+  });
+
   it('is absent from a file written without one, and from bytes that are no capture', async () => {
     const records = parseCapture(file);
     const header = file.subarray(0, records.headerLength);

@@ -8,17 +8,7 @@
  * only says where to read them.
  */
 import { crc32 } from './crc32.js';
-import {
-  CRC_SIZE,
-  MAX_RECORD_PAYLOAD,
-  RECORD_HEADER_SIZE,
-  RECORD_OVERHEAD,
-  RECORD_TYPE_INDEX,
-  REC_OFF_LENGTH,
-  REC_OFF_TYPE,
-  SYNC0,
-  SYNC1,
-} from './layout.js';
+import { CRC_SIZE, RECORD_HEADER_SIZE, RECORD_OVERHEAD, RECORD_TYPE_INDEX, REC_OFF_LENGTH, REC_OFF_TYPE, SYNC0, SYNC1 } from './layout.js';
 
 /** The index layout this code writes and reads (payload offset 0). */
 export const INDEX_VERSION = 1;
@@ -31,6 +21,8 @@ const SEGMENT_ENTRIES = 64;
 const SEGMENT_BYTES = 1 << 20;
 /** How far back from the end a reader looks for the last segment of a recording cut short. */
 const SEARCH_BACK_BYTES = 4 * SEGMENT_BYTES;
+/** Tags tried on the way back: a real segment is among the first few; crafted bytes cost no more than these. */
+const SEARCH_BACK_TAGS = 64;
 
 const FLAG_FINAL = 1;
 /**
@@ -45,6 +37,8 @@ const ENTRY_SIZE = 32;
 /** Payload end: u32 payload length, then the tag, so that a reader at the end of the file finds the record's start. */
 const TAIL_SIZE = 8;
 const TAG = [0x53, 0x53, 0x49, 0x58] as const; // "SSIX"
+/** The largest segment: every port and a full segment's entries, and one more entry (the record that made it due). */
+const MAX_SEGMENT_PAYLOAD = HEAD_SIZE + 256 * PORT_SIZE + (SEGMENT_ENTRIES + 1) * ENTRY_SIZE + TAIL_SIZE;
 
 /** Where one stretch of one port's records starts. */
 export interface IndexEntry {
@@ -268,8 +262,10 @@ async function segmentEndingAt(end: number, recordsFrom: number, read: ReadAt): 
 async function lastSegmentBefore(size: number, recordsFrom: number, read: ReadAt): Promise<Segment | null> {
   const from = Math.max(recordsFrom, size - SEARCH_BACK_BYTES);
   const bytes = await read(from, size - from);
-  for (let i = bytes.length - TAIL_SIZE / 2 - CRC_SIZE; i >= TAIL_SIZE / 2; i--) {
+  let tries = 0;
+  for (let i = bytes.length - TAIL_SIZE / 2 - CRC_SIZE; i >= TAIL_SIZE / 2 && tries < SEARCH_BACK_TAGS; i--) {
     if (bytes[i] !== TAG[0] || !tagAt(bytes, i)) continue;
+    tries++;
     const segment = await segmentEndingAt(from + i + TAIL_SIZE / 2 + CRC_SIZE, recordsFrom, read);
     if (segment !== null) return segment;
   }
@@ -285,7 +281,7 @@ async function segmentAt(at: number, recordsFrom: number, read: ReadAt): Promise
   const head = await read(at, RECORD_HEADER_SIZE);
   if (head.length < RECORD_HEADER_SIZE || head[0] !== SYNC0 || head[1] !== SYNC1 || head[REC_OFF_TYPE] !== RECORD_TYPE_INDEX) return null;
   const length = new DataView(head.buffer, head.byteOffset, head.length).getUint32(REC_OFF_LENGTH, true);
-  if (length > MAX_RECORD_PAYLOAD || length < HEAD_SIZE + TAIL_SIZE) return null;
+  if (length > MAX_SEGMENT_PAYLOAD || length < HEAD_SIZE + TAIL_SIZE) return null;
   const record = await read(at, RECORD_OVERHEAD + length);
   if (record.length < RECORD_OVERHEAD + length) return null;
   const view = new DataView(record.buffer, record.byteOffset, record.length);
