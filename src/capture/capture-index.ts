@@ -21,6 +21,8 @@ const SEGMENT_ENTRIES = 64;
 const SEGMENT_BYTES = 1 << 20;
 /** How far back from the end a reader looks for the last segment of a recording cut short. */
 const SEARCH_BACK_BYTES = 4 * SEGMENT_BYTES;
+/** Segments a reader follows back at most: a week of three ports writes about 28,000. */
+const MAX_SEGMENTS = 100_000;
 /** Tags tried on the way back: a real segment is among the first few; crafted bytes cost no more than these. */
 const SEARCH_BACK_TAGS = 64;
 
@@ -76,6 +78,9 @@ export interface CaptureIndex {
   /** Every entry, in file order. */
   readonly entries: readonly IndexEntry[];
 }
+
+/** A closed capture's span and counts, from its final index segment. */
+export type CaptureTotals = Pick<CaptureIndex, 'dataRecords' | 'eventRecords' | 'firstUs' | 'lastUs' | 'ports'>;
 
 /** What a writer keeps to index its records: entries not yet written, and each port's stretch. */
 export class IndexBuilder {
@@ -188,17 +193,34 @@ interface Segment {
 }
 
 /**
+ * The totals of a closed .sscap file of `size` bytes whose records start at `recordsFrom`: its
+ * final index segment alone, checked (one or two reads), or null when the file does not end
+ * with one that checks out. For a reader that needs the capture's size, not where its stretches
+ * start.
+ */
+export async function readCaptureTotals(size: number, recordsFrom: number, read: ReadAt): Promise<CaptureTotals | null> {
+  const last = await segmentEndingAt(size, recordsFrom, read);
+  return last?.final === true && fitsBefore(last, recordsFrom) ? last : null;
+}
+
+/** Whether the records a segment counts fit in the file before it (a count no file can hold is damage). */
+function fitsBefore(s: Segment, recordsFrom: number): boolean {
+  const bytes = s.ports.reduce((n, p) => n + p.bytes, 0);
+  return bytes + RECORD_OVERHEAD * (s.dataRecords + s.eventRecords) <= s.at - recordsFrom;
+}
+
+/**
  * The index of a .sscap file of `size` bytes whose records start at `recordsFrom` (the header's
  * length), or null when it has none or one that does not check out (then read the file plainly).
- * Reads the end of the file, then each segment.
+ * Reads the end of the file, then each segment back to the first (at most MAX_SEGMENTS).
  */
 export async function readCaptureIndex(size: number, recordsFrom: number, read: ReadAt): Promise<CaptureIndex | null> {
   let last = await segmentEndingAt(size, recordsFrom, read);
   if (last === null) last = await lastSegmentBefore(size, recordsFrom, read);
-  if (last === null) return null;
+  if (last === null || !fitsBefore(last, recordsFrom)) return null;
   const segments: Segment[] = [last];
   for (let s = last; s.previous >= 0; ) {
-    if (s.previous < recordsFrom || s.previous >= s.at) return null;
+    if (s.previous < recordsFrom || s.previous >= s.at || segments.length >= MAX_SEGMENTS) return null;
     const before = await segmentAt(s.previous, recordsFrom, read);
     if (before === null || before.final) return null;
     segments.push(before);

@@ -99,6 +99,8 @@ export class Recorder {
   /** Unfinished recordings from earlier sessions, newest last; the newest is offered. */
   #unfinished: (Marker & { bytes: number })[] = [];
   #error: string | null = null;
+  /** Writing this recording failed: what was written stands, and nothing more (no final index) is added. */
+  #failed = false;
 
   constructor(readonly onChange: (status: RecordingStatus) => void) {}
 
@@ -166,6 +168,7 @@ export class Recorder {
       handle = await (await dir.getFileHandle(name, { create: true })).createSyncAccessHandle();
       handle.truncate(0);
       this.#writer = new CaptureWriter({ ...meta, createdAt });
+      this.#failed = false;
       this.#handle = handle;
       this.#name = name;
       this.#createdAt = createdAt;
@@ -222,6 +225,7 @@ export class Recorder {
   }
 
   #fail(error: unknown): void {
+    this.#failed = true;
     this.#error = `Recording stopped: ${String(error)}. Everything written before this point is kept.`;
     void this.stop();
   }
@@ -231,7 +235,7 @@ export class Recorder {
     if (handle === undefined) return;
     try {
       // The final index, unless writing already failed (the file then ends with what was written).
-      if (this.#error === null && this.#writer !== undefined) this.#write(this.#writer.close());
+      if (!this.#failed && this.#writer !== undefined) this.#write(this.#writer.close());
     } catch (error) {
       this.#error = `The recording's index could not be written (${String(error)}): the file is read by a plain scan instead.`;
     }

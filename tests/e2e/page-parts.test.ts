@@ -52,8 +52,11 @@ describe.skipIf(skip !== null)('the page parts', () => {
     await page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor({ timeout: 10_000 });
     await expect(clipped(page, 'source-status')).resolves.toBe(false);
     await page.getByRole('button', { name: '● Record' }).click();
-    // The pill and the button as wide as a recording makes them: its progress shown.
-    await page.locator('.rec-info').filter({ hasText: /·.*\d/ }).waitFor({ timeout: 5000 });
+    // The pill and the button as wide as a recording makes them: a second or more recorded, its size shown.
+    await page
+      .locator('.rec-info')
+      .filter({ hasText: /^0:0[1-9]|^[1-9]|^0:[1-5]/ })
+      .waitFor({ timeout: 5000 });
     await expect(clipped(page, 'source-status')).resolves.toBe(false);
     await page.getByRole('button', { name: 'Stop recording' }).click();
     await page.getByRole('button', { name: 'Export .sscap' }).waitFor();

@@ -276,7 +276,10 @@ describe.skipIf(skip !== null)('the page on any screen', () => {
     expect(height).toBeLessThan(56);
     // Still one row while recording and with an export to offer.
     await page.getByRole('button', { name: '● Record' }).click();
-    await page.locator('.rec-info').filter({ hasText: /·.*\d/ }).waitFor({ timeout: 5000 });
+    await page
+      .locator('.rec-info')
+      .filter({ hasText: /^0:0[1-9]|^[1-9]|^0:[1-5]/ })
+      .waitFor({ timeout: 5000 });
     await expect(page.locator('.toolbar').evaluate((e) => e.getBoundingClientRect().height)).resolves.toBeLessThan(56);
     await page.getByRole('button', { name: 'Stop recording' }).click();
     await page.getByRole('button', { name: 'Export .sscap' }).waitFor();

@@ -13,7 +13,7 @@ import { captureChunksByPort, capturePorts } from '../../capture/facts.js';
 import { hasCaptureMagic } from '../../capture/layout.js';
 import { parseCapture } from '../../capture/reader.js';
 import { captureSpan } from '../../analysis/capture-span.js';
-import { type CaptureIndex, readCaptureIndex } from '../../capture/capture-index.js';
+import { type CaptureTotals, readCaptureTotals } from '../../capture/capture-index.js';
 
 /** A file this large gets a preview: under it, reading it whole is as quick. */
 const PREVIEW_MIN_BYTES = 32 << 20;
@@ -66,7 +66,7 @@ export async function previewOf(file: SlicedFile, sizes: PreviewSizes = SIZES): 
   let head: Capture;
   let tail: Capture;
   let headerLength = 0;
-  let index: CaptureIndex | null = null;
+  let totals: CaptureTotals | null = null;
   try {
     const start = new Uint8Array(await file.slice(0, headBytes).arrayBuffer());
     if (!hasCaptureMagic(start)) return null;
@@ -78,7 +78,7 @@ export async function previewOf(file: SlicedFile, sizes: PreviewSizes = SIZES): 
     end.set(start.subarray(0, headerLength));
     end.set(new Uint8Array(await file.slice(size - tailBytes, size).arrayBuffer()), headerLength);
     tail = parseCapture(end);
-    index = await readCaptureIndex(
+    totals = await readCaptureTotals(
       size,
       headerLength,
       async (offset, length) => new Uint8Array(await file.slice(offset, offset + length).arrayBuffer()),
@@ -91,19 +91,19 @@ export async function previewOf(file: SlicedFile, sizes: PreviewSizes = SIZES): 
   const startUs = captureSpan(head).startUs;
   const endUs = captureSpan(tail).endUs;
   if (!Number.isFinite(startUs) || !Number.isFinite(endUs) || endUs < startUs) return null;
-  const indexed = index?.final === true;
+  const indexed = totals !== null;
   return {
     head,
     ports: capturePorts(head),
     startUs,
     endUs,
-    expected: indexed ? counted(index as CaptureIndex) : guessed(head, size, headBytes - headerLength),
+    expected: totals !== null ? counted(totals) : guessed(head, size, headBytes - headerLength),
     indexed,
   };
 }
 
 /** The sizes a closed index counts. */
-function counted(index: CaptureIndex): ExpectedSize {
+function counted(index: CaptureTotals): ExpectedSize {
   const chunksByPort = new Array<number>(256).fill(0);
   for (const p of index.ports) chunksByPort[p.port] = p.records;
   return { records: index.dataRecords, dataBytes: index.ports.reduce((n, p) => n + p.bytes, 0), chunksByPort };
