@@ -74,14 +74,16 @@ export async function previewOf(file: SlicedFile, sizes: PreviewSizes = SIZES): 
     head = parsed;
     // The header as the reader found it, then the file's last bytes: a capture whose first record is cut.
     ({ headerLength } = parsed);
+    const last = new Uint8Array(await file.slice(size - tailBytes, size).arrayBuffer());
     const end = new Uint8Array(headerLength + tailBytes);
     end.set(start.subarray(0, headerLength));
-    end.set(new Uint8Array(await file.slice(size - tailBytes, size).arrayBuffer()), headerLength);
+    end.set(last, headerLength);
     tail = parseCapture(end);
-    totals = await readCaptureTotals(
-      size,
-      headerLength,
-      async (offset, length) => new Uint8Array(await file.slice(offset, offset + length).arrayBuffer()),
+    // The final index segment lies in the bytes just read (a segment is at most 8.3 KB).
+    totals = await readCaptureTotals(size, headerLength, async (offset, length) =>
+      offset >= size - tailBytes
+        ? last.subarray(offset - (size - tailBytes), offset - (size - tailBytes) + length)
+        : new Uint8Array(await file.slice(offset, offset + length).arrayBuffer()),
     );
   } catch {
     // Whatever is wrong (a damaged start, a file that cannot be read), reading the whole file says it.
