@@ -34,6 +34,9 @@ export class WaitedWorker<Result> {
     this.#port = channel.port1;
     const link: Link = { port: channel.port2, signal: this.#signal };
     this.#worker = new Worker(url, { workerData: { ...data, link }, transferList: [channel.port2] });
+    // A worker that throws has ended without its result, which `result` reports as undefined and
+    // the caller does the work itself; unheard, the error would end this process instead.
+    this.#worker.on('error', () => {});
   }
 
   /** Result `i` (from 0, in the order the worker posts them), waiting for it; undefined if the worker ended without it. */
