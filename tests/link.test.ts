@@ -166,7 +166,7 @@ describe('LinkMonitor: missed means missed', () => {
     expect(real.takeRetracted()).toEqual([]);
   });
 
-  it("where the receiver's counter counts, it judges a hold the moment frames resume: a stall beside a real dropout, or in a stream's last moments, is withdrawn", () => {
+  it("where the receiver's counter counts, it judges a hold by the counter over the burst that ends it: a stall beside a real dropout, or in a stream's last moments, is withdrawn", () => {
     /** Feeds slots (those in `lost` never sent; the counter reports them) delivered with `stallUs`; returns the holds withdrawn on the way. */
     const run = (link: LinkMonitor, slots: number, lost: Set<number>, stallUs: (k: number) => number): number[] => {
       const withdrawn: number[] = [];
@@ -190,9 +190,11 @@ describe('LinkMonitor: missed means missed', () => {
     expect(beside.stats).toMatchObject({ holds: 1, missedFrames: 14, failsafes: 0 });
     expect(beside.episodes.map((e) => e.lastFrameUs > 1_000_000)).toEqual([true]);
     // A 100 ms stall 0.1 s before the stream ends: no ledger window closes after it.
+    // Its burst lasts to the end: judged there.
     const late = new LinkMonitor({ jitterUs: 20_000 });
-    expect(run(late, 200, new Set(), (k) => (k === 131 ? 100_000 : 0))).toHaveLength(1);
+    expect(run(late, 200, new Set(), (k) => (k === 131 ? 100_000 : 0))).toHaveLength(0);
     late.finish(200 * 11_000);
+    expect(late.takeRetracted()).toHaveLength(1);
     expect(late.stats).toMatchObject({ holds: 0, missedFrames: 0 });
   });
 

@@ -169,7 +169,9 @@ describe('delivery stalls are not holds', () => {
     }
     // It looked like a hold while it lasted; the page was told to drop it.
     expect(c.episodes.some((e) => e.kind === 'hold')).toBe(true);
-    expect(retracted).toEqual(c.episodes.filter((e) => e.endUs === null).map((e) => e.id));
+    // Every hold it was shown (the one open during the stall; the silence, once the frame
+    // whose bytes straddled the stall came, may show again as one that ended) is withdrawn.
+    expect(retracted).toEqual([...new Set(c.episodes.map((e) => e.id))]);
     expect(engine.link.stats).toMatchObject({ holds: 0, failsafes: 0, missedFrames: 0 });
     expect(c.last!.link.holds).toBe(0);
   });

@@ -12,6 +12,7 @@
  */
 import type { LinkEpisode } from './episode.js';
 import type { LinkRestart, LinkState, LinkStats } from './link-types.js';
+import type { StallBurst, UnjudgedHold } from './link-stalls.js';
 
 declare const opaque: unique symbol;
 
@@ -57,8 +58,8 @@ export interface LedgerCheckpoint {
 export interface EpisodeGraph {
   episodes: LinkEpisode[];
   open: LinkEpisode | null;
-  unconfirmed: { episode: LinkEpisode; endFades: number }[];
-  burst: { episode: LinkEpisode; frames: number } | null;
+  unconfirmed: UnjudgedHold[];
+  burst: StallBurst | null;
 }
 
 /**
@@ -79,8 +80,8 @@ export function copyEpisodes(g: Readonly<EpisodeGraph>): EpisodeGraph {
   return {
     episodes: g.episodes.map(copy),
     open: g.open === null ? null : copy(g.open),
-    unconfirmed: g.unconfirmed.map((u) => ({ episode: copy(u.episode), endFades: u.endFades })),
-    burst: g.burst === null ? null : { episode: copy(g.burst.episode), frames: g.burst.frames },
+    unconfirmed: g.unconfirmed.map((u) => ({ ...u, episode: copy(u.episode) })),
+    burst: g.burst === null ? null : { ...g.burst, episode: copy(g.burst.episode) },
   };
 }
 

@@ -21,6 +21,16 @@ export class RestartWatch {
   /** The last frame's fade count (NaN: none yet). */
   #prevCount = NaN;
   readonly #restarts: LinkRestart[] = [];
+  #vouched = false;
+
+  /**
+   * Whether the last frame's count moved from the one before by just its `fadesDelta`: the
+   * receiver vouches for the frames the delta says were lost. A jump the decoder left out
+   * (another remote's count after a break) or a restart says nothing of the silence.
+   */
+  get vouched(): boolean {
+    return this.#vouched;
+  }
 
   /** The last receiver restarts (up to 64), oldest first. */
   get restarts(): readonly LinkRestart[] {
@@ -35,12 +45,14 @@ export class RestartWatch {
    */
   frame(frame: DecodedFrame, gapUs: number, s: LinkStats): number {
     const count = frame.fades;
+    this.#vouched = false;
     if (count === null) return 0;
     const prev = this.#prevCount;
     this.#prevCount = count;
+    const modulus = frame.remote === 'internal' ? 256 : 65536;
+    this.#vouched = (count - prev + modulus) % modulus === frame.fadesDelta;
     const p = s.nominalPeriodUs;
     if (!(count < prev) || !(gapUs >= RESTART_MIN_GAP_US) || !Number.isFinite(p)) return 0;
-    const modulus = frame.remote === 'internal' ? 256 : 65536;
     const due = Math.max(0, Math.round(gapUs / p) - 1);
     const wrapped = (count - prev + modulus) % modulus;
     if (Math.abs(wrapped - due) <= Math.max(8, 0.5 * due)) return 0;

@@ -1,14 +1,46 @@
 /**
  * Delivery stalls: the holds that wait to be judged, and the judgement that withdraws those
- * the adapter caused. A hold whose silence, by the evidence (the fade counter, the burst of
- * frames after it, or the frame count of the ledger window that closes over it), lost under
- * half the frames due in it was the adapter holding bytes back, not the link: it is withdrawn,
- * with the failsafe it became, and counted as a stall. The link monitor (link.ts) owns a judge,
- * over its own episodes and stats.
+ * the adapter caused. A hold whose silence, by the evidence (the fade counter over the burst
+ * of frames after it, the burst's frame count, or the frame count of the ledger window that
+ * closes over it), lost under half the frames due in it, and where the receiver's counter
+ * shows no run of lost frames itself long enough for a hold, was the adapter holding bytes
+ * back, not the link: it is withdrawn, with the failsafe it became, and counted as a stall.
+ * The link monitor (link.ts) owns a judge, over its own episodes and stats.
  */
 import type { LinkEpisode } from './episode.js';
 import type { FrameLedger } from './ledger.js';
 import type { LinkStats } from './link-types.js';
+
+/**
+ * The frames that came right after a hold, closer together than half a period: how many, the
+ * frames the receiver's counter says were lost before and between them, in all and in the
+ * longest run, and whether the counter counts (it did before, or moved in the burst).
+ */
+export interface StallBurst {
+  episode: LinkEpisode;
+  frames: number;
+  missed: number;
+  run: number;
+  counted: boolean;
+}
+
+/** What the judge needs of its link monitor: its thresholds, and a new episode in its list. */
+export interface StallMonitor {
+  holdAfterUs(): number;
+  readonly failsafeAfterUs: number;
+  add(kind: 'hold' | 'failsafe', startUs: number, lastFrameUs: number): LinkEpisode;
+}
+
+/**
+ * A hold not yet judged: the receiver's fade count when it ended, and once its burst is over
+ * without a counter known to count, what the counter said over it (judged by it should the
+ * counter later be seen to count).
+ */
+export interface UnjudgedHold {
+  episode: LinkEpisode;
+  endFades: number;
+  counter: { missed: number; run: number } | null;
+}
 import { FRAME_PERIOD_11MS_US } from './spec.js';
 
 /**
@@ -19,33 +51,37 @@ export class StallJudge {
   readonly #episodes: LinkEpisode[];
   readonly #stats: LinkStats;
   /**
-   * Holds not yet confirmed, with the receiver's fade count when each began: a hold whose
-   * silence the next punctual frame shows held no missing frame was the adapter holding bytes
-   * back (a delivery stall), not the link: it is withdrawn (`retracted`).
+   * Holds not yet confirmed: a hold whose silence the frames after it show held no missing
+   * frame was the adapter holding bytes back (a delivery stall), not the link: it is
+   * withdrawn (`retracted`).
    */
-  readonly #unconfirmed: { episode: LinkEpisode; endFades: number }[] = [];
+  readonly #unconfirmed: UnjudgedHold[] = [];
   readonly #retracted: number[] = [];
   /**
-   * A hold that just ended with no counter to judge it, and the frames that came right after
-   * it closer together than half a period: a stall delivers the frames it held all at once,
-   * while a link that lost them resumes at its pace.
+   * A hold that just ended and the frames that came right after it: a stall delivers the
+   * frames it held all at once, while a link that lost them resumes at its pace.
    */
-  #burst: { episode: LinkEpisode; frames: number } | null = null;
+  #burst: StallBurst | null = null;
   #closesSeen = 0;
+  readonly #monitor: StallMonitor;
 
-  /** Judges the holds of `episodes` (the monitor's list) and counts in `stats` (the monitor's). */
-  constructor(episodes: LinkEpisode[], stats: LinkStats) {
+  /**
+   * Judges the holds of `episodes` (the monitor's list) and counts in `stats` (the monitor's),
+   * by the monitor's thresholds; adds episodes through it.
+   */
+  constructor(episodes: LinkEpisode[], stats: LinkStats, monitor: StallMonitor) {
     this.#episodes = episodes;
     this.#stats = stats;
+    this.#monitor = monitor;
   }
 
   /** The holds not yet judged (the monitor's episode objects), oldest first: the judge's own list, for checkpoints to copy. */
-  get unconfirmed(): { episode: LinkEpisode; endFades: number }[] {
+  get unconfirmed(): UnjudgedHold[] {
     return this.#unconfirmed;
   }
 
   /** The burst after a hold still arriving, or null. */
-  get burst(): { episode: LinkEpisode; frames: number } | null {
+  get burst(): StallBurst | null {
     return this.#burst;
   }
 
@@ -61,38 +97,44 @@ export class StallJudge {
 
   /** A hold just opened: it waits to be judged (at most 64 wait). */
   held(episode: LinkEpisode): void {
-    this.#unconfirmed.push({ episode, endFades: 0 });
+    this.#unconfirmed.push({ episode, endFades: 0, counter: null });
     if (this.#unconfirmed.length > 64) this.#unconfirmed.shift();
   }
 
   /**
-   * A frame at `t` came, the last one before it at `last`: within a burst after a hold, frames
-   * closer together than half a period count in the burst (those of chunks delivered together
-   * may even be dated out of order); any other ends it.
+   * A frame at `t` came, the last one before it at `last`, its fade count moved by `fades`:
+   * within a burst after a hold, frames closer together than half a period count in the burst
+   * (those of chunks delivered together may even be dated out of order); any other ends it.
+   * Returns whether the frame counted in a burst.
    */
-  frame(t: number, last: number): void {
-    if (this.#burst === null) return;
+  frame(t: number, last: number, fades: number): boolean {
+    const b = this.#burst;
+    if (b === null) return false;
     const p = this.#stats.nominalPeriodUs;
-    if (Number.isFinite(t) && !(t - last >= (Number.isFinite(p) ? p : FRAME_PERIOD_11MS_US) / 2)) this.#burst.frames++;
-    else this.endBurst();
+    if (Number.isFinite(t) && !(t - last >= (Number.isFinite(p) ? p : FRAME_PERIOD_11MS_US) / 2)) {
+      b.frames++;
+      b.missed += fades;
+      if (fades > b.run) b.run = fades;
+      if (fades > 0) b.counted = true;
+      return true;
+    }
+    this.endBurst();
+    return false;
   }
 
   /**
-   * The silence of `open` ended with a frame whose fade count moved by `fades`. Where the
-   * counter counts (`counting`), that is the evidence (`missed`: the frames it says were lost)
-   * and a hold is judged now (a stall's frames arrive late, none missed); otherwise it waits
-   * for the burst after it and for the frame count of the ledger window that closes over it.
+   * The silence of `open` ended with a frame whose fade count moved by `fades`. The hold waits
+   * for the burst after it: where the counter counts (`counting`), the frames it says were lost
+   * (`missed` now, then those over the burst) are the evidence, and the hold is judged when the
+   * burst ends; otherwise by the burst's frame count, and then by the frame count of the ledger
+   * window that closes over it.
    */
   ended(open: LinkEpisode, counting: boolean, missed: number, fades: number): void {
-    const at = this.#unconfirmed.findIndex((x) => x.episode === open);
-    const u = this.#unconfirmed[at];
-    if (u !== undefined && counting) {
-      this.#unconfirmed.splice(at, 1);
-      this.#judge(u.episode, missed);
-    } else if (u !== undefined) {
-      u.endFades = fades;
-      this.#burst = { episode: u.episode, frames: 1 };
-    }
+    // The hold of this silence (`open` is its failsafe if it became one).
+    const u = this.#unconfirmed.find((x) => x.episode.lastFrameUs === open.lastFrameUs);
+    if (u === undefined) return;
+    u.endFades = fades;
+    this.#burst = { episode: u.episode, frames: 1, missed, run: missed, counted: counting || missed > 0 };
   }
 
   /** After a ledger window: holds before its most punctual frame are confirmed or withdrawn. */
@@ -108,19 +150,98 @@ export class StallJudge {
         continue;
       }
       this.#unconfirmed.splice(i, 1);
-      this.#judge(u.episode, Math.max(l.closedMissing, u.endFades));
+      this.#judge(u.episode, Math.max(l.closedMissing, u.endFades), 0);
     }
   }
 
-  /** The burst after a hold is over: a hold whose frames came in it is withdrawn now; any other waits for its ledger window. */
+  /**
+   * The burst after a hold is over: a hold is judged by the counter over it, for good; without
+   * one, a hold whose frames came in it is withdrawn now, any other waits for its ledger window.
+   */
   endBurst(): void {
     const b = this.#burst;
     this.#burst = null;
     if (b === null) return;
-    // The burst brought the silence's frames, and the frame due when it came.
-    const missed = Math.max(0, this.#dueIn(b.episode) + 1 - b.frames);
+    const counted = b.counted;
+    // Without a counter: the burst brought the silence's frames, and the frame due when it came.
+    const missed = counted ? b.missed : Math.max(0, this.#dueIn(b.episode) + 1 - b.frames);
     const at = this.#unconfirmed.findIndex((x) => x.episode === b.episode);
-    if (at >= 0 && this.#judge(b.episode, missed)) this.#unconfirmed.splice(at, 1);
+    const u = this.#unconfirmed[at];
+    if (u === undefined) return;
+    if (this.#judge(b.episode, missed, counted ? b.run : 0) || counted) this.#unconfirmed.splice(at, 1);
+    else u.counter = { missed: b.missed, run: b.run };
+  }
+
+  /**
+   * The receiver's counter was just seen to count for the first time: the holds whose bursts
+   * ended before are judged by what it said over them (a counter that stood still over a burst
+   * said no frame was lost there).
+   */
+  counting(): void {
+    for (let i = 0; i < this.#unconfirmed.length; ) {
+      const u = this.#unconfirmed[i] as UnjudgedHold;
+      if (u.counter === null) {
+        i++;
+        continue;
+      }
+      this.#unconfirmed.splice(i, 1);
+      this.#judge(u.episode, u.counter.missed, u.counter.run);
+    }
+  }
+
+  /**
+   * A frame at `t` ends the silence `open` (its hold or failsafe), which the clock opened while
+   * the frame's bytes were still arriving (the adapter held them back, or the decoder was
+   * finding its frames again). The frame's own time says how long the silence was: no hold
+   * within the hold threshold, no failsafe within the failsafe's; what did not happen is
+   * withdrawn (no stall counted). Returns the episode the frame ends: `open`, its hold open
+   * again, or null.
+   */
+  shorter(open: LinkEpisode, t: number): LinkEpisode | null {
+    const silence = t - open.lastFrameUs;
+    const last = open.lastFrameUs;
+    if (silence <= this.#monitor.holdAfterUs()) {
+      const at = this.#unconfirmed.findIndex((x) => x.episode.lastFrameUs === last);
+      if (at >= 0) this.#unconfirmed.splice(at, 1);
+      this.#remove(last);
+      return null;
+    }
+    if (silence >= this.#monitor.failsafeAfterUs || open.kind === 'hold') return open;
+    this.#remove(last, true);
+    for (let i = this.#episodes.length - 1; i >= 0; i--) {
+      const x = this.#episodes[i] as LinkEpisode;
+      if (x.lastFrameUs === last && x.kind === 'hold') {
+        x.endUs = null;
+        return x;
+      }
+    }
+    return null;
+  }
+
+  /**
+   * The receiver's counter says it lost the `fades` frames before the frame at `t`, in a row:
+   * its own line was silent for fades + 1 periods. Where a stall hid that from the adapter (the
+   * frames before it delivered late and together, `last` the latest), the episodes the silence
+   * was are added: a hold where none ended with this frame (`ended`), a failsafe where the
+   * hold that ended did not become one. Neither waits to be judged: the counter is the evidence.
+   */
+  hidden(t: number, last: number, fades: number, ended: LinkEpisode | null): void {
+    const s = this.#stats;
+    const m = this.#monitor;
+    const p = s.nominalPeriodUs;
+    const silence = (fades + 1) * p;
+    if (!Number.isFinite(silence) || !Number.isFinite(t) || !(silence > m.holdAfterUs())) return;
+    let hold = ended;
+    if (hold === null) {
+      s.holds++;
+      hold = m.add('hold', t - fades * p, Number.isFinite(last) ? last : t - silence);
+      hold.endUs = t;
+    }
+    if (hold.kind === 'hold' && silence >= m.failsafeAfterUs) {
+      s.failsafes++;
+      hold.endUs = t - silence + m.failsafeAfterUs;
+      m.add('failsafe', hold.endUs, hold.lastFrameUs).endUs = t;
+    }
   }
 
   /** The frames stopped for a reason that is not the link: a burst then is no evidence. */
@@ -143,12 +264,7 @@ export class StallJudge {
   }
 
   /** Puts the judge back where a checkpoint found it (`unconfirmed` and `burst` of the restored episodes). */
-  restore(
-    unconfirmed: readonly { episode: LinkEpisode; endFades: number }[],
-    burst: { episode: LinkEpisode; frames: number } | null,
-    retracted: readonly number[],
-    closesSeen: number,
-  ): void {
+  restore(unconfirmed: readonly UnjudgedHold[], burst: StallBurst | null, retracted: readonly number[], closesSeen: number): void {
     this.#unconfirmed.splice(0, this.#unconfirmed.length, ...unconfirmed); // at most 64
     this.#burst = burst;
     this.#retracted.splice(0, this.#retracted.length, ...retracted);
@@ -174,19 +290,35 @@ export class StallJudge {
 
   /**
    * Keeps a hold that ended, or withdraws it (and says so): `missed` is how many frames the
-   * evidence says were lost in its silence. A stall delivers the frames it held after it, so a
-   * hold that lost under half of them was the adapter's: a delivery stall, and so is the
-   * failsafe it became (the flight controller, on the receiver's own line, had its frames).
+   * evidence says were lost in its silence, `run` the most in a row the receiver's counter
+   * says it lost (0 without one). A stall delivers the frames it held after it, so a hold that
+   * lost under half of them was the adapter's: a delivery stall, and so is the failsafe it
+   * became (the flight controller, on the receiver's own line, had its frames), unless the
+   * receiver itself went silent long enough for a hold (a real dropout the stall hid in).
    */
-  #judge(e: LinkEpisode, missed: number): boolean {
+  #judge(e: LinkEpisode, missed: number, run: number): boolean {
     const due = this.#dueIn(e);
     if (due < 2 || missed >= due / 2) return false;
+    const p = this.#stats.nominalPeriodUs;
+    if (Number.isFinite(p) && (run + 1) * p > this.#monitor.holdAfterUs()) return false;
     const s = this.#stats;
     const silence = (this.#silenceEndUs(e) ?? e.lastFrameUs) - e.lastFrameUs;
+    this.#remove(e.lastFrameUs);
+    s.stalls++;
+    if (silence > s.longestStallUs) s.longestStallUs = silence;
+    return true;
+  }
+
+  /**
+   * Takes the hold and failsafe (or only the failsafe) of the silence after the frame at
+   * `lastFrameUs` out of the episodes and counts, and says so (`retracted`).
+   */
+  #remove(lastFrameUs: number, failsafeOnly = false): void {
+    const s = this.#stats;
     for (let i = this.#episodes.length - 1; i >= 0; i--) {
       const x = this.#episodes[i] as LinkEpisode;
-      if (x.lastFrameUs !== e.lastFrameUs) {
-        if (x.lastFrameUs < e.lastFrameUs) break;
+      if (x.lastFrameUs !== lastFrameUs || (failsafeOnly && x.kind === 'hold')) {
+        if (x.lastFrameUs < lastFrameUs) break;
         continue;
       }
       this.#episodes.splice(i, 1);
@@ -194,8 +326,5 @@ export class StallJudge {
       else s.failsafes--;
       this.#retracted.push(x.id);
     }
-    s.stalls++;
-    if (silence > s.longestStallUs) s.longestStallUs = silence;
-    return true;
   }
 }

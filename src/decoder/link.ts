@@ -23,9 +23,13 @@
  *   same whatever its timing. Failsafe follows one second after the last frame (§7.1).
  * - **Delivery delay and jitter** (how late frames reach us against the receiver's own
  *   schedule) are a measure of their own (`deliveryDelayUs`, `deliveryJitterUs`), never loss.
- *   A silence whose frames the evidence shows were sent (the fade counter did not move, or a
- *   burst brought them all) is a **delivery stall** (`stalls`): its hold, and its failsafe, are
- *   withdrawn, since the flight controller, which reads the receiver directly, saw neither.
+ *   A silence whose frames the evidence shows were sent (the fade counter did not move over the
+ *   burst that ended it, or the burst brought them all) is a **delivery stall** (`stalls`): its
+ *   hold, and its failsafe, are withdrawn, since the flight controller, which reads the receiver
+ *   directly, saw neither. The frame that ends a silence dates it (its first byte's time): a
+ *   hold or failsafe the clock opened while that frame was arriving late is withdrawn if the
+ *   frame came within its threshold. And a run of frames the counter says the receiver lost,
+ *   longer than a hold, is one even where a stall hid the gap from the adapter.
  * - **A receiver restart**: after a silence of `RESTART_MIN_GAP_US` or more, a fade counter that
  *   fell by more than a wrap explains started again from 0 at power-up (`restarts`). Its count
  *   then says nothing about the silence: the hold stands and the frames due in it are missed.
@@ -106,8 +110,8 @@ export class LinkMonitor {
     deliveryDelayUs: NaN,
     deliveryJitterUs: NaN,
   };
-  /** The holds that wait to be judged, and the delivery stalls they turn out to be. */
-  readonly #stalls = new StallJudge(this.#episodes, this.#stats);
+  /** The holds that wait to be judged, the delivery stalls they turn out to be, and the silences stalls hid. */
+  readonly #stalls: StallJudge;
 
   /** @throws {TypeError} when a duration is not a positive finite number. */
   constructor(options: LinkOptions = {}) {
@@ -121,6 +125,11 @@ export class LinkMonitor {
     this.#maxEpisodes = options.maxEpisodes ?? Infinity;
     this.#onMissed = options.onMissed;
     this.#ledger = new FrameLedger(this.#jitterPrior);
+    this.#stalls = new StallJudge(this.#episodes, this.#stats, {
+      holdAfterUs: () => this.holdAfterUs,
+      failsafeAfterUs: this.#failsafeAfterUs,
+      add: (kind, startUs, lastFrameUs) => this.#add(kind, startUs, lastFrameUs),
+    });
   }
 
   get state(): LinkState {
@@ -198,12 +207,15 @@ export class LinkMonitor {
       this.#redate(open.lastFrameUs, last);
     }
     const gap = Number.isFinite(t) && Number.isFinite(last) && t >= last ? t - last : NaN;
-    this.#stalls.frame(t, last);
+    const inBurst = this.#stalls.frame(t, last, frame.fadesDelta);
     const restartDue = this.#restarts.frame(frame, gap, s);
     const fades = frame.fadesDelta;
     s.fades += fades;
     this.#lastFades = fades;
-    if (frame.fades !== null && (frame.fades !== 0 || fades > 0)) this.#counting = true;
+    if (frame.fades !== null && (frame.fades !== 0 || fades > 0) && !this.#counting) {
+      this.#counting = true;
+      this.#stalls.counting();
+    }
     this.#lastInterval = NaN;
     if (Number.isFinite(t)) {
       if (!Number.isNaN(gap)) {
@@ -239,18 +251,20 @@ export class LinkMonitor {
     } else if (Number.isFinite(s.nominalPeriodUs) && Number.isFinite(t)) {
       s.missedBasis = 'frame-count';
     }
-    // A frame from before the silence began (the decoder held it, `update`'s `pendingUs`): the
-    // silence goes on, counted from this frame if it is the later one.
-    if (this.#open !== null && Number.isFinite(t) && t < this.#open.startUs) {
-      if (t > this.#open.lastFrameUs) this.#redate(this.#open.lastFrameUs, t);
-      return;
+    if (this.#open !== null && Number.isFinite(t)) {
+      // The frame the silence is counted from (the decoder held it, `update`'s `pendingUs`), or
+      // an older one: the silence goes on.
+      if (t <= this.#open.lastFrameUs) return;
+      this.#open = this.#stalls.shorter(this.#open, t);
     }
-    if (this.#open !== null) {
-      this.#open.endUs = Number.isFinite(t) ? t : this.#open.startUs;
+    const ended = this.#open;
+    if (ended !== null) {
+      ended.endUs = Number.isFinite(t) ? t : ended.startUs;
       // What the receiver says it missed in the silence: the evidence where its counter counts.
-      this.#stalls.ended(this.#open, this.#counting, restartDue > 0 ? restartDue : fades, fades);
+      this.#stalls.ended(ended, this.#counting && (restartDue > 0 || this.#restarts.vouched), restartDue > 0 ? restartDue : fades, fades);
       this.#open = null;
     }
+    if (this.#counting && this.#restarts.vouched && !inBurst && fades > 0) this.#stalls.hidden(t, last, fades, ended);
     this.#state = 'live';
   }
 
@@ -283,6 +297,8 @@ export class LinkMonitor {
     if (nowUs > this.#stoppedUs) nowUs = this.#stoppedUs;
     const last = pendingUs > this.#lastUs ? pendingUs : this.#lastUs;
     if (this.#state === 'waiting' || !Number.isFinite(last) || !Number.isFinite(nowUs)) return this.#state;
+    // A frame held since the silence began ends it: the silence goes on, counted from that frame.
+    if (this.#open !== null && last > this.#open.lastFrameUs) this.#redate(this.#open.lastFrameUs, last);
     const gap = nowUs - last;
     const s = this.#stats;
     // No hold threshold is below HOLD_MIN_US (or the holdAfterUs option): the common short gap
@@ -292,14 +308,14 @@ export class LinkMonitor {
       s.holds++;
       // The hold began when the next frame was due, whenever it was noticed.
       const p = s.nominalPeriodUs;
-      this.#openEpisode('hold', last + (Number.isFinite(p) ? p : this.holdAfterUs), last);
-      if (this.#open !== null) this.#stalls.held(this.#open);
+      this.#open = this.#add('hold', last + (Number.isFinite(p) ? p : this.holdAfterUs), last);
+      this.#stalls.held(this.#open);
     }
     if (gap >= this.#failsafeAfterUs && this.#state === 'hold') {
       this.#state = 'failsafe';
       s.failsafes++;
       if (this.#open !== null) this.#open.endUs = last + this.#failsafeAfterUs;
-      this.#openEpisode('failsafe', last + this.#failsafeAfterUs, last);
+      this.#open = this.#add('failsafe', last + this.#failsafeAfterUs, last);
     }
     return this.#state;
   }
@@ -465,11 +481,12 @@ export class LinkMonitor {
     }
   }
 
-  #openEpisode(kind: 'hold' | 'failsafe', startUs: number, lastFrameUs: number): void {
+  /** A new episode, kept in `episodes` (the newest never dropped). */
+  #add(kind: 'hold' | 'failsafe', startUs: number, lastFrameUs: number): LinkEpisode {
     const episode: LinkEpisode = { id: this.#nextEpisode++, kind, startUs, endUs: null, lastFrameUs };
     this.#episodes.push(episode);
-    // Drop the oldest in one go (an amortised splice), never the open one.
+    // Drop the oldest in one go (an amortised splice).
     if (this.#episodes.length > this.#maxEpisodes * 1.25) this.#episodes.splice(0, this.#episodes.length - this.#maxEpisodes);
-    this.#open = episode;
+    return episode;
   }
 }

@@ -235,8 +235,8 @@ export class Engine {
     const now = ended && Number.isFinite(this.#endUs) ? this.#endUs : nowUs;
     if (!ended && this.#mismatch === null) this.link.update(now, this.decoder.pendingSinceUs);
     const episodes = this.#newEpisodes();
-    const retracted = this.link.takeRetracted();
-    for (const id of retracted) this.#sent.delete(id);
+    // Only those the page was shown (a hold may open and be withdrawn between two batches).
+    const retracted = this.link.takeRetracted().filter((id) => this.#sent.delete(id));
     const series = this.#takeSeries(now);
     if (!this.#changed && before === this.link.state && episodes.length === 0 && retracted.length === 0 && series.settled === 0)
       return null;

@@ -1,0 +1,82 @@
+/**
+ * A live link whose adapter (or computer) stalls once, anywhere: the page's engine, fed the
+ * chunks as a browser would read them, ends with the holds and failsafes the receiver had,
+ * whatever the stall hid or looked like. A stall that holds back half a frame, one that runs
+ * into a real dropout, one that swallows a dropout's start, and the page's own timer stalling
+ * with it are all among the cases.
+ */
+import { describe, expect, it } from 'vitest';
+import { USB_CHUNK_JITTER_US } from '../src/decoder/spec.js';
+import { summarizeCapture } from '../src/analysis/summary.js';
+import { preset } from '../src/simulator/presets.js';
+import { Prng } from '../src/simulator/prng.js';
+import { simulate } from '../src/simulator/simulator.js';
+import { Engine } from '../src/worker/engine.js';
+import { perByteCapture } from './feeds.js';
+
+/** Where a stall starts (µs into the stream) and how long it lasts. */
+interface Stall {
+  atUs: number;
+  forUs: number;
+}
+
+/**
+ * The engine fed `bytes` as a serial reader wakes every 0.5–3.5 ms and takes what has arrived
+ * (one chunk, its time the wake), the page asking for a batch every 16–46 ms; over `stall`
+ * the reader sleeps (and, in half the cases, the page's timer too), then gets what piled up in
+ * pieces up to 2 ms apart. Ends 3.2 s after the last byte (the receiver quiet for good).
+ */
+function stalledFeed(bytes: Uint8Array, timesUs: Float64Array, stall: Stall, rng: Prng): Engine {
+  const engine = new Engine({ resolution: 'auto', jitterUs: USB_CHUNK_JITTER_US });
+  const stallAt = (timesUs[0] ?? 0) + stall.atUs;
+  const timerStalls = rng.chance(0.5);
+  let t = (timesUs[0] ?? 0) - 5_000;
+  let nextBatch = t;
+  let i = 0;
+  while (i < bytes.length) {
+    let step = rng.uniform(500, 3_500);
+    const stalled = t < stallAt && t + step >= stallAt;
+    if (stalled) step += stall.forUs;
+    for (; nextBatch < t + step && !(stalled && timerStalls); nextBatch += rng.uniform(16_000, 46_000)) engine.batch(nextBatch);
+    t += step;
+    let j = i;
+    while (j < bytes.length && (timesUs[j] ?? 0) <= t) j++;
+    while (i < j) {
+      const n = stalled ? Math.min(j - i, 1 + rng.int(200)) : j - i;
+      engine.push(bytes.subarray(i, i + n), t, t / 1000);
+      i += n;
+      if (stalled && i < j) t += rng.uniform(0, 2_000);
+    }
+    if (nextBatch < t) {
+      engine.batch(t);
+      nextBatch = t + rng.uniform(16_000, 46_000);
+    }
+  }
+  for (const end = t + 3_200_000; t < end; t += 16_000) engine.batch(t);
+  return engine;
+}
+
+describe('a stall of the delivery, anywhere in a link with real dropouts', () => {
+  it('ends with the holds and failsafes the receiver had, over 400 stalls of 30–430 ms', () => {
+    // A DSMX 11 ms link that drops out for 0.2 s (a hold) and for 1.3 s (a failsafe), then
+    // recovers; after its last frame, a third hold and failsafe (the receiver quiet for good).
+    const sim = simulate(preset('dropouts-failsafe'));
+    const truth = summarizeCapture(perByteCapture(sim)).episodes.map((e) => e.kind);
+    expect(truth).toEqual(['hold', 'hold', 'failsafe']);
+    const want = [...truth, 'hold', 'failsafe'];
+    const spanUs = (sim.timesUs.at(-1) ?? 0) - (sim.timesUs[0] ?? 0);
+    const wrong: string[] = [];
+    for (let seed = 1; seed <= 400; seed++) {
+      const rng = new Prng(seed);
+      const stall = { atUs: 0, forUs: rng.uniform(30_000, 430_000) };
+      // Starts anywhere, ends at least 50 ms before the last frame (one after it cannot be told from the end).
+      stall.atUs = rng.uniform(0, spanUs - stall.forUs - 50_000);
+      const engine = stalledFeed(sim.bytes, sim.timesUs, stall, rng);
+      const got = engine.link.episodes.map((e) => e.kind);
+      const { holds, failsafes } = engine.link.stats;
+      if (got.join() !== want.join() || holds !== 3 || failsafes !== 2)
+        wrong.push(`${(stall.forUs / 1e3).toFixed(0)} ms stall at ${(stall.atUs / 1e6).toFixed(3)} s: ${got.join(' ')}`);
+    }
+    expect(wrong).toEqual([]);
+  });
+});
