@@ -1,7 +1,7 @@
 import { describe, expect, it } from 'vitest';
 import type { DoctorFinding } from '../src/analysis/doctor-types.js';
 import { splitFindings } from '../src/app/components/Diagnosis/current.js';
-import { type LinkFacts, linkView } from '../src/app/components/LinkPanel/view.js';
+import { type LinkFacts, linkView, sinceLastFrame } from '../src/app/components/LinkPanel/view.js';
 import { setText } from '../src/app/text.js';
 
 /** Just enough of a DOM element and its Text children for setText: what replaced what. */
@@ -110,6 +110,15 @@ describe('the link panel', () => {
       expect(v.label).toBe('Ended');
       expect(v.hint).toMatch(/^Replay ended at 0:03\.0: there /);
     }
+  });
+
+  it('dates the last frame "ago" while time runs, and before the point a replay paused or ended at', () => {
+    expect(sinceLastFrame(12_400, facts({}))).toBe('12 ms ago');
+    expect(sinceLastFrame(3_250_000, facts({ kind: 'replay', sourceState: 'playing' }))).toBe('3.3 s ago');
+    expect(sinceLastFrame(1_000, facts({ kind: 'replay', sourceState: 'ended', ended: true }))).toBe('1 ms before the end');
+    expect(sinceLastFrame(1_000, facts({ kind: 'replay', sourceState: 'playing', ended: true }))).toBe('1 ms before the end');
+    expect(sinceLastFrame(40_000, facts({ kind: 'replay', sourceState: 'paused' }))).toBe('40 ms before this point');
+    expect(sinceLastFrame(Number.NaN, facts({}))).toBe('—');
   });
 
   it('gives a playing replay the link state at its position, named as the capture', () => {

@@ -128,10 +128,14 @@ describe.skipIf(skip !== null)('honest states', () => {
     await expect(page.getByTestId('link-hint').textContent()).resolves.toMatch(/: there the link was live\.$/);
     await expect(page.locator('.link dd').nth(1).textContent()).resolves.toBe(episodesText(summary.link.holds, summary.link.failsafes));
     await expect(page.getByTestId('count-missed').textContent()).resolves.toBe(String(summary.link.missedFrames));
+    // The last frame is dated against the end, not "ago" (the clock stands still there).
+    const since = await page.locator('.link dd').nth(0).textContent();
+    expect(since).toMatch(/^\d+(\.\d)? m?s before the end$/);
     await shot(page, 'replay-ended');
     // The wall clock moving on changes nothing.
     await page.waitForTimeout(1500);
     await expect(page.getByTestId('link-state').textContent()).resolves.toBe(state);
+    await expect(page.locator('.link dd').nth(0).textContent()).resolves.toBe(since);
     await expect(replayTime(page)).resolves.toEqual([end, span2]);
     expect(errors).toEqual([]);
     await page.context().close();

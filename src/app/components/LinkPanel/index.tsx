@@ -11,15 +11,9 @@ import { current, linkEnded, linkMismatch, linkState, replay, replayReading, res
 import { setText } from '../../text.js';
 import { drawEpisodes } from '../../timeline.js';
 import { TopFinding } from '../Diagnosis/index.js';
-import { linkView } from './view.js';
+import { linkView, sinceLastFrame } from './view.js';
 import { plural } from '../../../analysis/report-text.js';
 import './style.css';
-
-function ago(us: number): string {
-  if (!Number.isFinite(us)) return '—';
-  if (us < 1e6) return `${Math.round(us / 1000)} ms`;
-  return `${(us / 1e6).toFixed(1)} s`;
-}
 
 // The state, its hint and the panel's colour as signals bound to the DOM: a Live/Hold flip
 // changes two texts and a class, and re-renders nothing.
@@ -55,7 +49,9 @@ export function LinkPanel({ windowUs }: { windowUs: Signal<number> }) {
       const live = current();
       const l = live.link;
       const now = live.nowUs();
-      const text = l === null ? 'none yet' : `${ago(now - l.lastFrameUs)} ago`;
+      const s = status.value;
+      const text =
+        l === null ? 'none yet' : sinceLastFrame(now - l.lastFrameUs, { kind: s.kind, sourceState: s.state, ended: linkEnded.value });
       if (text !== shown && since.current !== null) {
         setText(since.current, text);
         shown = text;

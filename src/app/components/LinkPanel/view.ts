@@ -87,3 +87,21 @@ export function linkView(f: LinkFacts): LinkView {
   }
   return { key: f.state, label: WORD[f.state], hint: HINT[f.state] };
 }
+
+/** A duration as the panel shows it: ms under a second, else seconds to a tenth. */
+function duration(us: number): string {
+  return us < 1e6 ? `${Math.round(us / 1000)} ms` : `${(us / 1e6).toFixed(1)} s`;
+}
+
+/**
+ * The time since the last frame (`sinceUs`, NaN: none), as the panel says it: "ago" while time
+ * runs (live, or a replay playing on its own clock); a paused replay's before the point it
+ * stopped at, an ended one's before its end (its clock stands still there, and "1 ms ago"
+ * would read as now).
+ */
+export function sinceLastFrame(sinceUs: number, f: Pick<LinkFacts, 'kind' | 'sourceState' | 'ended'>): string {
+  if (!Number.isFinite(sinceUs)) return '—';
+  if (f.kind === 'replay' && (f.ended || f.sourceState === 'ended')) return `${duration(sinceUs)} before the end`;
+  if (f.kind === 'replay' && f.sourceState === 'paused') return `${duration(sinceUs)} before this point`;
+  return `${duration(sinceUs)} ago`;
+}
