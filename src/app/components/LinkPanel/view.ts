@@ -30,7 +30,11 @@ export interface LinkFacts {
   reading: boolean;
   /** The replay position on the capture's clock, from its start, µs (NaN: not a replay). */
   positionUs: number;
-  /** The source ended (a replay at its end). */
+  /**
+   * The source ended (a replay at its end), as of the batch whose figures the page shows: the
+   * worker sends its last batch, then the status 'ended', and the figures are drawn on the next
+   * animation frame. "Ended" waits for them (`sourceState` 'ended' alone says nothing here).
+   */
   ended: boolean;
   /** A forced resolution matching no frame: the resolution the stream looks like. */
   mismatch: 1024 | 2048 | null;
@@ -74,8 +78,7 @@ export function linkView(f: LinkFacts): LinkView {
     };
   if (f.kind === 'replay') {
     const at = formatClock(f.positionUs);
-    if (f.ended || f.sourceState === 'ended')
-      return { key: 'ended', label: 'Ended', hint: `Replay ended at ${at}: there ${WAS[f.state]}.` };
+    if (f.ended) return { key: 'ended', label: 'Ended', hint: `Replay ended at ${at}: there ${WAS[f.state]}.` };
     if (f.sourceState === 'paused')
       return { key: 'paused', label: 'Paused', hint: `Paused at ${at} of the capture: there ${WAS[f.state]}.` };
     if (f.state === 'waiting') return { key: 'waiting', label: WORD.waiting, hint: `No frame yet at ${at} of the capture.` };
@@ -101,7 +104,7 @@ function duration(us: number): string {
  */
 export function sinceLastFrame(sinceUs: number, f: Pick<LinkFacts, 'kind' | 'sourceState' | 'ended'>): string {
   if (!Number.isFinite(sinceUs)) return '—';
-  if (f.kind === 'replay' && (f.ended || f.sourceState === 'ended')) return `${duration(sinceUs)} before the end`;
+  if (f.kind === 'replay' && f.ended) return `${duration(sinceUs)} before the end`;
   if (f.kind === 'replay' && f.sourceState === 'paused') return `${duration(sinceUs)} before this point`;
   return `${duration(sinceUs)} ago`;
 }
