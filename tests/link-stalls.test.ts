@@ -7,6 +7,8 @@
  */
 import { describe, expect, it } from 'vitest';
 import { USB_CHUNK_JITTER_US } from '../src/decoder/spec.js';
+import { LinkMonitor } from '../src/decoder/link.js';
+import type { DecodedFrame } from '../src/decoder/types.js';
 import { summarizeCapture } from '../src/analysis/summary.js';
 import { preset } from '../src/simulator/presets.js';
 import { Prng } from '../src/simulator/prng.js';
@@ -78,5 +80,37 @@ describe('a stall of the delivery, anywhere in a link with real dropouts', () =>
         wrong.push(`${(stall.forUs / 1e3).toFixed(0)} ms stall at ${(stall.atUs / 1e6).toFixed(3)} s: ${got.join(' ')}`);
     }
     expect(wrong).toEqual([]);
+  });
+});
+
+/** A stand-in frame of an external remote: only what the monitor reads. */
+const frame = (timeUs: number, fades: number, fadesDelta: number): DecodedFrame =>
+  ({ timeUs, fades, fadesDelta, system: null, remote: 'external', rssi: null }) as DecodedFrame;
+
+describe("the receiver's counter, where the adapter saw no silence", () => {
+  it('counts a run of lost frames a stall hid as the hold it was, and its failsafe past a second', () => {
+    for (const [run, failsafes] of [
+      [18, 0],
+      [118, 1],
+    ] as const) {
+      const link = new LinkMonitor({ jitterUs: 20_000 });
+      let t = 0;
+      for (let k = 0; k < 50; k++, t += 11_000) link.frame(frame(t, 40, 0));
+      // The last frames before the silence came late, in a burst; the first after it 20 ms on.
+      link.frame(frame(t + 20_000, 40 + run, run));
+      expect(link.stats, `${run}`).toMatchObject({ holds: 1, failsafes, missedFrames: run });
+      const [hold] = link.episodes;
+      expect(hold?.startUs).toBe(t + 20_000 - run * 11_000);
+      expect(link.episodes.at(-1)?.endUs).toBe(t + 20_000);
+    }
+  });
+
+  it('adds nothing after a break in its view (an interrupt): the count spans time it did not see', () => {
+    const link = new LinkMonitor({ jitterUs: 20_000 });
+    let t = 0;
+    for (let k = 0; k < 50; k++, t += 11_000) link.frame(frame(t, 40, 0));
+    link.interrupt(t);
+    link.frame(frame(t + 3_000_000, 52, 12));
+    expect(link.stats).toMatchObject({ holds: 0, failsafes: 0 });
   });
 });

@@ -219,22 +219,25 @@ export class StallJudge {
   }
 
   /**
-   * The receiver's counter says it lost the `fades` frames before the frame at `t`, in a row:
-   * its own line was silent for fades + 1 periods. Where a stall hid that from the adapter (the
-   * frames before it delivered late and together, `last` the latest), the episodes the silence
-   * was are added: a hold where none ended with this frame (`ended`), a failsafe where the
-   * hold that ended did not become one. Neither waits to be judged: the counter is the evidence.
+   * The receiver's counter says it lost the `fades` frames between the frame before (at `last`)
+   * and the frame at `t`, which came less than a hold after it (else a hold ended here): they
+   * were in a row, its own line silent for fades + 1 periods, which only a stall can have hid
+   * from the adapter (the frames before delivered late and together). The episodes the silence
+   * was are added: a hold where none ended with this frame (`ended`), a failsafe where the hold
+   * that ended did not become one. Neither waits to be judged: the counter is the evidence.
+   * After a break in the monitor's view (`last` NaN: the start, an interrupt), the count spans
+   * time it did not see: nothing is added.
    */
   hidden(t: number, last: number, fades: number, ended: LinkEpisode | null): void {
     const s = this.#stats;
     const m = this.#monitor;
     const p = s.nominalPeriodUs;
     const silence = (fades + 1) * p;
-    if (!Number.isFinite(silence) || !Number.isFinite(t) || !(silence > m.holdAfterUs())) return;
+    if (!Number.isFinite(silence) || !Number.isFinite(t) || !Number.isFinite(last) || !(silence > m.holdAfterUs())) return;
     let hold = ended;
     if (hold === null) {
       s.holds++;
-      hold = m.add('hold', t - fades * p, Number.isFinite(last) ? last : t - silence);
+      hold = m.add('hold', t - fades * p, last);
       hold.endUs = t;
     }
     if (hold.kind === 'hold' && silence >= m.failsafeAfterUs) {
