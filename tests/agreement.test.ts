@@ -536,6 +536,24 @@ describe('a recorded unplug', () => {
     expect(text).toMatch(/^Port 0: the adapter was unplugged 1 time \(2\.0 s in all, from 0:02\.0\); nothing is counted for that time$/);
     expect(said(unplugged(11, 2e6, 4e6, false))).toEqual([]);
   });
+
+  it('is named by the doctor, with the figures the report gives, and by nothing without it', () => {
+    for (const [from, to] of [
+      [2e6, 4e6],
+      [1.5e6, 1.8e6],
+      [3e6, 5.9e6],
+    ] as const) {
+      const capture = unplugged(11, from, to);
+      const report = /unplugged (\d+ times?) \(([\d.]+ s) in all, from ([\d:.]+)\)/.exec(
+        healthReport(capture).verdict.find((f) => f.code === 'adapter-away')?.text ?? '',
+      );
+      const away = doctorCapture(capture).findings.filter((f) => f.code === 'adapter-away');
+      expect(away.map((f) => f.severity)).toEqual(['warning']);
+      const doctor = /lost (\d+ times?) \(([\d.]+ s) in all, the first at ([\d:.]+)\)/.exec(away[0]?.evidence[0]?.text ?? '');
+      expect(doctor?.slice(1), `${from}–${to}`).toEqual(report?.slice(1));
+      expect(doctorCapture(unplugged(11, from, to, false)).findings.map((f) => f.code)).not.toContain('adapter-away');
+    }
+  });
 });
 
 /** A truth: nothing was lost (no hold, failsafe or missed frame in info, no weak link from the doctor). */

@@ -627,6 +627,35 @@ describe('what the worker and the report take from the doctor', () => {
     expect(codes(s.findings(4.5 * SECOND))).not.toContain('nothing-arrives');
   });
 
+  it('names an adapter that went away, until its data came back, as the live worker tells it; a checkpoint keeps it', () => {
+    const s = new Session();
+    s.port(0, 'A');
+    s.doctor.open(0, 0);
+    s.feed(0, satellite(preset('dsmx-11ms-2048-internal'), 2 * SECOND));
+    expect(codes(s.findings(2 * SECOND))).not.toContain('adapter-away');
+    s.doctor.close(0, 2.1 * SECOND);
+    // Still away: counted to now.
+    const away = find(s.findings(3 * SECOND), 'adapter-away');
+    expect(away?.title).toBe('A: the USB adapter went away 1 time');
+    expect(away?.evidence[0]?.text).toMatch(/^The adapter was lost 1 time \(900 ms in all, the first at 0:02\.1\)/);
+    s.doctor.open(0, 3.5 * SECOND);
+    s.feed(0, satellite(preset('dsmx-11ms-2048-internal'), 1 * SECOND, 3.6 * SECOND));
+    s.doctor.close(0, 5 * SECOND);
+    s.doctor.close(0, 5.2 * SECOND);
+    s.doctor.open(0, 5.9 * SECOND);
+    s.feed(0, satellite(preset('dsmx-11ms-2048-internal'), 0.5 * SECOND, 6 * SECOND));
+    const twice = find(s.findings(7 * SECOND), 'adapter-away');
+    expect(twice?.evidence[0]?.text).toMatch(/^The adapter was lost 2 times \(2\.5 s in all, the first at 0:02\.1\)/);
+    expect(twice?.sinceUs).toBe(2.1 * SECOND);
+    const other = new Doctor();
+    other.restorePort(0, s.doctor.portCheckpoint(0)!, { ...s.port(0), label: 'A' });
+    expect(find(other.findings(7 * SECOND), 'adapter-away')?.evidence).toEqual(twice?.evidence);
+    // Untimed, nothing to count.
+    const raw = new Doctor({ timing: 'none' });
+    raw.close(0, Number.NaN);
+    expect(raw.findings(SECOND)).toEqual([]);
+  });
+
   it('forgets a detached port, so a remote given its number later starts clean', () => {
     const s = new Session();
     s.port(0, 'A');

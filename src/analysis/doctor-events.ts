@@ -6,6 +6,7 @@
  */
 import type { Capture } from '../capture/model.js';
 import type { Doctor } from './doctor.js';
+import { type Absences, absenceEnds, absenceStarts, absencesUntil, noAbsences } from './absences.js';
 
 /** A capture event's text names a WebSerial read error, e.g. "line error: FramingError". */
 const LINE_ERROR = /\b(FramingError|ParityError|BreakError|BufferOverrunError)\b/;
@@ -61,31 +62,28 @@ export class StopCursor {
   }
 }
 
-/** A time the adapter was away: from a recorded stop to the port's next recorded data (or the capture's last), µs. */
-export interface Absence {
-  readonly port: number;
-  readonly fromUs: number;
-  readonly toUs: number;
-}
-
-/**
- * The capture's recorded stops as absences, each until the port's next data chunk recorded
- * after it, or `endUs` (the capture's end) when none came; stops without a time are left out.
- */
-export function recordedAbsences(capture: Capture, endUs: number): Absence[] {
+/** A recording's absences (`Absences`) by port, up to `endUs` (the capture's end); ports without any are left out. */
+export function recordedAbsences(capture: Capture, endUs: number): Map<number, Omit<Absences, 'fromUs'>> {
   const { chunkPorts, chunkTimesUs } = capture;
-  const out: Absence[] = [];
-  for (const stop of recordedStops(capture)) {
-    if (!Number.isFinite(stop.timeUs)) continue;
-    let toUs = endUs;
-    for (let i = stop.chunkIndex; i < chunkPorts.length; i++) {
-      const t = chunkTimesUs[i] ?? Number.NaN;
-      if (chunkPorts[i] === stop.port && Number.isFinite(t)) {
-        toUs = t;
-        break;
-      }
-    }
-    out.push({ port: stop.port, fromUs: stop.timeUs, toUs: Math.max(stop.timeUs, toUs) });
+  const stops = recordedStops(capture);
+  const out = new Map<number, Omit<Absences, 'fromUs'>>();
+  if (stops.length === 0) return out;
+  const byPort = new Map<number, Absences>();
+  const of = (port: number): Absences => {
+    let a = byPort.get(port);
+    if (a === undefined) byPort.set(port, (a = noAbsences()));
+    return a;
+  };
+  let s = 0;
+  for (let i = 0; i < chunkPorts.length; i++) {
+    for (let stop = stops[s]; stop !== undefined && stop.chunkIndex <= i; stop = stops[++s]) absenceStarts(of(stop.port), stop.timeUs);
+    const a = byPort.get(chunkPorts[i] ?? -1);
+    if (a !== undefined) absenceEnds(a, chunkTimesUs[i] ?? Number.NaN);
+  }
+  for (; s < stops.length; s++) absenceStarts(of(stops[s]!.port), stops[s]!.timeUs);
+  for (const [port, a] of byPort) {
+    const t = absencesUntil(a, endUs);
+    if (t.count > 0) out.set(port, t);
   }
   return out;
 }
@@ -102,5 +100,5 @@ export function doctorEvent(doctor: Doctor, port: number, text: string, timeUs: 
   else if (OPENED.test(text)) {
     const baud = BAUD.exec(text);
     doctor.open(port, timeUs, baud !== null ? { baudRate: Number(baud[1]) } : {});
-  } else if (stopsPort(text)) doctor.close(port);
+  } else if (stopsPort(text)) doctor.close(port, timeUs);
 }

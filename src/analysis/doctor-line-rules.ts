@@ -24,6 +24,7 @@ import {
 } from './doctor-state.js';
 import type { AddFinding, Confidence, ConfirmProbe, Evidence, RuleContext } from './doctor-types.js';
 import { formatDuration, plural } from './report-text.js';
+import { absencesUntil } from './absences.js';
 
 export const NOTHING_TODO = [
   'Transmitter off, or the satellite not bound to this transmitter and model memory (most common). Satellite LED off: it has power but no link. Turn the transmitter on with the right model; if the LED stays off, bind again.',
@@ -66,6 +67,37 @@ export function nothingFindings(p: PortState, now: number, add: AddFinding): voi
     settings: [],
     confirm: null,
     sinceUs: p.openUs + NOTHING_AFTER_US,
+  });
+}
+
+/**
+ * The port's adapter went away ("device lost", live or recorded) and, until its data came
+ * back, nothing could be seen: said with the report's figures (`absences.ts`), and what makes
+ * an adapter drop off USB when nobody unplugged it.
+ */
+export function adapterAwayFinding(p: PortState, now: number, ctx: RuleContext, add: AddFinding): void {
+  const a = absencesUntil(p.away, now);
+  if (a.count === 0 || !ctx.timed) return;
+  add({
+    code: 'adapter-away',
+    ports: [p.port],
+    severity: 'warning',
+    confidence: 'certain',
+    title: `${p.label}: the USB adapter went away ${plural(a.count, 'time')}`,
+    evidence: [
+      {
+        text: `The adapter was lost ${plural(a.count, 'time')} (${formatDuration(a.totalUs)} in all, the first at ${ctx.at(a.firstUs)}) until its data came back. Nothing is counted for that time: no hold, failsafe or lost frame, since the link could not be seen.`,
+        timeUs: a.firstUs,
+      },
+    ],
+    todo: [
+      'If nobody unplugged it: the USB cable or connector (loose, or long), or a hub that cuts power; plug the adapter straight into the computer.',
+      "An adapter that resets when the satellite draws current: if the satellite is powered from the adapter's 3.3 V pin, power it from a 3.3 V regulator of its own (grounds common).",
+      'The computer suspending USB: keep it from sleeping while you record.',
+    ],
+    settings: [],
+    confirm: null,
+    sinceUs: a.firstUs,
   });
 }
 

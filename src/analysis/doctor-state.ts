@@ -2,6 +2,7 @@
  * What the doctor keeps per port: its thresholds, one-second bins of counters over the last
  * 64 seconds, and the state its rules read (activity, packets, frames, formats, restarts).
  */
+import type { Absences } from './absences.js';
 import type { Resolution } from '../decoder/spec.js';
 import type { BurstClock, BurstClockCheckpoint } from './burst-clock.js';
 import { PACKET_KINDS, type PacketKind, type PacketScanner, type PacketScannerCheckpoint } from './doctor-line.js';
@@ -159,6 +160,8 @@ export interface PortState {
   head: number[];
   /** The port's stream is over (`Doctor.ended`): judged on what it held, however short. */
   ended: boolean;
+  /** The times its adapter went away (`Doctor.close`) until its next data. */
+  away: Absences;
   /** Time of the latest data: a chunk without a time takes it. */
   lastTimeUs: number;
   bins: Bins;

@@ -24,6 +24,8 @@ export type DoctorCode =
   | 'noise'
   | 'unknown-stream'
   | 'overrun'
+  // The adapter went away
+  | 'adapter-away'
   // A satellite the flight controller will read wrong
   | 'fc-settings'
   | 'bind-mode'

@@ -14,10 +14,11 @@
  */
 import { FRAME_SIZE } from '../decoder/spec.js';
 import type { DecodedFrame } from '../decoder/types.js';
+import { absenceEnds, absenceStarts, noAbsences } from './absences.js';
 import { BurstClock } from './burst-clock.js';
 import { PACKET_KINDS, PacketScanner, type PacketKind } from './doctor-line.js';
 import { ArduPilotGuess } from './doctor-stacks.js';
-import { lineFindings, lineVerdict, noSatelliteFinding, nothingFindings } from './doctor-line-rules.js';
+import { adapterAwayFinding, lineFindings, lineVerdict, noSatelliteFinding, nothingFindings } from './doctor-line-rules.js';
 import { formatClock } from './report-text.js';
 import { satelliteFindings } from './doctor-satellite-rules.js';
 import { systemFindings } from './doctor-system-rules.js';
@@ -103,6 +104,7 @@ export class Doctor {
         bytes: 0,
         head: [],
         ended: false,
+        away: noAbsences(),
         lastTimeUs: NaN,
         bins: new Bins(),
         scanner: new PacketScanner((kind) => this.#packet(state, kind)),
@@ -169,9 +171,10 @@ export class Doctor {
     const p = this.#ports.get(port);
     if (p === undefined) return undefined;
     // The snapshots and records in the lists are never changed once made: the lists are copied.
-    const { source: _source, bins, scanner, burst, guess, probePackets, packetsEver, damagedAtUs, changes, head, ...plain } = p;
+    const { source: _source, bins, scanner, burst, guess, probePackets, packetsEver, damagedAtUs, changes, head, away, ...plain } = p;
     return {
       ...plain,
+      away: { ...away },
       head: [...head],
       probePackets: { ...probePackets },
       packetsEver: { ...packetsEver },
@@ -192,10 +195,11 @@ export class Doctor {
   restorePort(port: number, cp: PortCheckpoint, source: DoctorPortSource): void {
     this.detach(port);
     const p = this.#port(port);
-    const { bins, scanner, burst, guess, probePackets, packetsEver, damagedAtUs, changes, head, ...plain } = cp;
+    const { bins, scanner, burst, guess, probePackets, packetsEver, damagedAtUs, changes, head, away, ...plain } = cp;
     Object.assign(p, plain, {
       port,
       source,
+      away: { ...away },
       head: [...head],
       probePackets: { ...probePackets },
       packetsEver: { ...packetsEver },
@@ -235,8 +239,10 @@ export class Doctor {
   }
 
   /** The port was closed or lost: no "nothing arrives" for it until it opens again. */
-  close(port: number): void {
-    this.#port(port).openUs = NaN;
+  close(port: number, timeUs = Number.NaN): void {
+    const p = this.#port(port);
+    p.openUs = NaN;
+    absenceStarts(p.away, timeUs);
   }
 
   /**
@@ -287,6 +293,7 @@ export class Doctor {
       p.bins.add(M_BYTES, t, n);
     }
     this.#activity(p, t, n);
+    absenceEnds(p.away, time instanceof Float64Array ? (time[start] ?? NaN) : t);
     if (p.frames === 0) this.#census(p, bytes, start, end, time);
     p.bytes += n;
     p.scanTimeUs = t;
@@ -409,6 +416,7 @@ export class Doctor {
     const ports = [...this.#ports.values()].sort((a, b) => a.port - b.port);
     for (const p of ports) {
       nothingFindings(p, nowUs, add);
+      adapterAwayFinding(p, nowUs, ctx, add);
       const verdict = lineVerdict(p, nowUs, ctx);
       lineFindings(p, verdict, nowUs, ctx, add);
       noSatelliteFinding(p, verdict, nowUs, ctx, add);

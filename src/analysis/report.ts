@@ -263,16 +263,14 @@ export function healthReportFeeding(
     });
   }
   // A recorded unplug: the link counts nothing for it (LinkMonitor.stopped); the report says where it was.
-  const away = hasClock ? recordedAbsences(capture, span.endUs) : [];
-  for (const port of [...new Set(away.map((a) => a.port))]) {
-    const mine = away.filter((a) => a.port === port);
-    const total = mine.reduce((sum, a) => sum + (a.toUs - a.fromUs), 0);
+  const away = hasClock ? recordedAbsences(capture, span.endUs) : new Map();
+  for (const [port, a] of away) {
     const label = remotes.find((r) => r.port === port)?.label ?? `Port ${port}`;
     verdict.push({
       level: 'info',
       code: 'adapter-away',
       port,
-      text: `${label}: the adapter was unplugged ${plural(mine.length, 'time')} (${formatDuration(total)} in all, from ${formatClock((mine[0]?.fromUs ?? origin) - origin)}); nothing is counted for that time`,
+      text: `${label}: the adapter was unplugged ${plural(a.count, 'time')} (${formatDuration(a.totalUs)} in all, from ${formatClock(a.firstUs - origin)}); nothing is counted for that time`,
     });
   }
   if (ports.length === 0) {

@@ -143,8 +143,9 @@ export class Diagnosis {
     this.#doctor.lineError(id, name, timeUs);
   }
 
-  close(id: number): void {
-    this.#doctor.close(id);
+  /** A source's port was lost at `timeUs` (its adapter went away). */
+  close(id: number, timeUs: number): void {
+    this.#doctor.close(id, timeUs);
   }
 
   /** A source was removed: its port number may be given to another remote. */

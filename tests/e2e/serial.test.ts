@@ -117,6 +117,11 @@ describe.skipIf(skip !== null)('a receiver on a serial port', () => {
     await fake.writePaced(stream.bytes.subarray(half), stream.timesUs.subarray(half));
     await linkState(page, 'Live');
     const pageEpisodes = await page.locator('.link dd').nth(1).textContent();
+    // Back: the doctor names the time the adapter was away.
+    const away = page.locator('.diagnosis .finding[data-code="adapter-away"]');
+    await away.waitFor({ timeout: 5000 });
+    await expect(away.textContent()).resolves.toMatch(/the USB adapter went away 1 time/);
+    await shot(page, 'serial-back');
     await page.getByRole('button', { name: 'Stop recording' }).click();
     const download = page.waitForEvent('download');
     await page.getByRole('button', { name: 'Export .sscap' }).first().click();

@@ -116,7 +116,7 @@ export class SerialPorts implements Driver {
         recorder.event('device lost', now(), id);
         // No frame can arrive: the silence from here on is the adapter's, not the link's.
         source.engine.interrupt(now());
-        diagnosis.close(id);
+        diagnosis.close(id, now());
         registry.setState(source, 'lost');
         notice(
           host,
