@@ -13,7 +13,7 @@ import { build } from 'vite';
 const ENTRIES = {
   satscope: 'src/decoder/index.ts',
   'satscope/capture': 'src/capture/index.ts',
-  'satscope/report': 'src/analysis/index.ts',
+  'satscope/report': 'src/report/index.ts',
 };
 
 export async function entrySizes() {

@@ -4,7 +4,7 @@
  * came from.
  */
 import { describe, expect, it } from 'vitest';
-import { captureSpan, seedCaptureSpan } from '../src/analysis/capture-span.js';
+import { captureSpan, seedCaptureSpan } from '../src/report/capture-span.js';
 import {
   captureChunksByPort,
   captureFact,

@@ -5,7 +5,7 @@
  * hears there, and returns to 115200. The port is a stand-in with WebSerial's shape.
  */
 import { describe, expect, it } from 'vitest';
-import type { DoctorFinding } from '../src/analysis/doctor-types.js';
+import type { DoctorFinding } from '../src/report/doctor-types.js';
 import { importRaw } from '../src/capture/raw.js';
 import { crsfStream } from '../src/simulator/protocols.js';
 import { receiveAs } from '../src/simulator/line.js';

@@ -4,7 +4,7 @@
  * never "certain", and when the count moves it re-reads the remote, which is not a rebind.
  */
 import { describe, expect, it } from 'vitest';
-import { doctorCapture } from '../src/analysis/doctor-capture.js';
+import { doctorCapture } from '../src/report/doctor-capture.js';
 import { preset } from '../src/simulator/presets.js';
 import { simulate } from '../src/simulator/simulator.js';
 import { recording } from './feeds.js';

@@ -6,8 +6,8 @@
  * rests on its resolution is as certain in one as in the other.
  */
 import { describe, expect, it } from 'vitest';
-import { diagnosedHealthReport } from '../src/analysis/doctor-report.js';
-import { doctorCapture } from '../src/analysis/doctor-capture.js';
+import { diagnosedHealthReport } from '../src/report/doctor-report.js';
+import { doctorCapture } from '../src/report/doctor-capture.js';
 import type { Capture } from '../src/capture/model.js';
 import { preset } from '../src/simulator/presets.js';
 import { simulate } from '../src/simulator/simulator.js';

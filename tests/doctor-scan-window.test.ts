@@ -5,12 +5,12 @@
  * a long capture.
  */
 import { describe, expect, it } from 'vitest';
-import { captureSpan } from '../src/analysis/capture-span.js';
-import { decodeCapture } from '../src/analysis/capture-pass.js';
-import { Doctor } from '../src/analysis/doctor.js';
-import type { DoctorFinding } from '../src/analysis/doctor-types.js';
+import { captureSpan } from '../src/report/capture-span.js';
+import { decodeCapture } from '../src/report/capture-pass.js';
+import { Doctor } from '../src/report/doctor.js';
+import type { DoctorFinding } from '../src/report/doctor-types.js';
 // Not part of the package's surface: where the scan starts, to check it does leave bytes out.
-import { firstScanned } from '../src/analysis/capture-pass.js';
+import { firstScanned } from '../src/report/capture-pass.js';
 import { CaptureWriter } from '../src/capture/writer.js';
 import { readCapture } from '../src/capture/sniff.js';
 import type { Capture } from '../src/capture/model.js';

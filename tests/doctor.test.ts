@@ -6,12 +6,12 @@
 import { existsSync, readFileSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 import { describe, expect, it } from 'vitest';
-import { diagnosedHealthReport } from '../src/analysis/doctor-report.js';
-import { Doctor } from '../src/analysis/doctor.js';
-import { doctorCapture } from '../src/analysis/doctor-capture.js';
-import { doctorEvent } from '../src/analysis/doctor-events.js';
-import { reportHtml } from '../src/analysis/report-html.js';
-import type { DoctorFinding, DoctorOptions } from '../src/analysis/doctor-types.js';
+import { diagnosedHealthReport } from '../src/report/doctor-report.js';
+import { Doctor } from '../src/report/doctor.js';
+import { doctorCapture } from '../src/report/doctor-capture.js';
+import { doctorEvent } from '../src/report/doctor-events.js';
+import { reportHtml } from '../src/report/report-html.js';
+import type { DoctorFinding, DoctorOptions } from '../src/report/doctor-types.js';
 import { LinkMonitor } from '../src/decoder/link.js';
 import { SpektrumDecoder } from '../src/decoder/decoder.js';
 import { USB_CHUNK_JITTER_US } from '../src/decoder/spec.js';

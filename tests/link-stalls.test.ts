@@ -9,7 +9,7 @@ import { describe, expect, it } from 'vitest';
 import { USB_CHUNK_JITTER_US } from '../src/decoder/spec.js';
 import { LinkMonitor } from '../src/decoder/link.js';
 import type { DecodedFrame } from '../src/decoder/types.js';
-import { summarizeCapture } from '../src/analysis/summary.js';
+import { summarizeCapture } from '../src/report/summary.js';
 import { preset } from '../src/simulator/presets.js';
 import { Prng } from '../src/simulator/prng.js';
 import { simulate } from '../src/simulator/simulator.js';

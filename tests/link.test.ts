@@ -4,7 +4,7 @@ import { BYTE_TIME_US } from '../src/decoder/spec.js';
 import { LinkMonitor } from '../src/decoder/link.js';
 import { HOLD_MIN_US } from '../src/decoder/link-rules.js';
 import type { DecodedFrame } from '../src/decoder/types.js';
-import { LinkSeries, monitorWithSeries } from '../src/analysis/series.js';
+import { LinkSeries, monitorWithSeries } from '../src/report/series.js';
 
 /** A stand-in frame: only what the monitor reads. `fades: null` is a receiver without a counter. */
 function frame(timeUs: number, fadesDelta = 0, system: number | null = 0xb2, fades: number | null = 0): DecodedFrame {

@@ -1,6 +1,6 @@
 /**
  * The report decodes each port once and feeds the link monitor, the series, its own figures and
- * the doctor from that one decode (src/analysis/capture-pass.ts). Here the same captures are
+ * the doctor from that one decode (src/report/capture-pass.ts). Here the same captures are
  * read the long way, in separate passes built from the library's parts: every port decoded on
  * its own, §8's resolution key applied as written (every port read on its own, then every port
  * that is not an internal remote read again with the key, kept if it reads at least as many
@@ -18,16 +18,16 @@ import { captureChunks, type Capture } from '../src/capture/model.js';
 import { capturePorts } from '../src/capture/facts.js';
 import { encodeCapture, type CaptureRecordInput } from '../src/capture/writer.js';
 import { readCapture } from '../src/capture/sniff.js';
-import { Doctor } from '../src/analysis/doctor.js';
-import { captureSpan } from '../src/analysis/capture-span.js';
-import { diagnosedHealthReport } from '../src/analysis/doctor-report.js';
-import { doctorCapture } from '../src/analysis/doctor-capture.js';
-import { doctorEvent } from '../src/analysis/doctor-events.js';
-import { healthReport } from '../src/analysis/report.js';
-import { resolutionKey } from '../src/analysis/resolution-key.js';
-import { summarizeCapture } from '../src/analysis/summary.js';
-import { timingJitterUs } from '../src/analysis/capture-pass.js';
-import { SLICE_BYTES } from '../src/analysis/capture-pass.js';
+import { Doctor } from '../src/report/doctor.js';
+import { captureSpan } from '../src/report/capture-span.js';
+import { diagnosedHealthReport } from '../src/report/doctor-report.js';
+import { doctorCapture } from '../src/report/doctor-capture.js';
+import { doctorEvent } from '../src/report/doctor-events.js';
+import { healthReport } from '../src/report/report.js';
+import { resolutionKey } from '../src/report/resolution-key.js';
+import { summarizeCapture } from '../src/report/summary.js';
+import { timingJitterUs } from '../src/report/capture-pass.js';
+import { SLICE_BYTES } from '../src/report/capture-pass.js';
 import { preset } from '../src/simulator/presets.js';
 import { simulate } from '../src/simulator/simulator.js';
 import { perByteCapture, usbChunks } from './feeds.js';

@@ -47,7 +47,7 @@ describe('the npm package', () => {
     expect(Object.keys(exports)).toEqual(['.', './capture', './report', './simulator', './package.json']);
     for (const [name, entry] of Object.entries(exports))
       if (name !== './package.json') expect(Object.keys(entry)).toEqual(['types', 'default']);
-    expect((exports['./report'] as Record<string, string>).default).toBe('./dist/analysis/index.js');
+    expect((exports['./report'] as Record<string, string>).default).toBe('./dist/report/index.js');
     expect(pkg.bin).toEqual({ satscope: './dist/cli/main.js' });
   });
 
@@ -56,12 +56,12 @@ describe('the npm package', () => {
     expect(files).toContain('dist/capture/index.js');
     expect(files).toContain('dist/decoder/index.d.ts');
     expect(files).toContain('dist/simulator/index.js');
-    expect(files).toContain('dist/analysis/index.js');
+    expect(files).toContain('dist/report/index.js');
     expect(files).toContain('dist/cli/main.js');
     expect(files).toContain('README.md');
     expect(files).toContain('LICENSE');
     const stray = files.filter(
-      (f) => !/^(dist\/(decoder|capture|analysis|simulator|cli)\/.+\.(js|d\.ts)|README\.md|LICENSE|package\.json)$/.test(f),
+      (f) => !/^(dist\/(decoder|capture|report|simulator|cli)\/.+\.(js|d\.ts)|README\.md|LICENSE|package\.json)$/.test(f),
     );
     expect(stray).toEqual([]);
   });

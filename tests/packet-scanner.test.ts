@@ -5,7 +5,7 @@
  */
 import fc from 'fast-check';
 import { describe, expect, it } from 'vitest';
-import { PacketScanner, type PacketKind } from '../src/analysis/doctor-line.js';
+import { PacketScanner, type PacketKind } from '../src/report/doctor-line.js';
 import { crsfStream, ibusStream, sbusStream, srxl2Stream, srxlV1Stream } from '../src/simulator/protocols.js';
 import { preset } from '../src/simulator/presets.js';
 import { receiveAs } from '../src/simulator/line.js';

@@ -1,5 +1,5 @@
 import { describe, expect, it } from 'vitest';
-import type { DoctorFinding } from '../src/analysis/doctor-types.js';
+import type { DoctorFinding } from '../src/report/doctor-types.js';
 import { splitFindings } from '../src/app/components/Diagnosis/current.js';
 import { type LinkFacts, linkView, sinceLastFrame } from '../src/app/components/LinkPanel/view.js';
 import { setText } from '../src/app/text.js';

@@ -7,7 +7,7 @@ import { readFileSync } from 'node:fs';
 import { join } from 'node:path';
 import { describe, expect, it } from 'vitest';
 
-const ENTRIES = { satscope: 'decoder', 'satscope/capture': 'capture', 'satscope/report': 'analysis', 'satscope/simulator': 'simulator' };
+const ENTRIES = { satscope: 'decoder', 'satscope/capture': 'capture', 'satscope/report': 'report', 'satscope/simulator': 'simulator' };
 const SRC = join(import.meta.dirname, '../src');
 
 /** Each exported name of an entry and the module (file name) that declares it. */

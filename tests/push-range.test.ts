@@ -6,7 +6,7 @@
  * same state. A range that is not one of the bytes is refused.
  */
 import { describe, expect, it } from 'vitest';
-import { Doctor } from '../src/analysis/doctor.js';
+import { Doctor } from '../src/report/doctor.js';
 import type { DecoderEvent } from '../src/decoder/types.js';
 import { SpektrumDecoder } from '../src/decoder/decoder.js';
 import { ibusStream } from '../src/simulator/protocols.js';

@@ -5,7 +5,7 @@
  * chunk counts and chunk numbers, whether the times never go back, and the span with its events.
  */
 import { describe, expect, it } from 'vitest';
-import { captureSpan, spanBetween } from '../src/analysis/capture-span.js';
+import { captureSpan, spanBetween } from '../src/report/capture-span.js';
 import { BYTE_TIME_US } from '../src/decoder/spec.js';
 import { RecordTally } from '../src/capture/record-tally.js';
 import { captureChunksByPort, capturePortIndex, capturePorts, captureTimesInOrder } from '../src/capture/facts.js';

@@ -18,8 +18,8 @@ import { CHECKPOINT_US, ReplayPass, checkpointDue } from '../src/worker/replay/r
 import { checkpointChunks } from '../src/worker/replay/replay-split.js';
 import { passOverFile } from '../src/worker/replay/replay-file-pass.js';
 import { type PreviewSizes, previewOf } from '../src/worker/replay/replay-preview.js';
-import { captureSpan } from '../src/analysis/capture-span.js';
-import { healthReport } from '../src/analysis/report.js';
+import { captureSpan } from '../src/report/capture-span.js';
+import { healthReport } from '../src/report/report.js';
 import type { Overview } from '../src/worker/protocol.js';
 import { MINUTE, libraryUpTo, longCapture, longCaptureWithSeed } from './long-capture.js';
 import { FakeClock, ReadingClock, fakeHost } from './worker-fakes.js';

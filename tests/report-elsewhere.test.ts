@@ -5,10 +5,10 @@
  * together. Readings guessed wrong (another resolution than the report asks for) are not used.
  */
 import { describe, expect, it } from 'vitest';
-import { diagnosedHealthReport } from '../src/analysis/doctor-report.js';
-import { Doctor } from '../src/analysis/doctor.js';
-import { diagnosedReportJobs } from '../src/analysis/doctor-report.js';
-import { readPortMessage, sameReading, type PortReadingMessage } from '../src/analysis/report-port-message.js';
+import { diagnosedHealthReport } from '../src/report/doctor-report.js';
+import { Doctor } from '../src/report/doctor.js';
+import { diagnosedReportJobs } from '../src/report/doctor-report.js';
+import { readPortMessage, sameReading, type PortReadingMessage } from '../src/report/report-port-message.js';
 import type { Capture } from '../src/capture/model.js';
 import { crsfStream, ibusStream, srxlV1Stream } from '../src/simulator/protocols.js';
 import { preset } from '../src/simulator/presets.js';

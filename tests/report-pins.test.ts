@@ -8,9 +8,9 @@
 import { existsSync, readFileSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 import { describe, expect, it } from 'vitest';
-import { diagnosedHealthReport } from '../src/analysis/doctor-report.js';
-import { doctorCapture } from '../src/analysis/doctor-capture.js';
-import { summarizeCapture } from '../src/analysis/summary.js';
+import { diagnosedHealthReport } from '../src/report/doctor-report.js';
+import { doctorCapture } from '../src/report/doctor-capture.js';
+import { summarizeCapture } from '../src/report/summary.js';
 import { importSaleaeCsv } from '../src/capture/saleae.js';
 import type { Capture } from '../src/capture/model.js';
 import { ibusStream, srxlV1Stream } from '../src/simulator/protocols.js';

@@ -7,16 +7,16 @@
  * 1024 and 2048 resolution and on X-Plus channels, timed and untimed.
  */
 import { describe, expect, it } from 'vitest';
-import { decodeCapture } from '../src/analysis/capture-pass.js';
-import { healthReport } from '../src/analysis/report.js';
-import { REPORT_THRESHOLDS, SPIKE_MIN_JUMP_PERCENT } from '../src/analysis/report-thresholds.js';
+import { decodeCapture } from '../src/report/capture-pass.js';
+import { healthReport } from '../src/report/report.js';
+import { REPORT_THRESHOLDS, SPIKE_MIN_JUMP_PERCENT } from '../src/report/report-thresholds.js';
 import { importRaw } from '../src/capture/raw.js';
 import type { Capture } from '../src/capture/model.js';
 import { channelName, channelResolution, servoToMicros, servoToPercent } from '../src/decoder/spec.js';
 import { Prng } from '../src/simulator/prng.js';
 import { preset } from '../src/simulator/presets.js';
 import { simulate, type SimChunk } from '../src/simulator/simulator.js';
-import { SpikeFinder } from '../src/analysis/spikes.js';
+import { SpikeFinder } from '../src/report/spikes.js';
 import { perByteCapture } from './feeds.js';
 
 const SECOND = 1_000_000;

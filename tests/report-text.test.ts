@@ -1,6 +1,6 @@
 /** The clock every surface writes capture times in (info, report, doctor, the replay bar). */
 import { describe, expect, it } from 'vitest';
-import { formatClock } from '../src/analysis/report-text.js';
+import { formatClock } from '../src/report/report-text.js';
 
 describe('formatClock', () => {
   it('rounds to a tenth before it splits minutes and seconds: never 0:010.0 or 0:60.0', () => {

@@ -11,7 +11,7 @@ import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
 import { pathToFileURL } from 'node:url';
 import { afterAll, describe, expect, it } from 'vitest';
-import { diagnosedHealthReport, diagnosedReportJobs } from '../src/analysis/doctor-report.js';
+import { diagnosedHealthReport, diagnosedReportJobs } from '../src/report/doctor-report.js';
 import { parseCapture } from '../src/capture/reader.js';
 import { readCapture } from '../src/capture/sniff.js';
 import type { Capture } from '../src/capture/model.js';

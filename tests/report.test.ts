@@ -3,7 +3,7 @@
  * from the simulator, checked against its ground truth; and on the real PX4 captures when they
  * are beside the repository. The CLI tests need `npm run build:lib` first (`npm test` does it).
  */
-import { DATA_COLORS } from '../src/analysis/palette.js';
+import { DATA_COLORS } from '../src/report/palette.js';
 import { existsSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
@@ -14,12 +14,12 @@ import { importRaw } from '../src/capture/raw.js';
 import { importSaleaeCsv } from '../src/capture/saleae.js';
 import { readCapture } from '../src/capture/sniff.js';
 import type { Capture, CaptureMeta } from '../src/capture/model.js';
-import { diagnosedHealthReport } from '../src/analysis/doctor-report.js';
-import { reportHtml } from '../src/analysis/report-html.js';
-import { escapeHtml } from '../src/analysis/report-text.js';
-import { healthReport } from '../src/analysis/report.js';
-import { SPIKE_MIN_JUMP_PERCENT } from '../src/analysis/report-thresholds.js';
-import type { HealthReport } from '../src/analysis/report-types.js';
+import { diagnosedHealthReport } from '../src/report/doctor-report.js';
+import { reportHtml } from '../src/report/report-html.js';
+import { escapeHtml } from '../src/report/report-text.js';
+import { healthReport } from '../src/report/report.js';
+import { SPIKE_MIN_JUMP_PERCENT } from '../src/report/report-thresholds.js';
+import type { HealthReport } from '../src/report/report-types.js';
 import { encodeServo2048 } from '../src/simulator/encode.js';
 import { preset } from '../src/simulator/presets.js';
 import { simulate, type SimChunk } from '../src/simulator/simulator.js';

@@ -1,11 +1,11 @@
 /**
- * The binned series of a link (src/analysis/series.ts), column by column: every bin's frames,
+ * The binned series of a link (src/report/series.ts), column by column: every bin's frames,
  * fades, lost frames, RSSI and intervals are the plain sums of what the monitor decided for
  * each frame, in the bin the frame's time falls in, whenever the series is read (in the middle
  * of a bin too) and in its checkpoint.
  */
 import { describe, expect, it } from 'vitest';
-import { LinkSeries, monitorWithSeries } from '../src/analysis/series.js';
+import { LinkSeries, monitorWithSeries } from '../src/report/series.js';
 import type { DecodedFrame } from '../src/decoder/types.js';
 import { LinkMonitor } from '../src/decoder/link.js';
 import { SpektrumDecoder } from '../src/decoder/decoder.js';

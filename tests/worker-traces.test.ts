@@ -4,7 +4,7 @@
  * own rule finds, the same ones `satscope report` lists.
  */
 import { describe, expect, it } from 'vitest';
-import { healthReport } from '../src/analysis/report.js';
+import { healthReport } from '../src/report/report.js';
 import { CHANNEL_COUNT, channelResolution, servoToMicros } from '../src/decoder/spec.js';
 import { SpektrumDecoder } from '../src/decoder/decoder.js';
 import { preset } from '../src/simulator/presets.js';

@@ -8,7 +8,7 @@ import { encodeCapture } from '../src/capture/writer.js';
 import { importRaw } from '../src/capture/raw.js';
 import { readCapture } from '../src/capture/sniff.js';
 import type { Capture } from '../src/capture/model.js';
-import { captureSpan } from '../src/analysis/capture-span.js';
+import { captureSpan } from '../src/report/capture-span.js';
 import type { Batch } from '../src/worker/protocol.js';
 import { preset } from '../src/simulator/presets.js';
 import { simulate } from '../src/simulator/simulator.js';

@@ -5,7 +5,7 @@
  * their colours from `chartColors()` and are rebuilt when `theme` changes.
  */
 import { computed, signal } from '@preact/signals';
-import { type DataColors, DATA_COLORS } from '../analysis/palette.js';
+import { type DataColors, DATA_COLORS } from '../report/palette.js';
 
 export type Theme = 'light' | 'dark';
 

@@ -7,12 +7,12 @@
  */
 import { basename } from 'node:path';
 import { parseArgs } from 'node:util';
-import { doctorCapture, type DoctorReport } from '../analysis/doctor-capture.js';
-import { formatClock } from '../analysis/report-text.js';
-import type { DoctorFinding } from '../analysis/doctor-types.js';
+import { doctorCapture, type DoctorReport } from '../report/doctor-capture.js';
+import { formatClock } from '../report/report-text.js';
+import type { DoctorFinding } from '../report/doctor-types.js';
 import { loadCapture } from './input.js';
 import { TIMING_WORDS } from './format.js';
-import { plural } from '../analysis/report-text.js';
+import { plural } from '../report/report-text.js';
 
 export const DOCTOR_USAGE = `Usage:
   satscope doctor FILE [--json] [--resolution auto|1024|2048]

@@ -1,12 +1,12 @@
 /** Text forms of frames and summaries for the CLI. */
-import type { HealthReport, ReportFinding } from '../analysis/report-types.js';
-import type { CaptureSummary } from '../analysis/summary.js';
-import { formatClock, plural } from '../analysis/report-text.js';
+import type { HealthReport, ReportFinding } from '../report/report-types.js';
+import type { CaptureSummary } from '../report/summary.js';
+import { formatClock, plural } from '../report/report-text.js';
 import type { CaptureTiming } from '../capture/model.js';
 import { systemInfo } from '../decoder/spec.js';
 
 // One frame a line, as `satscope decode` prints it: the library's, which the page's export uses too.
-export { formatCsvHeader, formatCsvLine, formatJsonLine } from '../analysis/frame-text.js';
+export { formatCsvHeader, formatCsvLine, formatJsonLine } from '../report/frame-text.js';
 
 const ms = (us: number): string => `${(us / 1000).toFixed(us < 100_000 ? 2 : 0)} ms`;
 const hex = (v: number): string => `0x${v.toString(16).toUpperCase().padStart(2, '0')}`;

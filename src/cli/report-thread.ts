@@ -3,7 +3,7 @@
  * given (`readPortMessage`) one after another and posts each. Whatever goes wrong is posted as
  * an error instead: the report's thread then decodes that port itself.
  */
-import type { PortReadingJob, PortReadingMessage } from '../analysis/report-port-message.js';
+import type { PortReadingJob, PortReadingMessage } from '../report/report-port-message.js';
 import type { Capture } from '../capture/model.js';
 import { workerSide } from './waited-worker.js';
 
@@ -21,7 +21,7 @@ const send = (result: ReportThreadResult): void => post(result);
 
 try {
   // Loaded here rather than imported above: a module that fails to load is posted too.
-  const { readPortMessage } = await import('../analysis/report-port-message.js');
+  const { readPortMessage } = await import('../report/report-port-message.js');
   for (const job of data.jobs) {
     try {
       send({ ok: readPortMessage(data.capture, job) });

@@ -8,9 +8,9 @@
  * The report is synchronous, so this thread waits for a reading without an event loop
  * (`WaitedWorker`).
  */
-import { diagnosedHealthReport, diagnosedReportJobs } from '../analysis/doctor-report.js';
-import { sameReading, type PortReadingMessage } from '../analysis/report-port-message.js';
-import type { HealthReport, HealthReportOptions } from '../analysis/report-types.js';
+import { diagnosedHealthReport, diagnosedReportJobs } from '../report/doctor-report.js';
+import { sameReading, type PortReadingMessage } from '../report/report-port-message.js';
+import type { HealthReport, HealthReportOptions } from '../report/report-types.js';
 import type { Capture } from '../capture/model.js';
 import type { ReportThreadData, ReportThreadResult } from './report-thread.js';
 import { secondCore, WaitedWorker } from './waited-worker.js';

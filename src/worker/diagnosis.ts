@@ -1,5 +1,5 @@
 /**
- * The doctor in the worker (src/analysis): one `Doctor` per session, fed through the same path
+ * The doctor in the worker (src/report): one `Doctor` per session, fed through the same path
  * as the decoders: each engine's bytes and frames (its `tap`), each port's opening, read errors
  * and loss. Its findings go to the page when they change, at most 4× a second.
  *
@@ -9,9 +9,9 @@
  * decoders. Live ports can be asked to listen briefly at another line setting to confirm a
  * finding (`confirm`), and return to 115200.
  */
-import { Doctor } from '../analysis/doctor.js';
-import { doctorEvent } from '../analysis/doctor-events.js';
-import type { ConfirmProbe, DoctorFinding } from '../analysis/doctor-types.js';
+import { Doctor } from '../report/doctor.js';
+import { doctorEvent } from '../report/doctor-events.js';
+import type { ConfirmProbe, DoctorFinding } from '../report/doctor-types.js';
 import type { Capture } from '../capture/model.js';
 import type { Engine } from './engine.js';
 import { BROWSER_CLOCK, type Clock } from './host.js';

@@ -4,8 +4,8 @@
  * line formatter, the same frames and the same text. A span keeps the frames whose time falls
  * in it, as a user selects part of a capture; without timing there is no span, only the whole.
  */
-import { decodeCapture } from '../analysis/capture-pass.js';
-import { formatCsvHeader, formatCsvLine, formatJsonLine } from '../analysis/frame-text.js';
+import { decodeCapture } from '../report/capture-pass.js';
+import { formatCsvHeader, formatCsvLine, formatJsonLine } from '../report/frame-text.js';
 import type { Capture } from '../capture/model.js';
 
 export interface FramesExport {

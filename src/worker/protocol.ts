@@ -7,7 +7,7 @@
 import type { FormatInfo } from '../decoder/types.js';
 import type { LinkState, MissedBasis } from '../decoder/link-types.js';
 import type { InspectEntry } from './inspector.js';
-import type { ConfirmProbe, DoctorFinding } from '../analysis/doctor-types.js';
+import type { ConfirmProbe, DoctorFinding } from '../report/doctor-types.js';
 
 /** How the page names a port it was granted: its place in getPorts() and its USB IDs. */
 export interface PortIdentity {
@@ -226,7 +226,7 @@ export type FromWorker =
   | { type: 'inspection'; source: number; entries: InspectEntry[] }
   | { type: 'diagnosis'; diagnosis: DiagnosisStatus };
 
-/** The doctor's findings (src/analysis), sent when they change, at most 4× a second. */
+/** The doctor's findings (src/report), sent when they change, at most 4× a second. */
 export interface DiagnosisStatus {
   /** 'live': about the session now; 'replay': at the replay position, on the capture's clock. */
   mode: 'live' | 'replay';

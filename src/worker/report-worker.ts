@@ -6,8 +6,8 @@
 /// <reference lib="webworker" />
 import type { Capture } from '../capture/model.js';
 import { readCapture } from '../capture/sniff.js';
-import { diagnosedHealthReport } from '../analysis/doctor-report.js';
-import { reportHtml } from '../analysis/report-html.js';
+import { diagnosedHealthReport } from '../report/doctor-report.js';
+import { reportHtml } from '../report/report-html.js';
 import { type FramesExport, framesFile } from './frames-export.js';
 
 export interface ReportRequest {

@@ -3,7 +3,7 @@
  * remote (spec §8: "the internal remote provides the key for … all remotes") unless their bytes
  * refuse it, and a forced resolution that matches no frame is told to the user once.
  */
-import { resolutionKey } from '../analysis/resolution-key.js';
+import { resolutionKey } from '../report/resolution-key.js';
 import { type Host, notice } from './host.js';
 import type { Source, SourceRegistry } from './registry.js';
 

@@ -5,7 +5,7 @@
  * gathered between two batches and handed over as typed arrays with the batch. At most
  * MAX_TRACE_ROWS frames wait: what the page keeps at most; older ones, never shown, are dropped.
  */
-import { SpikeFinder } from '../analysis/spikes.js';
+import { SpikeFinder } from '../report/spikes.js';
 import { CHANNEL_COUNT, channelResolution, servoToMicros } from '../decoder/spec.js';
 import type { DecodedFrame } from '../decoder/types.js';
 import type { TraceBatch } from './protocol.js';

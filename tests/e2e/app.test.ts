@@ -16,9 +16,9 @@ import { captureChunks } from '../../src/capture/model.js';
 import { capturePorts } from '../../src/capture/facts.js';
 import { parseCapture } from '../../src/capture/reader.js';
 import { readCapture } from '../../src/capture/sniff.js';
-import { captureSpan } from '../../src/analysis/capture-span.js';
-import { decodeCapture } from '../../src/analysis/capture-pass.js';
-import { summarizeCapture } from '../../src/analysis/summary.js';
+import { captureSpan } from '../../src/report/capture-span.js';
+import { decodeCapture } from '../../src/report/capture-pass.js';
+import { summarizeCapture } from '../../src/report/summary.js';
 import { preset } from '../../src/simulator/presets.js';
 import { simulate } from '../../src/simulator/simulator.js';
 import {

@@ -10,7 +10,7 @@ import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import type { Page } from 'playwright-core';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
-import { healthReport } from '../../src/analysis/report.js';
+import { healthReport } from '../../src/report/report.js';
 import { preset } from '../../src/simulator/presets.js';
 import { simulate, type SimChunk } from '../../src/simulator/simulator.js';
 import { perByteCapture } from '../feeds.js';

@@ -14,7 +14,7 @@ import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { importRaw } from '../../src/capture/raw.js';
 import { importSaleaeCsv } from '../../src/capture/saleae.js';
 import { parseCapture } from '../../src/capture/reader.js';
-import { summarizeCapture } from '../../src/analysis/summary.js';
+import { summarizeCapture } from '../../src/report/summary.js';
 import { preset } from '../../src/simulator/presets.js';
 import { simulate } from '../../src/simulator/simulator.js';
 import { perByteCapture } from '../feeds.js';

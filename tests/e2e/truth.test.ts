@@ -19,7 +19,7 @@ import type { Capture } from '../../src/capture/model.js';
 import { LinkMonitor } from '../../src/decoder/link.js';
 import { SpektrumDecoder } from '../../src/decoder/decoder.js';
 import { USB_CHUNK_JITTER_US } from '../../src/decoder/spec.js';
-import { summarizeCapture } from '../../src/analysis/summary.js';
+import { summarizeCapture } from '../../src/report/summary.js';
 import { preset } from '../../src/simulator/presets.js';
 import { simulate } from '../../src/simulator/simulator.js';
 import { resolutionSource } from '../../src/app/components/SystemBadge/words.js';

@@ -12,7 +12,7 @@ import { join } from 'node:path';
 import type { Page } from 'playwright-core';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { readCapture } from '../../src/capture/sniff.js';
-import { summarizeCapture } from '../../src/analysis/summary.js';
+import { summarizeCapture } from '../../src/report/summary.js';
 import { preset } from '../../src/simulator/presets.js';
 import { simulate } from '../../src/simulator/simulator.js';
 import { agoLabel, agoSplits, decimals, niceSplits, niceTop, timeStep } from '../../src/app/axes.js';

@@ -8,9 +8,9 @@ import { FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US, FRAME_SIZE, systemInfo } fr
 import type { FormatInfo } from '../../decoder/types.js';
 import { episodeEndAt, type LinkEpisode } from '../../decoder/episode.js';
 import type { Capture } from '../../capture/model.js';
-import type { LinkSeries } from '../../analysis/series.js';
-import { captureSpan } from '../../analysis/capture-span.js';
-import { decodeCapture } from '../../analysis/capture-pass.js';
+import type { LinkSeries } from '../../report/series.js';
+import { captureSpan } from '../../report/capture-span.js';
+import { decodeCapture } from '../../report/capture-pass.js';
 import type { Overview } from '../protocol.js';
 
 /** The overview's widest bins: one second (a long capture's). */

@@ -11,9 +11,9 @@ import type { LinkMonitor } from '../../decoder/link.js';
 import { SpektrumDecoder } from '../../decoder/decoder.js';
 import type { Capture } from '../../capture/model.js';
 import { recordTimeUs } from '../../capture/record-walk.js';
-import { LinkSeries, monitorWithSeries } from '../../analysis/series.js';
-import { timingJitterUs } from '../../analysis/capture-pass.js';
-import { recordedStops, StopCursor } from '../../analysis/doctor-events.js';
+import { LinkSeries, monitorWithSeries } from '../../report/series.js';
+import { timingJitterUs } from '../../report/capture-pass.js';
+import { recordedStops, StopCursor } from '../../report/doctor-events.js';
 import { failsafeAsRead, failsafesOf, overviewBinUs, sumOverview } from './overview.js';
 import type { Overview } from '../protocol.js';
 

@@ -12,7 +12,7 @@ import type { SlicedFile } from '../../capture/record-walk.js';
 import { captureChunksByPort, capturePorts } from '../../capture/facts.js';
 import { hasCaptureMagic } from '../../capture/layout.js';
 import { parseCapture } from '../../capture/reader.js';
-import { captureSpan } from '../../analysis/capture-span.js';
+import { captureSpan } from '../../report/capture-span.js';
 import { type CaptureTotals, readCaptureTotals } from '../../capture/capture-index.js';
 
 /** A file this large gets a preview: under it, reading it whole is as quick. */

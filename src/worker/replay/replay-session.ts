@@ -6,13 +6,13 @@
  * grows, and a seek starts from that decode's nearest checkpoint. Others get their overview at
  * once (overview.ts) and seek with fresh decodes.
  */
-import { plural } from '../../analysis/report-text.js';
+import { plural } from '../../report/report-text.js';
 import { CaptureFormatError, type Capture } from '../../capture/model.js';
 import { capturePorts } from '../../capture/facts.js';
 import { readCapture } from '../../capture/sniff.js';
 import { FRAME_PERIOD_11MS_US } from '../../decoder/spec.js';
-import { captureSpan } from '../../analysis/capture-span.js';
-import { timingJitterUs } from '../../analysis/capture-pass.js';
+import { captureSpan } from '../../report/capture-span.js';
+import { timingJitterUs } from '../../report/capture-pass.js';
 import type { Batcher } from '../batcher.js';
 import type { Diagnosis } from '../diagnosis.js';
 import { type Host, notice } from '../host.js';

@@ -16,7 +16,7 @@
  */
 import type { Capture, ParsedCapture } from '../../capture/model.js';
 import { captureTimesInOrder, seedChunkFacts } from '../../capture/facts.js';
-import { seedCaptureSpan } from '../../analysis/capture-span.js';
+import { seedCaptureSpan } from '../../report/capture-span.js';
 import type { Clock } from '../host.js';
 import { addOverviews } from './overview.js';
 import { PieceReader, type ReadableFile } from './piece-reader.js';

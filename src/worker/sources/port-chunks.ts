@@ -5,7 +5,7 @@
 import { BYTE_TIME_US } from '../../decoder/spec.js';
 import { captureTimesInOrder } from '../../capture/facts.js';
 import { chunkFirstByteUs, type Capture } from '../../capture/model.js';
-import { recordedStops, StopCursor } from '../../analysis/doctor-events.js';
+import { recordedStops, StopCursor } from '../../report/doctor-events.js';
 
 /** One chunk's bytes with their times. */
 export interface Chunk {

@@ -7,7 +7,7 @@
 import { FRAME_PERIOD_11MS_US, FRAME_SIZE } from '../../decoder/spec.js';
 import { capturePortIndex, capturePorts } from '../../capture/facts.js';
 import type { Capture } from '../../capture/model.js';
-import { captureSpan } from '../../analysis/capture-span.js';
+import { captureSpan } from '../../report/capture-span.js';
 import { BROWSER_CLOCK, type Clock } from '../host.js';
 import { PortChunks } from './port-chunks.js';
 

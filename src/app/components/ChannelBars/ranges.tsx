@@ -4,7 +4,7 @@
  * bars, and written only while open, four times a second at most.
  */
 import { useEffect, useRef, useState } from 'preact/hooks';
-import { formatClock } from '../../../analysis/report-text.js';
+import { formatClock } from '../../../report/report-text.js';
 import { channelName } from '../../../decoder/spec.js';
 import { onFrame } from '../../frame-loop.js';
 import type { Live } from '../../live.js';

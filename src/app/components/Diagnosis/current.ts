@@ -3,7 +3,7 @@
  * gone (unplugged) describes a link that no longer exists: it is kept, as what was seen before
  * the loss, but never shown as current (nor as the worst finding under the link state).
  */
-import type { DoctorFinding } from '../../../analysis/doctor-types.js';
+import type { DoctorFinding } from '../../../report/doctor-types.js';
 
 export interface SplitFindings {
   /** About a port still read, or the whole session: worst first. */

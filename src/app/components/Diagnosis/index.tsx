@@ -1,5 +1,5 @@
 /**
- * The doctor's findings (src/analysis, fed by the worker): what is wrong with the setup and what
+ * The doctor's findings (src/report, fed by the worker): what is wrong with the setup and what
  * to change, worst first, each with its evidence, how sure it is, what to do and the flight
  * stack's settings. A finding appears once its evidence suffices and goes when it no longer
  * holds; in replay, the findings at the replay position. "Copy settings" puts the chosen flight
@@ -9,10 +9,10 @@
  */
 import { computed, signal } from '@preact/signals';
 import { useState } from 'preact/hooks';
-import type { DoctorFinding } from '../../../analysis/doctor-types.js';
-import type { FlightStack } from '../../../analysis/doctor-stacks.js';
+import type { DoctorFinding } from '../../../report/doctor-types.js';
+import type { FlightStack } from '../../../report/doctor-stacks.js';
 import { diagnosis, replayReading, send, sources } from '../../store.js';
-import { plural } from '../../../analysis/report-text.js';
+import { plural } from '../../../report/report-text.js';
 import { splitFindings } from './current.js';
 import './style.css';
 

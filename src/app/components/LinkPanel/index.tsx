@@ -12,7 +12,7 @@ import { setText } from '../../text.js';
 import { drawEpisodes } from '../../timeline.js';
 import { TopFinding } from '../Diagnosis/index.js';
 import { linkView, sinceLastFrame } from './view.js';
-import { plural } from '../../../analysis/report-text.js';
+import { plural } from '../../../report/report-text.js';
 import './style.css';
 
 // The state, its hint and the panel's colour as signals bound to the DOM: a Live/Hold flip

@@ -4,7 +4,7 @@
  * there; an ended one says it ended; a port that is gone says so (no frame can arrive, so the
  * link's state is unknown), never "Live" or "Failsafe" of a link nobody can see.
  */
-import { formatClock } from '../../../analysis/report-text.js';
+import { formatClock } from '../../../report/report-text.js';
 import type { LinkState } from '../../../decoder/link-types.js';
 
 export type LinkViewKey = LinkState | 'reading' | 'paused' | 'ended' | 'lost';

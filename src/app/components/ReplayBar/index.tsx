@@ -8,7 +8,7 @@ import { computed, useComputed, useSignal } from '@preact/signals';
 import { useEffect, useRef } from 'preact/hooks';
 import uPlot from 'uplot';
 import { overview, replay, replayName, replayReading, replaySpanUs, send } from '../../store.js';
-import { formatClock } from '../../../analysis/report-text.js';
+import { formatClock } from '../../../report/report-text.js';
 import { elapsedAxis } from '../../axes.js';
 import { chartColors, theme } from '../../theme.js';
 import { overviewColumns } from './columns.js';

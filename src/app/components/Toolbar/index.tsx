@@ -10,7 +10,7 @@ import type { SourceStatus } from '../../../worker/protocol.js';
 import { recording, replayName, resolutionOverride, send, sources } from '../../store.js';
 import { chooseCapture, openCapture, setCaptureInput } from '../../open-file.js';
 import { setTheme, theme, themeChoice } from '../../theme.js';
-import { plural } from '../../../analysis/report-text.js';
+import { plural } from '../../../report/report-text.js';
 import { Menu } from '../Menu/index.js';
 import { FramesExport } from './frames-export.js';
 import './style.css';

@@ -10,7 +10,7 @@
 import { type Signal, signal, useSignal } from '@preact/signals';
 import { useEffect, useRef } from 'preact/hooks';
 import type uPlot from 'uplot';
-import { SPIKE_MIN_JUMP_PERCENT, SPIKE_RETURN_PERCENT } from '../../../analysis/report-thresholds.js';
+import { SPIKE_MIN_JUMP_PERCENT, SPIKE_RETURN_PERCENT } from '../../../report/report-thresholds.js';
 import { CHANNEL_COUNT, channelName } from '../../../decoder/spec.js';
 import { layeredChart } from '../../axes-layer.js';
 import { agoAxis, hoverCursor, keyboardCursor, legendTimeAt, showNewest } from '../../axes.js';

@@ -2,7 +2,7 @@
  * satscope/report: what a whole capture or a live session says. Decoding a capture
  * (`decodeCapture`, `summarizeCapture` for `satscope info`), the one binned time series every
  * graph is drawn from (`LinkSeries`), the health report (`healthReport`, rendered by
- * `reportHtml`) and the doctor's findings. Every public name of src/analysis is exported here.
+ * `reportHtml`) and the doctor's findings. Every public name of src/report is exported here.
  *
  * The doctor: findings about a satellite setup from what the wire shows.
  *
