@@ -119,6 +119,8 @@ describe('the link panel', () => {
     expect(sinceLastFrame(1_000, facts({ kind: 'replay', sourceState: 'playing', ended: true }))).toBe('1 ms before the end');
     expect(sinceLastFrame(40_000, facts({ kind: 'replay', sourceState: 'paused' }))).toBe('40 ms before this point');
     expect(sinceLastFrame(Number.NaN, facts({}))).toBe('—');
+    // The page's clock a little behind the frame's: just now.
+    expect(sinceLastFrame(-4_000, facts({}))).toBe('0 ms ago');
   });
 
   it('gives a playing replay the link state at its position, named as the capture', () => {

@@ -6,7 +6,7 @@ import { closeSync, existsSync, mkdirSync, openSync, writeFileSync, writeSync } 
 import { join, resolve } from 'node:path';
 import type { Browser, Page } from 'playwright-core';
 import { CaptureWriter } from '../../src/capture/writer.js';
-import { Simulator } from '../../src/simulator/simulator.js';
+import { Simulator, type SimChunk } from '../../src/simulator/simulator.js';
 import { preset } from '../../src/simulator/presets.js';
 import { concatBytes } from '../bytes.js';
 import { usbChunks } from '../feeds.js';
@@ -44,6 +44,57 @@ export async function startApp(): Promise<AppSession> {
       await server.close();
     },
   };
+}
+
+/** `sim` with channel slot 0 of each frame in `frames` pushed 600 steps away, for that frame only. */
+export function withSpikes(sim: SimChunk, frames: number[]): SimChunk {
+  const bytes = sim.bytes.slice();
+  for (const k of frames) {
+    const f = sim.truth?.frames[k];
+    if (f === undefined) throw new Error(`no frame ${k}`);
+    const at = f.offset + 2;
+    const w = ((bytes[at] ?? 0) << 8) | (bytes[at + 1] ?? 0);
+    const pos = w & 0x7ff;
+    const spiked = (w & ~0x7ff) | (pos > 1024 ? pos - 600 : pos + 600);
+    bytes[at] = spiked >> 8;
+    bytes[at + 1] = spiked & 0xff;
+  }
+  return { ...sim, bytes };
+}
+
+/** The sizes the page is looked at: a phone, a laptop, a desktop. */
+export const SIZES = [
+  { name: '390', width: 390, height: 844 },
+  { name: '1280', width: 1280, height: 800 },
+  { name: '1920', width: 1920, height: 1080 },
+] as const;
+
+/** A page of the app at `/${query}` in a fresh context (1280 × 800, dark unless said), with its page and console errors. */
+export async function openPage(
+  app: AppSession,
+  options: { width?: number; height?: number; scheme?: 'light' | 'dark'; query?: string } = {},
+): Promise<{ page: Page; errors: string[] }> {
+  const context = await app.browser.newContext({
+    viewport: { width: options.width ?? 1280, height: options.height ?? 800 },
+    colorScheme: options.scheme ?? 'dark',
+    acceptDownloads: true,
+  });
+  const page = await context.newPage();
+  const errors: string[] = [];
+  page.on('pageerror', (e) => errors.push(e.message));
+  page.on('console', (m) => {
+    if (m.type() === 'error') errors.push(m.text());
+  });
+  await page.goto(app.server.url(`/${options.query ?? ''}`));
+  return { page, errors };
+}
+
+/** Opens the capture at `path` for replay and plays it at full speed to its end. */
+export async function replayToEnd(page: Page, path: string): Promise<void> {
+  await page.setInputFiles('input[type=file]', path);
+  await page.locator('section.replay').waitFor();
+  await page.getByRole('radio', { name: 'max' }).click();
+  await page.locator('[data-testid="source-status"]', { hasText: '(end)' }).waitFor({ timeout: 20_000 });
 }
 
 export interface SerialAppSession extends AppSession {

@@ -12,9 +12,19 @@ import type { Page } from 'playwright-core';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { healthReport } from '../../src/report/report.js';
 import { preset } from '../../src/simulator/presets.js';
-import { simulate, type SimChunk } from '../../src/simulator/simulator.js';
+import { simulate } from '../../src/simulator/simulator.js';
 import { perByteCapture } from '../feeds.js';
-import { SHOTS, browserUnavailable, startApp, usbChunks, writeCapture, type AppSession } from './app-fixture.js';
+import {
+  SHOTS,
+  browserUnavailable,
+  openPage,
+  replayToEnd,
+  startApp,
+  usbChunks,
+  withSpikes,
+  writeCapture,
+  type AppSession,
+} from './app-fixture.js';
 
 const skip = browserUnavailable();
 if (skip !== null) console.warn(`skipping the page-in-hand tests: ${skip}`);
@@ -27,22 +37,6 @@ let spikyGlitches = 0;
 /** A 0.74 s capture with one 66 ms hold, and a clean one as short. */
 let shortHold = '';
 let shortClean = '';
-
-/** `sim` with channel slot 0 of each frame in `frames` pushed 600 steps away, for that frame only. */
-function withSpikes(sim: SimChunk, frames: number[]): SimChunk {
-  const bytes = sim.bytes.slice();
-  for (const k of frames) {
-    const f = sim.truth?.frames[k];
-    if (f === undefined) throw new Error(`no frame ${k}`);
-    const at = f.offset + 2;
-    const w = ((bytes[at] ?? 0) << 8) | (bytes[at + 1] ?? 0);
-    const pos = w & 0x7ff;
-    const spiked = (w & ~0x7ff) | (pos > 1024 ? pos - 600 : pos + 600);
-    bytes[at] = spiked >> 8;
-    bytes[at + 1] = spiked & 0xff;
-  }
-  return { ...sim, bytes };
-}
 
 beforeAll(async () => {
   if (skip !== null) return;
@@ -66,29 +60,7 @@ afterAll(async () => {
   rmSync(dir, { recursive: true, force: true });
 });
 
-async function open(
-  options: { width?: number; height?: number; scheme?: 'light' | 'dark'; query?: string } = {},
-): Promise<{ page: Page; errors: string[] }> {
-  const context = await app.browser.newContext({
-    viewport: { width: options.width ?? 1280, height: options.height ?? 800 },
-    colorScheme: options.scheme ?? 'dark',
-  });
-  const page = await context.newPage();
-  const errors: string[] = [];
-  page.on('pageerror', (e) => errors.push(e.message));
-  page.on('console', (m) => {
-    if (m.type() === 'error') errors.push(m.text());
-  });
-  await page.goto(app.server.url(`/${options.query ?? ''}`));
-  return { page, errors };
-}
-
-async function replayed(page: Page, path: string): Promise<void> {
-  await page.setInputFiles('input[type=file]', path);
-  await page.locator('section.replay').waitFor();
-  await page.getByRole('radio', { name: 'max' }).click();
-  await page.locator('[data-testid="source-status"]', { hasText: '(end)' }).waitFor({ timeout: 20_000 });
-}
+const open = (options: Parameters<typeof openPage>[1] = {}) => openPage(app, options);
 
 /** The traces chart's series as uPlot holds them: labels and how many points have a value. */
 async function traceSeries(page: Page): Promise<{ label: string; values: number }[]> {
@@ -138,7 +110,7 @@ describe.skipIf(skip !== null)('channel traces', () => {
 
   it('marks in replay exactly the glitches the health report counts, on the window fitted to the capture', async () => {
     const { page, errors } = await open({ query: '?demo=0' });
-    await replayed(page, spiky);
+    await replayToEnd(page, spiky);
     expect(spikyGlitches).toBe(3);
     // A 3.2 s capture: the 10 s window, the smallest that holds it.
     await expect(page.getByRole('radio', { name: '10 s' }).getAttribute('aria-checked')).resolves.toBe('true');
@@ -170,7 +142,7 @@ describe.skipIf(skip !== null)('channel traces', () => {
     const raw = join(dir, 'untimed.bin');
     writeFileSync(raw, simulate(preset('dsmx-11ms-2048-internal'), 2_000_000).bytes);
     const { page, errors } = await open({ query: '?demo=0' });
-    await replayed(page, raw);
+    await replayToEnd(page, raw);
     await page.locator('.traces').scrollIntoViewIfNeeded();
     await expect.poll(() => page.locator('.trace-note').textContent()).toMatch(/no times/);
     await expect(page.locator('.traces [data-chart="traces"]').isVisible()).resolves.toBe(false);
@@ -227,7 +199,7 @@ describe.skipIf(skip !== null)('a phone at 390 px', () => {
 
   it('gives every control a touch target of 40 px or more, replay speed and window included', async () => {
     const { page, errors } = await open({ width: 390, height: 844, query: '?demo=0' });
-    await replayed(page, spiky);
+    await replayToEnd(page, spiky);
     for (const name of ['graphs', 'traces', 'diagnosis', 'counters', 'system']) await page.locator(`.p-${name} .fold-toggle`).click();
     await page.getByRole('button', { name: 'Inspect frames…' }).click();
     await page.locator('.insp-table').waitFor();
@@ -326,7 +298,7 @@ async function timeline(page: Page): Promise<{ width: number; lostColumns: numbe
 describe.skipIf(skip !== null)('a short capture', () => {
   it('draws a 66 ms hold of a 0.74 s capture as long as it was, on a time axis, in the 1 s window', async () => {
     const { page, errors } = await open({ query: '?demo=0' });
-    await replayed(page, shortHold);
+    await replayToEnd(page, shortHold);
     await page.locator('.replay .overview canvas').waitFor();
     await page.waitForTimeout(300);
     const t = await timeline(page);
@@ -343,7 +315,7 @@ describe.skipIf(skip !== null)('a short capture', () => {
 
   it('gives a clean short capture a time axis and no lost-frame bar', async () => {
     const { page, errors } = await open({ query: '?demo=0' });
-    await replayed(page, shortClean);
+    await replayToEnd(page, shortClean);
     await page.locator('.replay .overview canvas').waitFor();
     await page.waitForTimeout(300);
     const t = await timeline(page);
@@ -354,62 +326,4 @@ describe.skipIf(skip !== null)('a short capture', () => {
     expect(errors).toEqual([]);
     await page.context().close();
   });
-});
-
-const SIZES = [
-  { name: '390', width: 390, height: 844 },
-  { name: '1280', width: 1280, height: 800 },
-  { name: '1920', width: 1920, height: 1080 },
-] as const;
-/** Where the screenshots go, beside the other browser tests' (opened and looked at, not compared). */
-const OUT = join(SHOTS, 'hands');
-
-describe.skipIf(skip !== null)('screenshots', () => {
-  it('of the live demo, a replay, the inspector and the traces at 390, 1280 and 1920 px, light and dark', async () => {
-    mkdirSync(OUT, { recursive: true });
-    // One page a theme and state, resized to each width (the layout follows the width alone):
-    // the demo's 3 s of history is waited for once a theme, not once a shot.
-    for (const scheme of ['light', 'dark'] as const) {
-      const demo = await open({ width: 1920, height: 1080, scheme });
-      await demo.page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor({ timeout: 10_000 });
-      // 3 s of the demo's history (270 frames at 11 ms) in the graphs and traces.
-      await demo.page.waitForFunction(() => Number(document.querySelector('[data-testid="count-frames"]')?.textContent) >= 270);
-      for (const size of SIZES) {
-        await demo.page.setViewportSize({ width: size.width, height: size.height });
-        await demo.page.evaluate(() => window.scrollTo(0, 0));
-        await demo.page.screenshot({ path: join(OUT, `demo-first-screen-${size.name}-${scheme}.png`) });
-        await demo.page.screenshot({ path: join(OUT, `demo-${size.name}-${scheme}.png`), fullPage: true });
-        if (size.width < 600) {
-          for (const name of ['graphs', 'traces']) {
-            const toggle = demo.page.locator(`.p-${name} .fold-toggle`);
-            if ((await toggle.getAttribute('aria-expanded')) !== 'true') await toggle.click();
-          }
-          await demo.page.locator('.traces canvas').waitFor();
-          await demo.page.screenshot({ path: join(OUT, `demo-unfolded-${size.name}-${scheme}.png`), fullPage: true });
-        }
-        // The traces draw while on screen: shot once drawn (their glitch count is then shown).
-        await demo.page.locator('.traces').scrollIntoViewIfNeeded();
-        await demo.page.getByTestId('glitch-count').waitFor();
-        await demo.page.locator('.traces').screenshot({ path: join(OUT, `traces-${size.name}-${scheme}.png`) });
-      }
-      await demo.page.getByRole('button', { name: 'Inspect frames…' }).click();
-      await demo.page.locator('.insp-body .row.frame').first().waitFor();
-      for (const size of SIZES) {
-        await demo.page.setViewportSize({ width: size.width, height: size.height });
-        await demo.page.locator('.p-inspector').screenshot({ path: join(OUT, `inspector-${size.name}-${scheme}.png`) });
-      }
-      await demo.page.context().close();
-      const rep = await open({ width: 390, height: 844, scheme, query: '?demo=0' });
-      await replayed(rep.page, spiky);
-      await rep.page.locator('.p-traces .fold-toggle').click();
-      for (const size of SIZES) {
-        await rep.page.setViewportSize({ width: size.width, height: size.height });
-        await rep.page.locator('.traces').scrollIntoViewIfNeeded();
-        await rep.page.getByTestId('glitch-count').waitFor();
-        await rep.page.evaluate(() => window.scrollTo(0, 0));
-        await rep.page.screenshot({ path: join(OUT, `replay-${size.name}-${scheme}.png`), fullPage: true });
-      }
-      await rep.page.context().close();
-    }
-  }, 240_000);
 });

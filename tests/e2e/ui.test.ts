@@ -16,18 +16,24 @@ import { summarizeCapture } from '../../src/report/summary.js';
 import { preset } from '../../src/simulator/presets.js';
 import { simulate } from '../../src/simulator/simulator.js';
 import { agoLabel, agoSplits, decimals, niceSplits, niceTop, timeStep } from '../../src/app/axes.js';
-import { SHOTS, browserUnavailable, shot, startApp, usbChunks, writeCapture, type AppSession } from './app-fixture.js';
+import {
+  SHOTS,
+  SIZES,
+  browserUnavailable,
+  openPage,
+  replayToEnd,
+  shot,
+  startApp,
+  usbChunks,
+  writeCapture,
+  type AppSession,
+} from './app-fixture.js';
 
 const skip = browserUnavailable();
 if (skip !== null) console.warn(`skipping the page tests: ${skip}`);
 
 const AXE_SOURCE = readFileSync(createRequire(import.meta.url).resolve('axe-core/axe.min.js'), 'utf8');
 
-const SIZES = [
-  { name: '390', width: 390, height: 844 },
-  { name: '1280', width: 1280, height: 800 },
-  { name: '1920', width: 1920, height: 1080 },
-] as const;
 const THEMES = ['light', 'dark'] as const;
 
 let app: AppSession;
@@ -53,23 +59,7 @@ afterAll(async () => {
   rmSync(dir, { recursive: true, force: true });
 });
 
-async function open(
-  options: { width?: number; height?: number; scheme?: 'light' | 'dark'; query?: string } = {},
-): Promise<{ page: Page; errors: string[] }> {
-  const context = await app.browser.newContext({
-    viewport: { width: options.width ?? 1280, height: options.height ?? 800 },
-    colorScheme: options.scheme ?? 'dark',
-    acceptDownloads: true,
-  });
-  const page = await context.newPage();
-  const errors: string[] = [];
-  page.on('pageerror', (e) => errors.push(e.message));
-  page.on('console', (m) => {
-    if (m.type() === 'error') errors.push(m.text());
-  });
-  await page.goto(app.server.url(`/${options.query ?? ''}`));
-  return { page, errors };
-}
+const open = (options: Parameters<typeof openPage>[1] = {}) => openPage(app, options);
 
 /** The document's width against the viewport's (without its scrollbar). */
 async function widths(page: Page): Promise<{ document: number; viewport: number; inner: number }> {
@@ -138,13 +128,6 @@ async function demoRunning(page: Page): Promise<void> {
   await page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor({ timeout: 10_000 });
   // Attached: on a phone the remotes' panel is folded away.
   await page.locator('.remotes .state-chip', { hasText: 'live' }).nth(1).waitFor({ state: 'attached', timeout: 10_000 });
-}
-
-async function replayed(page: Page, path: string): Promise<void> {
-  await page.setInputFiles('input[type=file]', path);
-  await page.locator('section.replay').waitFor();
-  await page.getByRole('radio', { name: 'max' }).click();
-  await page.locator('[data-testid="source-status"]', { hasText: '(end)' }).waitFor({ timeout: 20_000 });
 }
 
 describe("the graphs' axes", () => {
@@ -453,7 +436,7 @@ describe.skipIf(skip !== null)('the page on any screen', () => {
     const expected = summarizeCapture(readCapture(bytes, 'vtx.sscap')).decoder;
     expect(expected.vtxFrames).toBeGreaterThan(0);
     const { page, errors } = await open({ query: '?demo=0' });
-    await replayed(page, vtxCapture);
+    await replayToEnd(page, vtxCapture);
     await page.getByRole('button', { name: 'Inspect frames…' }).click();
     const counts = page.getByTestId('inspector-counts');
     await counts.waitFor();
@@ -500,7 +483,7 @@ describe.skipIf(skip !== null)('the page on any screen', () => {
       await demo.page.context().close();
 
       const rep = await open({ scheme, query: '?demo=0' });
-      await replayed(rep.page, capture);
+      await replayToEnd(rep.page, capture);
       found.push(...(await axe(rep.page, `replay ${scheme}`)));
       await rep.page.context().close();
     }
@@ -537,7 +520,7 @@ describe.skipIf(skip !== null)('the page on any screen', () => {
       await demo.page.context().close();
 
       const rep = await open({ width: 390, height: 844, scheme, query: '?demo=0' });
-      await replayed(rep.page, capture);
+      await replayToEnd(rep.page, capture);
       await shootAll(rep.page, 'replay');
       await rep.page.context().close();
     }

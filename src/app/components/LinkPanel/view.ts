@@ -100,11 +100,13 @@ function duration(us: number): string {
  * The time since the last frame (`sinceUs`, NaN: none), as the panel says it: "ago" while time
  * runs (live, or a replay playing on its own clock); a paused replay's before the point it
  * stopped at, an ended one's before its end (its clock stands still there, and "1 ms ago"
- * would read as now).
+ * would read as now). A frame the page's clock has not caught up with came just now, never
+ * "−4 ms ago" (the page's clock runs on from the worker's last word, a little behind it).
  */
 export function sinceLastFrame(sinceUs: number, f: Pick<LinkFacts, 'kind' | 'sourceState' | 'ended'>): string {
   if (!Number.isFinite(sinceUs)) return '—';
-  if (f.kind === 'replay' && f.ended) return `${duration(sinceUs)} before the end`;
-  if (f.kind === 'replay' && f.sourceState === 'paused') return `${duration(sinceUs)} before this point`;
-  return `${duration(sinceUs)} ago`;
+  const d = duration(Math.max(0, sinceUs));
+  if (f.kind === 'replay' && f.ended) return `${d} before the end`;
+  if (f.kind === 'replay' && f.sourceState === 'paused') return `${d} before this point`;
+  return `${d} ago`;
 }
