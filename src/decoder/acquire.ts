@@ -91,11 +91,18 @@ export function acquire(d: Core): boolean {
     return false;
   }
   const forced = d.s.opts.resolution;
-  let best = bestStart(d, p, avail, forced === 'auto' ? 0 : forced, false);
+  const auto = forced === 'auto' && d.s.opts.remote === 'auto' && d.s.opts.headerMode === 'auto';
+  // Starts the last pass scored nothing at are not scored again: on noise, two thirds of a pass.
+  const known = auto ? Math.max(0, d.s.noStartBelow - (d.w.base + p)) : 0;
+  let best = bestStart(d, p, avail, forced === 'auto' ? 0 : forced, false, known);
   if (best.filler) withhold(d, 'filler', p);
-  else if (forced !== 'auto' || d.s.opts.remote !== 'auto' || d.s.opts.headerMode !== 'auto') best = matchForced(d, p, avail, best);
+  else if (!auto) best = matchForced(d, p, avail, best);
   if (best.score < 0 || (best.shift >= ACQUIRE_COMMIT && avail >= window)) {
     // No alignment starting in these 16 bytes works (or the best starts too late to commit).
+    // Where none of the ACQUIRE_SHIFTS starts did, each with all its frames here, the next
+    // pass (the same state: discarding changes none) would score the rest of them the same.
+    // (A start refused for the frame before it may read otherwise once that frame goes.)
+    if (auto && best.score < 0 && !best.filler && !d.chain.lateRefused && avail >= window) d.s.noStartBelow = d.w.base + p + ACQUIRE_SHIFTS;
     discard(d, p, Math.min(FRAME_SIZE, avail), lost);
     return true;
   }
@@ -156,6 +163,7 @@ export function acquire(d: Core): boolean {
     d.s.everLocked &&
     (d.s.remote !== (internal ? 'internal' : 'external') || d.s.system !== (internal ? system : null) || d.s.resolution !== resolution);
   d.s.locked = true;
+  d.s.noStartBelow = 0;
   d.s.stagedAt = -1;
   d.s.everLocked = true;
   d.s.forcedMismatch = null;
@@ -214,8 +222,9 @@ function chainsInto(d: Core, a: number, b: number, resolution: Resolution, inter
  * readings of the filler and its headers (`00 B2` then seven 0xFFFF slots, read a byte
  * early, has a channel 6 at 0x2FF), not frames.
  */
-function bestStart(d: Core, p: number, avail: number, only: 0 | Resolution, free: boolean): Best {
+function bestStart(d: Core, p: number, avail: number, only: 0 | Resolution, free: boolean, known = 0): Best {
   d.chain.fillerScore = -1;
+  d.chain.lateRefused = false;
   let score = -1;
   let shift = 0;
   let resolution: Resolution = 2048;
@@ -223,7 +232,8 @@ function bestStart(d: Core, p: number, avail: number, only: 0 | Resolution, free
   // the bytes parse as filler, which the first reading that parses tells (runs of 0xFF or
   // 0x00 would otherwise be scored at every shift, both ways, again every 16 bytes).
   const canLead = leadable(d, p, avail);
-  for (let s = 0; s < ACQUIRE_SHIFTS; s++) {
+  // The first `known` starts scored nothing at the last pass (`noStartBelow`): they would again.
+  for (let s = known; s < ACQUIRE_SHIFTS; s++) {
     if (!canLead && d.chain.fillerScore > -1) break;
     const frames = Math.min(ACQUIRE_FRAMES, Math.floor((avail - s) / FRAME_SIZE));
     if (frames < 1) break;
@@ -415,7 +425,10 @@ function scoreChain(d: Core, o: number, resolution: Resolution, frames: number, 
     channels |= layoutChannels(layout);
     zeroWords += countZeroWords(buf, f);
   }
-  if (!internal && readsInternalLate(d, o, resolution, length)) return -1;
+  if (!internal && readsInternalLate(d, o, resolution, length)) {
+    d.chain.lateRefused = true;
+    return -1;
+  }
   // Transmitters repeat their layouts (a pair of frames, mostly): a first frame whose layout
   // comes nowhere else in the chain may be damage (a stray byte that made a slot), not a frame.
   if (length >= MIN_CHAIN && !layoutInChain(d, slotLayout(buf, o, resolution), o + FRAME_SIZE, length - 1, resolution)) return -1;

@@ -41,7 +41,7 @@ interface CheckpointData {
 }
 
 /** Bumped whenever what a checkpoint holds changes: a checkpoint of another version is refused. */
-const CHECKPOINT_VERSION = 2;
+const CHECKPOINT_VERSION = 3;
 
 function checkResolution(resolution: unknown): asserts resolution is 'auto' | Resolution {
   if (resolution !== 'auto' && resolution !== 1024 && resolution !== 2048) {
@@ -139,6 +139,7 @@ export class SpektrumDecoder {
     s.opts.resolution = resolution;
     s.fixedBy = fixedBy;
     s.forcedMismatch = null;
+    s.noStartBelow = 0;
     if (s.withheld === 'forced') s.withheld = null;
     if (!s.locked) return;
     if (resolution === 'auto' ? s.reason === 'override' || s.reason === 'internal-remote' : resolution !== s.resolution) {

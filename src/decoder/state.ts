@@ -42,6 +42,12 @@ export interface DecoderState {
   haveLast: boolean;
   /** Whether a fade jump at the first frame after a lock is the receiver's own count (same remote, known layouts). */
   jumpTrusted: boolean;
+  /**
+   * Stream offset below which no start scored at the last acquisition pass (nothing chained,
+   * nothing parsed as filler), with every option 'auto': the next pass, under the same state,
+   * does not score those starts again (acquire.ts). 0: none.
+   */
+  noStartBelow: number;
   /** Slot layouts seen, a ring of LAYOUT_MEMORY. */
   layouts: Int32Array;
   layoutCount: number;
@@ -78,6 +84,7 @@ export function initialState(opts: DecoderState['opts'], fixedBy: DecoderState['
     last1: 0,
     haveLast: false,
     jumpTrusted: false,
+    noStartBelow: 0,
     layouts: new Int32Array(LAYOUT_MEMORY),
     layoutCount: 0,
     layoutNext: 0,
@@ -125,6 +132,11 @@ export interface Chain {
   /** Index in the chain of a frame with a damaged header, skipped over (not confirmed), or -1. */
   skipped: number;
   fillerScore: number;
+  /**
+   * A start was refused as an internal stream read late (`readsInternalLate`), which looks at
+   * the frame before it: once those bytes go, the same start may read otherwise.
+   */
+  lateRefused: boolean;
 }
 
 /** A decoder's parts as its two paths see them. */
@@ -138,7 +150,7 @@ export interface Core {
 }
 
 export function createChain(): Chain {
-  return { internal: false, system: 0, b0: B0_FADES, frames: 0, skipped: -1, fillerScore: -1 };
+  return { internal: false, system: 0, b0: B0_FADES, frames: 0, skipped: -1, fillerScore: -1, lateRefused: false };
 }
 
 type EventBody = DecoderEvent extends infer E ? (E extends DecoderEvent ? Omit<E, 'timeUs' | 'bytes'> : never) : never;
