@@ -19,7 +19,8 @@ describe('package entries in a bundle', () => {
     // monitor tells receiver restarts and delivery stalls from loss: 0.4 kB; 16.3 kB since a lock
     // needs evidence of a channel, forced options never pick the alignment and an ambiguous
     // header is said and re-read: 0.9 kB; 16.9 kB since a silence is dated by the frame that
-    // ends it and judged by the counter over the burst after it: 0.5 kB).
-    expect(sizes.satscope.gzip).toBeLessThan(17 * 1024);
+    // ends it and judged by the counter over the burst after it: 0.5 kB; 17.0 kB since an
+    // acquisition pass that finds no start is not scored again: 0.1 kB, 3.5x on noise).
+    expect(sizes.satscope.gzip).toBeLessThan(17.5 * 1024);
   }, 60_000);
 });

@@ -27,6 +27,7 @@ import {
 } from './header.js';
 import { FRAME_SIZE, type Resolution, systemInfo } from './spec.js';
 import { type Core, discard, event, knownLayout } from './state.js';
+import { byte0Evidence, byte0Still, NEED_MORE } from './byte0.js';
 import type { Withheld } from './types.js';
 
 /** Frames looked at before a lock. Pinned by the golden output (3 or 5 change it). */
@@ -46,13 +47,6 @@ const MIN_CHAIN = 3;
 const ACQUIRE_SHIFTS = 3 * FRAME_SIZE;
 const ACQUIRE_COMMIT = 2 * FRAME_SIZE;
 /**
- * Frames read, at most, to decide whether an internal remote's byte 0 is a fade count or
- * SPM4649T RSSI when every value so far could be either (a fade count of 156…226 reads as
- * -100…-30 dBm). RSSI wanders both ways; fades only rise. Without a fall or a value no RSSI
- * takes in this many frames the decoder says it does not know. Unpinned: 7 or 9 change no test.
- */
-const HEADER_EVIDENCE_FRAMES = 8;
-/**
  * Bytes of channel words that are not filler (`channelEvidence`) the first frame of a chain
  * must carry for a lock: more than a header's two, which is all a shifted reading of frames of
  * filler slots finds. A transmitter sends four channels or more, and every frame it sends
@@ -61,9 +55,6 @@ const HEADER_EVIDENCE_FRAMES = 8;
  * invented from filler); 4 changes no test.
  */
 const EVIDENCE_BYTES = 3;
-
-/** The answer depends on bytes that have not arrived. */
-export const NEED_MORE = -2;
 
 /** A start acquisition may lock on: its score (-1: none), shift from the head and resolution; `filler`: see bestStart. */
 interface Best {
@@ -306,38 +297,10 @@ function matchForced(d: Core, p: number, avail: number, best: Best): Best {
   return { score: -1, shift: 0, resolution, filler: false };
 }
 
-/** Whether byte 0 is the same in each of the `frames` frames from `o`. */
-function byte0Still(d: Core, o: number, frames: number): boolean {
-  const b0 = byteAt(d.w.buf, o);
-  for (let k = 1; k < frames; k++) if (byteAt(d.w.buf, o + k * FRAME_SIZE) !== b0) return false;
-  return true;
-}
-
 /** Whether every frame of the chain at `o` has a layout the lock knows. */
 function chainKnown(d: Core, o: number, resolution: Resolution, frames: number): boolean {
   for (let k = 0; k < frames; k++) if (!knownLayout(d.s, slotLayout(d.w.buf, o + k * FRAME_SIZE, resolution))) return false;
   return true;
-}
-
-/**
- * Reads byte 0 along the chain at `o` (an internal remote whose byte 0 has only been a plausible
- * RSSI): B0_FADES on a value no RSSI takes, B0_RSSI on a fall, B0_UNKNOWN after HEADER_EVIDENCE_FRAMES
- * without either (or where the chain ends), NEED_MORE when more bytes could decide it.
- */
-function byte0Evidence(d: Core, o: number, resolution: Resolution, system: number): number {
-  const buf = d.w.buf;
-  let prev = byteAt(buf, o);
-  for (let k = 1; k < HEADER_EVIDENCE_FRAMES; k++) {
-    const f = o + k * FRAME_SIZE;
-    if (f + FRAME_SIZE > d.w.tail) return d.w.ended ? B0_UNKNOWN : NEED_MORE;
-    const b0 = byteAt(buf, f);
-    if (buf[f + 1] !== system || slotLayout(buf, f, resolution) === INVALID || !byte0FollowsAcquiring(prev, b0, B0_UNKNOWN))
-      return B0_UNKNOWN;
-    if (!plausibleRssi(b0)) return B0_FADES;
-    if (b0 < prev) return B0_RSSI;
-    prev = b0;
-  }
-  return B0_UNKNOWN;
 }
 
 /**

@@ -19,7 +19,8 @@
  * an unlock into an acquisition, which itself consumes or locks with frames it has confirmed
  * (emitted unconditionally): so it always returns after bounded work.
  */
-import { acquire, chainStartsAt, NEED_MORE } from './acquire.js';
+import { acquire, chainStartsAt } from './acquire.js';
+import { NEED_MORE } from './byte0.js';
 import { byteAt, type FrameSlots, INVALID, readFrame, showSlots, slotLayout } from './frame.js';
 import { formatOf, setReason } from './format.js';
 import { B0_FADES, B0_RSSI, B0_UNKNOWN, byte0Follows, countFollows, FADE_STEP, plausibleRssi } from './header.js';
