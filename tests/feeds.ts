@@ -3,6 +3,7 @@ import { CaptureWriter } from '../src/capture/writer.js';
 import { readCapture } from '../src/capture/sniff.js';
 import type { Capture } from '../src/capture/model.js';
 import { concatBytes } from './bytes.js';
+import type { SimChunk } from '../src/simulator/simulator.js';
 
 /** A stream with every byte's time, as the simulator makes it. */
 export type Stream = { bytes: Uint8Array; timesUs: Float64Array };
@@ -66,4 +67,20 @@ export function oneAfterAnother(streams: Stream[]): Stream {
     offset = (times.at(-1) ?? 0) + 20_000;
   }
   return { bytes: concatBytes(streams.map((s) => s.bytes)), timesUs: Float64Array.from(times) };
+}
+
+/** `sim` with channel slot 0 of each frame in `frames` pushed 600 steps (about 44 % travel) away, for that frame only. */
+export function withSpikes(sim: SimChunk, frames: number[]): SimChunk {
+  const bytes = sim.bytes.slice();
+  for (const k of frames) {
+    const f = sim.truth?.frames[k];
+    if (f === undefined) throw new Error(`no frame ${k}`);
+    const at = f.offset + 2;
+    const w = ((bytes[at] ?? 0) << 8) | (bytes[at + 1] ?? 0);
+    const pos = w & 0x7ff;
+    const spiked = (w & ~0x7ff) | (pos > 1024 ? pos - 600 : pos + 600);
+    bytes[at] = spiked >> 8;
+    bytes[at + 1] = spiked & 0xff;
+  }
+  return { ...sim, bytes };
 }

@@ -12,23 +12,7 @@ import { simulate, type SimChunk } from '../src/simulator/simulator.js';
 import { Engine } from '../src/worker/engine.js';
 import type { TraceBatch } from '../src/worker/protocol.js';
 import { MAX_TRACE_ROWS, TraceLog } from '../src/worker/traces.js';
-import { perByteCapture } from './feeds.js';
-
-/** `sim` with channel slot 0 of each frame in `frames` pushed 600 steps (about 44 % travel) away, for that frame only. */
-function withSpikes(sim: SimChunk, frames: number[]): SimChunk {
-  const bytes = sim.bytes.slice();
-  for (const k of frames) {
-    const f = sim.truth?.frames[k];
-    if (f === undefined) throw new Error(`no frame ${k}`);
-    const at = f.offset + 2;
-    const w = ((bytes[at] ?? 0) << 8) | (bytes[at + 1] ?? 0);
-    const pos = w & 0x7ff;
-    const spiked = (w & ~0x7ff) | (pos > 1024 ? pos - 600 : pos + 600);
-    bytes[at] = spiked >> 8;
-    bytes[at + 1] = spiked & 0xff;
-  }
-  return { ...sim, bytes };
-}
+import { perByteCapture, withSpikes } from './feeds.js';
 
 /** Every batch of traces an engine hands out, fed `sim` in chunks of `chunk` bytes with a batch after each. */
 function traced(sim: SimChunk, chunk = 64): TraceBatch[] {

@@ -6,10 +6,10 @@ import { closeSync, existsSync, mkdirSync, openSync, writeFileSync, writeSync } 
 import { join, resolve } from 'node:path';
 import type { Browser, Page } from 'playwright-core';
 import { CaptureWriter } from '../../src/capture/writer.js';
-import { Simulator, type SimChunk } from '../../src/simulator/simulator.js';
+import { Simulator } from '../../src/simulator/simulator.js';
 import { preset } from '../../src/simulator/presets.js';
 import { concatBytes } from '../bytes.js';
-import { usbChunks } from '../feeds.js';
+import { usbChunks, withSpikes } from '../feeds.js';
 import { chromiumAvailable, launchChromium, startStaticServer, type LaunchChromiumOptions, type StaticServer } from './harness/browser.js';
 import { installSerialPolicy } from './harness/policy.js';
 import { openFakeSerialPort, type FakeSerialPort } from './harness/pty-serial.js';
@@ -44,22 +44,6 @@ export async function startApp(): Promise<AppSession> {
       await server.close();
     },
   };
-}
-
-/** `sim` with channel slot 0 of each frame in `frames` pushed 600 steps away, for that frame only. */
-export function withSpikes(sim: SimChunk, frames: number[]): SimChunk {
-  const bytes = sim.bytes.slice();
-  for (const k of frames) {
-    const f = sim.truth?.frames[k];
-    if (f === undefined) throw new Error(`no frame ${k}`);
-    const at = f.offset + 2;
-    const w = ((bytes[at] ?? 0) << 8) | (bytes[at + 1] ?? 0);
-    const pos = w & 0x7ff;
-    const spiked = (w & ~0x7ff) | (pos > 1024 ? pos - 600 : pos + 600);
-    bytes[at] = spiked >> 8;
-    bytes[at + 1] = spiked & 0xff;
-  }
-  return { ...sim, bytes };
 }
 
 /** The sizes the page is looked at: a phone, a laptop, a desktop. */
@@ -175,4 +159,4 @@ export function writeLongCapture(path: string, durationUs: number): void {
   }
 }
 
-export { usbChunks };
+export { usbChunks, withSpikes };
