@@ -89,6 +89,38 @@ describe('a stall of the delivery, anywhere in a link with real dropouts', () =>
   });
 });
 
+describe('a frame the decoder holds while the page asks for the state', () => {
+  it('ends the silence before it, as satscope info says, whenever the page asks', () => {
+    // The first frame after a dropout waits in the decoder for the one after it (its
+    // confirmation); a batch in between knows only that a frame came (`pendingSinceUs`).
+    for (const name of ['dsmx-22ms-2048-external', 'dsm2-22ms-1024-external', 'dsmx-11ms-2048-external']) {
+      const sim = simulate({
+        ...preset(name),
+        dropouts: [
+          { atUs: 500_000, durationUs: 300_000 },
+          { atUs: 1_500_000, durationUs: 1_300_000 },
+        ],
+        durationUs: 3_200_000,
+      });
+      const truth = summarizeCapture(perByteCapture(sim)).episodes.map((e) => e.kind);
+      expect(truth, name).toEqual(['hold', 'hold', 'failsafe']);
+      for (const chunk of [7, 16]) {
+        const engine = new Engine({ resolution: 'auto', jitterUs: USB_CHUNK_JITTER_US });
+        for (let i = 0; i < sim.bytes.length; i += chunk) {
+          const t = sim.timesUs[Math.min(sim.bytes.length, i + chunk) - 1] ?? 0;
+          engine.push(sim.bytes.subarray(i, i + chunk), t, t / 1000);
+          engine.batch(t + 500);
+        }
+        engine.end();
+        expect(
+          engine.link.episodes.map((e) => e.kind),
+          `${name}, ${chunk}-byte chunks`,
+        ).toEqual(truth);
+      }
+    }
+  });
+});
+
 /** A stand-in frame of an external remote: only what the monitor reads. */
 const frame = (timeUs: number, fades: number, fadesDelta: number): DecodedFrame =>
   ({ timeUs, fades, fadesDelta, system: null, remote: 'external', rssi: null }) as DecodedFrame;
@@ -109,6 +141,21 @@ describe("the receiver's counter, where the adapter saw no silence", () => {
       expect(hold?.startUs).toBe(t + 20_000 - run * 11_000);
       expect(link.episodes.at(-1)?.endUs).toBe(t + 20_000);
     }
+  });
+
+  it("dates them on the receiver's clock where the adapter saw a shorter silence: each episode starts before it ends", () => {
+    const link = new LinkMonitor({ jitterUs: 20_000 });
+    let t = 0;
+    for (let k = 0; k < 50; k++, t += 11_000) link.frame(frame(t, 40, 0));
+    // 300 ms without frames seen, then one whose count says 181 were lost (2 s).
+    link.update(t + 290_000);
+    link.frame(frame(t + 300_000, 40 + 181, 181));
+    expect(link.stats).toMatchObject({ holds: 1, failsafes: 1 });
+    const [hold, failsafe] = link.episodes;
+    expect(hold!.startUs).toBe(t + 300_000 - 181 * 11_000);
+    expect(hold!.endUs).toBe(failsafe!.startUs);
+    expect(failsafe!.startUs).toBeGreaterThan(hold!.startUs);
+    expect(failsafe!.endUs).toBe(t + 300_000);
   });
 
   it('adds nothing after a break in its view (an interrupt): the count spans time it did not see', () => {

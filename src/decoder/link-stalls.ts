@@ -234,14 +234,19 @@ export class StallJudge {
     const p = s.nominalPeriodUs;
     const silence = (fades + 1) * p;
     if (!Number.isFinite(silence) || !Number.isFinite(t) || !Number.isFinite(last) || !(silence > m.holdAfterUs())) return;
+    // When the receiver's first missing frame was due.
+    const rxStartUs = t - fades * p;
     let hold = ended;
     if (hold === null) {
       s.holds++;
-      hold = m.add('hold', t - fades * p, last);
+      hold = m.add('hold', rxStartUs, last);
       hold.endUs = t;
     }
     if (hold.kind === 'hold' && silence >= m.failsafeAfterUs) {
       s.failsafes++;
+      // On the receiver's clock: the hold from its first missing frame, the failsafe a second
+      // after its last frame (before the adapter saw the silence begin, where a stall hid it).
+      if (rxStartUs < hold.startUs) hold.startUs = rxStartUs;
       hold.endUs = t - silence + m.failsafeAfterUs;
       m.add('failsafe', hold.endUs, hold.lastFrameUs).endUs = t;
     }

@@ -297,8 +297,6 @@ export class LinkMonitor {
     if (nowUs > this.#stoppedUs) nowUs = this.#stoppedUs;
     const last = pendingUs > this.#lastUs ? pendingUs : this.#lastUs;
     if (this.#state === 'waiting' || !Number.isFinite(last) || !Number.isFinite(nowUs)) return this.#state;
-    // A frame held since the silence began ends it: the silence goes on, counted from that frame.
-    if (this.#open !== null && last > this.#open.lastFrameUs) this.#redate(this.#open.lastFrameUs, last);
     const gap = nowUs - last;
     const s = this.#stats;
     // No hold threshold is below HOLD_MIN_US (or the holdAfterUs option): the common short gap
@@ -314,8 +312,11 @@ export class LinkMonitor {
     if (gap >= this.#failsafeAfterUs && this.#state === 'hold') {
       this.#state = 'failsafe';
       s.failsafes++;
-      if (this.#open !== null) this.#open.endUs = last + this.#failsafeAfterUs;
-      this.#open = this.#add('failsafe', last + this.#failsafeAfterUs, last);
+      // One second after the last frame received (a held one too); it belongs to the hold's
+      // silence, which the held frame, once handed out, may show was shorter (`shorter`).
+      const hold = this.#open;
+      if (hold !== null) hold.endUs = last + this.#failsafeAfterUs;
+      this.#open = this.#add('failsafe', last + this.#failsafeAfterUs, hold?.lastFrameUs ?? last);
     }
     return this.#state;
   }
@@ -485,8 +486,8 @@ export class LinkMonitor {
   #add(kind: 'hold' | 'failsafe', startUs: number, lastFrameUs: number): LinkEpisode {
     const episode: LinkEpisode = { id: this.#nextEpisode++, kind, startUs, endUs: null, lastFrameUs };
     this.#episodes.push(episode);
-    // Drop the oldest in one go (an amortised splice).
-    if (this.#episodes.length > this.#maxEpisodes * 1.25) this.#episodes.splice(0, this.#episodes.length - this.#maxEpisodes);
+    // Drop the oldest in one go (an amortised splice), never this one.
+    if (this.#episodes.length > this.#maxEpisodes * 1.25) this.#episodes.splice(0, this.#episodes.length - Math.max(1, this.#maxEpisodes));
     return episode;
   }
 }

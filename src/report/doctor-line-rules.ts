@@ -86,7 +86,7 @@ export function adapterAwayFinding(p: PortState, now: number, ctx: RuleContext, 
     title: `${p.label}: the USB adapter went away ${plural(a.count, 'time')}`,
     evidence: [
       {
-        text: `The adapter was lost ${plural(a.count, 'time')} (${formatDuration(a.totalUs)} in all, the first at ${ctx.at(a.firstUs)}) until its data came back. Nothing is counted for that time: no hold, failsafe or lost frame, since the link could not be seen.`,
+        text: `The adapter was lost ${plural(a.count, 'time')} (${formatDuration(a.totalUs)} in all, the first at ${ctx.at(a.firstUs)}) until its data came back. No hold or failsafe is counted for that time, since the link could not be seen (frames the receiver's own counter says it lost then still count).`,
         timeUs: a.firstUs,
       },
     ],
