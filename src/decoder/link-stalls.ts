@@ -27,6 +27,12 @@ export interface StallBurst {
 /** What the judge needs of its link monitor: its thresholds, and a new episode in its list. */
 export interface StallMonitor {
   holdAfterUs(): number;
+  /**
+   * The hold threshold for a silence the receiver's counter measures, µs: with the delivery
+   * jitter the monitor was told to expect, not the one it measured (stalls inflate that, and
+   * the counter's silence has no delivery in it).
+   */
+  counterHoldUs(): number;
   readonly failsafeAfterUs: number;
   add(kind: 'hold' | 'failsafe', startUs: number, lastFrameUs: number): LinkEpisode;
 }
@@ -233,7 +239,7 @@ export class StallJudge {
     const m = this.#monitor;
     const p = s.nominalPeriodUs;
     const silence = (fades + 1) * p;
-    if (!Number.isFinite(silence) || !Number.isFinite(t) || !Number.isFinite(last) || !(silence > m.holdAfterUs())) return;
+    if (!Number.isFinite(silence) || !Number.isFinite(t) || !Number.isFinite(last) || !(silence > m.counterHoldUs())) return;
     // When the receiver's first missing frame was due.
     const rxStartUs = t - fades * p;
     let hold = ended;
@@ -308,7 +314,7 @@ export class StallJudge {
     const due = this.#dueIn(e);
     if (due < 2 || missed >= due / 2) return false;
     const p = this.#stats.nominalPeriodUs;
-    if (Number.isFinite(p) && (run + 1) * p > this.#monitor.holdAfterUs()) return false;
+    if (Number.isFinite(p) && (run + 1) * p > this.#monitor.counterHoldUs()) return false;
     const s = this.#stats;
     const silence = (this.#silenceEndUs(e) ?? e.lastFrameUs) - e.lastFrameUs;
     this.#remove(e.lastFrameUs);

@@ -127,6 +127,7 @@ export class LinkMonitor {
     this.#ledger = new FrameLedger(this.#jitterPrior);
     this.#stalls = new StallJudge(this.#episodes, this.#stats, {
       holdAfterUs: () => this.holdAfterUs,
+      counterHoldUs: () => this.#holdOption ?? holdThresholdUs(this.#stats.nominalPeriodUs, this.#jitterPrior),
       failsafeAfterUs: this.#failsafeAfterUs,
       add: (kind, startUs, lastFrameUs) => this.#add(kind, startUs, lastFrameUs),
     });
