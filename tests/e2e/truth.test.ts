@@ -144,8 +144,9 @@ describe.skipIf(skip !== null)('honest states', () => {
   it('says a forced resolution matches no frame, counts nothing as lost meanwhile, and leaves no episode after switching back', async () => {
     const { page, errors } = await open();
     await page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor({ timeout: 10_000 });
-    // After the demo's first short dropout (at 4 s), before its long one (at 27 s).
-    await page.waitForTimeout(5500);
+    // After the demo's first short dropout (a hold at 4 s), before its long one (at 27 s).
+    await expect.poll(() => page.locator('.link dd').nth(1).textContent(), { timeout: 10_000 }).toBe('1 hold · 0 failsafes');
+    await page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor({ timeout: 5000 });
     const episodes = await page.locator('.link dd').nth(1).textContent();
     const missed = Number(await page.getByTestId('count-missed').textContent());
     await page.getByRole('button', { name: 'Settings', exact: true }).click();

@@ -368,7 +368,8 @@ describe.skipIf(skip !== null)('the page on any screen', () => {
   it('shows the values under the cursor when a graph is hovered, or stepped through from the keyboard', async () => {
     const { page } = await open({ width: 1280, height: 800 });
     await demoRunning(page);
-    await page.waitForTimeout(3000);
+    // 3 s of the demo's history (270 frames at 11 ms) in the graphs.
+    await page.waitForFunction(() => Number(document.querySelector('[data-testid="count-frames"]')?.textContent) >= 270);
     const chart = page.locator('.chart[data-chart="periodMs"] .u-over');
     await chart.scrollIntoViewIfNeeded();
     const box = (await chart.boundingBox())!;
