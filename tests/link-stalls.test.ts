@@ -121,9 +121,9 @@ describe('a frame the decoder holds while the page asks for the state', () => {
   });
 });
 
-/** A stand-in frame of an external remote: only what the monitor reads. */
+/** A stand-in frame of an internal DSMX 11 ms remote (its system byte gives the period): only what the monitor reads. */
 const frame = (timeUs: number, fades: number, fadesDelta: number): DecodedFrame =>
-  ({ timeUs, fades, fadesDelta, system: null, remote: 'external', rssi: null }) as DecodedFrame;
+  ({ timeUs, fades: fades & 0xff, fadesDelta, system: 0xb2, remote: 'internal', rssi: null }) as DecodedFrame;
 
 describe("the receiver's counter, where the adapter saw no silence", () => {
   it('counts a run of lost frames a stall hid as the hold it was, and its failsafe past a second', () => {
@@ -156,6 +156,16 @@ describe("the receiver's counter, where the adapter saw no silence", () => {
     expect(hold!.endUs).toBe(failsafe!.startUs);
     expect(failsafe!.startUs).toBeGreaterThan(hold!.startUs);
     expect(failsafe!.endUs).toBe(t + 300_000);
+  });
+
+  it('adds nothing where the period is only estimated (an external remote): a period read twice too long makes every run a hold', () => {
+    const link = new LinkMonitor({ jitterUs: 20_000 });
+    const ext = (timeUs: number, fades: number, fadesDelta: number): DecodedFrame =>
+      ({ timeUs, fades, fadesDelta, system: null, remote: 'external', rssi: null }) as DecodedFrame;
+    let t = 0;
+    for (let k = 0; k < 50; k++, t += 11_000) link.frame(ext(t, 40, 0));
+    link.frame(ext(t + 20_000, 58, 18));
+    expect(link.stats).toMatchObject({ holds: 0, failsafes: 0, missedFrames: 18 });
   });
 
   it('adds nothing after a break in its view (an interrupt): the count spans time it did not see', () => {

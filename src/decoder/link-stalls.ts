@@ -33,6 +33,8 @@ export interface StallMonitor {
    * the counter's silence has no delivery in it).
    */
   counterHoldUs(): number;
+  /** Whether the frame period is the system byte's (known for sure), not an estimate from intervals. */
+  periodKnown(): boolean;
   readonly failsafeAfterUs: number;
   add(kind: 'hold' | 'failsafe', startUs: number, lastFrameUs: number): LinkEpisode;
 }
@@ -156,7 +158,7 @@ export class StallJudge {
         continue;
       }
       this.#unconfirmed.splice(i, 1);
-      this.#judge(u.episode, Math.max(l.closedMissing, u.endFades), 0);
+      this.#judge(u.episode, Math.max(l.closedMissing, u.endFades), 0, false);
     }
   }
 
@@ -174,7 +176,7 @@ export class StallJudge {
     const at = this.#unconfirmed.findIndex((x) => x.episode === b.episode);
     const u = this.#unconfirmed[at];
     if (u === undefined) return;
-    if (this.#judge(b.episode, missed, counted ? b.run : 0) || counted) this.#unconfirmed.splice(at, 1);
+    if (this.#judge(b.episode, missed, b.run, counted) || counted) this.#unconfirmed.splice(at, 1);
     else u.counter = { missed: b.missed, run: b.run };
   }
 
@@ -191,7 +193,7 @@ export class StallJudge {
         continue;
       }
       this.#unconfirmed.splice(i, 1);
-      this.#judge(u.episode, u.counter.missed, u.counter.run);
+      this.#judge(u.episode, u.counter.missed, u.counter.run, true);
     }
   }
 
@@ -239,7 +241,10 @@ export class StallJudge {
     const m = this.#monitor;
     const p = s.nominalPeriodUs;
     const silence = (fades + 1) * p;
-    if (!Number.isFinite(silence) || !Number.isFinite(t) || !Number.isFinite(last) || !(silence > m.counterHoldUs())) return;
+    // A hold's worth more than the adapter saw: a silence a stall hid, not the same one seen
+    // (nor a run a wrong period estimate stretches).
+    if (!m.periodKnown() || !Number.isFinite(silence) || !Number.isFinite(t) || !Number.isFinite(last)) return;
+    if (!(silence - (t - last) > m.counterHoldUs())) return;
     // When the receiver's first missing frame was due.
     const rxStartUs = t - fades * p;
     let hold = ended;
@@ -310,11 +315,16 @@ export class StallJudge {
    * became (the flight controller, on the receiver's own line, had its frames), unless the
    * receiver itself went silent long enough for a hold (a real dropout the stall hid in).
    */
-  #judge(e: LinkEpisode, missed: number, run: number): boolean {
+  #judge(e: LinkEpisode, missed: number, run: number, counted: boolean): boolean {
     const due = this.#dueIn(e);
-    if (due < 2 || missed >= due / 2) return false;
-    const p = this.#stats.nominalPeriodUs;
-    if (Number.isFinite(p) && (run + 1) * p > this.#monitor.counterHoldUs()) return false;
+    if (due < 2) return false;
+    // With the receiver's counter, the hold was the link's where a run of frames it lost is a
+    // hold's silence itself (lost frames scattered over a silence the adapter made are no hold
+    // on the receiver's line); without, where the frames that came after it do not stand for
+    // half of those due in it. A run is timed at the system byte's period, or, where the period
+    // is only estimated, at the shortest (never longer than it was).
+    const p = this.#monitor.periodKnown() ? this.#stats.nominalPeriodUs : FRAME_PERIOD_11MS_US;
+    if (counted ? (run + 1) * p > this.#monitor.counterHoldUs() : missed >= due / 2) return false;
     const s = this.#stats;
     const silence = (this.#silenceEndUs(e) ?? e.lastFrameUs) - e.lastFrameUs;
     this.#remove(e.lastFrameUs);

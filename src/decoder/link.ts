@@ -128,6 +128,7 @@ export class LinkMonitor {
     this.#stalls = new StallJudge(this.#episodes, this.#stats, {
       holdAfterUs: () => this.holdAfterUs,
       counterHoldUs: () => this.#holdOption ?? holdThresholdUs(this.#stats.nominalPeriodUs, this.#jitterPrior),
+      periodKnown: () => Number.isFinite(this.#systemPeriod) && this.#stats.nominalPeriodUs === this.#systemPeriod,
       failsafeAfterUs: this.#failsafeAfterUs,
       add: (kind, startUs, lastFrameUs) => this.#add(kind, startUs, lastFrameUs),
     });
@@ -310,14 +311,19 @@ export class LinkMonitor {
       this.#open = this.#add('hold', last + (Number.isFinite(p) ? p : this.holdAfterUs), last);
       this.#stalls.held(this.#open);
     }
-    if (gap >= this.#failsafeAfterUs && this.#state === 'hold') {
+    const hold = this.#state === 'hold' ? this.#open : null;
+    // A frame held now came a second or more after the hold's last one: the hold's own
+    // silence reached failsafe before it.
+    const heldLate = hold !== null && last - hold.lastFrameUs >= this.#failsafeAfterUs;
+    if ((gap >= this.#failsafeAfterUs || heldLate) && this.#state === 'hold') {
       this.#state = 'failsafe';
       s.failsafes++;
-      // One second after the last frame received (a held one too); it belongs to the hold's
-      // silence, which the held frame, once handed out, may show was shorter (`shorter`).
-      const hold = this.#open;
-      if (hold !== null) hold.endUs = last + this.#failsafeAfterUs;
-      this.#open = this.#add('failsafe', last + this.#failsafeAfterUs, hold?.lastFrameUs ?? last);
+      // One second after the last frame received (a held one too), or after the hold's own last
+      // frame; it belongs to the hold's silence, which the held frame, once handed out, may show
+      // was shorter (`shorter`).
+      const from = heldLate ? (hold?.lastFrameUs ?? last) : last;
+      if (hold !== null) hold.endUs = from + this.#failsafeAfterUs;
+      this.#open = this.#add('failsafe', from + this.#failsafeAfterUs, hold?.lastFrameUs ?? last);
     }
     return this.#state;
   }
