@@ -87,6 +87,20 @@ describe('a stall of the delivery, anywhere in a link with real dropouts', () =>
     }
     expect(wrong).toEqual([]);
   });
+
+  it('and with a stall that ends with the feed: its hold is judged once the frames stop for good', () => {
+    const sim = simulate(preset('dropouts-failsafe'));
+    const spanUs = (sim.timesUs.at(-1) ?? 0) - (sim.timesUs[0] ?? 0);
+    const wrong: string[] = [];
+    for (let seed = 1; seed <= 100; seed++) {
+      const rng = new Prng(seed);
+      const forUs = rng.uniform(30_000, 430_000);
+      const stall = { atUs: spanUs - forUs + rng.uniform(-60_000, 0), forUs };
+      const got = stalledFeed(sim.bytes, sim.timesUs, [stall], rng).link.episodes.map((e) => e.kind);
+      if (got.join() !== 'hold,hold,failsafe,hold,failsafe') wrong.push(`${(forUs / 1e3).toFixed(0)} ms at the end: ${got.join(' ')}`);
+    }
+    expect(wrong).toEqual([]);
+  });
 });
 
 describe('a frame the decoder holds while the page asks for the state', () => {

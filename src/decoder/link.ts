@@ -304,6 +304,8 @@ export class LinkMonitor {
     // No hold threshold is below HOLD_MIN_US (or the holdAfterUs option): the common short gap
     // is decided without working the threshold out.
     if (this.#state === 'live' && gap > (this.#holdOption ?? HOLD_MIN_US) && gap > this.holdAfterUs) {
+      // A new silence: a counted burst before it is over (the frames may have stopped for good).
+      if (this.#stalls.burst?.counted === true) this.#stalls.endBurst();
       this.#state = 'hold';
       s.holds++;
       // The hold began when the next frame was due, whenever it was noticed.
@@ -318,9 +320,7 @@ export class LinkMonitor {
     if ((gap >= this.#failsafeAfterUs || heldLate) && this.#state === 'hold') {
       this.#state = 'failsafe';
       s.failsafes++;
-      // One second after the last frame received (a held one too), or after the hold's own last
-      // frame; it belongs to the hold's silence, which the held frame, once handed out, may show
-      // was shorter (`shorter`).
+      // A second after the last frame received (held or not), or the hold's own; of the hold's silence.
       const from = heldLate ? (hold?.lastFrameUs ?? last) : last;
       if (hold !== null) hold.endUs = from + this.#failsafeAfterUs;
       this.#open = this.#add('failsafe', from + this.#failsafeAfterUs, hold?.lastFrameUs ?? last);
