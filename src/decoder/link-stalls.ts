@@ -13,13 +13,12 @@ import type { LinkStats } from './link-types.js';
 
 /**
  * The frames that came right after a hold, closer together than half a period: how many, the
- * frames the receiver's counter says were lost before and between them, in all and in the
- * longest run, and whether the counter counts (it did before, or moved in the burst).
+ * longest run of frames the receiver's counter says were lost before one of them, and whether
+ * the counter counts (it did before, or moved in the burst).
  */
 export interface StallBurst {
   episode: LinkEpisode;
   frames: number;
-  missed: number;
   run: number;
   counted: boolean;
 }
@@ -41,13 +40,13 @@ export interface StallMonitor {
 
 /**
  * A hold not yet judged: the receiver's fade count when it ended, and once its burst is over
- * without a counter known to count, what the counter said over it (judged by it should the
- * counter later be seen to count).
+ * without a counter known to count, the longest run the counter said was lost over it (judged
+ * by it should the counter later be seen to count), else null.
  */
 export interface UnjudgedHold {
   episode: LinkEpisode;
   endFades: number;
-  counter: { missed: number; run: number } | null;
+  counterRun: number | null;
 }
 import { FRAME_PERIOD_11MS_US } from './spec.js';
 
@@ -105,7 +104,7 @@ export class StallJudge {
 
   /** A hold just opened: it waits to be judged (at most 64 wait). */
   held(episode: LinkEpisode): void {
-    this.#unconfirmed.push({ episode, endFades: 0, counter: null });
+    this.#unconfirmed.push({ episode, endFades: 0, counterRun: null });
     if (this.#unconfirmed.length > 64) this.#unconfirmed.shift();
   }
 
@@ -121,7 +120,6 @@ export class StallJudge {
     const p = this.#stats.nominalPeriodUs;
     if (Number.isFinite(t) && !(t - last >= (Number.isFinite(p) ? p : FRAME_PERIOD_11MS_US) / 2)) {
       b.frames++;
-      b.missed += fades;
       if (fades > b.run) b.run = fades;
       if (fades > 0) b.counted = true;
       return true;
@@ -132,7 +130,7 @@ export class StallJudge {
 
   /**
    * The silence of `open` ended with a frame whose fade count moved by `fades`. The hold waits
-   * for the burst after it: where the counter counts (`counting`), the frames it says were lost
+   * for the burst after it: where the counter counts (`counting`), the runs it says were lost
    * (`missed` now, then those over the burst) are the evidence, and the hold is judged when the
    * burst ends; otherwise by the burst's frame count, and then by the frame count of the ledger
    * window that closes over it.
@@ -142,7 +140,7 @@ export class StallJudge {
     const u = this.#unconfirmed.find((x) => x.episode.lastFrameUs === open.lastFrameUs);
     if (u === undefined) return;
     u.endFades = fades;
-    this.#burst = { episode: u.episode, frames: 1, missed, run: missed, counted: counting || missed > 0 };
+    this.#burst = { episode: u.episode, frames: 1, run: missed, counted: counting || missed > 0 };
   }
 
   /** After a ledger window: holds before its most punctual frame are confirmed or withdrawn. */
@@ -158,7 +156,7 @@ export class StallJudge {
         continue;
       }
       this.#unconfirmed.splice(i, 1);
-      this.#judge(u.episode, Math.max(l.closedMissing, u.endFades), 0, false);
+      this.#judge(u.episode, null, Math.max(l.closedMissing, u.endFades));
     }
   }
 
@@ -170,14 +168,13 @@ export class StallJudge {
     const b = this.#burst;
     this.#burst = null;
     if (b === null) return;
-    const counted = b.counted;
-    // Without a counter: the burst brought the silence's frames, and the frame due when it came.
-    const missed = counted ? b.missed : Math.max(0, this.#dueIn(b.episode) + 1 - b.frames);
     const at = this.#unconfirmed.findIndex((x) => x.episode === b.episode);
     const u = this.#unconfirmed[at];
     if (u === undefined) return;
-    if (this.#judge(b.episode, missed, b.run, counted) || counted) this.#unconfirmed.splice(at, 1);
-    else u.counter = { missed: b.missed, run: b.run };
+    // Without a counter: the burst brought the silence's frames, and the frame due when it came.
+    const missed = Math.max(0, this.#dueIn(b.episode) + 1 - b.frames);
+    if (this.#judge(b.episode, b.counted ? b.run : null, missed) || b.counted) this.#unconfirmed.splice(at, 1);
+    else u.counterRun = b.run;
   }
 
   /**
@@ -188,12 +185,12 @@ export class StallJudge {
   counting(): void {
     for (let i = 0; i < this.#unconfirmed.length; ) {
       const u = this.#unconfirmed[i] as UnjudgedHold;
-      if (u.counter === null) {
+      if (u.counterRun === null) {
         i++;
         continue;
       }
       this.#unconfirmed.splice(i, 1);
-      this.#judge(u.episode, u.counter.missed, u.counter.run, true);
+      this.#judge(u.episode, u.counterRun, 0);
     }
   }
 
@@ -308,14 +305,13 @@ export class StallJudge {
   }
 
   /**
-   * Keeps a hold that ended, or withdraws it (and says so): `missed` is how many frames the
-   * evidence says were lost in its silence, `run` the most in a row the receiver's counter
-   * says it lost (0 without one). A stall delivers the frames it held after it, so a hold that
-   * lost under half of them was the adapter's: a delivery stall, and so is the failsafe it
-   * became (the flight controller, on the receiver's own line, had its frames), unless the
-   * receiver itself went silent long enough for a hold (a real dropout the stall hid in).
+   * Keeps a hold that ended, or withdraws it (and says so): `run` is the most frames in a row
+   * the receiver's counter says it lost (null without a counter), `missed` how many the frame
+   * count says were lost in its silence (used without a counter). A stall delivers the frames
+   * it held after it, and the failsafe the hold became is the adapter's too (the flight
+   * controller, on the receiver's own line, had its frames).
    */
-  #judge(e: LinkEpisode, missed: number, run: number, counted: boolean): boolean {
+  #judge(e: LinkEpisode, run: number | null, missed: number): boolean {
     const due = this.#dueIn(e);
     if (due < 2) return false;
     // With the receiver's counter, the hold was the link's where a run of frames it lost is a
@@ -324,7 +320,7 @@ export class StallJudge {
     // half of those due in it. A run is timed at the system byte's period, or, where the period
     // is only estimated, at the shortest (never longer than it was).
     const p = this.#monitor.periodKnown() ? this.#stats.nominalPeriodUs : FRAME_PERIOD_11MS_US;
-    if (counted ? (run + 1) * p > this.#monitor.counterHoldUs() : missed >= due / 2) return false;
+    if (run !== null ? (run + 1) * p > this.#monitor.counterHoldUs() : missed >= due / 2) return false;
     const s = this.#stats;
     const silence = (this.#silenceEndUs(e) ?? e.lastFrameUs) - e.lastFrameUs;
     this.#remove(e.lastFrameUs);
