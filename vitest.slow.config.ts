@@ -2,7 +2,7 @@ import { defineConfig } from 'vitest/config';
 
 /**
  * The slow tier (`npm run test:slow`, which `.ci/run` runs after the README's test command): the
- * long fuzz, and the screenshots to look at.
+ * long fuzz, and the page in every size and theme (screenshots to look at, axe-core in light).
  */
 export default defineConfig({
   test: {

@@ -73,6 +73,20 @@ export async function openPage(
   return { page, errors };
 }
 
+/** Waits for the demo's two remotes to be live (on a phone their panel is folded away: attached is enough). */
+export async function demoRunning(page: Page): Promise<void> {
+  await page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor({ timeout: 10_000 });
+  await page.locator('.remotes .state-chip', { hasText: 'live' }).nth(1).waitFor({ state: 'attached', timeout: 10_000 });
+}
+
+/** Waits until the selected remote's frame counter has counted `n` more frames than it shows now. */
+export async function moreFrames(page: Page, n: number): Promise<void> {
+  const now = Number(await page.getByTestId('count-frames').textContent());
+  await page.waitForFunction((min) => Number(document.querySelector('[data-testid="count-frames"]')?.textContent) >= min, now + n, {
+    timeout: 20_000,
+  });
+}
+
 /** Opens the capture at `path` for replay and plays it at full speed to its end. */
 export async function replayToEnd(page: Page, path: string): Promise<void> {
   await page.setInputFiles('input[type=file]', path);

@@ -26,6 +26,7 @@ import {
   SHOTS as SHOTS_DIR,
   barValues,
   browserUnavailable,
+  moreFrames,
   shot,
   startApp,
   usbChunks,
@@ -89,7 +90,8 @@ describe.skipIf(skip !== null)('the page', () => {
     }
     await expect(page.getByTestId('protocol').textContent()).resolves.toBe('DSMX 11 ms');
     await expect(page.getByTestId('source-status').textContent()).resolves.toMatch(/Demo receiver/);
-    await page.waitForTimeout(1500);
+    // 1.5 s of history in the graphs (11 ms frames).
+    await moreFrames(page, 136);
     await shot(page, 'live-demo');
     // Strict CSP, everything from this origin, no violation.
     await expect(page.locator('meta[http-equiv="Content-Security-Policy"]').getAttribute('content')).resolves.toMatch(
@@ -181,7 +183,8 @@ describe.skipIf(skip !== null)('the page', () => {
     const { page, errors } = await open();
     await page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor({ timeout: 10_000 });
     await page.getByRole('button', { name: '● Record' }).click();
-    await page.waitForTimeout(2000);
+    // 2 s of the demo recorded.
+    await moreFrames(page, 180);
     await page.getByRole('button', { name: 'Stop recording' }).click();
     const download = page.waitForEvent('download');
     await page.getByRole('button', { name: 'Export .sscap' }).first().click();
@@ -230,7 +233,7 @@ describe.skipIf(skip !== null)('the page', () => {
 
     // Start again and reload without stopping: the recording is kept and offered back.
     await page.getByRole('button', { name: '● Record' }).click();
-    await page.waitForTimeout(1500);
+    await moreFrames(page, 136);
     await page.reload();
     const banner = page.locator('.recovered');
     await banner.waitFor();
@@ -258,7 +261,7 @@ describe.skipIf(skip !== null)('the page', () => {
     await page.getByTestId('remote-B').click();
     await page.locator('.panel h2', { hasText: 'remote B' }).waitFor();
     await expect(page.getByTestId('remote').textContent()).resolves.toBe('External remote');
-    await page.waitForTimeout(1000);
+    await moreFrames(page, 90);
     await shot(page, 'remotes-demo');
     expect(errors).toEqual([]);
     await page.context().close();

@@ -6,8 +6,7 @@
  * Then the panel in replay at 390 and 1280 px, light and dark: it fits, and screenshots go to
  * test-results/screenshots/.
  */
-import { mkdirSync, mkdtempSync, readFileSync, rmSync } from 'node:fs';
-import { createRequire } from 'node:module';
+import { mkdirSync, mkdtempSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import type { Browser, BrowserContext, Page } from 'playwright-core';
@@ -17,27 +16,12 @@ import { preset } from '../../src/simulator/presets.js';
 import { receiveAs } from '../../src/simulator/line.js';
 import { simulate } from '../../src/simulator/simulator.js';
 import { SHOTS, browserUnavailable, usbChunks, writeCapture, startSerialApp, type SerialAppSession } from './app-fixture.js';
+import { axe } from './axe.js';
 import type { StaticServer } from './harness/browser.js';
 import { fakeSerialUnsupportedReason, type FakeSerialPort } from './harness/pty-serial.js';
 
 const skip = browserUnavailable() ?? fakeSerialUnsupportedReason();
 if (skip !== null) console.warn(`skipping the Diagnosis tests: ${skip}`);
-
-const AXE_SOURCE = readFileSync(createRequire(import.meta.url).resolve('axe-core/axe.min.js'), 'utf8');
-
-/** axe-core's serious and critical violations inside the Diagnosis panel and the top finding. */
-async function axe(page: Page): Promise<string[]> {
-  await page.evaluate(AXE_SOURCE);
-  return page.evaluate(async () => {
-    const w = window as unknown as {
-      axe: { run(ctx: object, opts: object): Promise<{ violations: { id: string; impact: string; nodes: { target: string[] }[] }[] }> };
-    };
-    const r = await w.axe.run({ include: [['.p-diagnosis'], ['.top-finding']] }, { resultTypes: ['violations'] });
-    return r.violations
-      .filter((v) => v.impact === 'serious' || v.impact === 'critical')
-      .map((v) => `${v.id}: ${v.nodes.map((n) => n.target.join(' ')).join(', ')}`);
-  });
-}
 
 /** The issue's bar: the right finding on the panel within this long. */
 const WITHIN_MS = 2000;
@@ -233,36 +217,34 @@ describe.skipIf(skip !== null)('the Diagnosis panel in replay, on a phone and a 
     const i = ibus(2_000_000);
     const foreign = join(dir, 'ibus.sscap');
     writeCapture(foreign, usbChunks(i.bytes, i.timesUs));
-    for (const [name, file, code] of [
-      ['1024', sat, 'bind-mode'],
-      ['ibus', foreign, 'ibus'],
+    // Each capture at one width and theme, the two between them covering both (the panel at every
+    // size and theme is in the slow tier's screenshots).
+    for (const [name, file, code, width, scheme] of [
+      ['1024', sat, 'bind-mode', 390, 'light'],
+      ['ibus', foreign, 'ibus', 1280, 'dark'],
     ] as const) {
-      for (const width of [390, 1280]) {
-        for (const scheme of ['light', 'dark'] as const) {
-          const { context, page, errors } = await open({ width, scheme });
-          await page.setInputFiles('input[type=file]', file);
-          await page.locator('section.replay').waitFor();
-          await page.getByRole('radio', { name: 'max' }).click();
-          await page.locator('[data-testid="source-status"]', { hasText: '(end)' }).waitFor({ timeout: 20_000 });
-          // On a phone the panel is folded under the channel bars until tapped.
-          if (width < 600) await page.locator('.p-diagnosis .fold-toggle').click();
-          await page.locator(`.diagnosis .finding[data-code="${code}"]`).waitFor({ timeout: 5000 });
-          // The panel hears at most 4× a second: let the last word of the replay arrive.
-          await page.waitForTimeout(600);
-          // Open the finding with settings, so the screenshot shows what a user copies.
-          const withSettings = page.locator('.diagnosis .finding', { has: page.locator('pre') }).first();
-          if (!(await withSettings.locator('details').evaluate((d) => (d as HTMLDetailsElement).open)))
-            await withSettings.locator('summary').click();
-          await expect(page.getByTestId('top-finding').isVisible()).resolves.toBe(true);
-          const w = await fits(page);
-          expect(w.document, `${name} ${width} ${scheme}`).toBeLessThanOrEqual(w.viewport);
-          await page.locator('.p-diagnosis').screenshot({ path: join(SHOTS, `diagnosis-${name}-panel-${width}-${scheme}.png`) });
-          expect(await axe(page), `${name} ${width} ${scheme}`).toEqual([]);
-          await page.screenshot({ path: join(SHOTS, `diagnosis-${name}-page-${width}-${scheme}.png`), fullPage: width === 390 });
-          expect(errors).toEqual([]);
-          await context.close();
-        }
-      }
+      const { context, page, errors } = await open({ width, scheme });
+      await page.setInputFiles('input[type=file]', file);
+      await page.locator('section.replay').waitFor();
+      await page.getByRole('radio', { name: 'max' }).click();
+      await page.locator('[data-testid="source-status"]', { hasText: '(end)' }).waitFor({ timeout: 20_000 });
+      // On a phone the panel is folded under the channel bars until tapped.
+      if (width < 600) await page.locator('.p-diagnosis .fold-toggle').click();
+      await page.locator(`.diagnosis .finding[data-code="${code}"]`).waitFor({ timeout: 5000 });
+      // The panel hears at most 4× a second: let the last word of the replay arrive.
+      await page.waitForTimeout(600);
+      // Open the finding with settings, so the screenshot shows what a user copies.
+      const withSettings = page.locator('.diagnosis .finding', { has: page.locator('pre') }).first();
+      if (!(await withSettings.locator('details').evaluate((d) => (d as HTMLDetailsElement).open)))
+        await withSettings.locator('summary').click();
+      await expect(page.getByTestId('top-finding').isVisible()).resolves.toBe(true);
+      const w = await fits(page);
+      expect(w.document, `${name} ${width} ${scheme}`).toBeLessThanOrEqual(w.viewport);
+      await page.locator('.p-diagnosis').screenshot({ path: join(SHOTS, `diagnosis-${name}-panel-${width}-${scheme}.png`) });
+      expect(await axe(page, `diagnosis ${name} ${width} ${scheme}`, ['.p-diagnosis', '.top-finding'])).toEqual([]);
+      await page.screenshot({ path: join(SHOTS, `diagnosis-${name}-page-${width}-${scheme}.png`), fullPage: width === 390 });
+      expect(errors).toEqual([]);
+      await context.close();
     }
   });
 });

@@ -79,86 +79,91 @@ describe.skipIf(skip !== null)('the page parts', () => {
     await page.context().close();
   });
 
-  for (const width of [390, 1280])
-    for (const theme of ['light', 'dark'] as const)
-      it(`shows the Bind panel at ${width} px (${theme}): themed wiring, 11 px text, arrow keys, the guide, Escape`, async () => {
-        const { page, errors } = await open(width, theme);
-        await page.getByRole('button', { name: 'Bind…' }).first().click();
-        const panel = page.getByRole('region', { name: 'Bind a satellite' });
-        await panel.waitFor();
-        const svg = panel.locator('.wiring-scroll svg');
-        await svg.waitFor();
-        // The diagram's background is the panel's, in either theme.
-        const colours = await panel.evaluate((p) => {
-          const bg = p.querySelector('.wiring-scroll .bg');
-          return { bg: bg === null ? '' : getComputedStyle(bg).fill, panel: getComputedStyle(p).backgroundColor };
-        });
-        expect(colours.bg).toBe(colours.panel);
-        // Its smallest text as drawn: at least 11 px.
-        const smallest = await svg.evaluate((s) => {
-          const scale = s.getBoundingClientRect().width / 900;
-          return Math.min(...[...s.querySelectorAll('text')].map((t) => Number.parseFloat(getComputedStyle(t).fontSize) * scale));
-        });
-        expect(smallest).toBeGreaterThanOrEqual(11);
-        // The bind modes are radios: the arrow keys move the choice.
-        await page.getByRole('radio', { name: '9 pulses' }).focus();
-        await page.keyboard.press('ArrowDown');
-        await expect(page.getByRole('radio', { name: '10 pulses' }).isChecked()).resolves.toBe(true);
-        await page.keyboard.press('ArrowUp');
-        await expect(page.getByRole('radio', { name: '9 pulses' }).isChecked()).resolves.toBe(true);
-        // The wiring guide ships with the page.
-        await page.getByText('Guide: binding wiring and timeline').click();
-        await expect(page.getByTestId('bind-guide').textContent()).resolves.toMatch(/^# Binding a satellite from the page/);
-        await page.getByText('Guide: binding wiring and timeline').click();
-        await shot(page, `parts-${width}-${theme}-bind`);
-        // Escape closes the panel.
-        await page.keyboard.press('Escape');
-        await panel.waitFor({ state: 'detached', timeout: 2000 });
-        expect(errors).toEqual([]);
-        await page.context().close();
+  // Each width once and each theme once (every size in both themes: the slow tier's screenshots).
+  for (const [width, theme] of [
+    [390, 'light'],
+    [1280, 'dark'],
+  ] as const)
+    it(`shows the Bind panel at ${width} px (${theme}): themed wiring, 11 px text, arrow keys, the guide, Escape`, async () => {
+      const { page, errors } = await open(width, theme);
+      await page.getByRole('button', { name: 'Bind…' }).first().click();
+      const panel = page.getByRole('region', { name: 'Bind a satellite' });
+      await panel.waitFor();
+      const svg = panel.locator('.wiring-scroll svg');
+      await svg.waitFor();
+      // The diagram's background is the panel's, in either theme.
+      const colours = await panel.evaluate((p) => {
+        const bg = p.querySelector('.wiring-scroll .bg');
+        return { bg: bg === null ? '' : getComputedStyle(bg).fill, panel: getComputedStyle(p).backgroundColor };
       });
+      expect(colours.bg).toBe(colours.panel);
+      // Its smallest text as drawn: at least 11 px.
+      const smallest = await svg.evaluate((s) => {
+        const scale = s.getBoundingClientRect().width / 900;
+        return Math.min(...[...s.querySelectorAll('text')].map((t) => Number.parseFloat(getComputedStyle(t).fontSize) * scale));
+      });
+      expect(smallest).toBeGreaterThanOrEqual(11);
+      // The bind modes are radios: the arrow keys move the choice.
+      await page.getByRole('radio', { name: '9 pulses' }).focus();
+      await page.keyboard.press('ArrowDown');
+      await expect(page.getByRole('radio', { name: '10 pulses' }).isChecked()).resolves.toBe(true);
+      await page.keyboard.press('ArrowUp');
+      await expect(page.getByRole('radio', { name: '9 pulses' }).isChecked()).resolves.toBe(true);
+      // The wiring guide ships with the page.
+      await page.getByText('Guide: binding wiring and timeline').click();
+      await expect(page.getByTestId('bind-guide').textContent()).resolves.toMatch(/^# Binding a satellite from the page/);
+      await page.getByText('Guide: binding wiring and timeline').click();
+      await shot(page, `parts-${width}-${theme}-bind`);
+      // Escape closes the panel.
+      await page.keyboard.press('Escape');
+      await panel.waitFor({ state: 'detached', timeout: 2000 });
+      expect(errors).toEqual([]);
+      await page.context().close();
+    });
 
-  for (const width of [390, 1280])
-    for (const theme of ['light', 'dark'] as const)
-      it(`says Paused and Ended in a replay at ${width} px (${theme}), never Live`, async () => {
-        const sim = simulate(preset('dropouts-failsafe'), undefined, { truth: true });
-        const path = join(dir, `dropouts-${width}-${theme}.sscap`);
-        writeCapture(path, usbChunks(sim.bytes, sim.timesUs));
-        const { page, errors } = await open(width, theme, '?demo=0');
-        await page.setInputFiles('input[type=file]', path);
-        await page.locator('section.replay').waitFor();
-        await page.getByRole('button', { name: 'Pause' }).click();
-        // The worker says it paused: wait for its word, then read the hint it came with.
-        await page
-          .getByTestId('link-state')
-          .filter({ hasText: /^Paused$/ })
-          .waitFor({ timeout: 5000 });
-        await expect.poll(() => page.getByTestId('link-hint').textContent()).toMatch(/^Paused at \d:\d\d\.\d of the capture: there /);
-        await shot(page, `parts-${width}-${theme}-paused`);
-        await page.getByRole('radio', { name: 'max' }).click();
-        await page.getByRole('button', { name: 'Play' }).click();
-        await page.getByTestId('link-state').filter({ hasText: 'Ended' }).waitFor({ timeout: 20_000 });
-        await expect(page.getByTestId('link-hint').textContent()).resolves.toMatch(/^Replay ended at 0:03\.\d: there the link was live\.$/);
-        // Min / max / last open, and the frames export in the Report menu, fit the width.
-        await page.getByText('Min / max / last per channel').first().click();
-        await page.getByTestId('channel-ranges').first().locator('tbody tr').first().filter({ hasText: 'µs' }).waitFor();
-        await page.getByRole('button', { name: 'Report', exact: true }).click();
-        await page.getByRole('group', { name: 'Decoded frames of remote A' }).waitFor();
-        await expect(page.evaluate(() => document.documentElement.scrollWidth)).resolves.toBeLessThanOrEqual(width);
-        const pop = await page.locator('.menu-pop:not([hidden])').boundingBox();
-        expect(pop?.x).toBeGreaterThanOrEqual(0);
-        expect((pop?.x ?? 0) + (pop?.width ?? 0)).toBeLessThanOrEqual(width);
-        const table = await page
-          .getByTestId('channel-ranges')
-          .first()
-          .evaluate((t) => t.getBoundingClientRect().right);
-        const box = await page
-          .locator('section.channels')
-          .first()
-          .evaluate((c) => c.getBoundingClientRect().right);
-        expect(table).toBeLessThanOrEqual(box + 1);
-        await shot(page, `parts-${width}-${theme}-ended`);
-        expect(errors).toEqual([]);
-        await page.context().close();
-      });
+  for (const [width, theme] of [
+    [390, 'dark'],
+    [1280, 'light'],
+  ] as const)
+    it(`says Paused and Ended in a replay at ${width} px (${theme}), never Live`, async () => {
+      const sim = simulate(preset('dropouts-failsafe'), undefined, { truth: true });
+      const path = join(dir, `dropouts-${width}-${theme}.sscap`);
+      writeCapture(path, usbChunks(sim.bytes, sim.timesUs));
+      const { page, errors } = await open(width, theme, '?demo=0');
+      await page.setInputFiles('input[type=file]', path);
+      await page.locator('section.replay').waitFor();
+      await page.getByRole('button', { name: 'Pause' }).click();
+      // The worker says it paused: wait for its word, then read the hint it came with.
+      await page
+        .getByTestId('link-state')
+        .filter({ hasText: /^Paused$/ })
+        .waitFor({ timeout: 5000 });
+      await expect.poll(() => page.getByTestId('link-hint').textContent()).toMatch(/^Paused at \d:\d\d\.\d of the capture: there /);
+      await shot(page, `parts-${width}-${theme}-paused`);
+      await page.getByRole('radio', { name: 'max' }).click();
+      await page.getByRole('button', { name: 'Play' }).click();
+      await page.getByTestId('link-state').filter({ hasText: 'Ended' }).waitFor({ timeout: 20_000 });
+      await expect(page.getByTestId('link-hint').textContent()).resolves.toMatch(/^Replay ended at 0:03\.\d: there the link was live\.$/);
+      // Min / max / last open, and the frames export in the Report menu, fit the width.
+      await page.getByText('Min / max / last per channel').first().click();
+      await page.getByTestId('channel-ranges').first().locator('tbody tr').first().filter({ hasText: 'µs' }).waitFor();
+      await page.getByRole('button', { name: 'Report', exact: true }).click();
+      await page.getByRole('group', { name: 'Decoded frames of remote A' }).waitFor();
+      await expect(page.evaluate(() => document.documentElement.scrollWidth)).resolves.toBeLessThanOrEqual(width);
+      const pop = await page.locator('.menu-pop:not([hidden])').boundingBox();
+      expect(pop?.x).toBeGreaterThanOrEqual(0);
+      expect((pop?.x ?? 0) + (pop?.width ?? 0)).toBeLessThanOrEqual(width);
+      const table = await page
+        .getByTestId('channel-ranges')
+        .first()
+        .evaluate((t) => t.getBoundingClientRect().right);
+      const box = await page
+        .locator('section.channels')
+        .first()
+        .evaluate((c) => c.getBoundingClientRect().right);
+      expect(table).toBeLessThanOrEqual(box + 1);
+      await shot(page, `parts-${width}-${theme}-ended`);
+      expect(errors).toEqual([]);
+      await page.context().close();
+    });
 });

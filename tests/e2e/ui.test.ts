@@ -2,11 +2,10 @@
  * The page on any screen and with any input, in Debian's Chromium: nothing wider than a phone's
  * viewport, a one-row toolbar on a laptop, the empty state that says what to do, keyboard-only
  * use with visible focus, light and dark themes, graphs that label their axes and show values
- * on hover, and axe-core with no serious or critical violation. Screenshots of the demo, a
- * replay and the empty state at three sizes in both themes go to test-results/screenshots/.
+ * on hover, and axe-core with no serious or critical violation (the dark theme here; the light
+ * one, and screenshots at three sizes in both themes, in tests/slow/screenshots.test.ts).
  */
 import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
-import { createRequire } from 'node:module';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import type { Page } from 'playwright-core';
@@ -18,23 +17,19 @@ import { simulate } from '../../src/simulator/simulator.js';
 import { agoLabel, agoSplits, decimals, niceSplits, niceTop, timeStep } from '../../src/app/axes.js';
 import {
   SHOTS,
-  SIZES,
   browserUnavailable,
+  demoRunning,
   openPage,
   replayToEnd,
-  shot,
   startApp,
   usbChunks,
   writeCapture,
   type AppSession,
 } from './app-fixture.js';
+import { axeStates } from './axe.js';
 
 const skip = browserUnavailable();
 if (skip !== null) console.warn(`skipping the page tests: ${skip}`);
-
-const AXE_SOURCE = readFileSync(createRequire(import.meta.url).resolve('axe-core/axe.min.js'), 'utf8');
-
-const THEMES = ['light', 'dark'] as const;
 
 let app: AppSession;
 let dir = '';
@@ -93,41 +88,6 @@ async function overflowing(page: Page): Promise<string[]> {
     }
     return out.slice(0, 10);
   });
-}
-
-/** axe-core's violations of impact serious or critical, as "rule: target" lines (and all counted). */
-async function axe(page: Page, label: string): Promise<string[]> {
-  const t0 = Date.now();
-  await page.evaluate(AXE_SOURCE);
-  const result = await page.evaluate(async () => {
-    const w = window as unknown as {
-      axe: {
-        run(
-          ctx: Document,
-          opts: object,
-        ): Promise<{ violations: { id: string; impact: string; nodes: { target: string[] }[] }[]; passes: unknown[] }>;
-      };
-    };
-    const r = await w.axe.run(document, { resultTypes: ['violations'] });
-    return {
-      violations: r.violations.map((v) => ({ id: v.id, impact: v.impact, targets: v.nodes.map((n) => n.target.join(' ')) })),
-      passes: r.passes.length,
-    };
-  });
-  const byImpact: Record<string, number> = {};
-  for (const v of result.violations) byImpact[v.impact] = (byImpact[v.impact] ?? 0) + v.targets.length;
-  console.log(
-    `axe ${label} (${Date.now() - t0} ms): ${JSON.stringify(byImpact)} ${result.violations.map((v) => `${v.id}(${v.impact})`).join(' ')}`,
-  );
-  return result.violations
-    .filter((v) => v.impact === 'serious' || v.impact === 'critical')
-    .map((v) => `${v.id}: ${v.targets.slice(0, 3).join(', ')}`);
-}
-
-async function demoRunning(page: Page): Promise<void> {
-  await page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor({ timeout: 10_000 });
-  // Attached: on a phone the remotes' panel is folded away.
-  await page.locator('.remotes .state-chip', { hasText: 'live' }).nth(1).waitFor({ state: 'attached', timeout: 10_000 });
 }
 
 describe("the graphs' axes", () => {
@@ -456,77 +416,8 @@ describe.skipIf(skip !== null)('the page on any screen', () => {
     await page.context().close();
   });
 
-  it('has no serious or critical axe-core violation, in either theme', async () => {
-    const found: string[] = [];
-    for (const scheme of THEMES) {
-      const empty = await open({ scheme, query: '?demo=0' });
-      await empty.page.getByTestId('empty-state').waitFor();
-      found.push(...(await axe(empty.page, `empty ${scheme}`)));
-      await empty.page.context().close();
-
-      const demo = await open({ scheme });
-      await demoRunning(demo.page);
-      await demo.page.getByRole('button', { name: 'Inspect frames…' }).click();
-      await demo.page.locator('.insp-table').waitFor();
-      // Paused, the inspector holds its thousand rows still while axe walks them.
-      await demo.page.getByRole('button', { name: 'Follow' }).click();
-      await demo.page.locator('.counters .help summary').click();
-      found.push(...(await axe(demo.page, `demo+inspector ${scheme}`)));
-      // Its thousand rows were walked: closed, so the panels after are walked alone.
-      await demo.page.getByRole('button', { name: 'Close the inspector' }).click();
-      await demo.page.getByRole('button', { name: 'Settings', exact: true }).click();
-      await demo.page.getByRole('combobox', { name: 'Resolution' }).waitFor();
-      found.push(...(await axe(demo.page, `demo+settings ${scheme}`)));
-      await demo.page.keyboard.press('Escape');
-      await demo.page.getByRole('button', { name: 'Bind…' }).click();
-      await demo.page.locator('.bind').waitFor();
-      await demo.page.locator('.bind .technical summary').click();
-      found.push(...(await axe(demo.page, `demo+bind ${scheme}`)));
-      await shot(demo.page, `ui-bind-1280-${scheme}`);
-      await demo.page.context().close();
-
-      const rep = await open({ scheme, query: '?demo=0' });
-      await replayToEnd(rep.page, capture);
-      found.push(...(await axe(rep.page, `replay ${scheme}`)));
-      await rep.page.context().close();
-    }
-    expect(found).toEqual([]);
-  }, 180_000);
-
-  it('takes screenshots of the demo, a replay and the empty state at three sizes in both themes, none wider than its viewport', async () => {
-    const report: string[] = [];
-    // One page a theme and state, resized to each width (the layout follows the width alone).
-    for (const scheme of THEMES) {
-      const shootAll = async (page: Page, state: string) => {
-        for (const size of SIZES) {
-          await page.setViewportSize({ width: size.width, height: size.height });
-          const w = await widths(page);
-          report.push(`${size.name} ${scheme} ${state}: document ${w.document} / viewport ${w.viewport}`);
-          expect(w.document, `${state} ${size.name} ${scheme}`).toBe(w.viewport);
-          if (size.width >= 1280) {
-            const h = await page.locator('.toolbar').evaluate((e) => e.getBoundingClientRect().height);
-            expect(h, `toolbar at ${size.name} (${state})`).toBeLessThan(56);
-          }
-          await shot(page, `ui-${state}-${size.name}-${scheme}`);
-        }
-      };
-      const empty = await open({ width: 390, height: 844, scheme, query: '?demo=0' });
-      await empty.page.getByTestId('empty-state').waitFor();
-      await shootAll(empty.page, 'empty');
-      await empty.page.context().close();
-
-      const demo = await open({ width: 390, height: 844, scheme });
-      await demoRunning(demo.page);
-      // 4 s of the demo's history (360 frames at 11 ms) in the graphs.
-      await demo.page.waitForFunction(() => Number(document.querySelector('[data-testid="count-frames"]')?.textContent) >= 360);
-      await shootAll(demo.page, 'demo');
-      await demo.page.context().close();
-
-      const rep = await open({ width: 390, height: 844, scheme, query: '?demo=0' });
-      await replayToEnd(rep.page, capture);
-      await shootAll(rep.page, 'replay');
-      await rep.page.context().close();
-    }
-    console.log(report.join('\n'));
-  }, 240_000);
+  // The light theme's walk is in the slow tier (tests/slow/screenshots.test.ts).
+  it('has no serious or critical axe-core violation in any state of the page (dark theme)', async () => {
+    expect(await axeStates(app, 'dark', capture)).toEqual([]);
+  }, 120_000);
 });

@@ -1,28 +1,33 @@
 /**
- * Screenshots to open and look at (not compared): the live demo, a replay with glitches, the
- * inspector and the channel traces at 390, 1280 and 1920 px, light and dark, in
- * test-results/screenshots/hands/. They assert nothing the main tier's browser tests do not, so
- * they run in the slow tier (`npm run test:slow`, which `.ci/run` runs too). Needs the built
- * page (`npm run build`) and Debian's Chromium.
+ * The page looked at in every size and theme, in the slow tier (`npm run test:slow`, which
+ * `.ci/run` runs too): screenshots to open (not compared) of the live demo, a replay with
+ * glitches, the inspector, the channel traces, Bind and the empty state at 390, 1280 and 1920 px,
+ * light and dark (test-results/screenshots/), with none wider than its viewport; and axe-core
+ * on every state in the light theme. The main tier's browser tests check each behaviour at one
+ * size and theme, and axe in the dark. Needs the built page (`npm run build`) and Chromium.
  */
 import { mkdirSync, mkdtempSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { afterAll, beforeAll, describe, it } from 'vitest';
+import type { Page } from 'playwright-core';
+import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { preset } from '../../src/simulator/presets.js';
 import { simulate } from '../../src/simulator/simulator.js';
 import {
   SHOTS,
   SIZES,
   browserUnavailable,
+  demoRunning,
   openPage,
   replayToEnd,
+  shot,
   startApp,
   usbChunks,
   withSpikes,
   writeCapture,
   type AppSession,
 } from '../e2e/app-fixture.js';
+import { axeStates } from '../e2e/axe.js';
 
 const skip = browserUnavailable();
 if (skip !== null) console.warn(`skipping the screenshots: ${skip}`);
@@ -100,4 +105,51 @@ describe.skipIf(skip !== null)('screenshots', () => {
       await rep.page.context().close();
     }
   }, 240_000);
+
+  it('takes screenshots of the demo, Bind, a replay and the empty state at three sizes in both themes, none wider than its viewport', async () => {
+    const report: string[] = [];
+    // One page a theme and state, resized to each width (the layout follows the width alone).
+    for (const scheme of ['light', 'dark'] as const) {
+      const shootAll = async (page: Page, state: string) => {
+        for (const size of SIZES) {
+          await page.setViewportSize({ width: size.width, height: size.height });
+          const w = await page.evaluate(() => ({
+            document: document.documentElement.scrollWidth,
+            viewport: document.documentElement.clientWidth,
+          }));
+          report.push(`${size.name} ${scheme} ${state}: document ${w.document} / viewport ${w.viewport}`);
+          expect(w.document, `${state} ${size.name} ${scheme}`).toBe(w.viewport);
+          if (size.width >= 1280) {
+            const h = await page.locator('.toolbar').evaluate((e) => e.getBoundingClientRect().height);
+            expect(h, `toolbar at ${size.name} (${state})`).toBeLessThan(56);
+          }
+          await shot(page, `ui-${state}-${size.name}-${scheme}`);
+        }
+      };
+      const empty = await open({ width: 390, height: 844, scheme, query: '?demo=0' });
+      await empty.page.getByTestId('empty-state').waitFor();
+      await shootAll(empty.page, 'empty');
+      await empty.page.context().close();
+
+      const demo = await open({ width: 390, height: 844, scheme });
+      await demoRunning(demo.page);
+      // 4 s of the demo's history (360 frames at 11 ms) in the graphs.
+      await demo.page.waitForFunction(() => Number(document.querySelector('[data-testid="count-frames"]')?.textContent) >= 360);
+      await shootAll(demo.page, 'demo');
+      await demo.page.getByRole('button', { name: 'Bind…' }).click();
+      await demo.page.locator('.bind').waitFor();
+      await shootAll(demo.page, 'bind');
+      await demo.page.context().close();
+
+      const rep = await open({ width: 390, height: 844, scheme, query: '?demo=0' });
+      await replayToEnd(rep.page, spiky);
+      await shootAll(rep.page, 'replay');
+      await rep.page.context().close();
+    }
+    console.log(report.join('\n'));
+  }, 240_000);
+
+  it('has no serious or critical axe-core violation in any state of the page (light theme)', async () => {
+    expect(await axeStates(app, 'light', spiky)).toEqual([]);
+  }, 180_000);
 });
