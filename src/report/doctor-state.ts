@@ -206,5 +206,21 @@ export type PortCheckpoint = Omit<PortState, 'source' | 'bins' | 'scanner' | 'bu
   readonly guess: ArduPilotGuessCheckpoint;
 };
 
+/**
+ * The parts of a port's state that later bytes change in place (lists, counts by key), copied:
+ * a checkpoint and the port restored from it never share one. The snapshots and records in the
+ * lists never change once made, so the lists are copied, not their items.
+ */
+export function copiedParts(p: Pick<PortState, 'away' | 'head' | 'probePackets' | 'packetsEver' | 'damagedAtUs' | 'changes'>) {
+  return {
+    away: { ...p.away },
+    head: [...p.head],
+    probePackets: { ...p.probePackets },
+    packetsEver: { ...p.packetsEver },
+    damagedAtUs: [...p.damagedAtUs],
+    changes: [...p.changes],
+  };
+}
+
 /** "2.4 s" */
 export const dur = (us: number): string => `${(us / 1e6).toFixed(1)} s`;

@@ -38,6 +38,7 @@ import {
   M_PACKETS,
   SETUP_MIN_FRAMES,
   type FormatSnapshot,
+  copiedParts,
   type PortCheckpoint,
   type PortState,
 } from './doctor-state.js';
@@ -170,16 +171,10 @@ export class Doctor {
   portCheckpoint(port: number): PortCheckpoint | undefined {
     const p = this.#ports.get(port);
     if (p === undefined) return undefined;
-    // The snapshots and records in the lists are never changed once made: the lists are copied.
-    const { source: _source, bins, scanner, burst, guess, probePackets, packetsEver, damagedAtUs, changes, head, away, ...plain } = p;
+    const { source: _source, bins, scanner, burst, guess, ...plain } = p;
     return {
       ...plain,
-      away: { ...away },
-      head: [...head],
-      probePackets: { ...probePackets },
-      packetsEver: { ...packetsEver },
-      damagedAtUs: [...damagedAtUs],
-      changes: [...changes],
+      ...copiedParts(p),
       bins: bins.checkpoint(),
       scanner: scanner.checkpoint(),
       burst: burst.checkpoint(),
@@ -195,17 +190,8 @@ export class Doctor {
   restorePort(port: number, cp: PortCheckpoint, source: DoctorPortSource): void {
     this.detach(port);
     const p = this.#port(port);
-    const { bins, scanner, burst, guess, probePackets, packetsEver, damagedAtUs, changes, head, away, ...plain } = cp;
-    Object.assign(p, plain, {
-      port,
-      source,
-      away: { ...away },
-      head: [...head],
-      probePackets: { ...probePackets },
-      packetsEver: { ...packetsEver },
-      damagedAtUs: [...damagedAtUs],
-      changes: [...changes],
-    });
+    const { bins, scanner, burst, guess, ...plain } = cp;
+    Object.assign(p, plain, copiedParts(cp), { port, source });
     p.bins.restore(bins);
     p.scanner.restore(scanner);
     p.burst.restore(burst);
