@@ -254,7 +254,8 @@ describe('a decoder and link monitor restored from a checkpoint', () => {
   });
 
   it('a day of holds stays linear: settled episodes are shared, never copied into each checkpoint', () => {
-    // 20 minutes with a dropout every 2 s, each tenth a failsafe: more than two blocks of the log.
+    // 20 minutes with a dropout every 2 s, each tenth a failsafe: two full blocks of the log and more
+    // (an external remote read in 64-byte chunks, 88 ms of frames each: no batch is a hold).
     const dropouts = Array.from({ length: 600 }, (_, k) => ({ atUs: 1e6 + k * 2e6, durationUs: k % 10 === 0 ? 1_200_000 : 300_000 }));
     const sim = simulate({ ...preset('dsm2-22ms-1024-external'), dropouts }, 1_201_000_000);
     const decoder = new SpektrumDecoder();
@@ -272,7 +273,7 @@ describe('a decoder and link monitor restored from a checkpoint', () => {
       for (let f = decoder.next(); f !== undefined; f = decoder.next()) link.frame(f);
       fed++;
     }
-    expect(link.episodes.length).toBeGreaterThan(1000);
+    expect(link.episodes.length).toBeGreaterThan(2 * 256);
     // Each checkpoint copies only the episodes still open to change (at most 64 holds wait to be
     // judged, and the silence still open), however many came before; full blocks are the same objects.
     const objects = new Set<object>();
@@ -282,7 +283,7 @@ describe('a decoder and link monitor restored from a checkpoint', () => {
     }
     expect(objects.size).toBeLessThanOrEqual(link.episodes.length);
     const last = taken.at(-1)!.cp;
-    expect(last.settled.length).toBeGreaterThan(2);
+    expect(last.settled.length).toBeGreaterThanOrEqual(2);
     expect(taken[taken.length - 2]!.cp.settled[1]).toBe(last.settled[1]);
     // Restored (also after a structured clone, as a checkpoint crosses workers), a fresh monitor has
     // the episodes the original had there, and goes on to the same end.

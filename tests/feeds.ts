@@ -39,13 +39,13 @@ export function perByteCapture(sim: { bytes: Uint8Array; timesUs: Float64Array }
 }
 
 /**
- * Streams of several ports recorded as the page records them, as the bytes of an .sscap: 16 ms
- * USB chunks merged in time order, each port named "port N" and opened at 0 (`timed: false`:
- * without any time).
+ * Streams of several ports recorded as the page records them, as the bytes of an .sscap: USB
+ * chunks (16 ms unless `windowUs` says) merged in time order, each port named "port N" and
+ * opened at 0 (`timed: false`: without any time).
  */
-export function recordingFile(ports: Stream[], timed = true): Uint8Array {
+export function recordingFile(ports: Stream[], timed = true, windowUs = 16_000): Uint8Array {
   const w = new CaptureWriter({ baudRate: 115200, source: 'test', ports: ports.map((_, i) => ({ name: `port ${i}` })) });
-  const records = ports.flatMap((p, port) => usbChunks(p.bytes, p.timesUs).map((c) => ({ ...c, port })));
+  const records = ports.flatMap((p, port) => usbChunks(p.bytes, p.timesUs, windowUs).map((c) => ({ ...c, port })));
   records.sort((a, b) => a.timeUs - b.timeUs || a.port - b.port);
   const parts = [w.header(), ...ports.map((_, port) => w.event('port opened', timed ? 0 : NaN, port))];
   for (const r of records) parts.push(w.data(r.bytes, timed ? r.timeUs : NaN, r.port));
@@ -53,8 +53,8 @@ export function recordingFile(ports: Stream[], timed = true): Uint8Array {
 }
 
 /** `recordingFile`, read. */
-export function recording(ports: Stream[], timed = true): Capture {
-  return readCapture(recordingFile(ports, timed), 'recording.sscap');
+export function recording(ports: Stream[], timed = true, windowUs = 16_000): Capture {
+  return readCapture(recordingFile(ports, timed, windowUs), 'recording.sscap');
 }
 
 /** Streams one after another on one line, each shifted to start 20 ms after the last ended. */

@@ -20,7 +20,8 @@ export interface StallBurst {
   episode: LinkEpisode;
   frames: number;
   run: number;
-  counted: boolean;
+  /** null: the counter moved over the silence by a count no frame's delta gives: it says nothing of this burst. */
+  counted: boolean | null;
 }
 
 /** What the judge needs of its link monitor: its thresholds, and a new episode in its list. */
@@ -121,7 +122,7 @@ export class StallJudge {
     if (Number.isFinite(t) && !(t - last >= (Number.isFinite(p) ? p : FRAME_PERIOD_11MS_US) / 2)) {
       b.frames++;
       if (fades > b.run) b.run = fades;
-      if (fades > 0) b.counted = true;
+      if (fades > 0 && b.counted !== null) b.counted = true;
       return true;
     }
     this.endBurst();
@@ -132,15 +133,16 @@ export class StallJudge {
    * The silence of `open` ended with a frame whose fade count moved by `fades`. The hold waits
    * for the burst after it: where the counter counts (`counting`), the runs it says were lost
    * (`missed` now, then those over the burst) are the evidence, and the hold is judged when the
-   * burst ends; otherwise by the burst's frame count, and then by the frame count of the ledger
-   * window that closes over it.
+   * burst ends; otherwise (and where the count moved by what no delta gives, `counting` null:
+   * the decoder relocked after the silence, and the frames lost in it are not known) by the
+   * burst's frame count, and then by the frame count of the ledger window that closes over it.
    */
-  ended(open: LinkEpisode, counting: boolean, missed: number, fades: number): void {
+  ended(open: LinkEpisode, counting: boolean | null, missed: number, fades: number): void {
     // The hold of this silence (`open` is its failsafe if it became one).
     const u = this.#unconfirmed.find((x) => x.episode.lastFrameUs === open.lastFrameUs);
     if (u === undefined) return;
     u.endFades = fades;
-    this.#burst = { episode: u.episode, frames: 1, run: missed, counted: counting || missed > 0 };
+    this.#burst = { episode: u.episode, frames: 1, run: missed, counted: counting === null ? null : counting || missed > 0 };
   }
 
   /** After a ledger window: holds before its most punctual frame are confirmed or withdrawn. */
@@ -312,15 +314,20 @@ export class StallJudge {
    * controller, on the receiver's own line, had its frames).
    */
   #judge(e: LinkEpisode, run: number | null, missed: number): boolean {
-    const due = this.#dueIn(e);
-    if (due < 2) return false;
     // With the receiver's counter, the hold was the link's where a run of frames it lost is a
     // hold's silence itself (lost frames scattered over a silence the adapter made are no hold
-    // on the receiver's line); without, where the frames that came after it do not stand for
-    // half of those due in it. A run is timed at the system byte's period, or, where the period
-    // is only estimated, at the shortest (never longer than it was).
-    const p = this.#monitor.periodKnown() ? this.#stats.nominalPeriodUs : FRAME_PERIOD_11MS_US;
-    if (run !== null ? (run + 1) * p > this.#monitor.counterHoldUs() : missed >= due / 2) return false;
+    // on the receiver's line). A run is timed at the system byte's period, or, where the period
+    // is only estimated or not known at all (an external remote read in batches longer than its
+    // frames' spacing), at the shortest (never longer than it was).
+    if (run !== null) {
+      const p = this.#monitor.periodKnown() ? this.#stats.nominalPeriodUs : FRAME_PERIOD_11MS_US;
+      if ((run + 1) * p > this.#monitor.counterHoldUs()) return false;
+    } else {
+      // Without, where the frames that came after it do not stand for half of those due in it;
+      // with no period to count them by, it stands.
+      const due = this.#dueIn(e);
+      if (due < 2 || missed >= due / 2) return false;
+    }
     const s = this.#stats;
     const silence = (this.#silenceEndUs(e) ?? e.lastFrameUs) - e.lastFrameUs;
     this.#remove(e.lastFrameUs);

@@ -254,16 +254,17 @@ export class LinkMonitor {
       s.missedBasis = 'frame-count';
     }
     if (this.#open !== null && Number.isFinite(t)) {
-      // The frame the silence is counted from (the decoder held it, `update`'s `pendingUs`), or
-      // an older one: the silence goes on.
+      // The frame the silence is counted from (held by the decoder: `pendingUs`) or older: it goes on.
       if (t <= this.#open.lastFrameUs) return;
       this.#open = this.#stalls.shorter(this.#open, t);
     }
     const ended = this.#open;
     if (ended !== null) {
       ended.endUs = Number.isFinite(t) ? t : ended.startUs;
-      // What the receiver says it missed in the silence: the evidence where its counter counts.
-      this.#stalls.ended(ended, this.#counting && (restartDue > 0 || this.#restarts.vouched), restartDue > 0 ? restartDue : fades, fades);
+      // What the receiver says it missed in the silence: the evidence where its counter counts
+      // (null: it moved by more than the decoder could attribute, a relock after the silence).
+      const counter = this.#counting && (restartDue > 0 || this.#restarts.vouched || (frame.fades === null ? false : null));
+      this.#stalls.ended(ended, counter, restartDue > 0 ? restartDue : fades, fades);
       this.#open = null;
     }
     if (this.#counting && this.#restarts.vouched && !inBurst && fades > 0) this.#stalls.hidden(t, last, fades, ended);
@@ -314,8 +315,7 @@ export class LinkMonitor {
       this.#stalls.held(this.#open);
     }
     const hold = this.#state === 'hold' ? this.#open : null;
-    // A frame held now came a second or more after the hold's last one: the hold's own
-    // silence reached failsafe before it.
+    // A frame held now came a second or more after the hold's: the hold's silence reached failsafe.
     const heldLate = hold !== null && last - hold.lastFrameUs >= this.#failsafeAfterUs;
     if ((gap >= this.#failsafeAfterUs || heldLate) && this.#state === 'hold') {
       this.#state = 'failsafe';
