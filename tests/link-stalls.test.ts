@@ -182,19 +182,23 @@ describe("the receiver's counter, where the adapter saw no silence", () => {
     expect(link.stats).toMatchObject({ holds: 0, failsafes: 0, missedFrames: 18 });
   });
 
-  it('shows no hold for an external remote read in batches longer than a hold, and measures its period over them', () => {
+  it('withdraws the holds of an external remote read in batches longer than a hold, where no period can be measured', () => {
     // An adapter that hands over 66–200 ms at a time (a long latency timer): every batch is a
     // silence longer than a hold to the adapter, while the receiver's counter shows no frame lost
-    // in it. Frames come 1.4 ms apart inside a batch: the period is the mean over the batches.
+    // in it. Its frames come 1.4 ms apart inside a batch, so the period stays unknown.
     for (const name of ['dsmx-11ms-2048-external', 'dsm2-22ms-1024-external', 'dsmx-22ms-2048-external'] as const) {
       const sim = simulate(preset(name), 10e6);
       const truth = summarizeCapture(perByteCapture(sim));
       for (const windowUs of [66_000, 88_000, 120_000, 200_000]) {
         const s = summarizeCapture(recording([sim], true, windowUs));
-        const at = `${name} in ${windowUs / 1000} ms batches`;
-        expect(s.episodes, at).toEqual([]);
-        expect(s.link.missedFrames, at).toBe(truth.link.missedFrames);
-        expect(s.link.nominalPeriodUs, at).toBe(truth.link.nominalPeriodUs);
+        // The last batch's time may lie up to a window after its last frame: the capture's end,
+        // silent that long, may be a hold.
+        const held = s.episodes.filter((e) => e.kind === 'hold' && e.endUs !== null);
+        expect(held, `${name} in ${windowUs / 1000} ms batches`).toEqual([]);
+        expect(s.link.failsafes).toBe(truth.link.failsafes);
+        expect(s.link.missedFrames).toBe(truth.link.missedFrames);
+        // A batch that long is a stall every time (66 ms ones only where the frames fall so).
+        if (windowUs > 80_000) expect(s.link.stalls).toBeGreaterThan(10e6 / windowUs / 2);
       }
     }
   });

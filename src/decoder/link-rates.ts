@@ -6,7 +6,7 @@
 import type { LinkCheckpoint } from './checkpoint.js';
 import { nominalPeriodOf } from './link-rules.js';
 import type { LinkStats } from './link-types.js';
-import { FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US } from './spec.js';
+import { FRAME_PERIOD_11MS_US } from './spec.js';
 
 const PERIOD_WINDOW = 33;
 /** A mean frame interval below this (0.8 × 11 ms) is no system's period: frames a delivery burst brought together. */
@@ -33,20 +33,9 @@ export class LinkRates {
   #rateCount = 0;
   #rateNext = 0;
 
-  /** Forgets the period window's frames (after an interruption: no interval spans it). */
+  /** Forgets the period window's frames (after a gap or an interruption: no interval spans it). */
   clearPeriod(): void {
     this.#periodCount = 0;
-  }
-
-  /**
-   * A gap of `gapUs` before the next frame: longer than 3 periods (of 22 ms while none is known),
-   * the period window starts afresh, as frames lost in it would stretch the mean interval;
-   * unless the receiver's counter says none was (`delivered`): the adapter held the frames
-   * back and handed them over in a batch, and the mean interval over the batches stays true
-   * (an adapter that hands over 88 ms at a time leaves no other way to measure the period).
-   */
-  gap(gapUs: number, periodUs: number, delivered: boolean): void {
-    if (!delivered && gapUs > 3 * (Number.isFinite(periodUs) ? periodUs : FRAME_PERIOD_22MS_US)) this.#periodCount = 0;
   }
 
   /**

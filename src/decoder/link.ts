@@ -37,7 +37,7 @@
  * - Fades are the decoder's `fadesDelta`: the decoder already leaves out counter jumps it cannot
  *   attribute to the receiver (`DecoderStats.fadeJumps`).
  */
-import { FAILSAFE_TIMEOUT_US, FRAME_PERIOD_11MS_US, systemInfo } from './spec.js';
+import { FAILSAFE_TIMEOUT_US, FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US, systemInfo } from './spec.js';
 import type { DecodedFrame } from './types.js';
 import { EpisodeLog } from './episode-log.js';
 import type { LinkEpisode } from './episode.js';
@@ -226,7 +226,7 @@ export class LinkMonitor {
         if (gap > s.longestGapUs) s.longestGapUs = gap;
         const p = s.nominalPeriodUs;
         if (Number.isFinite(p) && isFrameInterval(gap, p, this.jitterUs)) this.#lastInterval = gap;
-        this.#rates.gap(gap, p, this.#counting && this.#restarts.vouched && fades === 0);
+        if (gap > 3 * (Number.isFinite(p) ? p : FRAME_PERIOD_22MS_US)) this.#rates.clearPeriod();
       }
       this.#lastUs = t;
       this.#rates.measure(t, fades, s, !Number.isFinite(this.#systemPeriod));
