@@ -49,7 +49,7 @@ export interface UnjudgedHold {
   endFades: number;
   counterRun: number | null;
 }
-import { FRAME_PERIOD_11MS_US } from './spec.js';
+import { FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US } from './spec.js';
 
 /**
  * The holds not yet confirmed and the burst after one, judged as the evidence comes; writes
@@ -316,11 +316,16 @@ export class StallJudge {
   #judge(e: LinkEpisode, run: number | null, missed: number): boolean {
     // With the receiver's counter, the hold was the link's where a run of frames it lost is a
     // hold's silence itself (lost frames scattered over a silence the adapter made are no hold
-    // on the receiver's line). A run is timed at the system byte's period, or, where the period
-    // is only estimated or not known at all (an external remote read in batches longer than its
-    // frames' spacing), at the shortest (never longer than it was).
+    // on the receiver's line). A run is timed at the system byte's period; where the period is
+    // only estimated, at the shortest (an estimate read twice too long made every run a hold);
+    // where none is known at all (an external remote read in batches longer than its frames'
+    // spacing), at the longest: the hold goes only where no period makes the run one.
     if (run !== null) {
-      const p = this.#monitor.periodKnown() ? this.#stats.nominalPeriodUs : FRAME_PERIOD_11MS_US;
+      const p = this.#monitor.periodKnown()
+        ? this.#stats.nominalPeriodUs
+        : Number.isFinite(this.#stats.nominalPeriodUs)
+          ? FRAME_PERIOD_11MS_US
+          : FRAME_PERIOD_22MS_US;
       if ((run + 1) * p > this.#monitor.counterHoldUs()) return false;
     } else {
       // Without, where the frames that came after it do not stand for half of those due in it;
