@@ -193,7 +193,9 @@ describe.skipIf(!!skipReason)('e2e harness: real WebSerial on a pty in place of 
     timings.pacedLateMaxUs = result.lateMaxUs;
     timings.pacedChunks = data.length;
     expect(spanMs).toBeGreaterThan((frames - 1) * 11 * 0.9);
-    expect(spanMs).toBeLessThan((frames - 1) * 11 + 100);
+    // No longer than the schedule, plus what the writer itself measured it fell behind (a loaded
+    // machine delays the writer's timers, which the page then sees).
+    expect(spanMs).toBeLessThan((frames - 1) * 11 + 100 + result.lateMaxUs / 1000);
     expect(data.length).toBeGreaterThanOrEqual(frames * 0.8); // one read per frame, mostly
   });
 
