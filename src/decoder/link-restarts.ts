@@ -21,15 +21,23 @@ export class RestartWatch {
   /** The last frame's fade count (NaN: none yet). */
   #prevCount = NaN;
   readonly #restarts: LinkRestart[] = [];
-  #vouched = false;
+  /** What the last frame's count says of the frames lost before it (`evidence`). */
+  #evidence: boolean | null = false;
 
   /**
-   * Whether the last frame's count moved from the one before by just its `fadesDelta`: the
-   * receiver vouches for the frames the delta says were lost. A jump the decoder left out
-   * (another remote's count after a break) or a restart says nothing of the silence.
+   * What the last frame's count says of the frames lost before it: true where it moved from the
+   * one before by just its `fadesDelta` (the receiver vouches for the frames the delta says were
+   * lost); null where it moved by a count no delta gives (a jump the decoder left out: another
+   * remote's count after a break, a relock after a silence, a restart), so how many were lost is
+   * not known; false where the frame has no count.
    */
+  get evidence(): boolean | null {
+    return this.#evidence;
+  }
+
+  /** `evidence` is true. */
   get vouched(): boolean {
-    return this.#vouched;
+    return this.#evidence === true;
   }
 
   /** The last receiver restarts (up to 64), oldest first. */
@@ -45,12 +53,12 @@ export class RestartWatch {
    */
   frame(frame: DecodedFrame, gapUs: number, s: LinkStats): number {
     const count = frame.fades;
-    this.#vouched = false;
+    this.#evidence = false;
     if (count === null) return 0;
     const prev = this.#prevCount;
     this.#prevCount = count;
     const modulus = frame.remote === 'internal' ? 256 : 65536;
-    this.#vouched = (count - prev + modulus) % modulus === frame.fadesDelta;
+    this.#evidence = (count - prev + modulus) % modulus === frame.fadesDelta ? true : null;
     const p = s.nominalPeriodUs;
     if (!(count < prev) || !(gapUs >= RESTART_MIN_GAP_US) || !Number.isFinite(p)) return 0;
     const due = Math.max(0, Math.round(gapUs / p) - 1);

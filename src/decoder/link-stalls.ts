@@ -316,17 +316,9 @@ export class StallJudge {
   #judge(e: LinkEpisode, run: number | null, missed: number): boolean {
     // With the receiver's counter, the hold was the link's where a run of frames it lost is a
     // hold's silence itself (lost frames scattered over a silence the adapter made are no hold
-    // on the receiver's line). A run is timed at the system byte's period; where the period is
-    // only estimated, at the shortest (an estimate read twice too long made every run a hold);
-    // where none is known at all (an external remote read in batches longer than its frames'
-    // spacing), at the longest: the hold goes only where no period makes the run one.
+    // on the receiver's line).
     if (run !== null) {
-      const p = this.#monitor.periodKnown()
-        ? this.#stats.nominalPeriodUs
-        : Number.isFinite(this.#stats.nominalPeriodUs)
-          ? FRAME_PERIOD_11MS_US
-          : FRAME_PERIOD_22MS_US;
-      if ((run + 1) * p > this.#monitor.counterHoldUs()) return false;
+      if ((run + 1) * this.#runPeriodUs() > this.#monitor.counterHoldUs()) return false;
     } else {
       // Without, where the frames that came after it do not stand for half of those due in it;
       // with no period to count them by, it stands.
@@ -339,6 +331,18 @@ export class StallJudge {
     s.stalls++;
     if (silence > s.longestStallUs) s.longestStallUs = silence;
     return true;
+  }
+
+  /**
+   * The period a run of frames the counter says were lost is timed at: the system byte's; where
+   * the period is only estimated, the shortest (an estimate read twice too long made every run a
+   * hold); where none is known at all (an external remote read in batches longer than its
+   * frames' spacing), the longest: a hold goes only where no period makes the run one.
+   */
+  #runPeriodUs(): number {
+    const p = this.#stats.nominalPeriodUs;
+    if (this.#monitor.periodKnown()) return p;
+    return Number.isFinite(p) ? FRAME_PERIOD_11MS_US : FRAME_PERIOD_22MS_US;
   }
 
   /**

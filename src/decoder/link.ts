@@ -263,7 +263,7 @@ export class LinkMonitor {
       ended.endUs = Number.isFinite(t) ? t : ended.startUs;
       // What the receiver says it missed in the silence: the evidence where its counter counts
       // (null: it moved by more than the decoder could attribute, a relock after the silence).
-      const counter = this.#counting && (restartDue > 0 || this.#restarts.vouched || (frame.fades === null ? false : null));
+      const counter = this.#counting && (restartDue > 0 || this.#restarts.evidence);
       this.#stalls.ended(ended, counter, restartDue > 0 ? restartDue : fades, fades);
       this.#open = null;
     }
