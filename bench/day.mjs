@@ -7,7 +7,8 @@
  * growth can be read against the file size. Measurement only: the files live in os.tmpdir()
  * (never in the repository) and are kept there for the next run (`--fresh` makes them again).
  *
- * Options: --only 1m,1h (durations to run), --fresh, --keep-html.
+ * Options: --only 1m,1h (durations to run; 7d, a week of 3 GB, only when named), --fresh,
+ * --keep-html, --make-only (make the captures, run no command: for bench/replay.mjs and the page).
  */
 import { spawnSync } from 'node:child_process';
 import { closeSync, existsSync, openSync, renameSync, rmSync, statSync, writeSync } from 'node:fs';
@@ -18,14 +19,18 @@ import { CaptureWriter } from '../dist/capture/index.js';
 import { Simulator, preset } from '../dist/simulator/index.js';
 
 const VERSION = 1; // bump when the generated stream changes, so old files are not reused
-const DURATIONS = { '1m': 60e6, '1h': 3600e6, '24h': 24 * 3600e6 };
+const DURATIONS = { '1m': 60e6, '1h': 3600e6, '24h': 24 * 3600e6, '7d': 7 * 24 * 3600e6 };
+/** Made and run unless `--only` says otherwise: the week (3 GB) only when asked for. */
+const DEFAULT = ['1m', '1h', '24h'];
 const USB_WINDOW_US = 16_000;
 const BLOCK_US = 1_000_000;
 const cli = fileURLToPath(new URL('../dist/cli/main.js', import.meta.url));
 
 const args = process.argv.slice(2);
-const only = args.includes('--only') ? args[args.indexOf('--only') + 1].split(',') : Object.keys(DURATIONS);
+const only = args.includes('--only') ? args[args.indexOf('--only') + 1].split(',') : DEFAULT;
 const fresh = args.includes('--fresh');
+/** Only make the captures (for bench/replay.mjs and the page bench), run no command. */
+const makeOnly = args.includes('--make-only');
 
 /** Writes the capture of `durationUs` to `path` (through a temporary file: a cut-off run leaves no half file). */
 function makeCapture(path, durationUs) {
@@ -114,6 +119,7 @@ for (const name of only) {
     console.log(`(made ${path} in ${((performance.now() - t0) / 1000).toFixed(1)} s)`);
   }
   const fileMB = statSync(path).size / 2 ** 20;
+  if (makeOnly) continue;
   const html = join(tmpdir(), `satscope-bench-day-${name}.html`);
   for (const [command, argv] of [
     ['info', ['info', path]],

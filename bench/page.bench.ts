@@ -3,12 +3,13 @@
  * says what each section measures and how to run parts of it. Results are printed and written
  * to bench-results/page.json; nothing is asserted (a benchmark measures, tests assert).
  *
- * Sections (BENCH_ONLY=serial,demo,four,record,hour,day,bundle picks some):
+ * Sections (BENCH_ONLY=serial,demo,four,record,hour,day,week,bundle picks some):
  * - serial: one receiver on the real WebSerial stack through a pty, at real pace, recording;
  * - demo: the built-in demo (two simulated remotes in the worker);
  * - four: four remotes at 11 ms for 10 minutes, a four-port capture replayed at 1×;
  * - record: an 8-hour recording fed through the pty faster than real time, heap sampled;
- * - hour: opening a 1-hour capture; day: opening the 24-hour capture and seeking in it;
+ * - hour: opening a 1-hour capture; day: opening the 24-hour capture and seeking in it; week:
+ *   the 7-day capture (3 GB, bench/day.mjs --only 7d --make-only): memory and seeks;
  * - bundle: initial JS and CSS, gzipped.
  */
 import { mkdirSync, mkdtempSync, readdirSync, readFileSync, rmSync, statSync, writeFileSync, existsSync } from 'node:fs';
@@ -35,7 +36,7 @@ const FOUR_SECONDS = env('BENCH_FOUR_SECONDS', 600);
 /** Hours of recording fed through the pty, and how many times faster than real time. */
 const RECORD_HOURS = env('BENCH_RECORD_HOURS', 8);
 const RECORD_SPEED = env('BENCH_RECORD_SPEED', 48);
-const ONLY = (process.env.BENCH_ONLY ?? 'serial,demo,four,record,hour,day,bundle').split(',');
+const ONLY = (process.env.BENCH_ONLY ?? 'serial,demo,four,record,hour,day,week,bundle').split(',');
 /** The 24-hour capture bench/day.mjs makes (two remotes at 11 ms, 446 MB). */
 const DAY_FILE = join(tmpdir(), 'satscope-bench-day-v1-24h.sscap');
 /** Times the day capture is opened, each on a new page after the same-run baseline (`twoCoreBaselineMs`). */
@@ -1193,6 +1194,56 @@ it(
           (results.openDayCapture as Record<string, unknown>).workerAllocatedMBWhileOpening = allocated;
         } else {
           results.openDayCapture = `skipped: ${DAY_FILE} is missing (node bench/day.mjs makes it)`;
+        }
+      }
+
+      // The week (bench/day.mjs --only 7d --make-only, 3 GB): memory stays bounded, seeks stay quick.
+      if (ONLY.includes('week')) {
+        const file = DAY_FILE.replace('-24h.', '-7d.');
+        if (existsSync(file)) {
+          const page = await newPage();
+          await page.goto(server.url('/?bench&demo=0'));
+          const idle = threadTimes();
+          // The renderer's resident memory sampled while the week opens: its peak is the figure.
+          let peakRssMB = idle?.rssMB ?? Number.NaN;
+          const sampler = setInterval(() => {
+            const rss = threadTimes()?.rssMB ?? Number.NaN;
+            if (rss > peakRssMB || Number.isNaN(peakRssMB)) peakRssMB = rss;
+          }, 250);
+          let open: Awaited<ReturnType<typeof openTimes>>;
+          try {
+            open = await openTimes(page, file, 900_000);
+          } finally {
+            clearInterval(sampler);
+          }
+          const fractions = [0.5, 0.1, 0.9, 0.99, 0.01, 0.5, 0.3, 0.7];
+          const seeks: number[] = [];
+          for (const f of fractions) {
+            seeks.push((await seekTime(page, f)).ms);
+            await page.waitForTimeout(500);
+          }
+          const worker = await WorkerTarget.attach(browser);
+          const pageH = await pageHeap(page);
+          const workerH = await worker?.heapMB();
+          results.openWeekCapture = {
+            fileMB: round(statSync(file).size / (1 << 20)),
+            openToCompleteOverviewMs: round(open.completeMs, 0),
+            openToOverviewMs: round(open.ms, 0),
+            openToFramesCountedMs: round(open.countedMs, 0),
+            seekFractions: fractions,
+            seekMs: seeks.map((x) => round(x, 0)),
+            seekMsMedian: round(pct(seeks, 50), 0),
+            pageHeapMB: pageH,
+            workerHeapMB: workerH,
+            rendererRssMBBefore: round(idle?.rssMB ?? Number.NaN, 0),
+            rendererRssMBPeakWhileOpening: round(peakRssMB, 0),
+            rendererRssMBAfterSeeks: round(threadTimes()?.rssMB ?? Number.NaN, 0),
+            load: load(),
+          };
+          await worker?.detach();
+          await page.close();
+        } else {
+          results.openWeekCapture = `skipped: ${file} is missing (node bench/day.mjs --only 7d --make-only makes it)`;
         }
       }
 

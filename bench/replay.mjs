@@ -3,18 +3,19 @@
  * Opening and seeking a replay in the worker, in Node (npm run bench:day makes the captures:
  * `node bench/day.mjs --only 1m,1h` for the small ones). The worker's dispatcher is bundled from
  * src/ with Rolldown and driven with a fake host whose replay never ticks (its timers for one
- * shot run, so the capture's decode goes on in slices), so only the work of `replay-open` and
- * `replay-seek` is timed: to the first overview sent (of a long capture, that of its first
- * records, before the whole file is read: src/worker/replay/replay-preview.ts); the rest of that decode (the overview complete, the checkpoints); and a
- * seek, from the nearest checkpoint a minute or more before the target. Each file runs in a
- * child of its own (`--expose-gc`): the heap and array buffers the worker holds once the capture
- * is read are measured after a collection, against the file size.
+ * shot run, so the capture's walk goes on between them), so only the work of `replay-open` and
+ * `replay-seek` is timed: to the first overview sent; to the overview complete (every record
+ * walked and decoded, the checkpoints made); and a seek, from the nearest checkpoint a minute or
+ * more before the target, reading its window of the file. Each file runs in a child of its own
+ * (`--expose-gc`): the heap and array buffers the worker holds once the overview is complete
+ * are measured after a collection, against the file size.
  *
- * Options: --only 1h,24h (default: 1m,1h,24h, those that exist), --seeks N (default 15).
+ * Options: --only 1h,24h (default: 1m,1h,24h, those that exist), --seeks N (default 15),
+ * --src DIR (bundle another tree's src/, e.g. a worktree of an older commit, to compare).
  * Measurement only: it asserts nothing.
  */
 import { spawnSync } from 'node:child_process';
-import { existsSync, openAsBlob, rmSync, statSync } from 'node:fs';
+import { existsSync, openAsBlob, readFileSync, rmSync, statSync } from 'node:fs';
 import { loadavg, tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -23,9 +24,7 @@ const args = process.argv.slice(2);
 const arg = (name, fallback) => (args.includes(name) ? args[args.indexOf(name) + 1] : fallback);
 
 if (args[0] === '--child') {
-  await child(args[1], args[2], Number(args[3]), args[4] === 'helper');
-} else if (args[0] === '--helper') {
-  await helperThread(args[1]);
+  await child(args[1], args[2], Number(args[3]));
 } else {
   await main();
 }
@@ -34,11 +33,12 @@ async function main() {
   // Rolldown (Vite's bundler) turns the worker's TypeScript into one module Node can run.
   const { build } = await import('rolldown');
   const bundle = join(tmpdir(), `satscope-bench-replay-${process.pid}`);
+  const src = arg('--src', fileURLToPath(new URL('../src', import.meta.url)));
   await build({
     input: {
-      dispatcher: fileURLToPath(new URL('../src/worker/dispatcher.ts', import.meta.url)),
-      'file-pass': fileURLToPath(new URL('../src/worker/replay/replay-file-pass.ts', import.meta.url)),
-      decoder: fileURLToPath(new URL('../src/decoder/index.ts', import.meta.url)),
+      dispatcher: join(src, 'worker/dispatcher.ts'),
+      decoder: join(src, 'decoder/index.ts'),
+      reader: join(src, 'capture/reader.ts'),
     },
     platform: 'node',
     logLevel: 'silent',
@@ -60,11 +60,10 @@ async function main() {
       console.log(`${d}: ${path} missing (node bench/day.mjs --only ${d})`);
       continue;
     }
-    // Each file twice, interleaved: the worker alone, and with a helper thread on half the ports.
-    for (const helper of ['alone', 'helper']) {
+    {
       const run = spawnSync(
         process.execPath,
-        ['--expose-gc', '--max-old-space-size=8192', fileURLToPath(import.meta.url), '--child', bundle, path, String(seeks), helper],
+        ['--expose-gc', '--max-old-space-size=8192', fileURLToPath(import.meta.url), '--child', bundle, path, String(seeks)],
         {
           encoding: 'utf8',
           stdio: ['ignore', 'pipe', 'inherit'],
@@ -76,9 +75,10 @@ async function main() {
       }
       const r = JSON.parse(run.stdout.trim().split('\n').at(-1));
       const mb = (n) => (n / 1e6).toFixed(1);
-      const range = (x, digits) => `${x.median.toFixed(digits)} (${x.min.toFixed(digits)}–${x.max.toFixed(digits)})`;
+      const fixed = (x, digits) => (x === null ? '–' : x.toFixed(digits));
+      const range = (x, digits) => `${fixed(x.median, digits)} (${fixed(x.min, digits)}–${fixed(x.max, digits)})`;
       console.log(
-        `${d} ${helper} | ${mb(r.fileBytes)} | ${r.firstS.toFixed(2)} | ${r.openS.toFixed(2)} | ${r.openRatio.toFixed(2)} | ${mb(r.heldBytes)} | ${(r.heldBytes / r.fileBytes).toFixed(2)} | ` +
+        `${d} | ${mb(r.fileBytes)} | ${r.firstS.toFixed(2)} | ${r.openS.toFixed(2)} | ${fixed(r.openRatio, 2)} | ${mb(r.heldBytes)} | ${(r.heldBytes / r.fileBytes).toFixed(2)} | ` +
           `${range(r.seekMs, 0)} | ${range(r.seekRatio, 2)} | ${r.seekMs.n}`,
       );
     }
@@ -87,11 +87,7 @@ async function main() {
   rmSync(bundle, { recursive: true, force: true });
 }
 
-/**
- * Held memory: what the heap and the memory outside it hold after a full collection. `external`
- * holds the array buffers, those transferred from the helper thread too (the capture it kept);
- * `arrayBuffers` counts only those allocated on this thread.
- */
+/** Held memory: what the heap and the memory outside it (array buffers) hold after a full collection. */
 function held() {
   globalThis.gc();
   globalThis.gc();
@@ -130,21 +126,10 @@ function bareDecodeMs(SpektrumDecoder, capture, fromUs, toUs) {
   return performance.now() - started;
 }
 
-/** The replay helper on a thread of its own (the page's is a worker: src/worker/replay/replay-helper-worker.ts). */
-async function helperThread(bundle) {
-  const { parentPort } = await import('node:worker_threads');
-  const { helperReceiver } = await import(join(bundle, 'file-pass.mjs'));
-  // As src/worker/replay/replay-helper-worker.ts: its job, then the file's pieces as the worker reads them.
-  const receive = helperReceiver(
-    (r, transfer) => parentPort.postMessage(r, transfer),
-    () => performance.now(),
-  );
-  parentPort.on('message', receive);
-}
-
-async function child(bundle, path, seeks, withHelper) {
+async function child(bundle, path, seeks) {
   const { Dispatcher } = await import(join(bundle, 'dispatcher.mjs'));
   const { SpektrumDecoder } = await import(join(bundle, 'decoder.mjs'));
+  const { parseCapture } = await import(join(bundle, 'reader.mjs'));
   // One-shot timers run (the capture's decode goes on in slices); the replay's ticks never do.
   const clock = { now: () => performance.now(), after: (ms, fn) => setTimeout(fn, ms), every: () => 0, cancel: (h) => clearTimeout(h) };
   let status = null;
@@ -159,21 +144,8 @@ async function child(bundle, path, seeks, withHelper) {
     clock,
     timeOriginMs: 0,
   };
-  const { Worker } = await import('node:worker_threads');
-  const passHelper = withHelper
-    ? (job, onReport) => {
-        const thread = new Worker(fileURLToPath(import.meta.url), { argv: ['--helper', bundle] });
-        thread.on('message', onReport);
-        thread.on('error', (e) => onReport({ type: 'failed', why: String(e) }));
-        thread.postMessage({ job });
-        return {
-          feed: (piece) => thread.postMessage({ piece }, [piece.buffer]),
-          fail: (why) => thread.postMessage({ failed: why }),
-          stop: () => void thread.terminate(),
-        };
-      }
-    : null;
-  const worker = new Dispatcher(host, { passHelper });
+  // Without a helper (an older tree that has one, as on a one-core machine).
+  const worker = new Dispatcher(host, { passHelper: null });
   const base = held();
   const fileBytes = statSync(path).size;
   // The page hands the worker the File, which the worker reads: here a Blob backed by the file.
@@ -183,13 +155,16 @@ async function child(bundle, path, seeks, withHelper) {
   });
   const t0 = performance.now();
   await worker.handle(message);
-  const firstMs = firstAt - t0;
   await done;
+  const firstMs = firstAt - t0;
   const openMs = performance.now() - t0;
   message.data = null;
   const heldBytes = held() - base;
-  const capture = worker.replay.source.capture;
-  const openRatio = openMs / bareDecodeMs(SpektrumDecoder, capture, -Infinity, Infinity);
+  // The bare decode's capture is read after the worker's memory is measured (Node reads no file
+  // over 2 GiB at once: a week's capture goes without the ratios).
+  const capture = fileBytes < 2 ** 31 ? parseCapture(new Uint8Array(readFileSync(path))) : null;
+  const bare = (fromUs, toUs) => (capture === null ? Number.NaN : bareDecodeMs(SpektrumDecoder, capture, fromUs, toUs));
+  const openRatio = openMs / bare(-Infinity, Infinity);
   const { startUs, endUs } = status;
   // Seek targets spread over the file in a fixed order (a seeded walk), both ends included.
   const targets = [startUs, endUs];
@@ -206,7 +181,7 @@ async function child(bundle, path, seeks, withHelper) {
     const ms = performance.now() - s;
     times.push(ms);
     // Ten minutes before the target (what a seek fed before checkpoints) through bare decoders, right after.
-    ratios.push(ms / Math.max(0.01, bareDecodeMs(SpektrumDecoder, capture, t - 600e6, t + 1)));
+    ratios.push(ms / Math.max(0.01, bare(t - 600e6, t + 1)));
   }
   if (process.env.BENCH_VERBOSE)
     console.error(times.map((t, i) => `${((targets[i] - startUs) / 60e6).toFixed(1)} min: ${t.toFixed(0)} ms`).join(', '));

@@ -151,7 +151,7 @@ function fromReplay(capture: Capture, speed: number, seekAtUs?: number): Story {
   let engine = new Engine({ resolution: 'auto', jitterUs: timingJitterUs(capture.timing) });
   let ended = false;
   const r: ReplaySource = new ReplaySource(
-    capture,
+    { capture },
     (_port, bytes, time) => engine.push(bytes, time, 0),
     () => {
       engine.batch(r.linkNowUs(0));
@@ -463,7 +463,7 @@ function replayDoctorSays(capture: Capture): DoctorFinding[] {
   const engine = new Engine({ resolution: 'auto', jitterUs: timingJitterUs(capture.timing) });
   let ended = false;
   const r: ReplaySource = new ReplaySource(
-    capture,
+    { capture },
     (_port, bytes, time) => engine.push(bytes, time, 0),
     () => engine.batch(r.linkNowUs(0)),
     () => {
@@ -479,7 +479,7 @@ function replayDoctorSays(capture: Capture): DoctorFinding[] {
     () => [],
     { now: () => clock.ms, after: () => undefined } as unknown as Clock,
   );
-  diagnosis.replay(capture, r.startUs);
+  diagnosis.replay(capture.timing, capture.events, r.startUs);
   diagnosis.attach(0, engine, 'Port 0');
   r.setSpeed(0);
   r.play();

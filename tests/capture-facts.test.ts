@@ -4,15 +4,8 @@
  * came from.
  */
 import { describe, expect, it } from 'vitest';
-import { captureSpan, seedCaptureSpan } from '../src/report/capture-span.js';
-import {
-  captureChunksByPort,
-  captureFact,
-  capturePortIndex,
-  capturePorts,
-  captureTimesInOrder,
-  seedCaptureFact,
-} from '../src/capture/facts.js';
+import { captureSpan } from '../src/report/capture-span.js';
+import { captureChunksByPort, captureFact, capturePortIndex, capturePorts, captureTimesInOrder } from '../src/capture/facts.js';
 import type { Capture } from '../src/capture/model.js';
 
 function capture(ports: number[], times: number[]): Capture {
@@ -66,18 +59,6 @@ describe('facts kept with a capture', () => {
     const index = capturePortIndex(capture([2, 0, 2, 255, 0, 2], [1, 2, 3, 4, 5, 6]));
     expect(index.length).toBe(256);
     expect([index[0], index[1], index[2], index[255]].map((a) => Array.from(a ?? [9]))).toEqual([[1, 4], [], [0, 2, 5], [3]]);
-  });
-
-  it('keeps a fact seeded from elsewhere instead of working it out, until the capture changes', () => {
-    const c = capture([0], [100]);
-    let work = 0;
-    seedCaptureFact(c, 'n', 42);
-    expect(captureFact(c, 'n', () => ++work)).toBe(42);
-    seedCaptureSpan(c, { startUs: 7, endUs: 8 });
-    expect(captureSpan(c)).toEqual({ startUs: 7, endUs: 8 });
-    const moved = Object.assign(c, { chunkTimesUs: Float64Array.from([50]) });
-    expect([captureFact(moved, 'n', () => ++work), work]).toEqual([1, 1]);
-    expect(captureSpan(moved)).toEqual({ startUs: 50, endUs: 50 });
   });
 
   it('works it out again when the events or a column are no longer the ones it came from', () => {

@@ -153,7 +153,8 @@ describe('the worker doctor on a replayed file without a Spektrum stream', () =>
       );
       const bytes = Uint8Array.from({ length }, (_, i) => (i * 37 + (i >> 3)) & 0xff);
       bytes.set([0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a]);
-      diagnosis.replay(importRaw(bytes), 0);
+      const raw = importRaw(bytes);
+      diagnosis.replay(raw.timing, raw.events, 0);
       const engine = new Engine({ resolution: 'auto', jitterUs: 0 });
       diagnosis.attach(0, engine, 'Port 0');
       // As the replay feeds an untimed file: 16 bytes every 11 ms, without a time.

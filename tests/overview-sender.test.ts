@@ -27,7 +27,7 @@ describe('the growing overview sent to the page', () => {
     const sender = new OverviewSender(host);
     const sent = () => of('overview').map((m) => [m.overview.readUntilUs / 1e6, m.overview.complete]);
     expect(sender.due()).toBe(true);
-    // Both halves of a split pass report before either has read: the span alone, hatched.
+    // One offered before anything is read: the span alone, hatched.
     sender.offer(overview(0));
     clock.advance(250);
     expect(sender.due()).toBe(true);

@@ -1,6 +1,7 @@
 /** A fake clock and host for driving the worker's parts in Node: time moves only when a test says. */
 import type { Clock, Host } from '../src/worker/host.js';
-import type { Batch, FromWorker } from '../src/worker/protocol.js';
+import { Dispatcher } from '../src/worker/dispatcher.js';
+import type { Batch, FromWorker, ToWorker } from '../src/worker/protocol.js';
 import type { ReplayClock } from '../src/worker/sources/replay.js';
 
 interface Timer {
@@ -70,8 +71,12 @@ export class FakeClock implements Clock {
 /** A clock that moves 10 ms each time it is read, so the capture's decode goes in slices. */
 export class ReadingClock extends FakeClock {
   #extra = 0;
+  /** @param stepMs how far each reading moves the clock */
+  constructor(readonly stepMs = 10) {
+    super();
+  }
   override now(): number {
-    this.#extra += 10;
+    this.#extra += this.stepMs;
     return super.now() + this.#extra;
   }
 }
@@ -122,4 +127,28 @@ export class SimulatedClock implements ReplayClock {
   run(done: () => boolean): void {
     for (let guard = 0; !done() && this.#timers.size > 0 && guard < 1e6; guard++) this.tick();
   }
+}
+
+/**
+ * A dispatcher on a fake host for replay tests: `send` waits for each command to be handled,
+ * `walked` for a file's records to be walked to the end (its overview sent complete), which goes
+ * on between the commands as it does in the worker.
+ */
+export function openReplay(clock: FakeClock = new FakeClock()) {
+  const fake = fakeHost(clock);
+  const worker = new Dispatcher(fake.host);
+  const send = async (...messages: ToWorker[]): Promise<void> => {
+    for (const m of messages) worker.receive(m);
+    await worker.queue.idle();
+  };
+  const walked = async (): Promise<void> => {
+    for (let guard = 0; guard < 100_000; guard++) {
+      if (fake.of('overview').at(-1)?.overview.complete === true) return;
+      // The walk yields to the clock now and then (the fake one moves only when advanced).
+      clock.advance(1);
+      await new Promise((resolve) => setTimeout(resolve, 0));
+    }
+    throw new Error('the walk did not end');
+  };
+  return { ...fake, worker, send, walked };
 }

@@ -215,7 +215,7 @@ function replayOf(capture: Capture, options: { untimedPeriodUs?: number } = {}) 
   let ended = 0;
   const engine = new Engine({ resolution: 'auto', jitterUs: 0 });
   const r: ReplaySource = new ReplaySource(
-    capture,
+    { capture },
     (_p, bytes, time) => engine.push(bytes, time, 0),
     (clockUs) => {
       positions.push(clockUs);
@@ -329,7 +329,7 @@ describe('a seek', () => {
   function firstFed(capture: Capture, targetUs: number): number[] {
     const first: number[] = [];
     const r = new ReplaySource(
-      capture,
+      { capture },
       (port, bytes) => {
         first[port] ??= bytes.byteOffset / 4;
       },
@@ -361,7 +361,7 @@ describe('a seek', () => {
     };
     const fedAt: number[] = [];
     const r = new ReplaySource(
-      capture,
+      { capture },
       (_p, _b, _t, _at, fedAtMs) => fedAt.push(fedAtMs),
       () => undefined,
       () => undefined,
@@ -407,7 +407,7 @@ describe('a seek', () => {
     };
     const fed: number[] = [];
     const r = new ReplaySource(
-      capture,
+      { capture },
       (port, bytes) => {
         fed[port] ??= bytes.byteOffset;
       },

@@ -3,8 +3,6 @@
  * times are in order and each port's chunk numbers; its span in the analysis), kept with the
  * capture: the surfaces that each ask for them (a report and its jobs, a replay's session and its
  * source) then pay one pass over the chunks, not one each; a day-long capture has eleven million.
- * A reader that walks the capture's records anyway can find them on the way (record-tally.ts)
- * and seed them (`seedCaptureFact`): then no pass is paid at all.
  *
  * A capture's columns are typed arrays nobody writes once the capture is made. A fact is
  * worked out again when the capture's chunk columns or events are no longer the ones it was
@@ -57,16 +55,6 @@ export function captureFact<T>(capture: Capture, name: string, work: (capture: C
   return fact;
 }
 
-/**
- * Keeps `fact` as the capture's `name`, worked out elsewhere: as the capture's file was walked
- * (a long capture's replay, replay-split.ts), so that no pass over its columns repeats it. Who
- * seeds a fact answers for it being what `captureFact`'s `work` would give (tests hold each
- * tally to its pass).
- */
-export function seedCaptureFact<T>(capture: Capture, name: string, fact: T): void {
-  factsOf(capture).set(name, fact);
-}
-
 /** The port indices that have at least one data chunk, in increasing order (one pass per capture: `captureFact`). */
 export function capturePorts(capture: Capture): number[] {
   const counts = captureFact(capture, PORT_CHUNKS, chunksByPort);
@@ -108,9 +96,8 @@ function timesInOrder(capture: Capture): boolean {
 
 /**
  * Each port's chunks (0–255, empty for a port without any): the capture's chunk numbers, in
- * order. One counting sort over the chunks, once per capture (`captureFact`), unless a walk of
- * its records found them (`seedChunkFacts`); the arrays are handed out as they are kept: not to
- * be written (a day-long capture's are 44 MB).
+ * order. One counting sort over the chunks, once per capture (`captureFact`); the arrays are
+ * handed out as they are kept: not to be written (a day-long capture's are 44 MB).
  */
 export function capturePortIndex(capture: Capture): readonly Uint32Array[] {
   return captureFact(capture, PORT_INDEX, portIndex);
@@ -133,18 +120,4 @@ function indexByPort(chunkPorts: Uint8Array, counts: Uint32Array): Uint32Array[]
     at[p] = k + 1;
   }
   return Array.from(starts, (start, p) => all.subarray(start, start + (counts[p] ?? 0)));
-}
-
-/** What a walk of a capture's records found of its chunks (`RecordTally`): the facts above, kept for the capture it reads. */
-export interface ChunkFacts {
-  chunksByPort: Uint32Array;
-  timesInOrder: boolean;
-  portIndex: Uint32Array[];
-}
-
-/** Keeps `facts` as the capture's, found as its records were walked (`seedCaptureFact`). */
-export function seedChunkFacts(capture: Capture, facts: ChunkFacts): void {
-  seedCaptureFact(capture, PORT_CHUNKS, facts.chunksByPort);
-  seedCaptureFact(capture, TIMES_IN_ORDER, facts.timesInOrder);
-  seedCaptureFact(capture, PORT_INDEX, facts.portIndex);
 }

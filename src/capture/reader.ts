@@ -105,12 +105,7 @@ function readSscap(bytes: Uint8Array, work: CaptureReaderWork, shared: boolean):
     if (skipKind === 'garbage') {
       issues.push({ kind: 'garbage', offset: at, length, message: `${length} byte(s) at offset ${at} belong to no record; skipped` });
     } else if (skipKind === 'cut' && atEof) {
-      issues.push({
-        kind: 'truncated-record',
-        offset: at,
-        length,
-        message: `the file ends inside a record at offset ${at} (${length} byte(s) present): the recording was cut off`,
-      });
+      issues.push(truncatedRecord(at, length));
     } else {
       // A damaged header, a CRC mismatch, or a length running past the end of the file even
       // though intact records follow (so the length itself was damaged).
@@ -200,4 +195,14 @@ function plausibleHeader(bytes: Uint8Array, view: DataView, p: number, n: number
   if (n - p < RECORD_HEADER_SIZE) return false;
   const type = bytes[p + REC_OFF_TYPE];
   return isRecordType(type) && view.getUint32(p + REC_OFF_LENGTH, true) <= MAX_RECORD_PAYLOAD;
+}
+
+/** The issue of a file that ends inside a record starting at `offset`, `length` bytes of it there. */
+export function truncatedRecord(offset: number, length: number): CaptureIssue {
+  return {
+    kind: 'truncated-record',
+    offset,
+    length,
+    message: `the file ends inside a record at offset ${offset} (${length} byte(s) present): the recording was cut off`,
+  };
 }

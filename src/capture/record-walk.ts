@@ -1,10 +1,9 @@
 /**
  * The data records of an intact .sscap, read from a Blob (a File) a slice at a time and handed
  * over where they lie in the slice: no payload copied, no columns kept, and the CRC checked only
- * of the records the reader asks for. For a reader that learns elsewhere whether the whole file
- * is intact: the replay decodes a long capture's ports this way in two workers, each checking
- * the records it decodes, one of them keeping the capture (capture-builder.ts), which counts
- * only if both walked to the end (src/worker/replay/replay-split.ts).
+ * of the records the reader asks for. A walk that throws leaves the file to the salvaging
+ * reader: the replay walks a capture's records this way from its File, every CRC checked, to
+ * decode it once without reading it whole (src/worker/replay/replay-session.ts).
  */
 import {
   CRC_SIZE,
@@ -44,10 +43,11 @@ export interface SlicedFile {
 
 /**
  * One data record: its payload is `bytes[start, end)` (`view` over `bytes`), recorded on `port` at
- * `recordTimeUs(view, start)`. The time is read where it is used, not handed over: a double handed
- * to a call that is not inlined is boxed (an allocation a record).
+ * `recordTimeUs(view, start)`; `bytes[0]` is the file's byte `at`, so the record starts at file
+ * offset `at + start - RECORD_HEADER_SIZE`. The time is read where it is used, not handed over:
+ * a double handed to a call that is not inlined is boxed (an allocation a record).
  */
-export type RecordSink = (bytes: Uint8Array, view: DataView, start: number, end: number, port: number) => void;
+export type RecordSink = (bytes: Uint8Array, view: DataView, start: number, end: number, port: number, at: number) => void;
 
 /** The time (µs) of the data record whose payload starts at `start` of `view` (a RecordSink's). */
 export function recordTimeUs(view: DataView, start: number): number {
@@ -193,8 +193,7 @@ interface WalkCount {
  * checked and handed to `sink` as walkDataRecords says, counted into `count`; returns where the
  * first record not whole in the slice starts. The walk's hot loop, in a function of its own,
  * called once a slice: the async walk's code between slices (run for the first time at a
- * slice's end) threw the loop's optimised code away with it, and it was compiled again: nine
- * TurboFan compiles in the two workers of one open of the day capture, four now. Nothing
+ * slice's end) threw the loop's optimised code away with it, and it was compiled again. Nothing
  * follows the loop but the return: code after a loop has not run when the loop is first
  * optimised, and reaching it threw that code away too.
  */
@@ -222,10 +221,10 @@ function walkRun(
     if ((data ? checked(port) : eventsChecked) && !crcFollows(bytes, p + REC_OFF_TYPE, end, view))
       throw new CaptureFormatError(`damaged record at offset ${at + p} (its CRC-32 check failed)`);
     if (data) {
-      sink(bytes, view, p + RECORD_HEADER_SIZE, end, port);
+      sink(bytes, view, p + RECORD_HEADER_SIZE, end, port, at);
       count.chunks++;
       count.dataBytes += total - RECORD_OVERHEAD;
-    } else if (type === RECORD_TYPE_EVENT) events?.(bytes, view, p + RECORD_HEADER_SIZE, end, port);
+    } else if (type === RECORD_TYPE_EVENT) events?.(bytes, view, p + RECORD_HEADER_SIZE, end, port, at);
     p += total;
   }
   return p;

@@ -3,7 +3,7 @@
  * of the record that starts there, the sizes of a file's records planned from their headers
  * alone, a payload copied into the data column, and the columns trimmed to what they hold.
  * The salvaging reader (reader.ts), the reading in parts (parts.ts), the record walk
- * (record-walk.ts) and the capture kept from it (capture-builder.ts) all read records so.
+ * (record-walk.ts) and a replay's windows (src/worker/replay/capture-file.ts) all read records so.
  */
 import {
   isRecordType,

@@ -45,6 +45,14 @@ function follows(last: number, t: number): boolean {
   return t >= last - TIME_BACK_TOLERANCE_US && t <= last + TIME_MAX_GAP_US;
 }
 
+/**
+ * Whether the time `t` needs no stepping over after `last`, the time before it (NaN: `t` is the
+ * first): a walk over a file's records that finds every time so can play them as recorded.
+ */
+export function timeInLine(last: number, t: number): boolean {
+  return plausible(t) && (Number.isNaN(last) || follows(last, t));
+}
+
 /** What the rule did to one run of times. */
 interface RunDamage {
   /** Times that were stepped over (dated at the time before them), and the first of them: where, and what it said. */

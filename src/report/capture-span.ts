@@ -3,11 +3,11 @@
  * events), on the capture's clock, µs. Every surface starts and ends a capture here: the
  * report's time zero, replay's timeline, the end at which the link's state is judged. Worked
  * out once per capture from its columns (`captureSpan`), or from the earliest and latest
- * time found as its records are walked (a long capture's replay: the capture's RecordTally),
- * by the same rule (`SpanTally`).
+ * time found as its records are walked (a capture replayed from its File), by the same rule
+ * (`SpanTally`).
  */
 import { type Capture, chunkFirstByteUs } from '../capture/model.js';
-import { captureFact, seedCaptureFact } from '../capture/facts.js';
+import { captureFact } from '../capture/facts.js';
 import { BYTE_TIME_US } from '../decoder/spec.js';
 
 export interface CaptureSpan {
@@ -51,11 +51,8 @@ export class SpanTally {
   }
 }
 
-/**
- * The span from the earliest to the latest time found (by a SpanTally, or by a walk of the
- * capture's records, RecordTally): NaN for both when nothing was timed.
- */
-export function spanBetween(earliestUs: number, latestUs: number): CaptureSpan {
+/** The span from the earliest to the latest time found: NaN for both when nothing was timed. */
+function spanBetween(earliestUs: number, latestUs: number): CaptureSpan {
   return earliestUs <= latestUs ? { startUs: earliestUs, endUs: latestUs } : { startUs: NaN, endUs: NaN };
 }
 
@@ -63,11 +60,6 @@ export function spanBetween(earliestUs: number, latestUs: number): CaptureSpan {
 export function captureSpan(capture: Capture): CaptureSpan {
   const { startUs, endUs } = captureFact(capture, SPAN, spanOf);
   return { startUs, endUs };
-}
-
-/** Keeps `span` as the capture's, worked out as it was walked by a SpanTally (`seedCaptureFact`). */
-export function seedCaptureSpan(capture: Capture, span: CaptureSpan): void {
-  seedCaptureFact(capture, SPAN, { startUs: span.startUs, endUs: span.endUs });
 }
 
 function spanOf(capture: Capture): CaptureSpan {

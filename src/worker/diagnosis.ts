@@ -12,7 +12,7 @@
 import { Doctor } from '../report/doctor.js';
 import { doctorEvent } from '../report/doctor-events.js';
 import type { ConfirmProbe, DoctorFinding } from '../report/doctor-types.js';
-import type { Capture } from '../capture/model.js';
+import type { CaptureEvent, CaptureTiming } from '../capture/model.js';
 import type { Engine } from './engine.js';
 import { BROWSER_CLOCK, type Clock } from './host.js';
 import type { DiagnosisStatus, FromWorker } from './protocol.js';
@@ -36,8 +36,11 @@ export interface ProbeHooks {
 export class Diagnosis {
   #doctor = new Doctor();
   #mode: 'live' | 'replay' = 'live';
-  #capture: Capture | null = null;
-  #events: { port: number; timeUs: number; text: string }[] = [];
+  #timing: CaptureTiming = 'per-chunk';
+  /** A capture read whole: all its recorded events, in time order. */
+  #captureEvents: CaptureEvent[] = [];
+  /** The recorded events the doctor hears as the replay reaches them: the capture's, or those of the file's windows read since the last start. */
+  #events: CaptureEvent[] = [];
   #nextEvent = 0;
   #labels = new Map<number, string>();
   #probing: DiagnosisStatus['probing'] = null;
@@ -61,7 +64,7 @@ export class Diagnosis {
   /** A new live session (every port closed): a fresh doctor, its sentences timed from now. */
   reset(): void {
     this.#mode = 'live';
-    this.#capture = null;
+    this.#captureEvents = [];
     this.#events = [];
     this.#labels.clear();
     this.#doctor = new Doctor({ originUs: this.clockUs() });
@@ -69,13 +72,24 @@ export class Diagnosis {
     this.tick(true);
   }
 
-  /** A capture opens for replay. */
-  replay(capture: Capture, startUs: number): void {
+  /**
+   * A capture opens for replay: with its timing and, read whole, its recorded events (a file
+   * played a window at a time tells each window's, `replayEvents`).
+   */
+  replay(timing: CaptureTiming, events: readonly CaptureEvent[], startUs: number): void {
     this.#mode = 'replay';
-    this.#capture = capture;
-    this.#events = [...capture.events].map((e) => ({ port: e.port, timeUs: e.timeUs, text: e.text })).sort((a, b) => a.timeUs - b.timeUs);
+    this.#timing = timing;
+    this.#captureEvents = [...events].sort((a, b) => a.timeUs - b.timeUs);
     this.#labels.clear();
     this.#restartReplay(startUs);
+  }
+
+  /** A window of the file's records starts to play: its recorded events, heard as the replay reaches them. */
+  replayEvents(events: readonly CaptureEvent[]): void {
+    if (this.#mode !== 'replay' || events.length === 0) return;
+    const waiting = [...this.#events.slice(this.#nextEvent), ...events].sort((a, b) => a.timeUs - b.timeUs);
+    this.#events = waiting;
+    this.#nextEvent = 0;
   }
 
   /** The replay starts over (a seek): the decoders are new, and so is the doctor. */
@@ -84,8 +98,8 @@ export class Diagnosis {
   }
 
   #restartReplay(startUs: number): void {
-    const timing = this.#capture?.timing ?? 'per-chunk';
-    this.#doctor = new Doctor({ timing, memoryUs: Infinity, originUs: Number.isFinite(startUs) ? startUs : 0 });
+    this.#doctor = new Doctor({ timing: this.#timing, memoryUs: Infinity, originUs: Number.isFinite(startUs) ? startUs : 0 });
+    this.#events = this.#captureEvents;
     this.#nextEvent = 0;
   }
 

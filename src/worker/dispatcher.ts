@@ -5,7 +5,6 @@
  * gives it the browser's.
  */
 import { USB_CHUNK_JITTER_US } from '../decoder/spec.js';
-import type { Capture } from '../capture/model.js';
 import { Batcher } from './batcher.js';
 import { bind } from './binding.js';
 import { Diagnosis } from './diagnosis.js';
@@ -16,8 +15,6 @@ import { TaskQueue } from './queue.js';
 import { Recorder } from './recorder.js';
 import { SourceRegistry } from './registry.js';
 import { ReplaySession } from './replay/replay-session.js';
-import type { PreviewSizes } from './replay/replay-preview.js';
-import { type PassHelperMaker, WORKER_PASS_HELPER } from './replay/replay-helper.js';
 import { type ReportMaker, WORKER_REPORT_MAKER, report } from './report.js';
 import type { ReportRequest } from './report-worker.js';
 import { setResolution, shareResolution, tellMismatch } from './resolution.js';
@@ -28,10 +25,6 @@ import { SerialPorts } from './sources/serial-ports.js';
 export interface DispatcherOptions {
   findPort?: (identity: PortIdentity) => Promise<SerialPort | undefined>;
   makeReport?: ReportMaker;
-  /** How much of a long capture is read first (tests, on small files); replay-preview.ts has the defaults. */
-  previewSizes?: PreviewSizes;
-  /** The helper that decodes half the ports of a long capture (default: a worker, with a second core); null: none. */
-  passHelper?: PassHelperMaker | null;
 }
 
 export class Dispatcher {
@@ -43,8 +36,6 @@ export class Dispatcher {
   readonly serial: SerialPorts;
   readonly sink: LiveSink;
   readonly #makeReport: ReportMaker;
-  readonly #previewSizes: PreviewSizes | undefined;
-  readonly #passHelper: PassHelperMaker | undefined;
 
   constructor(
     readonly host: Host,
@@ -84,8 +75,6 @@ export class Dispatcher {
       findPort: options.findPort,
     });
     this.#makeReport = options.makeReport ?? WORKER_REPORT_MAKER;
-    this.#previewSizes = options.previewSizes;
-    this.#passHelper = options.passHelper === null ? undefined : (options.passHelper ?? WORKER_PASS_HELPER);
   }
 
   /** A message from the page: queued behind those before it. */
@@ -142,8 +131,8 @@ export class Dispatcher {
       }
       case 'report': {
         const replay = this.replay;
-        let of: { capture: Capture } | { bytes: Uint8Array } | null = null;
-        if (replay !== undefined) of = { capture: replay.source.capture };
+        let of: ReportRequest['of'] | null = null;
+        if (replay !== undefined) of = replay.of();
         else {
           const bytes = await recorder.current();
           if (bytes !== null) of = { bytes };
@@ -170,12 +159,10 @@ export class Dispatcher {
           registry,
           diagnosis: this.diagnosis,
           batcher: this.batcher,
-          previewSizes: this.#previewSizes,
-          passHelper: this.#passHelper,
         });
         break;
       case 'replay-play':
-        this.replay?.play();
+        await this.replay?.play();
         break;
       case 'replay-pause':
         this.replay?.pause();
@@ -184,7 +171,7 @@ export class Dispatcher {
         this.replay?.setSpeed(message.speed);
         break;
       case 'replay-seek':
-        this.replay?.seek(message.timeUs);
+        await this.replay?.seek(message.timeUs);
         break;
       case 'set-resolution':
         setResolution(registry, message.resolution);
@@ -205,7 +192,7 @@ export class Dispatcher {
     const replay = this.replay;
     let of: ReportRequest['of'] | null = null;
     let transfer: Transferable[] = [];
-    if (replay !== undefined) of = { capture: replay.source.capture };
+    if (replay !== undefined) of = replay.of();
     else {
       const bytes = await this.recorder.current();
       if (bytes !== null) {

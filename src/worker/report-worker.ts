@@ -11,8 +11,11 @@ import { reportHtml } from '../report/report-html.js';
 import { type FramesExport, framesFile } from './frames-export.js';
 
 export interface ReportRequest {
-  /** A capture file's bytes (the live session's recording), or a capture already read (the one being replayed). */
-  of: { bytes: Uint8Array } | { capture: Capture };
+  /**
+   * A capture file's bytes (the live session's recording), a capture already read (one replayed
+   * from memory), or the file of one replayed from its File (read here, whole).
+   */
+  of: { bytes: Uint8Array } | { capture: Capture } | { file: Blob };
   name: string;
   format: 'html' | 'json';
   resolution: 'auto' | 1024 | 2048;
@@ -25,10 +28,11 @@ export type ReportReply = { data: ArrayBuffer; frames?: number; error?: undefine
 
 const scope = self as unknown as DedicatedWorkerGlobalScope;
 
-scope.addEventListener('message', (event: MessageEvent<ReportRequest>) => {
+scope.addEventListener('message', async (event: MessageEvent<ReportRequest>) => {
   const { of, name, format, resolution, frames } = event.data;
   try {
-    const capture = 'capture' in of ? of.capture : readCapture(of.bytes, name);
+    const capture =
+      'capture' in of ? of.capture : readCapture('bytes' in of ? of.bytes : new Uint8Array(await of.file.arrayBuffer()), name);
     if (frames !== undefined) {
       const file = framesFile(capture, { ...frames, resolution });
       const reply: ReportReply = { data: file.data, frames: file.frames };

@@ -4,7 +4,6 @@
  * capture takes a good part of a second, and this worker must keep reading ports meanwhile (a
  * stall shows as a gap in the data and in the recording).
  */
-import type { Capture } from '../capture/model.js';
 import { type Host, notice } from './host.js';
 import type { ReportReply, ReportRequest } from './report-worker.js';
 
@@ -35,7 +34,7 @@ export const WORKER_REPORT_MAKER: ReportMaker = (request, transfer) =>
 export async function report(
   host: Host,
   make: ReportMaker,
-  of: { bytes: Uint8Array } | { capture: Capture } | null,
+  of: ReportRequest['of'] | null,
   name: string,
   format: 'html' | 'json',
   resolution: 'auto' | 1024 | 2048,

@@ -4,12 +4,10 @@
  * order (dispatcher.ts), with the browser's post and clock as the host.
  */
 /// <reference lib="webworker" />
-import { detachEarly } from './detach-early.js';
 import { Dispatcher } from './dispatcher.js';
 import { BROWSER_CLOCK } from './host.js';
 import type { ToWorker } from './protocol.js';
 
-detachEarly();
 const scope = self as unknown as DedicatedWorkerGlobalScope;
 const worker = new Dispatcher({
   post: (message, transfer = []) => scope.postMessage(message, transfer),

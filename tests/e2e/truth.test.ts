@@ -302,8 +302,8 @@ describe.skipIf(skip !== null)('the graphs and the counters', () => {
 });
 
 describe.skipIf(skip !== null)('a capture being read', () => {
-  // Two hours of two remotes: over 32 MB, so the page shows its span and overview while it reads,
-  // and decodes it on two workers, the helper keeping the capture (src/worker/replay/replay-split.ts).
+  // Two hours of two remotes: the page shows its span and overview while it walks the records,
+  // and plays it from the file a window at a time (src/worker/replay/replay-session.ts).
   let path = '';
   beforeAll(() => {
     path = join(dir, 'two-hours.sscap');
@@ -343,7 +343,7 @@ describe.skipIf(skip !== null)('a capture being read', () => {
     await page.context().close();
   }, 90_000);
 
-  it('reports on it exactly as satscope report does: the capture the helper kept is the one the CLI reads', async () => {
+  it('reports on it exactly as satscope report does: the page reads the file the CLI reads', async () => {
     const { page, errors } = await open('?demo=0');
     await page.setInputFiles('input[type=file]', path);
     await page

@@ -14,9 +14,8 @@ const OVERVIEW_EVERY_MS = 1000;
 
 /**
  * A capture's growing overview sent to the page, as often as OVERVIEW_EVERY_MS says; never one
- * read less far than the last (the halves of a split pass catching up), and nothing after the
- * complete one. The first with anything read goes as soon as it is offered: the day capture's
- * came 1 s after the empty one, which both halves of a split pass make before either has read.
+ * read less far than the last, and nothing after the complete one. The first with anything read
+ * goes as soon as it is offered, however soon after one with nothing read.
  */
 export class OverviewSender {
   readonly #host: Host;

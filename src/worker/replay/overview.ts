@@ -149,36 +149,7 @@ export function failsafesOf(episodes: readonly LinkEpisode[]): LinkEpisode[] {
   return episodes.filter((e) => e.kind === 'failsafe');
 }
 
-/** Failsafe episodes by start (then end): the same list however the ports were split. */
+/** Failsafe episodes by start (then end), whatever order the ports gave them in. */
 function inTimeOrder(failsafe: Overview['failsafe']): Overview['failsafe'] {
   return failsafe.sort((a, b) => a.startUs - b.startUs || a.endUs - b.endUs);
-}
-
-/**
- * Overviews of different ports of one capture on the same bins (a pass split between workers,
- * replay-split.ts) added up: read as far as all of them are, complete when all are, failsafes in
- * time order. No parts: nothing read yet, from `originUs`.
- */
-export function addOverviews(parts: readonly Overview[], originUs: number): Overview {
-  const complete = parts.length > 0 && parts.every((p) => p.complete);
-  const readUntilUs = parts.length === 0 ? originUs : Math.min(...parts.map((p) => p.readUntilUs));
-  const lengths = parts.map((p) => p.t.length);
-  const n = parts.length === 0 ? 0 : complete ? Math.max(...lengths) : Math.min(...lengths);
-  const longest = parts.find((p) => p.t.length >= n);
-  const t = new Float64Array(n);
-  const fadeRate = new Float32Array(n);
-  const lost = new Float32Array(n);
-  if (longest !== undefined) t.set(longest.t.subarray(0, n));
-  for (const p of parts) {
-    for (let b = 0; b < Math.min(n, p.t.length); b++) {
-      fadeRate[b] = (fadeRate[b] ?? 0) + (p.fadeRate[b] ?? 0);
-      lost[b] = (lost[b] ?? 0) + (p.lost[b] ?? 0);
-    }
-  }
-  const failsafe = failsafeAsRead(
-    parts.flatMap((p) => p.failsafe),
-    readUntilUs,
-    complete,
-  );
-  return { t, binUs: parts[0]?.binUs ?? BIN_US, fadeRate, lost, failsafe: inTimeOrder(failsafe), readUntilUs, complete };
 }

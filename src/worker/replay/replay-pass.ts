@@ -1,9 +1,10 @@
 /**
  * The one decode of a whole capture a replay makes when it opens (captures with recorded chunk
- * times): every port's decoder, link monitor and 1 s link series (the report's), fed the chunks
- * in the capture's order a slice at a time, so that the page draws the overview as it grows and
- * stays responsive. On the way it keeps a checkpoint of every port's decoder and link monitor
- * each CHECKPOINT_US of capture time: a seek restores the nearest one and feeds only from there,
+ * times): every port's decoder, link monitor and link series (the report's), fed the chunks in
+ * the capture's order a slice at a time (of a capture read whole, or of a file's records as they
+ * are walked), so that the page draws the overview as it grows and stays responsive. On the way
+ * it keeps a checkpoint of every port's decoder and link monitor each CHECKPOINT_US of capture
+ * time, with where its chunk lies: a seek restores the nearest one and feeds only from there,
  * with the counters, episodes and link state of the whole capture up to the target.
  */
 import type { DecoderCheckpoint, LinkCheckpoint } from '../../decoder/checkpoint.js';
@@ -11,6 +12,7 @@ import type { LinkMonitor } from '../../decoder/link.js';
 import { SpektrumDecoder } from '../../decoder/decoder.js';
 import type { Capture } from '../../capture/model.js';
 import { recordTimeUs } from '../../capture/record-walk.js';
+import { RECORD_HEADER_SIZE } from '../../capture/layout.js';
 import { LinkSeries, monitorWithSeries } from '../../report/series.js';
 import { timingJitterUs } from '../../report/capture-pass.js';
 import { recordedStops, StopCursor } from '../../report/doctor-events.js';
@@ -18,18 +20,7 @@ import { failsafeAsRead, failsafesOf, overviewBinUs, sumOverview } from './overv
 import type { Overview } from '../protocol.js';
 
 /** Capture time between two checkpoints: 1440 of them a day, each a few kilobytes a port. */
-export const CHECKPOINT_US = 60e6;
-
-/**
- * The rule for where checkpoints fall: a chunk arriving at `atUs` at or past `nextUs` gets one
- * before it, and the next is due a whole interval on, however long the silence before it.
- * Returns the next due time (`nextUs` itself when this chunk gets none).
- */
-export function checkpointDue(nextUs: number, atUs: number): number {
-  let next = nextUs;
-  while (next <= atUs) next += CHECKPOINT_US;
-  return next;
-}
+const CHECKPOINT_US = 60e6;
 
 /**
  * How far behind the slowest port's last frame the overview is drawn while the pass runs: frames
@@ -47,34 +38,18 @@ interface PortPass {
 /** Every port's decode state before the capture's chunk `chunk` (all chunks before it fed). */
 export interface Checkpoint {
   chunk: number;
+  /** The file offset of that chunk's record (a file's records walked); NaN for a capture read whole. */
+  offset: number;
   /** The latest arrival among the chunks fed, µs: a seek to a target at or after it may start here. */
   fedUntilUs: number;
   ports: Map<number, { decoder: DecoderCheckpoint; link: LinkCheckpoint }>;
 }
 
-/** What the replay asks of its capture's decode, made here or split with a helper (replay-split.ts). */
-export interface OverviewPass {
-  readonly resolution: 'auto' | 1024 | 2048;
-  readonly done: boolean;
-  /** Nothing to decode here until a helper reports (it wakes the replay then). */
-  readonly waiting: boolean;
-  /** Decodes for about `budgetMs`; whether the pass is done. */
-  step(budgetMs: number, now: () => number): boolean;
-  overview(): Overview;
-  checkpointFor(targetUs: number, historyUs: number): Checkpoint | undefined;
-  /** The pass is dropped (the replay closed): anything it runs elsewhere stops. */
-  stop(): void;
-}
-
-export class ReplayPass implements OverviewPass {
+export class ReplayPass {
   readonly checkpoints: Checkpoint[] = [];
-  /**
-   * The capture decoded; while `#prefix`, only the first records of the file (replay-preview.ts);
-   * null: a file's records fed one by one as it is read (`feed`, replay-file-pass.ts).
-   */
-  #capture: Capture | null;
-  #prefix: boolean;
-  readonly #ports: PortPass[];
+  /** The capture decoded; null: a file's records fed one by one as it is walked (`feedRecord`). */
+  readonly #capture: Capture | null;
+  readonly #ports: PortPass[] = [];
   /** The overview's bin width (overviewBinUs: a short capture's are narrow). */
   readonly #binUs: number;
   /** Each port's decode by port number (0–255), undefined for the ports not decoded here. */
@@ -82,78 +57,58 @@ export class ReplayPass implements OverviewPass {
   /** The next chunk of the capture to feed (the count fed so far). */
   #chunk = 0;
   #fedUntilUs = Number.NEGATIVE_INFINITY;
-  /** The time of the chunk being fed (`#feed`). */
-  readonly #at = new Float64Array(1);
+  /** The time of the chunk being fed (`#feed`), and its record's file offset (NaN: a capture's chunk). */
+  readonly #at = new Float64Array([Number.NaN, Number.NaN]);
   #nextCheckpointUs: number;
   #done = false;
   /** The capture's recorded stops ("device lost"), each told to its port's link before the chunk after it. */
-  #stops: StopCursor;
+  readonly #stops: StopCursor;
 
   /**
    * @param originUs, endUs the capture's span (`captureSpan`): bin 0 starts at the first, the links are judged at the last
-   * @param prefix `capture` is the file's first records only: decoding stops at its end, and
-   *   goes on once `continueWith` is given the whole capture
-   * @param capture null: the chunks come through `feed` (records of a file with chunk times)
+   * @param capture null: the chunks come through `feedRecord` (records of a file with chunk times)
+   * @param ports the ports decoded; null: every port a record is found on (a file whose ports
+   *   are not known before it is walked), each from its first record on
    */
   constructor(
     capture: Capture | null,
-    readonly ports: readonly number[],
+    ports: readonly number[] | null,
     readonly resolution: 'auto' | 1024 | 2048,
     readonly originUs: number,
     readonly endUs: number,
-    prefix = false,
   ) {
     this.#capture = capture;
-    this.#prefix = prefix;
     this.#stops = new StopCursor(capture === null ? [] : recordedStops(capture));
     this.#binUs = overviewBinUs(endUs - originUs);
-    this.#ports = ports.map((port) => {
-      const series = new LinkSeries(this.#binUs, originUs);
-      return {
-        port,
-        decoder: new SpektrumDecoder({ resolution }),
-        link: monitorWithSeries({ jitterUs: timingJitterUs(capture?.timing ?? 'per-chunk') }, series),
-        series,
-      };
-    });
-    for (const p of this.#ports) this.#byPort[p.port] = p;
+    this.#anyPort = ports === null;
+    for (const port of ports ?? []) this.#add(port);
     this.#nextCheckpointUs = originUs + CHECKPOINT_US;
+  }
+
+  /** Every port a record is found on is decoded. */
+  readonly #anyPort: boolean;
+
+  /** The ports decoded, in increasing order. */
+  get ports(): number[] {
+    return this.#ports.map((p) => p.port);
+  }
+
+  #add(port: number): PortPass {
+    const series = new LinkSeries(this.#binUs, this.originUs);
+    const p: PortPass = {
+      port,
+      decoder: new SpektrumDecoder({ resolution: this.resolution }),
+      link: monitorWithSeries({ jitterUs: timingJitterUs(this.#capture?.timing ?? 'per-chunk') }, series),
+      series,
+    };
+    this.#byPort[port] = p;
+    this.#ports.push(p);
+    this.#ports.sort((a, b) => a.port - b.port);
+    return p;
   }
 
   get done(): boolean {
     return this.#done;
-  }
-
-  /** Everything is decoded here. */
-  readonly waiting = false;
-
-  /** Nothing runs elsewhere: nothing to stop. */
-  stop(): void {}
-
-  /**
-   * A pass begun on the file's first records goes on with the whole capture, when that starts
-   * with every chunk decoded so far (the same ends, times and ports), on the same ports and span;
-   * false (and nothing changed) otherwise.
-   */
-  continueWith(capture: Capture, ports: readonly number[], originUs: number, endUs: number): boolean {
-    const head = this.#capture;
-    const n = this.#chunk;
-    if (head === null || !this.#prefix || originUs !== this.originUs || endUs !== this.endUs || capture.chunkEnds.length < n) return false;
-    if (ports.length !== this.ports.length || ports.some((p, k) => p !== this.ports[k])) return false;
-    for (let i = 0; i < n; i++) {
-      if (
-        capture.chunkEnds[i] !== head.chunkEnds[i] ||
-        capture.chunkTimesUs[i] !== head.chunkTimesUs[i] ||
-        capture.chunkPorts[i] !== head.chunkPorts[i]
-      )
-        return false;
-    }
-    this.#capture = capture;
-    this.#prefix = false;
-    // The stops before chunk n were told from the head, which holds the same chunks.
-    this.#stops = new StopCursor(recordedStops(capture));
-    this.#stops.seek(n);
-    return true;
   }
 
   /**
@@ -176,8 +131,7 @@ export class ReplayPass implements OverviewPass {
       // The clock is read every 256 chunks: reading it costs more than a chunk.
       if ((i & 0xff) === 0 && now() - started >= budgetMs) break;
     }
-    // A prefix's end is not the capture's: the rest comes with continueWith.
-    if (i < n || this.#prefix) return false;
+    if (i < n) return false;
     this.finish();
     return true;
   }
@@ -191,9 +145,13 @@ export class ReplayPass implements OverviewPass {
     this.#feed(bytes, start, end, port);
   }
 
-  /** `feed()` of a data record of a file as it is walked (a RecordSink): its time is read from `view` here. */
-  feedRecord(bytes: Uint8Array, view: DataView, start: number, end: number, port: number): void {
+  /**
+   * `feed()` of a data record of a file as it is walked (a RecordSink, `bytes[0]` the file's
+   * byte `at`): its time is read from `view` here.
+   */
+  feedRecord(bytes: Uint8Array, view: DataView, start: number, end: number, port: number, at: number): void {
     this.#at[0] = recordTimeUs(view, start);
+    this.#at[1] = at + start - RECORD_HEADER_SIZE;
     this.#feed(bytes, start, end, port);
   }
 
@@ -204,7 +162,7 @@ export class ReplayPass implements OverviewPass {
   #feed(bytes: Uint8Array, start: number, end: number, port: number): void {
     const atUs = this.#at[0] ?? Number.NaN;
     if (atUs >= this.#nextCheckpointUs) this.#checkpoint(this.#chunk, atUs);
-    const p = this.#byPort[port];
+    const p = this.#byPort[port] ?? (this.#anyPort ? this.#add(port) : undefined);
     if (p !== undefined) {
       // A NaN time is none: the chunk goes in untimed. Two calls, not one with `undefined` or the
       // time: a call given only doubles can have pushRange inlined, where the other boxes the time.
@@ -245,8 +203,11 @@ export class ReplayPass implements OverviewPass {
   #checkpoint(chunk: number, atUs: number): void {
     const ports = new Map<number, { decoder: DecoderCheckpoint; link: LinkCheckpoint }>();
     for (const p of this.#ports) ports.set(p.port, { decoder: p.decoder.checkpoint(), link: p.link.checkpoint() });
-    this.checkpoints.push({ chunk, fedUntilUs: this.#fedUntilUs, ports });
-    this.#nextCheckpointUs = checkpointDue(this.#nextCheckpointUs, atUs);
+    this.checkpoints.push({ chunk, offset: this.#at[1] ?? Number.NaN, fedUntilUs: this.#fedUntilUs, ports });
+    // The next is due a whole interval on, however long the silence before this chunk.
+    let next = this.#nextCheckpointUs;
+    while (next <= atUs) next += CHECKPOINT_US;
+    this.#nextCheckpointUs = next;
   }
 
   /**

@@ -1,189 +1,234 @@
 /**
- * A capture opened for replay: read once, played through the live path by a ReplaySource
+ * A capture opened for replay: played through the live path by a ReplaySource
  * (sources/replay.ts) feeding one source per port, with play, pause, speed and seek, and its
- * status sent to the page a few times a second. A capture with recorded chunk times is decoded
- * once more, a slice at a time while it plays (replay-pass.ts): its overview is sent as it
- * grows, and a seek starts from that decode's nearest checkpoint. Others get their overview at
- * once (overview.ts) and seek with fresh decodes.
+ * status sent to the page a few times a second.
+ *
+ * One pipeline. An intact .sscap with recorded times is never read whole: its start, end and
+ * index are read (capture-file.ts), its records are walked once from the File, a slice at a
+ * time, by the decode that draws the overview and keeps checkpoints (replay-pass.ts), and it
+ * plays a window of records at a time; a seek reads the window at its checkpoint. Memory is the
+ * overview, the checkpoints and a few windows, however long the capture. A file whose ports its
+ * index does not give plays once the walk has found them (the overview grows meanwhile). Any
+ * other file (raw bytes, a Saleae export, a .sscap that is damaged or whose times need stepping
+ * over) is read whole and salvaged, and plays from memory; seeks start from the same decode's
+ * checkpoints where it has recorded times.
  */
 import { plural } from '../../report/report-text.js';
-import { CaptureFormatError, type Capture } from '../../capture/model.js';
+import { CaptureFormatError, type Capture, type CaptureIssue, type CaptureMeta } from '../../capture/model.js';
 import { capturePorts } from '../../capture/facts.js';
 import { readCapture } from '../../capture/sniff.js';
+import { truncatedRecord } from '../../capture/reader.js';
+import { recordTimeUs, walkDataRecords } from '../../capture/record-walk.js';
 import { FRAME_PERIOD_11MS_US } from '../../decoder/spec.js';
 import { captureSpan } from '../../report/capture-span.js';
 import { timingJitterUs } from '../../report/capture-pass.js';
+import { stopsPort } from '../../report/doctor-events.js';
 import type { Batcher } from '../batcher.js';
 import type { Diagnosis } from '../diagnosis.js';
 import { type Host, notice } from '../host.js';
 import { overviewOf } from './overview.js';
-import type { Overview, ReplayStatus } from '../protocol.js';
+import type { ReplayStatus } from '../protocol.js';
 import type { Driver, SourceRegistry } from '../registry.js';
-import { type Checkpoint, type OverviewPass, ReplayPass } from './replay-pass.js';
-import { type PreviewSizes, previewOf, previewed } from './replay-preview.js';
-import type { PassHelperMaker } from './replay-helper.js';
-import { type SplitPass, keptCapture, readInPieces, startSplit } from './replay-split.js';
+import { type Checkpoint, ReplayPass } from './replay-pass.js';
+import { CaptureFile, WalkCheck } from './capture-file.js';
 import { OverviewSender } from './overview-sender.js';
-import { ReplaySource } from '../sources/replay.js';
+import { type ReplayData, type ReplayPosition, ReplaySource } from '../sources/replay.js';
 
 /** The position moves every tick; the page needs it a few times a second. */
 const STATUS_MS = 200;
 /** A seek from a checkpoint feeds at least this much before the target: the graphs' history (their default window). */
 const SEEK_HISTORY_US = 60e6;
+/**
+ * A seek further than this past the decode's latest checkpoint starts fresh decodes a little
+ * before the target instead (the link figures then count from there until the decode gets there).
+ */
+const FRESH_SEEK_US = 15 * 60e6;
 /** The capture is decoded for this long at a time, then messages and playback go through. */
 const PASS_SLICE_MS = 40;
+/** A file is walked this much at a time (read ahead while the last is decoded). */
+const WALK_SLICE_BYTES = 256 << 10;
 
 export interface ReplayParts {
   host: Host;
   registry: SourceRegistry;
   diagnosis: Diagnosis;
   batcher: Batcher;
-  /** How much of a long capture is read first (default: replay-preview.ts's). */
-  previewSizes?: PreviewSizes | undefined;
-  /** Starts the helper that decodes half the ports of a long capture (replay-split.ts); none: one worker decodes all. */
-  passHelper?: PassHelperMaker | undefined;
 }
+
+/** What was opened: the file itself, or the capture read whole from it. */
+type Opened = { file: CaptureFile; ports: number[] } | { capture: Capture };
 
 export class ReplaySession implements Driver {
   readonly kind = 'replay';
   readonly source: ReplaySource;
   readonly #p: ReplayParts;
+  readonly #blob: Blob;
+  readonly #opened: Opened;
   #lastStatusMs = Number.NEGATIVE_INFINITY;
   /** The capture's decode for the overview and the checkpoints (null: the overview came at once, seeks decode afresh). */
-  readonly #pass: OverviewPass | null;
+  #pass: ReplayPass | null = null;
   #passTimer: unknown;
   readonly #sender: OverviewSender;
   #stopped = false;
+  /** What was skipped reading the file (a recording cut off inside its last record). */
+  #issues: readonly CaptureIssue[];
 
   /**
-   * Reads `file` and starts playing it, every source before it closed; null (the user told why)
-   * when it is not a capture. A long capture's start and end are read first: its span is shown
-   * at once; with a helper, its ports are decoded in two halves as the file is read (the
-   * overview first, replay-split.ts), else its first records are.
+   * Opens `file` and starts playing it, every source before it closed; null (the user told why)
+   * when it is not a capture. `whole`: read it whole (a file found damaged as it was walked).
    */
-  static async open(name: string, file: Blob, parts: ReplayParts): Promise<ReplaySession | null> {
-    const { host, registry, diagnosis } = parts;
-    // A long capture: its start decoded and shown on its whole span before all of it is read.
-    if (previewed(file.size, parts.previewSizes)) parts.passHelper?.prepare?.();
-    const preview = await previewOf(file, parts.previewSizes);
-    const sender = new OverviewSender(host);
-    let early: ReplayPass | null = null;
-    let split: SplitPass | null = null;
-    let capture: Capture | null = null;
-    let session: ReplaySession | null = null;
+  static async open(name: string, file: Blob, parts: ReplayParts, whole = false): Promise<ReplaySession | null> {
+    const { host } = parts;
     const cannotOpen = (why: string): null => {
       notice(host, 'error', `Cannot open ${name}`, why);
-      split?.stop();
-      if (preview !== null) host.post({ type: 'replay', replay: null });
       return null;
     };
-    if (preview !== null) {
-      await registry.closeAll();
-      const { ports, startUs, endUs } = preview;
-      host.post({ type: 'replay', replay: readingStatus(name, startUs, endUs) });
-      const { resolution } = registry;
-      const span = { originUs: startUs, endUs, resolution };
-      const halves = startSplit(file, ports, span, preview.expected, parts.passHelper, host.clock, parts.previewSizes?.sliceBytes, () => {
-        // Until the capture is read the overview is drawn from here, after from the replay's slices.
-        // Complete once both halves are (every record checked): the parse is not waited for.
-        if (session !== null) session.#readOn();
-        else if (split !== null && (split.overviewComplete || sender.due())) sender.offer(split.overview());
-      });
-      split = halves?.pass ?? null;
-      if (halves === null) {
-        early = new ReplayPass(preview.head, ports, registry.resolution, startUs, endUs, true);
-        early.step(PASS_SLICE_MS, () => host.clock.now());
-        sender.offer(early.overview());
-      } else {
-        try {
-          // Read once, piece by piece, each piece to both halves as it comes: the overview first.
-          await readInPieces(file, halves.mine, halves.theirs, parts.previewSizes?.sliceBytes);
-          await Promise.all([halves.mine.ended, halves.theirs.ended]);
-        } catch (error) {
-          return cannotOpen(`The file could not be read (${String(error)}).`);
-        }
-        // An intact file is the capture the helper's half kept as it walked; anything else is read again and parsed.
-        capture = keptCapture(halves.mine, halves.theirs);
-      }
+    let opened: CaptureFile | null = null;
+    try {
+      if (!whole) opened = await CaptureFile.open(file);
+    } catch (error) {
+      return cannotOpen(`The file could not be read (${String(error)}).`);
     }
-    if (capture === null) {
-      let bytes: Uint8Array;
-      try {
-        bytes = new Uint8Array(await file.arrayBuffer());
-      } catch (error) {
-        return cannotOpen(`The file could not be read (${String(error)}).`);
-      }
-      try {
-        // The file itself is not kept: the capture holds what replay and a report need.
-        capture = readCapture(bytes, name);
-      } catch (error) {
-        return cannotOpen(error instanceof CaptureFormatError ? error.message : String(error));
-      }
+    if (opened !== null) return ReplaySession.#openFile(name, file, opened, parts);
+    let capture: Capture;
+    try {
+      capture = readCapture(new Uint8Array(await file.arrayBuffer()), name);
+    } catch (error) {
+      if (error instanceof CaptureFormatError) return cannotOpen(error.message);
+      return cannotOpen(`The file could not be read (${String(error)}).`);
     }
-    if (preview === null) await registry.closeAll();
-    if (capture.issues.length > 0) {
-      notice(
-        host,
-        'warning',
-        `${name}: ${plural(capture.issues.length, 'damaged part')} skipped`,
-        `${capture.issues[0]?.message ?? ''} Every intact record is kept.`,
-      );
-    }
+    await parts.registry.closeAll();
+    ReplaySession.#opens++;
     const ports = capturePorts(capture);
-    let pass: OverviewPass | null = null;
-    let overview: Overview | null = null;
-    let periodUs = FRAME_PERIOD_11MS_US;
-    const span = capture.timing === 'per-chunk' ? captureSpan(capture) : undefined;
-    if (split !== null && span !== undefined) {
-      // The halves count if the capture read whole agrees with them (replay-split.ts).
-      split.adopt(capture, ports, span);
-      pass = split;
-    } else if (span !== undefined && Number.isFinite(span.startUs)) {
-      split?.stop();
-      // The preview's decode goes on where the whole capture starts as its first records did.
-      pass =
-        early?.continueWith(capture, ports, span.startUs, span.endUs) === true
-          ? early
-          : new ReplayPass(capture, ports, registry.resolution, span.startUs, span.endUs);
-    } else {
-      split?.stop();
-      ({ overview, periodUs } = overviewOf(capture, ports, registry.resolution));
-    }
-    session = new ReplaySession(name, capture, periodUs, parts, pass, sender);
-    const r = session.source;
-    await registry.use(session);
-    diagnosis.replay(capture, r.startUs);
-    if (overview !== null) sender.offer(overview);
-    else session.#readOn(true);
-    if (!r.recordedTiming) {
-      notice(
-        host,
-        'info',
-        `${name}: no recorded timing`,
-        `Replayed at the receiver's pace (a frame every ${periodUs / 1000} ms). Holds, failsafes, lost frames and the frame period cannot be measured without the recorded times.`,
-      );
-    }
-    session.#resetSources();
-    r.play();
-    registry.setAllStates('playing');
-    session.status();
+    const span = captureSpan(capture);
+    const timed = capture.timing === 'per-chunk' && Number.isFinite(span.startUs);
+    // Without chunk times the overview is made at once (it also finds the period to pace at).
+    const once = timed ? null : overviewOf(capture, ports, parts.registry.resolution);
+    const session = new ReplaySession(name, file, { capture }, parts, capture.issues, once?.periodUs ?? FRAME_PERIOD_11MS_US);
+    if (timed) session.#pass = new ReplayPass(capture, ports, parts.registry.resolution, span.startUs, span.endUs);
+    await session.#start();
+    if (once !== null) session.#sender.offer(once.overview);
+    else session.#stepPass(true);
     return session;
+  }
+
+  /**
+   * An intact-looking .sscap: played from the File. Its records are walked once for the overview
+   * and checkpoints; with its ports known from its index it plays at once, else once walked.
+   */
+  static async #openFile(name: string, blob: Blob, file: CaptureFile, parts: ReplayParts): Promise<ReplaySession | null> {
+    const { host, registry } = parts;
+    await registry.closeAll();
+    const token = ++ReplaySession.#opens;
+    const pass = new ReplayPass(null, file.ports, registry.resolution, file.startUs, file.endUs);
+    let session: ReplaySession | null = null;
+    if (file.ports === null) host.post({ type: 'replay', replay: readingStatus(name, file.startUs, file.endUs) });
+    else {
+      session = new ReplaySession(name, blob, { file, ports: file.ports }, parts, [], FRAME_PERIOD_11MS_US);
+      session.#pass = pass;
+      await session.#start();
+    }
+    // Not awaited: the walk goes on between the messages and the playback.
+    ReplaySession.#walk(name, blob, file, pass, session, parts, token).catch((error: unknown) => {
+      if (token === ReplaySession.#opens) notice(host, 'error', `${name} could not be read to its end`, String(error));
+    });
+    return session;
+  }
+
+  /** Counts opens: a walk whose replay was replaced by another source or file stops. */
+  static #opens = 0;
+
+  /**
+   * Walks the file's records once into `pass` (checked, each CRC), sending the overview as it
+   * grows; then plays the file if it was waiting for its ports. Anything the walk finds that the
+   * windows cannot play as recorded (damage, times that need stepping over, a span other than its
+   * first and last records showed) opens it again, read whole: the reader salvages it.
+   */
+  static async #walk(
+    name: string,
+    blob: Blob,
+    file: CaptureFile,
+    pass: ReplayPass,
+    playing: ReplaySession | null,
+    parts: ReplayParts,
+    token: number,
+  ): Promise<void> {
+    const { host, registry } = parts;
+    const sender = playing === null ? new OverviewSender(host) : playing.#sender;
+    const replaced = (): boolean => token !== ReplaySession.#opens || (playing === null ? registry.driver !== undefined : playing.#stopped);
+    const check = new WalkCheck();
+    const utf8 = new TextDecoder();
+    let yieldedMs = host.clock.now();
+    let walked: Awaited<ReturnType<typeof walkDataRecords>> = null;
+    try {
+      walked = await walkDataRecords(
+        blob,
+        (bytes, view, start, end, port, at) => {
+          check.data(recordTimeUs(view, start), end - start);
+          pass.feedRecord(bytes, view, start, end, port, at);
+        },
+        {
+          checked: () => true,
+          events: (bytes, view, start, end, port) => {
+            const atUs = recordTimeUs(view, start);
+            check.event(atUs);
+            // A recorded stop ("device lost") is the adapter's absence, not the link's (LinkMonitor.stopped).
+            if (stopsPort(utf8.decode(bytes.subarray(start, end)))) pass.stopped(port, atUs);
+          },
+          goOn: async () => {
+            if (sender.due()) sender.offer(pass.overview());
+            // Playback and messages go through every PASS_SLICE_MS.
+            if (host.clock.now() - yieldedMs >= PASS_SLICE_MS) {
+              await new Promise<void>((resolve) => host.clock.after(0, resolve));
+              yieldedMs = host.clock.now();
+            }
+            return !replaced();
+          },
+          sliceBytes: WALK_SLICE_BYTES,
+        },
+      );
+    } catch (error) {
+      if (!(error instanceof CaptureFormatError)) throw error;
+      check.damaged = true;
+    }
+    if (replaced()) return;
+    const span = check.span;
+    if (walked === null || !check.inLine || span.startUs !== file.startUs || span.endUs !== file.endUs) {
+      await ReplaySession.open(name, blob, parts, true);
+      return;
+    }
+    pass.finish();
+    sender.offer(pass.overview());
+    const issues = walked.cutAt === undefined ? [] : [truncatedRecord(walked.cutAt, blob.size - walked.cutAt)];
+    if (playing !== null) {
+      playing.#issues = issues;
+      playing.status();
+      return;
+    }
+    const session = new ReplaySession(name, blob, { file, ports: pass.ports }, parts, issues, FRAME_PERIOD_11MS_US, sender);
+    session.#pass = pass;
+    await session.#start();
   }
 
   private constructor(
     readonly name: string,
-    capture: Capture,
-    periodUs: number,
+    blob: Blob,
+    opened: Opened,
     parts: ReplayParts,
-    pass: OverviewPass | null,
-    sender: OverviewSender,
+    issues: readonly CaptureIssue[],
+    /** Without recorded timing, the receiver's frame period its bytes are paced at. */
+    readonly periodUs: number,
+    sender = new OverviewSender(parts.host),
   ) {
     this.#p = parts;
-    this.#pass = pass;
+    this.#blob = blob;
+    this.#opened = opened;
+    this.#issues = issues;
     this.#sender = sender;
     const { host, registry } = parts;
+    const data: ReplayData = opened;
     this.source = new ReplaySource(
-      capture,
+      data,
       (port, bytes, time, _atUs, fedAtMs) => registry.get(port)?.engine.push(bytes, time, host.timeOriginMs + fedAtMs),
       () => {
         parts.batcher.flush();
@@ -200,11 +245,59 @@ export class ReplaySession implements Driver {
         this.status();
       },
       {
-        untimedPeriodUs: periodUs,
+        untimedPeriodUs: this.periodUs,
         clock: host.clock,
         onStop: (port, atUs) => registry.get(port)?.engine.interrupt(atUs),
+        onWindow: (w) => parts.diagnosis.replayEvents(w.capture.events),
       },
     );
+  }
+
+  /** The session takes over the registry and plays from the start. */
+  async #start(): Promise<void> {
+    const { registry, diagnosis, host } = this.#p;
+    const r = this.source;
+    await registry.use(this);
+    diagnosis.replay(this.#timing, 'capture' in this.#opened ? this.#opened.capture.events : [], r.startUs);
+    if (this.#issues.length > 0) {
+      notice(
+        host,
+        'warning',
+        `${this.name}: ${plural(this.#issues.length, 'damaged part')} skipped`,
+        `${this.#issues[0]?.message ?? ''} Every intact record is kept.`,
+      );
+    }
+    if (!r.recordedTiming) {
+      notice(
+        host,
+        'info',
+        `${this.name}: no recorded timing`,
+        `Replayed at the receiver's pace (a frame every ${this.periodUs / 1000} ms). Holds, failsafes, lost frames and the frame period cannot be measured without the recorded times.`,
+      );
+    }
+    r.play();
+    this.#resetSources();
+    registry.setAllStates('playing');
+    await r.seek(r.startUs, this.#first);
+    this.status();
+  }
+
+  /** Where the capture's first chunk is. */
+  get #first(): ReplayPosition {
+    return { chunk: 0, offset: 'file' in this.#opened ? this.#opened.file.recordsFrom : 0 };
+  }
+
+  get #timing(): Capture['timing'] {
+    return 'capture' in this.#opened ? this.#opened.capture.timing : 'per-chunk';
+  }
+
+  get #meta(): CaptureMeta {
+    return 'capture' in this.#opened ? this.#opened.capture.meta : this.#opened.file.head.meta;
+  }
+
+  /** What a report or an export of this replay reads: the capture read whole, or the file again. */
+  of(): { capture: Capture } | { file: Blob } {
+    return 'capture' in this.#opened ? { capture: this.#opened.capture } : { file: this.#blob };
   }
 
   clockUs(): number {
@@ -220,12 +313,13 @@ export class ReplaySession implements Driver {
   }
 
   /**
-   * Decodes the next slice of the capture for the overview and the checkpoints (the first one
-   * now, the others after the messages and ticks waiting), and sends the overview as it grows.
+   * Decodes the next slice of a capture read whole for the overview and the checkpoints (the
+   * first one now, the others after the messages and ticks waiting), and sends the overview as
+   * it grows.
    */
-  #readOn(now = false): void {
+  #stepPass(now = false): void {
     const pass = this.#pass;
-    if (pass === null || this.#stopped || this.#passTimer !== undefined) return;
+    if (pass === null || this.#stopped || this.#passTimer !== undefined || !('capture' in this.#opened)) return;
     const { host } = this.#p;
     const sender = this.#sender;
     const slice = (): void => {
@@ -233,8 +327,7 @@ export class ReplaySession implements Driver {
       if (this.#stopped || sender.complete) return;
       const done = pass.step(PASS_SLICE_MS, () => host.clock.now());
       if (done || sender.due()) sender.offer(pass.overview());
-      // Waiting for a half decoded elsewhere: its next report wakes this (replay-split.ts).
-      if (!done && !pass.waiting) this.#passTimer = host.clock.after(0, slice);
+      if (!done) this.#passTimer = host.clock.after(0, slice);
     };
     if (now) slice();
     else this.#passTimer = host.clock.after(0, slice);
@@ -242,7 +335,6 @@ export class ReplaySession implements Driver {
 
   async stop(): Promise<void> {
     this.#stopped = true;
-    this.#pass?.stop();
     this.#p.host.clock.cancel(this.#passTimer);
     this.#passTimer = undefined;
     this.source.stop();
@@ -256,25 +348,24 @@ export class ReplaySession implements Driver {
   #resetSources(): void {
     const { registry, diagnosis } = this.#p;
     const r = this.source;
-    const capture = r.capture;
     const ports = r.ports;
     registry.clear();
     diagnosis.replayReset(r.startUs);
     for (const port of ports) {
-      const s = registry.add('replay', port, `${this.name}${ports.length > 1 ? ` port ${port}` : ''}`, timingJitterUs(capture.timing));
+      const s = registry.add('replay', port, `${this.name}${ports.length > 1 ? ` port ${port}` : ''}`, timingJitterUs(this.#timing));
       // The label the remote had when it was recorded.
-      const saved = capture.meta.ports?.[port]?.name;
+      const saved = this.#meta.ports?.[port]?.name;
       if (typeof saved === 'string' && saved !== '') s.label = saved;
       s.state = r.playing ? 'playing' : 'paused';
     }
   }
 
-  play(): void {
+  async play(): Promise<void> {
     const r = this.source;
     // At the end, play starts over.
     if (r.ended) {
       this.#resetSources();
-      r.seek(r.startUs);
+      await r.seek(r.startUs, this.#first);
     }
     r.play();
     this.#p.registry.setAllStates('playing');
@@ -296,10 +387,10 @@ export class ReplaySession implements Driver {
   /**
    * Starts over at `timeUs`: from the capture's decode's nearest checkpoint at least a graph
    * history before it, with the whole capture's counters, episodes and link state up to there;
-   * without one (no such decode, or another resolution chosen since), fresh decodes fed the
-   * history before it (ReplaySource.seek).
+   * without one (no such decode, another resolution chosen since, or the decode not there yet),
+   * fresh decodes fed the history before it (ReplaySource.seek).
    */
-  seek(timeUs: number): void {
+  async seek(timeUs: number): Promise<void> {
     const state = this.source.playing ? 'playing' : 'paused';
     this.#resetSources();
     const from = this.#checkpointFor(timeUs);
@@ -311,8 +402,9 @@ export class ReplaySession implements Driver {
         this.#p.diagnosis.restored(port);
       }
     }
-    this.source.seek(timeUs, from === undefined ? undefined : (from?.chunk ?? 0));
+    const start: ReplayPosition | undefined = from === null ? this.#first : from;
     this.#p.registry.setAllStates(state);
+    await this.source.seek(timeUs, start);
     this.status();
   }
 
@@ -325,14 +417,16 @@ export class ReplaySession implements Driver {
     if (pass === null || this.#p.registry.resolution !== pass.resolution) return undefined;
     const r = this.source;
     const target = Math.min(Math.max(timeUs, r.startUs), r.endUs);
-    return pass.checkpointFor(target, SEEK_HISTORY_US) ?? null;
+    const cp = pass.checkpointFor(target, SEEK_HISTORY_US);
+    const fromUs = cp?.fedUntilUs ?? r.startUs;
+    if (!pass.done && target - fromUs > FRESH_SEEK_US) return undefined;
+    return cp ?? null;
   }
 
   /** Tells the page where the replay is. */
   status(): void {
     const { host, registry } = this.#p;
     const r = this.source;
-    const c = r.capture;
     this.#lastStatusMs = host.clock.now();
     let frames = 0;
     for (const s of registry.list()) frames += s.engine.decoder.stats.frames;
@@ -340,15 +434,15 @@ export class ReplaySession implements Driver {
       type: 'replay',
       replay: {
         name: this.name,
-        kind: c.kind,
-        timing: c.timing,
+        kind: 'capture' in this.#opened ? this.#opened.capture.kind : 'sscap',
+        timing: this.#timing,
         startUs: r.startUs,
         endUs: r.endUs,
         positionUs: r.positionUs,
         playing: r.playing,
         speed: r.speed,
         frames,
-        issues: c.issues.map((i) => i.message),
+        issues: this.#issues.map((i) => i.message),
         recordedTiming: r.recordedTiming,
         ended: r.ended,
         reading: false,
@@ -357,7 +451,7 @@ export class ReplaySession implements Driver {
   }
 }
 
-/** The replay's status while a long capture's file is still being read: its span, nothing played. */
+/** The replay's status while a capture's records are walked before it can play: its span, nothing played. */
 function readingStatus(name: string, startUs: number, endUs: number): ReplayStatus {
   return {
     name,

@@ -2,12 +2,15 @@
  * Replay: a capture file played back through exactly the live path, chunk by chunk at the
  * recorded times, at 1×, 4× or as fast as possible, with pause and seek. A capture may hold
  * several ports (remotes) with one common clock: each port feeds its own decode, and all of
- * them advance with the one replay clock.
+ * them advance with the one replay clock. A capture read whole plays from memory; a .sscap
+ * replayed from its File plays a window of its records at a time (capture-file.ts), the next
+ * one read while this one plays, and the clock never runs past the records read.
  */
 import { FRAME_PERIOD_11MS_US, FRAME_SIZE } from '../../decoder/spec.js';
 import { capturePortIndex, capturePorts } from '../../capture/facts.js';
 import type { Capture } from '../../capture/model.js';
 import { captureSpan } from '../../report/capture-span.js';
+import type { CaptureFile, CaptureWindow } from '../replay/capture-file.js';
 import { BROWSER_CLOCK, type Clock } from '../host.js';
 import { PortChunks } from './port-chunks.js';
 
@@ -24,6 +27,8 @@ export interface ReplayOptions {
   untimedPeriodUs?: number;
   /** A port's recorded stop ("device lost" at `atUs`), told before the first byte recorded after it. */
   onStop?: (port: number, atUs: number) => void;
+  /** A window of a file's records starts to play (its recorded events go to the doctor). */
+  onWindow?: (window: CaptureWindow) => void;
 }
 
 /**
@@ -49,16 +54,38 @@ const MAX_STEP_MS = 100;
  */
 const SEEK_HISTORY_US = 10 * 60e6;
 
+/** What a replay plays: a capture read whole, or a .sscap read from its File a window at a time. */
+export type ReplayData = { capture: Capture } | { file: CaptureFile; ports: readonly number[] };
+
+/** Where a seek starts: a checkpoint's chunk of a capture read whole, or its record's file offset. */
+export interface ReplayPosition {
+  chunk: number;
+  offset: number;
+}
+
 export class ReplaySource {
   readonly ports: readonly number[];
-  readonly #chunks: PortChunks[];
+  /** The records being played (a capture read whole is one window), and each port's chunks in it. */
+  #window: CaptureWindow;
+  #chunks: PortChunks[];
+  /** The last time recorded in the window: with the next not read yet, nothing after it is known. */
+  #windowEndUs: number;
+  /** The window after this one: read, being read, or not asked for. */
+  #next: CaptureWindow | Promise<CaptureWindow> | null = null;
+  /** A seek is reading its windows: nothing is fed and no link judged until it has. */
+  #seeking = false;
+  /** Counts seeks (and the stop): a seek whose reads settle after a later one began lets it be. */
+  #seeks = 0;
+  readonly #file: CaptureFile | null;
   /** The capture's first and last recorded time (`captureSpan`), or the paced clock's span without timing. */
   readonly startUs: number;
   readonly endUs: number;
   /** False for a capture without timing: its clock is the receiver's pace, not a recording. */
   readonly recordedTiming: boolean;
+  readonly #usPerByte: number;
   readonly #clock: ReplayClock;
   readonly #onStop: (port: number, atUs: number) => void;
+  readonly #onWindow: (window: CaptureWindow) => void;
   #clockUs: number;
   #wallMs = 0;
   #speed = 1;
@@ -75,7 +102,7 @@ export class ReplaySource {
    * @param onEnd when the clock has reached the end and every port's last chunk has been fed
    */
   constructor(
-    readonly capture: Capture,
+    data: ReplayData,
     readonly sink: ReplaySink,
     readonly onTick: (clockUs: number) => void,
     readonly onEnd: () => void,
@@ -83,22 +110,75 @@ export class ReplaySource {
   ) {
     this.#clock = options.clock ?? BROWSER_CLOCK;
     this.#onStop = options.onStop ?? (() => {});
-    this.ports = capturePorts(capture);
-    const span = captureSpan(capture);
-    this.recordedTiming = Number.isFinite(span.startUs);
-    const usPerByte = this.recordedTiming ? NaN : (options.untimedPeriodUs ?? FRAME_PERIOD_11MS_US) / FRAME_SIZE;
-    const index = capturePortIndex(capture);
-    this.#chunks = this.ports.map((p) => new PortChunks(capture, p, index[p] ?? new Uint32Array(0), usPerByte));
-    if (this.recordedTiming) {
-      this.startUs = span.startUs;
-      this.endUs = span.endUs;
+    this.#onWindow = options.onWindow ?? (() => {});
+    if ('capture' in data) {
+      const { capture } = data;
+      this.#file = null;
+      this.ports = capturePorts(capture);
+      const span = captureSpan(capture);
+      this.recordedTiming = Number.isFinite(span.startUs);
+      this.#usPerByte = this.recordedTiming ? NaN : (options.untimedPeriodUs ?? FRAME_PERIOD_11MS_US) / FRAME_SIZE;
+      this.#window = { capture, offset: 0, end: 0, last: true };
+      this.#chunks = this.#chunksOf(capture);
+      if (this.recordedTiming) {
+        this.startUs = span.startUs;
+        this.endUs = span.endUs;
+      } else {
+        let end = 0;
+        for (const c of this.#chunks) if (c.length > 0) end = Math.max(end, c.atUs(c.length - 1));
+        this.startUs = 0;
+        this.endUs = end;
+      }
     } else {
-      let end = 0;
-      for (const c of this.#chunks) if (c.length > 0) end = Math.max(end, c.atUs(c.length - 1));
-      this.startUs = 0;
-      this.endUs = end;
+      const { file } = data;
+      this.#file = file;
+      this.ports = data.ports;
+      this.recordedTiming = true;
+      this.#usPerByte = NaN;
+      this.startUs = file.startUs;
+      this.endUs = file.endUs;
+      // The file's first records, read at open, until the first window asked for replaces them.
+      this.#window = { capture: file.head, offset: file.recordsFrom, end: file.recordsFrom, last: false };
+      this.#chunks = this.#chunksOf(file.head);
+      this.#chunks.forEach((c) => {
+        c.next = c.length;
+      });
     }
+    this.#windowEndUs = captureSpan(this.#window.capture).endUs;
     this.#clockUs = this.startUs;
+  }
+
+  #chunksOf(capture: Capture): PortChunks[] {
+    const index = capturePortIndex(capture);
+    return this.ports.map((p) => new PortChunks(capture, p, index[p] ?? new Uint32Array(0), this.#usPerByte));
+  }
+
+  /** Plays `window` from its first chunk on (a seek's, or the one after the last). */
+  #enter(window: CaptureWindow): void {
+    this.#window = window;
+    this.#chunks = this.#chunksOf(window.capture);
+    const span = captureSpan(window.capture);
+    this.#windowEndUs = Number.isFinite(span.endUs) ? span.endUs : this.#windowEndUs;
+    this.#next = null;
+    this.#onWindow(window);
+    this.#readAhead();
+  }
+
+  /** The next window is read while this one plays. */
+  #readAhead(): void {
+    const file = this.#file;
+    if (file === null || this.#window.last || this.#next !== null) return;
+    const reading = file.window(this.#window.end);
+    this.#next = reading;
+    reading.then(
+      (w) => {
+        if (this.#next === reading) this.#next = w;
+      },
+      () => {
+        // The file could not be read on: the replay ends with what was read.
+        if (this.#next === reading) this.#next = { ...this.#window, last: true, offset: this.#window.end };
+      },
+    );
   }
 
   /** Whether there is a timeline to play and seek on. */
@@ -108,13 +188,17 @@ export class ReplaySource {
 
   /**
    * The time a port's link is judged at (hold, failsafe): the replay clock, but never past the
-   * next byte not fed yet, so that a frame still to come is never taken for silence. This keeps
-   * every state the same at 1×, 4× and full speed. NaN without recorded timing.
+   * next byte not fed yet, so that a frame still to come is never taken for silence; with the
+   * window's bytes all fed and the next not read, never past the window's last time. This keeps
+   * every state the same at 1×, 4× and full speed. NaN without recorded timing, and while a seek
+   * reads its first window.
    */
   linkNowUs(port: number): number {
-    if (!this.recordedTiming) return NaN;
+    if (!this.recordedTiming || this.#seeking) return NaN;
     const c = this.#chunks[this.ports.indexOf(port)];
-    return c === undefined ? this.#clockUs : Math.min(this.#clockUs, c.nextByteUs());
+    if (c === undefined) return this.#clockUs;
+    const next = c.done && !this.#window.last ? this.#windowEndUs : c.nextByteUs();
+    return Math.min(this.#clockUs, next);
   }
 
   /** Whether the replay has reached its end. */
@@ -154,21 +238,42 @@ export class ReplaySource {
 
   /**
    * Moves to `timeUs`: the caller resets its decode state first, or restores it to a checkpoint
-   * taken before the capture's chunk `fromChunk`; the chunks from there (or, without one, from
-   * a while before the target) are fed at once so history is there, then playback goes on from
-   * the target.
+   * taken at `from`; the chunks from there (or, without one, from a while before the target)
+   * are fed at once so history is there, then playback goes on from the target. Settles once
+   * they are (a file's windows are read first).
    */
-  seek(timeUs: number, fromChunk?: number): void {
+  async seek(timeUs: number, from?: ReplayPosition): Promise<void> {
     const target = Math.min(Math.max(timeUs, this.startUs), this.endUs);
+    const history = target - SEEK_HISTORY_US;
     this.#lastFedUs = NaN;
     this.#ended = false;
-    const from = target - SEEK_HISTORY_US;
-    for (const c of this.#chunks) {
-      if (fromChunk === undefined) c.seekTo(from);
-      else c.seekToChunk(fromChunk);
+    this.#clockUs = target;
+    const file = this.#file;
+    if (file === null) {
+      for (const c of this.#chunks) {
+        if (from === undefined) c.seekTo(history);
+        else c.seekToChunk(from.chunk);
+      }
+    } else {
+      const seeking = ++this.#seeks;
+      this.#seeking = true;
+      try {
+        const offset = from?.offset ?? (await file.offsetBefore(history));
+        const window = await file.window(offset);
+        // A later seek has begun: it plays, not this one.
+        if (seeking !== this.#seeks) return;
+        this.#next = null;
+        this.#enter(window);
+        if (from === undefined) for (const c of this.#chunks) c.seekTo(history);
+        while (!this.#feedUntil(target, Infinity) && this.#waitingForWindow()) {
+          await this.#next;
+          if (seeking !== this.#seeks) return;
+        }
+      } finally {
+        if (seeking === this.#seeks) this.#seeking = false;
+      }
     }
     const done = this.#feedUntil(target, Infinity);
-    this.#clockUs = target;
     this.#wallMs = this.#clock.now();
     if (done && target >= this.endUs) {
       this.#finish();
@@ -177,8 +282,14 @@ export class ReplaySource {
     this.onTick(this.#clockUs);
   }
 
+  /** Every chunk of the window is fed and the next is still being read. */
+  #waitingForWindow(): boolean {
+    return this.#next instanceof Promise && this.#chunks.every((c) => c.done);
+  }
+
   stop(): void {
     this.pause();
+    this.#seeks++;
   }
 
   #feed(c: PortChunks, bytes: Uint8Array, time: number | Float64Array | undefined, atUs: number): void {
@@ -190,12 +301,29 @@ export class ReplaySource {
 
   /**
    * Feeds every byte whose time is at or before `clockUs`, port by port (a chunk-timed chunk
-   * whole once its arrival has passed; a per-byte-timed one range by range), for at most
-   * `budgetMs` of wall time. Returns whether everything has been fed.
+   * whole once its arrival has passed; a per-byte-timed one range by range), window after window
+   * as they have been read, for at most `budgetMs` of wall time. Returns whether everything has
+   * been fed.
    */
   #feedUntil(clockUs: number, budgetMs: number): boolean {
     const started = this.#clock.now();
     this.#fedAtMs = started;
+    for (;;) {
+      if (!this.#feedWindow(clockUs, budgetMs, started)) return false;
+      if (this.#window.last) return true;
+      const next = this.#next;
+      if (next === null || next instanceof Promise) {
+        this.#readAhead();
+        return false;
+      }
+      // The window's stops after each port's last chunk in it, then the next window.
+      for (const c of this.#chunks) for (let t = c.takeStop(c.length); t !== undefined; t = c.takeStop(c.length)) this.#onStop(c.port, t);
+      this.#enter(next);
+    }
+  }
+
+  /** `#feedUntil` in the window: whether every chunk of it has been fed. */
+  #feedWindow(clockUs: number, budgetMs: number, started: number): boolean {
     let unclocked = 0;
     for (const c of this.#chunks) {
       while (c.next < c.length) {
@@ -246,6 +374,7 @@ export class ReplaySource {
   }
 
   #tick(): void {
+    if (this.#seeking) return;
     const nowMs = this.#clock.now();
     let done: boolean;
     if (this.#speed === 0) {
@@ -254,8 +383,11 @@ export class ReplaySource {
       if (Number.isFinite(this.#lastFedUs)) this.#clockUs = Math.min(this.endUs, Math.max(this.#clockUs, this.#lastFedUs));
     } else {
       // A stall (a long task, a background tab) must not jump the clock past silent data: that
-      // would show a hold or failsafe that is not in the capture. Nor does it run past the end.
-      this.#clockUs = Math.min(this.endUs, this.#clockUs + Math.min(nowMs - this.#wallMs, MAX_STEP_MS) * 1000 * this.#speed);
+      // would show a hold or failsafe that is not in the capture. Nor does it run past the end,
+      // nor past the records read (the next window not read yet).
+      const readUntil = this.#waitingForWindow() ? Math.max(this.#clockUs, this.#windowEndUs) : this.endUs;
+      const step = Math.min(nowMs - this.#wallMs, MAX_STEP_MS) * 1000 * this.#speed;
+      this.#clockUs = Math.min(this.endUs, readUntil, this.#clockUs + step);
       done = this.#feedUntil(this.#clockUs, SLICE_MS) && this.#clockUs >= this.endUs;
     }
     this.#wallMs = nowMs;

@@ -1,0 +1,201 @@
+/**
+ * A .sscap replayed from its File, never read whole: at open its header, its first and last
+ * records (the span, before the rest is read) and its index's totals (the ports); then windows
+ * of its records, a few megabytes each, read where the replay plays or seeks. The File stays the
+ * one source of the bytes: a week's capture plays in the memory of a few windows.
+ */
+import { type Capture, CaptureFormatError, type ParsedCapture } from '../../capture/model.js';
+import { hasCaptureMagic, RECORD_HEADER_SIZE, RECORD_TYPE_DATA, REC_OFF_TYPE } from '../../capture/layout.js';
+import { parseCapture } from '../../capture/reader.js';
+import { recordSize } from '../../capture/records.js';
+import { crcFollows } from '../../capture/crc32.js';
+import { recordTimeUs, type SlicedFile } from '../../capture/record-walk.js';
+import { readCaptureTotals } from '../../capture/capture-index.js';
+import { capturePorts } from '../../capture/facts.js';
+import { type CaptureSpan, captureSpan, SpanTally } from '../../report/capture-span.js';
+import { TIME_BACK_TOLERANCE_US, timeInLine } from '../../capture/time-rule.js';
+
+/** A window's records: about a minute of two remotes recorded as a USB adapter hands them over, or an hour of a quiet one. */
+export const WINDOW_BYTES = 512 << 10;
+/** The start read at open: the header (its metadata is at most 1 MiB) and the first records. */
+const HEAD_BYTES = 2 << 20;
+/** The end read at open, for the last recorded time. */
+const TAIL_BYTES = 64 << 10;
+/** Read at a time when looking for a record near a file offset (a seek the decode has not reached). */
+const PROBE_BYTES = 16 << 10;
+
+/** The records of the file from `offset` to `end`, as a capture of their own. */
+export interface CaptureWindow {
+  readonly capture: Capture;
+  readonly offset: number;
+  /** Where the window's last whole record ends: the next window starts here. */
+  readonly end: number;
+  /** No record follows (the file's end, or bytes that are no record: the decode of the whole file says which). */
+  readonly last: boolean;
+}
+
+export class CaptureFile {
+  private constructor(
+    readonly file: SlicedFile,
+    /** The header's bytes, put before each window's records so that it reads as a capture. */
+    readonly header: Uint8Array,
+    /** The file's first records: the ports and timing seen first, and the first window. */
+    readonly head: ParsedCapture,
+    /** The first and last recorded time, from the file's first and last records. */
+    readonly startUs: number,
+    readonly endUs: number,
+    /** Every port with data, from the index of a file closed with one that checks out; null without. */
+    readonly ports: number[] | null,
+  ) {}
+
+  /**
+   * The capture in `file` ready to be read in windows, or null when it is not one that can be
+   * (not a .sscap, its header or first records damaged, no recorded chunk times): read whole.
+   */
+  static async open(file: SlicedFile): Promise<CaptureFile | null> {
+    try {
+      const start = await read(file, 0, HEAD_BYTES);
+      if (!hasCaptureMagic(start)) return null;
+      const head = parseCapture(start);
+      const { headerLength } = head;
+      // Damage at the start (anything but the record the read cut) is for the whole file's reader to salvage.
+      if (head.timing !== 'per-chunk' || head.issues.some((i) => i.kind !== 'truncated-record')) return null;
+      const header = start.slice(0, headerLength);
+      const tailFrom = Math.max(headerLength, file.size - TAIL_BYTES);
+      const tail = parseCapture(joined(header, await read(file, tailFrom, TAIL_BYTES)));
+      const startUs = captureSpan(head).startUs;
+      const endUs = file.size <= HEAD_BYTES ? captureSpan(head).endUs : captureSpan(tail).endUs;
+      if (!(startUs <= endUs)) return null;
+      const totals = await readCaptureTotals(file.size, headerLength, (offset, length) => read(file, offset, length));
+      const ports =
+        totals === null
+          ? file.size <= HEAD_BYTES && head.issues.length === 0
+            ? capturePorts(head)
+            : null
+          : totals.ports.filter((p) => p.records > 0).map((p) => p.port);
+      return new CaptureFile(file, header, head, startUs, endUs, ports);
+    } catch (error) {
+      if (error instanceof CaptureFormatError) return null;
+      throw error;
+    }
+  }
+
+  /** Where the records start. */
+  get recordsFrom(): number {
+    return this.header.length;
+  }
+
+  /**
+   * The window of records starting at `offset` (a record's start): up to WINDOW_BYTES of whole
+   * records, more when one record is longer.
+   */
+  async window(offset: number): Promise<CaptureWindow> {
+    const size = this.file.size;
+    for (let want = WINDOW_BYTES; ; want *= 2) {
+      const bytes = await read(this.file, offset, want);
+      const view = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
+      let p = 0;
+      let damaged = false;
+      while (p + RECORD_HEADER_SIZE <= bytes.length) {
+        const total = recordSize(bytes, view, p);
+        if (total < 0) {
+          damaged = true;
+          break;
+        }
+        if (p + total > bytes.length) break;
+        p += total;
+      }
+      const end = offset + p;
+      const atFileEnd = offset + bytes.length >= size;
+      // A record longer than the window: read more, up to the file's end.
+      if (p === 0 && !damaged && !atFileEnd) continue;
+      const capture = parseCapture(joined(this.header, bytes.subarray(0, p)));
+      // At the file's end, what follows the last whole record is a record cut short.
+      return { capture, offset, end, last: damaged || atFileEnd };
+    }
+  }
+
+  /**
+   * The start of a data record at or a little after `offset` whose CRC checks (so a chance
+   * pattern in a payload is not taken for one), with its time; null when none is found before
+   * the end of a probe.
+   */
+  async recordNear(offset: number): Promise<{ offset: number; timeUs: number } | null> {
+    const from = Math.max(this.recordsFrom, offset);
+    const bytes = await read(this.file, from, PROBE_BYTES);
+    const view = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
+    for (let p = 0; p + RECORD_HEADER_SIZE <= bytes.length; p++) {
+      const total = recordSize(bytes, view, p);
+      if (total < 0 || p + total > bytes.length || bytes[p + REC_OFF_TYPE] !== RECORD_TYPE_DATA) continue;
+      if (!crcFollows(bytes, p + REC_OFF_TYPE, p + total - 4, view)) continue;
+      const timeUs = recordTimeUs(view, p + RECORD_HEADER_SIZE);
+      if (Number.isFinite(timeUs)) return { offset: from + p, timeUs };
+    }
+    return null;
+  }
+
+  /**
+   * A record's start whose time is at or before `timeUs` and not far before it (a few probes'
+   * width of the file), found by bisecting the file by time: where a seek the decode has not
+   * reached yet starts reading. The records' times go forward as recorded; where they do not, the
+   * bisection still ends at a record, and the seek feeds what lies between.
+   */
+  async offsetBefore(timeUs: number): Promise<number> {
+    let lo = this.recordsFrom;
+    let hi = this.file.size;
+    while (hi - lo > 4 * PROBE_BYTES) {
+      const mid = lo + Math.floor((hi - lo) / 2);
+      const found = await this.recordNear(mid);
+      if (found === null || found.timeUs > timeUs) hi = mid;
+      else lo = found.offset;
+    }
+    return lo === this.recordsFrom ? lo : ((await this.recordNear(lo))?.offset ?? this.recordsFrom);
+  }
+}
+
+/**
+ * What a walk of a file's records finds that decides whether its windows play it as recorded:
+ * every time in line (time-rule.ts: a reader steps over none, so a window's times are the
+ * whole file's), no damage, and its span (the rule every surface starts and ends a capture at).
+ */
+export class WalkCheck {
+  inLine = true;
+  damaged = false;
+  readonly #span = new SpanTally();
+  /** The last data record's time, and the latest event since it (an event must come no later than the data after it). */
+  readonly #at = new Float64Array([Number.NaN, Number.NaN]);
+
+  /** A data record of `count` bytes recorded at `timeUs`. */
+  data(timeUs: number, count: number): void {
+    const at = this.#at;
+    if (!timeInLine(at[0] ?? Number.NaN, timeUs) || (at[1] ?? Number.NaN) > timeUs + TIME_BACK_TOLERANCE_US) this.inLine = false;
+    at[0] = timeUs;
+    at[1] = Number.NaN;
+    if (count > 0) this.#span.chunk(timeUs, count);
+  }
+
+  /** An event recorded at `timeUs` (NaN: unknown, as a reader keeps it). */
+  event(timeUs: number): void {
+    if (Number.isNaN(timeUs)) return;
+    const at = this.#at;
+    if (!timeInLine(at[0] ?? Number.NaN, timeUs)) this.inLine = false;
+    if (!(timeUs <= (at[1] ?? Number.NaN))) at[1] = timeUs;
+    this.#span.event(timeUs);
+  }
+
+  get span(): CaptureSpan {
+    return this.#span.span;
+  }
+}
+
+async function read(file: SlicedFile, from: number, length: number): Promise<Uint8Array> {
+  const to = Math.min(file.size, from + length);
+  return to <= from ? new Uint8Array(0) : new Uint8Array(await file.slice(from, to).arrayBuffer());
+}
+
+function joined(a: Uint8Array, b: Uint8Array): Uint8Array {
+  const out = new Uint8Array(a.length + b.length);
+  out.set(a);
+  out.set(b, a.length);
+  return out;
+}

@@ -1,0 +1,173 @@
+/**
+ * A .sscap replayed from its File (capture-file.ts, replay-session.ts): never read whole, played
+ * a window of records at a time to the same frames and figures as the capture decoded whole;
+ * files the windows cannot play as recorded (damaged, times stepped over) read whole as before;
+ * a file cut short or without an index plays once its records are walked, with every port.
+ */
+import { describe, expect, it } from 'vitest';
+import { capturePorts } from '../src/capture/facts.js';
+import { RECORD_HEADER_SIZE, RECORD_TYPE_INDEX, REC_OFF_TYPE } from '../src/capture/layout.js';
+import { recordSize } from '../src/capture/records.js';
+import { readCapture } from '../src/capture/sniff.js';
+import { parseCapture } from '../src/capture/reader.js';
+import { encodeCapture } from '../src/capture/writer.js';
+import { WINDOW_BYTES } from '../src/worker/replay/capture-file.js';
+import { overviewOf } from '../src/worker/replay/overview.js';
+import { preset } from '../src/simulator/presets.js';
+import { simulate } from '../src/simulator/simulator.js';
+import { usbChunks } from './feeds.js';
+import { longCapture } from './long-capture.js';
+import type { Capture } from '../src/capture/model.js';
+import { captureChunks } from '../src/capture/model.js';
+import { SpektrumDecoder } from '../src/decoder/decoder.js';
+import { LinkMonitor } from '../src/decoder/link.js';
+import { USB_CHUNK_JITTER_US } from '../src/decoder/spec.js';
+import { FakeClock, openReplay } from './worker-fakes.js';
+
+const FILE = longCapture();
+
+/** A Blob that counts what is read of it: never the whole at once, for a file replayed from it. */
+class CountingBlob extends Blob {
+  wholeReads = 0;
+  largestSlice = 0;
+  override slice(start?: number, end?: number, type?: string): Blob {
+    this.largestSlice = Math.max(this.largestSlice, (end ?? this.size) - (start ?? 0));
+    return super.slice(start, end, type);
+  }
+  override arrayBuffer(): Promise<ArrayBuffer> {
+    this.wholeReads++;
+    return super.arrayBuffer();
+  }
+}
+
+/** `file` without its index records: a capture written before the index, or by another writer. */
+function withoutIndex(file: Uint8Array): Uint8Array {
+  const view = new DataView(file.buffer, file.byteOffset, file.byteLength);
+  const header = parseCapture(file).headerLength;
+  const parts: Uint8Array[] = [file.subarray(0, header)];
+  for (let p = header; p + RECORD_HEADER_SIZE <= file.length; ) {
+    const total = recordSize(file, view, p);
+    if (total < 0) throw new Error(`no record at ${p}`);
+    if (file[p + REC_OFF_TYPE] !== RECORD_TYPE_INDEX) parts.push(file.subarray(p, p + total));
+    p += total;
+  }
+  const out = new Uint8Array(parts.reduce((n, b) => n + b.length, 0));
+  let at = 0;
+  for (const b of parts) {
+    out.set(b, at);
+    at += b.length;
+  }
+  return out;
+}
+
+/** What the library's decoder and link monitor say of `port`, fed all of it and ended, as replay ends. */
+function decodedWhole(capture: Capture, port: number) {
+  const decoder = new SpektrumDecoder();
+  const link = new LinkMonitor({ jitterUs: USB_CHUNK_JITTER_US });
+  const drain = () => {
+    for (let f = decoder.next(); f !== undefined; f = decoder.next()) link.frame(f);
+  };
+  for (const c of captureChunks(capture, port)) {
+    decoder.push(c.bytes, c.time);
+    drain();
+  }
+  decoder.end();
+  drain();
+  return { decoder: { ...decoder.stats }, link: { ...link.stats } };
+}
+
+/** Opens `bytes`, lets its records be walked, plays it to its end at full speed; what the worker showed. */
+async function playToEnd(bytes: Uint8Array | Blob, name = 'long.sscap') {
+  const clock = new FakeClock();
+  const r = openReplay(clock);
+  const file = bytes instanceof Blob ? bytes : new Blob([bytes.slice()]);
+  await r.send({ type: 'replay-open', name, file }, { type: 'replay-pause' });
+  await r.walked();
+  await r.send({ type: 'replay-seek', timeUs: 0 }, { type: 'replay-speed', speed: 0 }, { type: 'replay-play' });
+  for (let guard = 0; guard < 100_000 && r.of('replay').at(-1)?.replay?.ended !== true; guard++) {
+    clock.advance(10);
+    await new Promise((resolve) => setTimeout(resolve, 0));
+  }
+  expect(r.of('replay').at(-1)?.replay?.ended).toBe(true);
+  return r;
+}
+
+function expectAsDecodedWhole(r: Awaited<ReturnType<typeof playToEnd>>, bytes: Uint8Array): void {
+  const capture = readCapture(bytes);
+  for (const port of capturePorts(capture)) {
+    const engine = r.worker.registry.get(port)?.engine;
+    const want = decodedWhole(capture, port);
+    expect({ port, decoder: { ...engine?.decoder.stats } }).toEqual({ port, decoder: want.decoder });
+    const l = engine?.link.stats;
+    const w = want.link;
+    expect({ port, frames: l?.frames, fades: l?.fades, lost: l?.lostFrames }).toEqual({
+      port,
+      frames: w.frames,
+      fades: w.fades,
+      lost: w.lostFrames,
+    });
+  }
+  const once = overviewOf(capture, capturePorts(capture), 'auto').overview;
+  const last = r.of('overview').at(-1)?.overview;
+  expect(last?.complete).toBe(true);
+  expect(Array.from(last?.lost ?? [])).toEqual(Array.from(once.lost));
+  expect(Array.from(last?.fadeRate ?? [])).toEqual(Array.from(once.fadeRate));
+  expect(last?.failsafe).toEqual(once.failsafe);
+}
+
+describe('a capture replayed from its file', () => {
+  it('plays a window at a time, never reading the file whole, to the frames and figures of the capture decoded whole', async () => {
+    expect(FILE.length).toBeGreaterThan(WINDOW_BYTES);
+    const blob = new CountingBlob([FILE.slice()]);
+    const r = await playToEnd(blob);
+    expect(blob.wholeReads).toBe(0);
+    expect(blob.largestSlice).toBeLessThanOrEqual(WINDOW_BYTES * 2);
+    expect(r.worker.replay?.of()).toEqual({ file: blob });
+    expectAsDecodedWhole(r, FILE);
+    expect(r.of('replay').at(-1)?.replay?.issues).toEqual([]);
+  });
+
+  it('plays a file without an index once its records are walked, every port found', async () => {
+    const bare = withoutIndex(FILE);
+    expect(bare.length).toBeLessThan(FILE.length);
+    const r = await playToEnd(bare);
+    expect(r.of('replay').find((m) => m.replay !== null)?.replay?.reading).toBe(true);
+    expect(r.worker.registry.list().map((s) => s.id)).toEqual([0, 1]);
+    expectAsDecodedWhole(r, bare);
+  });
+
+  it('plays a recording cut off inside a record from its file, and says it was cut', async () => {
+    const cut = FILE.slice(0, FILE.length - 20_000);
+    const r = await playToEnd(cut);
+    expect('file' in (r.worker.replay?.of() ?? {})).toBe(true);
+    expect(r.of('replay').at(-1)?.replay?.issues).toEqual([expect.stringContaining('the recording was cut off')]);
+    expectAsDecodedWhole(r, cut);
+  });
+
+  it('reads a damaged file whole, every intact record kept, the damage said', async () => {
+    const damaged = FILE.slice();
+    const at = Math.floor(damaged.length / 2);
+    damaged[at] = (damaged[at] ?? 0) ^ 0x5a;
+    const r = await playToEnd(damaged);
+    expect('capture' in (r.worker.replay?.of() ?? {})).toBe(true);
+    expect(r.of('replay').at(-1)?.replay?.issues.length).toBeGreaterThan(0);
+    expect(r.of('notice').some((n) => n.title.includes('damaged part'))).toBe(true);
+    const once = overviewOf(readCapture(damaged), [0, 1], 'auto').overview;
+    expect(r.of('overview').at(-1)?.overview.failsafe).toEqual(once.failsafe);
+    expect(Array.from(r.of('overview').at(-1)?.overview.lost ?? [])).toEqual(Array.from(once.lost));
+  });
+
+  it('reads whole a file whose clock stepped back (its times are stepped over as every reader does)', async () => {
+    const a = simulate({ ...preset('dsmx-11ms-2048-internal'), seed: 2 }, 20e6);
+    const records = usbChunks(a.bytes, a.timesUs).map((c) => ({ type: 'data' as const, bytes: c.bytes, timeUs: c.timeUs, port: 0 }));
+    // Half way the recorder's clock goes back 30 s, and on from there.
+    const half = records.length >> 1;
+    const stepped = records.map((c, i) => (i < half ? c : { ...c, timeUs: c.timeUs - 30e6 }));
+    const bytes = encodeCapture({ baudRate: 115200 }, stepped);
+    const r = await playToEnd(bytes, 'stepped.sscap');
+    expect('capture' in (r.worker.replay?.of() ?? {})).toBe(true);
+    const capture = readCapture(bytes);
+    expect(capture.issues.map((i) => i.kind)).toEqual(['bad-time']);
+    expect({ ...r.worker.registry.get(0)?.engine.decoder.stats }).toEqual(decodedWhole(capture, 0).decoder);
+  });
+});
