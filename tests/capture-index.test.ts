@@ -4,7 +4,7 @@
  * the capture's own columns (parseCapture), never the writer's bookkeeping.
  */
 import { describe, expect, it } from 'vitest';
-import { type CaptureIndex, INDEX_STRETCH_US, type IndexEntry, readCaptureIndex, readCaptureTotals } from '../src/capture/capture-index.js';
+import { type CaptureIndex, INDEX_STRETCH_US, type IndexEntry, readCaptureIndex, readLastTotals } from '../src/capture/capture-index.js';
 import { crc32 } from '../src/capture/crc32.js';
 import { REC_OFF_PORT, REC_OFF_TIME, REC_OFF_TYPE, RECORD_TYPE_DATA } from '../src/capture/layout.js';
 import type { ParsedCapture } from '../src/capture/model.js';
@@ -190,17 +190,23 @@ describe('the capture index', () => {
     expect(none).toBeGreaterThan(0);
   });
 
-  it('gives its totals from the final segment alone, and none for a file cut short', async () => {
+  it('gives its totals from the final segment alone, or for a file cut short the last segment and where it ends', async () => {
     const index = (await readCaptureIndex(file.length, capture.headerLength, readerOf(file))) as CaptureIndex;
     let reads = 0;
-    const totals = await readCaptureTotals(file.length, capture.headerLength, (offset, length) => {
+    const totals = await readLastTotals(file.length, capture.headerLength, (offset, length) => {
       reads++;
       return readerOf(file)(offset, length);
     });
-    expect(totals).toMatchObject({ dataRecords: index.dataRecords, eventRecords: index.eventRecords, ports: index.ports });
+    expect(totals).toMatchObject({ final: true, dataRecords: index.dataRecords, eventRecords: index.eventRecords, ports: index.ports });
     expect(reads).toBeLessThanOrEqual(3);
     const open = recording(12, true).file;
-    expect(await readCaptureTotals(open.length, capture.headerLength, readerOf(open))).toBeNull();
+    const cut = (await readCaptureIndex(open.length, capture.headerLength, readerOf(open))) as CaptureIndex;
+    expect(await readLastTotals(open.length, capture.headerLength, readerOf(open))).toMatchObject({
+      final: false,
+      coversTo: cut.coversTo,
+      dataRecords: cut.dataRecords,
+      ports: cut.ports,
+    });
   });
 
   it('is none when its counts could not fit in the file, however intact its CRC', async () => {
@@ -212,7 +218,7 @@ describe('the capture index', () => {
     view.setFloat64(at + 16 + 56 + 8, 2 ** 40, true);
     view.setUint32(at + 16 + length, crc32(forged, at + 2, at + 16 + length), true);
     expect(await readCaptureIndex(forged.length, capture.headerLength, readerOf(forged))).toBeNull();
-    expect(await readCaptureTotals(forged.length, capture.headerLength, readerOf(forged))).toBeNull();
+    expect(await readLastTotals(forged.length, capture.headerLength, readerOf(forged))).toBeNull();
   });
 
   it('gives up in bounded work on crafted bytes: tags everywhere, each pointing at a large record', async () => {

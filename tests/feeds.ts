@@ -3,6 +3,9 @@ import { CaptureWriter } from '../src/capture/writer.js';
 import { readCapture } from '../src/capture/sniff.js';
 import type { Capture } from '../src/capture/model.js';
 import { concatBytes } from './bytes.js';
+import { parseCapture } from '../src/capture/reader.js';
+import { RECORD_HEADER_SIZE, RECORD_TYPE_INDEX, REC_OFF_TYPE } from '../src/capture/layout.js';
+import { recordSize } from '../src/capture/records.js';
 import type { SimChunk } from '../src/simulator/simulator.js';
 
 /** A stream with every byte's time, as the simulator makes it. */
@@ -83,4 +86,18 @@ export function withSpikes(sim: SimChunk, frames: number[]): SimChunk {
     bytes[at + 1] = spiked & 0xff;
   }
   return { ...sim, bytes };
+}
+
+/** An intact .sscap `file` without its index records: one written before the index, or by another writer. */
+export function withoutIndex(file: Uint8Array): Uint8Array {
+  const view = new DataView(file.buffer, file.byteOffset, file.byteLength);
+  const header = parseCapture(file).headerLength;
+  const parts: Uint8Array[] = [file.subarray(0, header)];
+  for (let p = header; p + RECORD_HEADER_SIZE <= file.length; ) {
+    const total = recordSize(file, view, p);
+    if (total < 0) throw new Error(`no record at offset ${p}`);
+    if (file[p + REC_OFF_TYPE] !== RECORD_TYPE_INDEX) parts.push(file.subarray(p, p + total));
+    p += total;
+  }
+  return concatBytes(parts);
 }

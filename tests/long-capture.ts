@@ -15,7 +15,11 @@ export function longCapture(): Uint8Array {
   return longCaptureWithSeed(3);
 }
 
-export function longCaptureWithSeed(seed: number): Uint8Array {
+/**
+ * Two remotes for `minutes` (12 by default), the internal one with dropouts at 2, 5 (into
+ * failsafe) and 9.5 minutes.
+ */
+export function longCaptureWithSeed(seed: number, minutes = 12): Uint8Array {
   const a = simulate(
     {
       ...preset('dsmx-11ms-2048-internal'),
@@ -26,9 +30,9 @@ export function longCaptureWithSeed(seed: number): Uint8Array {
         { atUs: 9.5 * MINUTE, durationUs: 200_000 },
       ],
     },
-    12 * MINUTE,
+    minutes * MINUTE,
   );
-  const b = simulate({ ...preset('dsmx-11ms-2048-external'), seed: 4 }, 12 * MINUTE);
+  const b = simulate({ ...preset('dsmx-11ms-2048-external'), seed: 4 }, minutes * MINUTE);
   const records = [
     ...usbChunks(a.bytes, a.timesUs).map((c) => ({ type: 'data' as const, bytes: c.bytes, timeUs: c.timeUs, port: 0 })),
     ...usbChunks(b.bytes, b.timesUs).map((c) => ({ type: 'data' as const, bytes: c.bytes, timeUs: c.timeUs + 3, port: 1 })),

@@ -8,15 +8,18 @@ import { elapsedLabel } from '../src/app/axes.js';
 import { BIN_US, overviewBinUs } from '../src/worker/replay/overview.js';
 
 describe('the replay timeline', () => {
-  it('bins a capture in the narrowest round width that keeps it to 2000 bins, a second at most', () => {
+  it('bins a capture in the narrowest round width that keeps it to 2000 bins, a second at most up to three days, and wider bins past that', () => {
     expect(overviewBinUs(740_000)).toBe(20_000);
     expect(overviewBinUs(40e6)).toBe(20_000);
     expect(overviewBinUs(41e6)).toBe(50_000);
     expect(overviewBinUs(600e6)).toBe(500_000);
     expect(overviewBinUs(86_400e6)).toBe(BIN_US);
+    expect(overviewBinUs(3 * 86_400e6)).toBe(BIN_US);
+    expect(overviewBinUs(7 * 86_400e6)).toBe(5e6);
+    expect(overviewBinUs(365 * 86_400e6)).toBe(60e6);
     expect(overviewBinUs(Number.NaN)).toBe(BIN_US);
-    for (const span of [1e3, 1e5, 3.3e6, 1e8, 1e9, 1e11])
-      expect(span / overviewBinUs(span)).toBeLessThanOrEqual(Math.max(2000, span / BIN_US));
+    for (const span of [1e3, 1e5, 3.3e6, 1e8, 1e9, 1e11, 1e12, 1e13])
+      expect(span / overviewBinUs(span)).toBeLessThanOrEqual(Math.max(2000, Math.min(span / BIN_US, 1 << 18), span / 60e6));
   });
 
   it('labels time since the start in the step it counts in', () => {

@@ -6,17 +6,14 @@
  */
 import { describe, expect, it } from 'vitest';
 import { capturePorts } from '../src/capture/facts.js';
-import { RECORD_HEADER_SIZE, RECORD_TYPE_INDEX, REC_OFF_TYPE } from '../src/capture/layout.js';
-import { recordSize } from '../src/capture/records.js';
 import { readCapture } from '../src/capture/sniff.js';
-import { parseCapture } from '../src/capture/reader.js';
 import { encodeCapture } from '../src/capture/writer.js';
 import { WINDOW_BYTES } from '../src/worker/replay/capture-file.js';
 import { overviewOf } from '../src/worker/replay/overview.js';
 import { preset } from '../src/simulator/presets.js';
 import { simulate } from '../src/simulator/simulator.js';
-import { usbChunks } from './feeds.js';
-import { longCapture } from './long-capture.js';
+import { usbChunks, withoutIndex } from './feeds.js';
+import { longCapture, longCaptureWithSeed } from './long-capture.js';
 import type { Capture } from '../src/capture/model.js';
 import { captureChunks } from '../src/capture/model.js';
 import { SpektrumDecoder } from '../src/decoder/decoder.js';
@@ -25,6 +22,8 @@ import { USB_CHUNK_JITTER_US } from '../src/decoder/spec.js';
 import { FakeClock, openReplay } from './worker-fakes.js';
 
 const FILE = longCapture();
+/** 45 minutes of the same (15 MB): longer than the walk's slices and many windows. */
+const LONGER = longCaptureWithSeed(3, 45);
 
 /** A Blob that counts what is read of it: never the whole at once, for a file replayed from it. */
 class CountingBlob extends Blob {
@@ -38,26 +37,6 @@ class CountingBlob extends Blob {
     this.wholeReads++;
     return super.arrayBuffer();
   }
-}
-
-/** `file` without its index records: a capture written before the index, or by another writer. */
-function withoutIndex(file: Uint8Array): Uint8Array {
-  const view = new DataView(file.buffer, file.byteOffset, file.byteLength);
-  const header = parseCapture(file).headerLength;
-  const parts: Uint8Array[] = [file.subarray(0, header)];
-  for (let p = header; p + RECORD_HEADER_SIZE <= file.length; ) {
-    const total = recordSize(file, view, p);
-    if (total < 0) throw new Error(`no record at ${p}`);
-    if (file[p + REC_OFF_TYPE] !== RECORD_TYPE_INDEX) parts.push(file.subarray(p, p + total));
-    p += total;
-  }
-  const out = new Uint8Array(parts.reduce((n, b) => n + b.length, 0));
-  let at = 0;
-  for (const b of parts) {
-    out.set(b, at);
-    at += b.length;
-  }
-  return out;
 }
 
 /** What the library's decoder and link monitor say of `port`, fed all of it and ended, as replay ends. */
@@ -117,13 +96,14 @@ function expectAsDecodedWhole(r: Awaited<ReturnType<typeof playToEnd>>, bytes: U
 
 describe('a capture replayed from its file', () => {
   it('plays a window at a time, never reading the file whole, to the frames and figures of the capture decoded whole', async () => {
-    expect(FILE.length).toBeGreaterThan(WINDOW_BYTES);
-    const blob = new CountingBlob([FILE.slice()]);
+    expect(LONGER.length).toBeGreaterThan(12 * WINDOW_BYTES);
+    const blob = new CountingBlob([LONGER.slice()]);
     const r = await playToEnd(blob);
     expect(blob.wholeReads).toBe(0);
-    expect(blob.largestSlice).toBeLessThanOrEqual(WINDOW_BYTES * 2);
+    // The walk's slices (4 MB) are the largest reads.
+    expect(blob.largestSlice).toBeLessThanOrEqual(4 << 20);
     expect(r.worker.replay?.of()).toEqual({ file: blob });
-    expectAsDecodedWhole(r, FILE);
+    expectAsDecodedWhole(r, LONGER);
     expect(r.of('replay').at(-1)?.replay?.issues).toEqual([]);
   });
 

@@ -1,16 +1,12 @@
-/** Opening a capture file (button or drag-and-drop): the File goes to the worker, which reads it. */
+/**
+ * Opening a capture file (button or drag-and-drop): the File goes to the worker, which reads it
+ * (a .sscap a window at a time, whatever its size; what it must read whole, up to a limit).
+ */
 import { notify, send } from './store.js';
-
-/** Captures over this size are refused with a message rather than freezing the tab. */
-const MAX_BYTES = 512 << 20;
 
 export async function openCapture(file: File): Promise<void> {
   if (file.size === 0) {
     notify('error', `Cannot open ${file.name}`, 'The file is empty.');
-    return;
-  }
-  if (file.size > MAX_BYTES) {
-    notify('error', `Cannot open ${file.name}`, `It is ${(file.size / (1 << 20)).toFixed(0)} MB; SatScope opens captures up to 512 MB.`);
     return;
   }
   // Marks on the performance timeline (DevTools, bench:page) split opening a capture into the

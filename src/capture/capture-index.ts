@@ -193,14 +193,17 @@ interface Segment {
 }
 
 /**
- * The totals of a closed .sscap file of `size` bytes whose records start at `recordsFrom`: its
- * final index segment alone, checked (one or two reads), or null when the file does not end
- * with one that checks out. For a reader that needs the capture's size, not where its stretches
- * start.
+ * The totals of a .sscap file's last index segment that checks out, the final one or (a
+ * recording cut short) the last before the end, with where it ends: the records after
+ * `coversTo` are not counted. Null when there is none. Two or three reads, not the whole index.
  */
-export async function readCaptureTotals(size: number, recordsFrom: number, read: ReadAt): Promise<CaptureTotals | null> {
-  const last = await segmentEndingAt(size, recordsFrom, read);
-  return last?.final === true && fitsBefore(last, recordsFrom) ? last : null;
+export async function readLastTotals(
+  size: number,
+  recordsFrom: number,
+  read: ReadAt,
+): Promise<(CaptureTotals & Pick<CaptureIndex, 'final' | 'coversTo'>) | null> {
+  const last = (await segmentEndingAt(size, recordsFrom, read)) ?? (await lastSegmentBefore(size, recordsFrom, read));
+  return last !== null && fitsBefore(last, recordsFrom) ? { ...last, coversTo: last.end } : null;
 }
 
 /** Whether the records a segment counts fit in the file before it (a count no file can hold is damage). */

@@ -15,6 +15,7 @@ import { TaskQueue } from './queue.js';
 import { Recorder } from './recorder.js';
 import { SourceRegistry } from './registry.js';
 import { ReplaySession } from './replay/replay-session.js';
+import { tooLargeToReadWhole } from './replay/capture-file.js';
 import { type ReportMaker, WORKER_REPORT_MAKER, report } from './report.js';
 import type { ReportRequest } from './report-worker.js';
 import { setResolution, shareResolution, tellMismatch } from './resolution.js';
@@ -203,6 +204,11 @@ export class Dispatcher {
     }
     if (of === null) {
       notice(this.host, 'warning', 'No frames to export', 'Record the live session (● Record) or open a capture first.');
+      return;
+    }
+    const tooLarge = 'file' in of ? tooLargeToReadWhole(of.file.size, 'a capture whose frames are exported') : null;
+    if (tooLarge !== null) {
+      notice(this.host, 'error', 'The frames could not be exported', tooLarge);
       return;
     }
     const name = replay?.name ?? 'satscope-live';

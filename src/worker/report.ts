@@ -5,6 +5,7 @@
  * stall shows as a gap in the data and in the recording).
  */
 import { type Host, notice } from './host.js';
+import { tooLargeToReadWhole } from './replay/capture-file.js';
 import type { ReportReply, ReportRequest } from './report-worker.js';
 
 /** The helper that makes one report: a fresh worker in the browser, a stand-in in tests. */
@@ -46,6 +47,11 @@ export async function report(
       'Nothing to report on yet',
       'Record the live session (● Record) or open a capture; the report covers what was recorded.',
     );
+    return;
+  }
+  const tooLarge = 'file' in of ? tooLargeToReadWhole(of.file.size, 'a capture reported on') : null;
+  if (tooLarge !== null) {
+    notice(host, 'error', 'The report could not be made', tooLarge);
     return;
   }
   let request: ReportRequest;

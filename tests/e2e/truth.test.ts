@@ -34,6 +34,7 @@ import {
   writeLongCapture,
   type AppSession,
 } from './app-fixture.js';
+import { withoutIndex } from '../feeds.js';
 
 const skip = browserUnavailable();
 if (skip !== null) console.warn(`skipping the honest-state page tests: ${skip}`);
@@ -144,6 +145,8 @@ describe.skipIf(skip !== null)('honest states', () => {
   it('says a forced resolution matches no frame, counts nothing as lost meanwhile, and leaves no episode after switching back', async () => {
     const { page, errors } = await open();
     await page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor({ timeout: 10_000 });
+    // The demo runs in real time from about here: remote B's first dropout is 12 s in.
+    const liveAtMs = Date.now();
     // After the demo's first short dropout (a hold at 4 s), before its long one (at 27 s).
     await expect.poll(() => page.locator('.link dd').nth(1).textContent(), { timeout: 10_000 }).toBe('1 hold · 0 failsafes');
     await page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor({ timeout: 5000 });
@@ -166,8 +169,11 @@ describe.skipIf(skip !== null)('honest states', () => {
     await page.getByTestId('link-state').filter({ hasText: 'Live' }).waitFor({ timeout: 5000 });
     await page.waitForTimeout(1000);
     await expect(page.locator('.link dd').nth(1).textContent()).resolves.toBe(episodes);
-    // Remote B has no dropout in its first 12 s: whatever the worker's timers did, no hold.
-    await expect(page.locator('.remotes tbody tr').nth(1).textContent()).resolves.toMatch(/0 \/ 0/);
+    // Remote B has no dropout in its first 12 s: whatever the worker's timers did, no hold (on a
+    // machine slow enough to be past its first dropout by now, that one is real).
+    const row = await page.locator('.remotes tbody tr').nth(1).textContent();
+    if (Date.now() - liveAtMs < 10_500) expect(row).toMatch(/0 \/ 0/);
+    else expect(row).toMatch(/[01] \/ 0/);
     // At most what the receiver's own counter says it missed meanwhile (the demo fades a few an s), not the ~270 frames not decoded.
     expect(Number(await page.getByTestId('count-missed').textContent()) - missed).toBeLessThan(20);
     expect(errors).toEqual([]);
@@ -305,12 +311,16 @@ describe.skipIf(skip !== null)('a capture being read', () => {
   // Two hours of two remotes: the page shows its span and overview while it walks the records,
   // and plays it from the file a window at a time (src/worker/replay/replay-session.ts).
   let path = '';
+  /** The same capture without its index: its ports are known only once its records are walked. */
+  let bare = '';
   beforeAll(() => {
     path = join(dir, 'two-hours.sscap');
     writeLongCapture(path, 2 * 3600e6);
+    bare = join(dir, 'two-hours-no-index.sscap');
+    writeFileSync(bare, withoutIndex(new Uint8Array(readFileSync(path))));
   });
 
-  it("says the capture is being read, never a receiver's wiring hint, until it plays", async () => {
+  it("says a capture without an index is being read, never a receiver's wiring hint, until it plays", async () => {
     const { page, errors } = await open('?demo=0');
     await page.getByTestId('empty-state').waitFor();
     // Every state and hint the link panel shows, and whether Play could be pressed then.
@@ -327,7 +337,7 @@ describe.skipIf(skip !== null)('a capture being read', () => {
       };
       new MutationObserver(note).observe(document.body, { subtree: true, childList: true, characterData: true, attributes: true });
     });
-    await page.setInputFiles('input[type=file]', path);
+    await page.setInputFiles('input[type=file]', bare);
     await page
       .getByTestId('link-state')
       .filter({ hasText: /^Live$/ })

@@ -5,20 +5,42 @@
  * one source of the bytes: a week's capture plays in the memory of a few windows.
  */
 import { type Capture, CaptureFormatError, type ParsedCapture } from '../../capture/model.js';
-import { hasCaptureMagic, RECORD_HEADER_SIZE, RECORD_TYPE_DATA, REC_OFF_TYPE } from '../../capture/layout.js';
+import {
+  CRC_SIZE,
+  HEADER_FIXED_SIZE,
+  hasCaptureMagic,
+  MAX_META_BYTES,
+  OFF_META_LENGTH,
+  RECORD_HEADER_SIZE,
+  RECORD_TYPE_DATA,
+  REC_OFF_TYPE,
+} from '../../capture/layout.js';
 import { parseCapture } from '../../capture/reader.js';
 import { recordSize } from '../../capture/records.js';
 import { crcFollows } from '../../capture/crc32.js';
 import { recordTimeUs, type SlicedFile } from '../../capture/record-walk.js';
-import { readCaptureTotals } from '../../capture/capture-index.js';
+import { readLastTotals } from '../../capture/capture-index.js';
 import { capturePorts } from '../../capture/facts.js';
 import { type CaptureSpan, captureSpan, SpanTally } from '../../report/capture-span.js';
 import { TIME_BACK_TOLERANCE_US, timeInLine } from '../../capture/time-rule.js';
 
+/**
+ * The largest file the page reads whole (raw bytes, a Saleae export, a .sscap that is damaged or
+ * has no recorded times): it holds about twice its size in memory. Larger ones are refused with
+ * a message; `satscope` on the command line reads them.
+ */
+export const READ_WHOLE_MAX_BYTES = 512 << 20;
+
+/** Refused: `size` bytes read whole, over READ_WHOLE_MAX_BYTES; the sentence that says so. */
+export function tooLargeToReadWhole(size: number, what: string): string | null {
+  if (size <= READ_WHOLE_MAX_BYTES) return null;
+  return `It is ${(size / (1 << 20)).toFixed(0)} MB, and ${what} is read whole: the page does that up to ${READ_WHOLE_MAX_BYTES >> 20} MB. \`satscope info\`, \`report\` and \`doctor\` on the command line read it.`;
+}
+
 /** A window's records: about a minute of two remotes recorded as a USB adapter hands them over, or an hour of a quiet one. */
 export const WINDOW_BYTES = 512 << 10;
-/** The start read at open: the header (its metadata is at most 1 MiB) and the first records. */
-const HEAD_BYTES = 2 << 20;
+/** The longest window a seek reads at once (all it will feed, up to its target). */
+const MOST_WINDOW_BYTES = 16 << 20;
 /** The end read at open, for the last recorded time. */
 const TAIL_BYTES = 64 << 10;
 /** Read at a time when looking for a record near a file offset (a seek the decode has not reached). */
@@ -54,8 +76,13 @@ export class CaptureFile {
    */
   static async open(file: SlicedFile): Promise<CaptureFile | null> {
     try {
-      const start = await read(file, 0, HEAD_BYTES);
-      if (!hasCaptureMagic(start)) return null;
+      // The header (its metadata is at most 1 MiB) and a window of records.
+      const fixed = await read(file, 0, HEADER_FIXED_SIZE);
+      if (!hasCaptureMagic(fixed) || fixed.length < HEADER_FIXED_SIZE) return null;
+      const metaLength = new DataView(fixed.buffer, fixed.byteOffset).getUint32(OFF_META_LENGTH, true);
+      if (metaLength > MAX_META_BYTES) return null;
+      const start = await read(file, 0, HEADER_FIXED_SIZE + metaLength + CRC_SIZE + WINDOW_BYTES);
+      const whole = start.length === file.size;
       const head = parseCapture(start);
       const { headerLength } = head;
       // Damage at the start (anything but the record the read cut) is for the whole file's reader to salvage.
@@ -64,15 +91,9 @@ export class CaptureFile {
       const tailFrom = Math.max(headerLength, file.size - TAIL_BYTES);
       const tail = parseCapture(joined(header, await read(file, tailFrom, TAIL_BYTES)));
       const startUs = captureSpan(head).startUs;
-      const endUs = file.size <= HEAD_BYTES ? captureSpan(head).endUs : captureSpan(tail).endUs;
+      const endUs = whole ? captureSpan(head).endUs : captureSpan(tail).endUs;
       if (!(startUs <= endUs)) return null;
-      const totals = await readCaptureTotals(file.size, headerLength, (offset, length) => read(file, offset, length));
-      const ports =
-        totals === null
-          ? file.size <= HEAD_BYTES && head.issues.length === 0
-            ? capturePorts(head)
-            : null
-          : totals.ports.filter((p) => p.records > 0).map((p) => p.port);
+      const ports = whole && head.issues.length === 0 ? capturePorts(head) : await portsOf(file, header);
       return new CaptureFile(file, header, head, startUs, endUs, ports);
     } catch (error) {
       if (error instanceof CaptureFormatError) return null;
@@ -86,12 +107,14 @@ export class CaptureFile {
   }
 
   /**
-   * The window of records starting at `offset` (a record's start): up to WINDOW_BYTES of whole
-   * records, more when one record is longer.
+   * The window of records starting at `offset` (a record's start): up to `bytes` (WINDOW_BYTES,
+   * or what a seek will feed, up to MOST_WINDOW_BYTES) of whole records, more when one record is
+   * longer.
    */
-  async window(offset: number): Promise<CaptureWindow> {
+  async window(offset: number, bytes = WINDOW_BYTES): Promise<CaptureWindow> {
     const size = this.file.size;
-    for (let want = WINDOW_BYTES; ; want *= 2) {
+    const first = Number.isFinite(bytes) ? Math.min(MOST_WINDOW_BYTES, Math.max(WINDOW_BYTES, Math.ceil(bytes))) : WINDOW_BYTES;
+    for (let want = first; ; want *= 2) {
       const bytes = await read(this.file, offset, want);
       const view = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
       let p = 0;
@@ -127,7 +150,7 @@ export class CaptureFile {
     for (let p = 0; p + RECORD_HEADER_SIZE <= bytes.length; p++) {
       const total = recordSize(bytes, view, p);
       if (total < 0 || p + total > bytes.length || bytes[p + REC_OFF_TYPE] !== RECORD_TYPE_DATA) continue;
-      if (!crcFollows(bytes, p + REC_OFF_TYPE, p + total - 4, view)) continue;
+      if (!crcFollows(bytes, p + REC_OFF_TYPE, p + total - CRC_SIZE, view)) continue;
       const timeUs = recordTimeUs(view, p + RECORD_HEADER_SIZE);
       if (Number.isFinite(timeUs)) return { offset: from + p, timeUs };
     }
@@ -165,8 +188,13 @@ export class WalkCheck {
   /** The last data record's time, and the latest event since it (an event must come no later than the data after it). */
   readonly #at = new Float64Array([Number.NaN, Number.NaN]);
 
-  /** A data record of `count` bytes recorded at `timeUs`. */
-  data(timeUs: number, count: number): void {
+  /**
+   * A data record whose payload is `view`'s bytes [start, end) (a RecordSink's): its time read
+   * here, not handed over (a double handed to a call not inlined is boxed, a record at a time).
+   */
+  data(view: DataView, start: number, end: number): void {
+    const timeUs = recordTimeUs(view, start);
+    const count = end - start;
     const at = this.#at;
     if (!timeInLine(at[0] ?? Number.NaN, timeUs) || (at[1] ?? Number.NaN) > timeUs + TIME_BACK_TOLERANCE_US) this.inLine = false;
     at[0] = timeUs;
@@ -186,6 +214,19 @@ export class WalkCheck {
   get span(): CaptureSpan {
     return this.#span.span;
   }
+}
+
+/**
+ * Every port with data in `file`: those its last index segment counts and those of the records
+ * after it (a recording cut short: at most a few megabytes); null without an index (only a
+ * walk of the records can tell).
+ */
+async function portsOf(file: SlicedFile, header: Uint8Array): Promise<number[] | null> {
+  const totals = await readLastTotals(file.size, header.length, (offset, length) => read(file, offset, length));
+  if (totals === null) return null;
+  const ports = new Set(totals.ports.filter((p) => p.records > 0).map((p) => p.port));
+  if (!totals.final) for (const p of capturePorts(parseCapture(joined(header, await read(file, totals.coversTo, file.size))))) ports.add(p);
+  return [...ports].sort((a, b) => a - b);
 }
 
 async function read(file: SlicedFile, from: number, length: number): Promise<Uint8Array> {

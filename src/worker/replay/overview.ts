@@ -23,14 +23,25 @@ const BIN_WIDTHS_US = [20_000, 50_000, 100_000, 200_000, 500_000, BIN_US];
 /** Bins at most across a capture: two a pixel of a timeline about a thousand pixels wide. */
 const MOST_BINS = 2000;
 
+/** Wider bins, for a capture longer than MOST_SECOND_BINS seconds. */
+const LONG_WIDTHS_US = [2_000_000, 5_000_000, 10_000_000, 30_000_000, 60_000_000];
+/**
+ * One-second bins at most, about three days of them: a longer capture's bins are wider, so that
+ * its overview, and the series the worker keeps to make it, stay a few megabytes however long it
+ * is (a week's 1 s bins held 67 MB a port in the worker).
+ */
+const MOST_SECOND_BINS = 1 << 18;
+
 /**
  * The bins of a capture `spanUs` long: the narrowest round width that keeps it to MOST_BINS, so
  * that a short capture's timeline draws a hold or a lost frame as long as it was (a 0.74 s
  * capture in 20 ms bins, not in one bin of a second that the whole timeline would stand for);
- * BIN_US for a long capture, and for one whose span is unknown.
+ * BIN_US for a long capture, and for one whose span is unknown; wider for one over three days.
  */
 export function overviewBinUs(spanUs: number): number {
-  return BIN_WIDTHS_US.find((w) => spanUs / w <= MOST_BINS) ?? BIN_US;
+  const short = BIN_WIDTHS_US.find((w) => spanUs / w <= MOST_BINS);
+  if (short !== undefined || !(spanUs / BIN_US > MOST_SECOND_BINS)) return short ?? BIN_US;
+  return LONG_WIDTHS_US.find((w) => spanUs / w <= MOST_SECOND_BINS) ?? (LONG_WIDTHS_US.at(-1) as number);
 }
 
 /** The frame period a decoder's format implies (its system byte, or 1024 resolution: 22 ms), NaN when it implies none. */

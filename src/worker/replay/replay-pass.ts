@@ -3,8 +3,8 @@
  * times): every port's decoder, link monitor and link series (the report's), fed the chunks in
  * the capture's order a slice at a time (of a capture read whole, or of a file's records as they
  * are walked), so that the page draws the overview as it grows and stays responsive. On the way
- * it keeps a checkpoint of every port's decoder and link monitor each CHECKPOINT_US of capture
- * time, with where its chunk lies: a seek restores the nearest one and feeds only from there,
+ * it keeps a checkpoint of every port's decoder and link monitor each minute of capture
+ * time (further apart in a capture of days), with where its chunk lies: a seek restores the nearest one and feeds only from there,
  * with the counters, episodes and link state of the whole capture up to the target.
  */
 import type { DecoderCheckpoint, LinkCheckpoint } from '../../decoder/checkpoint.js';
@@ -19,8 +19,19 @@ import { recordedStops, StopCursor } from '../../report/doctor-events.js';
 import { failsafeAsRead, failsafesOf, overviewBinUs, sumOverview } from './overview.js';
 import type { Overview } from '../protocol.js';
 
-/** Capture time between two checkpoints: 1440 of them a day, each a few kilobytes a port. */
+/** Capture time between two checkpoints: 1440 of them a day, each about 10 kB a port. */
 const CHECKPOINT_US = 60e6;
+/**
+ * Checkpoints in a capture, at most: one a minute for two days, further apart in a longer one (a
+ * week's 3.5 minutes), so that they hold tens of megabytes, not hundreds (a week's at one a
+ * minute held 180 MB of the worker's). A seek feeds one interval and a graph's history at most.
+ */
+const MOST_CHECKPOINTS = 2880;
+
+/** The capture time between two checkpoints of a capture `spanUs` long. */
+function checkpointEveryUs(spanUs: number): number {
+  return Number.isFinite(spanUs) ? Math.max(CHECKPOINT_US, Math.ceil(spanUs / MOST_CHECKPOINTS)) : CHECKPOINT_US;
+}
 
 /**
  * How far behind the slowest port's last frame the overview is drawn while the pass runs: frames
@@ -60,6 +71,7 @@ export class ReplayPass {
   /** The time of the chunk being fed (`#feed`), and its record's file offset (NaN: a capture's chunk). */
   readonly #at = new Float64Array([Number.NaN, Number.NaN]);
   #nextCheckpointUs: number;
+  readonly #checkpointEveryUs: number;
   #done = false;
   /** The capture's recorded stops ("device lost"), each told to its port's link before the chunk after it. */
   readonly #stops: StopCursor;
@@ -82,7 +94,8 @@ export class ReplayPass {
     this.#binUs = overviewBinUs(endUs - originUs);
     this.#anyPort = ports === null;
     for (const port of ports ?? []) this.#add(port);
-    this.#nextCheckpointUs = originUs + CHECKPOINT_US;
+    this.#checkpointEveryUs = checkpointEveryUs(endUs - originUs);
+    this.#nextCheckpointUs = originUs + this.#checkpointEveryUs;
   }
 
   /** Every port a record is found on is decoded. */
@@ -206,8 +219,20 @@ export class ReplayPass {
     this.checkpoints.push({ chunk, offset: this.#at[1] ?? Number.NaN, fedUntilUs: this.#fedUntilUs, ports });
     // The next is due a whole interval on, however long the silence before this chunk.
     let next = this.#nextCheckpointUs;
-    while (next <= atUs) next += CHECKPOINT_US;
+    while (next <= atUs) next += this.#checkpointEveryUs;
     this.#nextCheckpointUs = next;
+  }
+
+  /** The first checkpoint taken after `targetUs`'s data: where a seek to it has fed all it will. */
+  checkpointAfter(targetUs: number): Checkpoint | undefined {
+    let lo = 0;
+    let hi = this.checkpoints.length;
+    while (lo < hi) {
+      const mid = (lo + hi) >>> 1;
+      if ((this.checkpoints[mid]?.fedUntilUs ?? Number.POSITIVE_INFINITY) < targetUs) lo = mid + 1;
+      else hi = mid;
+    }
+    return this.checkpoints[lo];
   }
 
   /**

@@ -30,7 +30,7 @@ import { overviewOf } from './overview.js';
 import type { ReplayStatus } from '../protocol.js';
 import type { Driver, SourceRegistry } from '../registry.js';
 import { type Checkpoint, ReplayPass } from './replay-pass.js';
-import { CaptureFile, WalkCheck } from './capture-file.js';
+import { CaptureFile, WalkCheck, tooLargeToReadWhole } from './capture-file.js';
 import { OverviewSender } from './overview-sender.js';
 import { type ReplayData, type ReplayPosition, ReplaySource } from '../sources/replay.js';
 
@@ -46,7 +46,7 @@ const FRESH_SEEK_US = 15 * 60e6;
 /** The capture is decoded for this long at a time, then messages and playback go through. */
 const PASS_SLICE_MS = 40;
 /** A file is walked this much at a time (read ahead while the last is decoded). */
-const WALK_SLICE_BYTES = 256 << 10;
+const WALK_SLICE_BYTES = 4 << 20;
 
 export interface ReplayParts {
   host: Host;
@@ -90,6 +90,11 @@ export class ReplaySession implements Driver {
       return cannotOpen(`The file could not be read (${String(error)}).`);
     }
     if (opened !== null) return ReplaySession.#openFile(name, file, opened, parts);
+    const tooLarge = tooLargeToReadWhole(
+      file.size,
+      whole ? 'a damaged capture' : 'a file that is not an intact .sscap with recorded times',
+    );
+    if (tooLarge !== null) return cannotOpen(tooLarge);
     let capture: Capture;
     try {
       capture = readCapture(new Uint8Array(await file.arrayBuffer()), name);
@@ -164,7 +169,7 @@ export class ReplaySession implements Driver {
       walked = await walkDataRecords(
         blob,
         (bytes, view, start, end, port, at) => {
-          check.data(recordTimeUs(view, start), end - start);
+          check.data(view, start, end);
           pass.feedRecord(bytes, view, start, end, port, at);
         },
         {
@@ -202,6 +207,7 @@ export class ReplaySession implements Driver {
     const issues = walked.cutAt === undefined ? [] : [truncatedRecord(walked.cutAt, blob.size - walked.cutAt)];
     if (playing !== null) {
       playing.#issues = issues;
+      playing.#tellIssues();
       playing.status();
       return;
     }
@@ -259,14 +265,7 @@ export class ReplaySession implements Driver {
     const r = this.source;
     await registry.use(this);
     diagnosis.replay(this.#timing, 'capture' in this.#opened ? this.#opened.capture.events : [], r.startUs);
-    if (this.#issues.length > 0) {
-      notice(
-        host,
-        'warning',
-        `${this.name}: ${plural(this.#issues.length, 'damaged part')} skipped`,
-        `${this.#issues[0]?.message ?? ''} Every intact record is kept.`,
-      );
-    }
+    this.#tellIssues();
     if (!r.recordedTiming) {
       notice(
         host,
@@ -285,6 +284,18 @@ export class ReplaySession implements Driver {
   /** Where the capture's first chunk is. */
   get #first(): ReplayPosition {
     return { chunk: 0, offset: 'file' in this.#opened ? this.#opened.file.recordsFrom : 0 };
+  }
+
+  /** What reading the file skipped, told once known. */
+  #tellIssues(): void {
+    const issues = this.#issues;
+    if (issues.length === 0) return;
+    notice(
+      this.#p.host,
+      'warning',
+      `${this.name}: ${plural(issues.length, 'damaged part')} skipped`,
+      `${issues[0]?.message ?? ''} Every intact record is kept.`,
+    );
   }
 
   get #timing(): Capture['timing'] {
@@ -402,7 +413,8 @@ export class ReplaySession implements Driver {
         this.#p.diagnosis.restored(port);
       }
     }
-    const start: ReplayPosition | undefined = from === null ? this.#first : from;
+    const start: ReplayPosition | undefined =
+      from === undefined ? undefined : { ...(from ?? this.#first), readTo: this.#pass?.checkpointAfter(timeUs)?.offset };
     this.#p.registry.setAllStates(state);
     await this.source.seek(timeUs, start);
     this.status();
@@ -423,8 +435,9 @@ export class ReplaySession implements Driver {
     return cp ?? null;
   }
 
-  /** Tells the page where the replay is. */
+  /** Tells the page where the replay is (nothing once another source or file has taken over). */
   status(): void {
+    if (this.#stopped) return;
     const { host, registry } = this.#p;
     const r = this.source;
     this.#lastStatusMs = host.clock.now();

@@ -61,6 +61,8 @@ export type ReplayData = { capture: Capture } | { file: CaptureFile; ports: read
 export interface ReplayPosition {
   chunk: number;
   offset: number;
+  /** The file offset the seek will feed to (a checkpoint after its target): read at once. */
+  readTo?: number | undefined;
 }
 
 export class ReplaySource {
@@ -188,17 +190,17 @@ export class ReplaySource {
 
   /**
    * The time a port's link is judged at (hold, failsafe): the replay clock, but never past the
-   * next byte not fed yet, so that a frame still to come is never taken for silence; with the
-   * window's bytes all fed and the next not read, never past the window's last time. This keeps
-   * every state the same at 1×, 4× and full speed. NaN without recorded timing, and while a seek
-   * reads its first window.
+   * next byte not fed yet, so that a frame still to come is never taken for silence. This keeps
+   * every state the same at 1×, 4× and full speed. NaN (not judged now) without recorded timing,
+   * while a seek reads its first window, and for a port whose next byte lies in a window not
+   * entered yet: when it is, is not known.
    */
   linkNowUs(port: number): number {
     if (!this.recordedTiming || this.#seeking) return NaN;
     const c = this.#chunks[this.ports.indexOf(port)];
     if (c === undefined) return this.#clockUs;
-    const next = c.done && !this.#window.last ? this.#windowEndUs : c.nextByteUs();
-    return Math.min(this.#clockUs, next);
+    if (c.done && !this.#window.last) return Number.NaN;
+    return Math.min(this.#clockUs, c.nextByteUs());
   }
 
   /** Whether the replay has reached its end. */
@@ -259,7 +261,7 @@ export class ReplaySource {
       this.#seeking = true;
       try {
         const offset = from?.offset ?? (await file.offsetBefore(history));
-        const window = await file.window(offset);
+        const window = await file.window(offset, (from?.readTo ?? Number.NaN) - offset);
         // A later seek has begun: it plays, not this one.
         if (seeking !== this.#seeks) return;
         this.#next = null;

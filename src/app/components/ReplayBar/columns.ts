@@ -1,8 +1,8 @@
 /**
  * The replay's overview reduced to the columns its timeline is drawn in: a day-long capture has
- * 86 400 one-second bins and the timeline about a thousand device pixels. Each column shows its
- * worst second: the most frames lost and the highest fade rate of the bins that fall in it, each
- * a value one second of the capture had. Drawn bin by bin the bars would overlap to the same
+ * 86 400 one-second bins (a week's are 5 s) and the timeline about a thousand device pixels.
+ * Each column shows its worst bin: the most frames lost and the highest fade rate of the bins
+ * that fall in it, each a value one bin of the capture had. Drawn bin by bin the bars would overlap to the same
  * picture, at the cost of drawing every bin (about 0.1 s of the page's CPU while a day capture
  * opens, measured) each time the growing overview is drawn.
  */
