@@ -151,3 +151,39 @@ describe('a capture replayed from its file', () => {
     expect({ ...r.worker.registry.get(0)?.engine.decoder.stats }).toEqual(decodedWhole(capture, 0).decoder);
   });
 });
+
+describe('a recorded unplug in a replay at 1x', () => {
+  it('shows no failsafe for the time the adapter was away, however long before its next chunk the stop was recorded', async () => {
+    // Port 0's data stops at 10 s; the adapter is lost half a second later and back 30 s on.
+    const a = simulate({ ...preset('dsmx-11ms-2048-internal'), seed: 8, fades: { lossRate: 0, randomRate: 0 } }, 50e6);
+    const chunks = usbChunks(a.bytes, a.timesUs);
+    const start = chunks[0]?.timeUs ?? 0;
+    const data = chunks
+      .filter((c) => c.timeUs < start + 10e6 || c.timeUs >= start + 40e6)
+      .map((c) => ({ type: 'data' as const, ...c, port: 0 }));
+    const events = [
+      { type: 'event' as const, text: 'device lost', timeUs: start + 10.5e6, port: 0 },
+      { type: 'event' as const, text: 'port opened', timeUs: start + 39.9e6, port: 0 },
+    ];
+    const bytes = encodeCapture(
+      { baudRate: 115200 },
+      [...data, ...events].sort((x, y) => x.timeUs - y.timeUs),
+    );
+    for (const indexed of [true, false]) {
+      const clock = new FakeClock();
+      const r = openReplay(clock);
+      // Played at once (its index gives its port), and once walked (without one).
+      const file = new Blob([(indexed ? bytes : withoutIndex(bytes)).slice()]);
+      await r.send({ type: 'replay-open', name: 'unplug.sscap', file });
+      await r.walked();
+      await r.send({ type: 'replay-seek', timeUs: start }, { type: 'replay-play' });
+      for (let guard = 0; guard < 6000 && r.of('replay').at(-1)?.replay?.ended !== true; guard++) {
+        clock.advance(10);
+        if (guard % 50 === 0) await new Promise((resolve) => setTimeout(resolve, 0));
+      }
+      expect(r.of('replay').at(-1)?.replay?.ended).toBe(true);
+      const failsafes = r.batches().flatMap((b) => b.batch.episodes.filter((e) => e.kind === 'failsafe'));
+      expect({ indexed, failsafes }).toEqual({ indexed, failsafes: [] });
+    }
+  });
+});

@@ -47,10 +47,13 @@ export class StopCursor {
   #next = 0;
   constructor(readonly stops: readonly RecordedStop[]) {}
 
-  /** The next stop recorded before the capture's chunk `chunk` (Infinity: all left), taken; undefined when none. */
-  take(chunk: number): RecordedStop | undefined {
+  /**
+   * The next stop recorded before the capture's chunk `chunk` (Infinity: all left) and, with
+   * `untilUs`, at or before that time, taken; undefined when none.
+   */
+  take(chunk: number, untilUs = Number.POSITIVE_INFINITY): RecordedStop | undefined {
     const e = this.stops[this.#next];
-    if (e === undefined || e.chunkIndex > chunk) return undefined;
+    if (e === undefined || e.chunkIndex > chunk || !(e.timeUs <= untilUs || untilUs === Number.POSITIVE_INFINITY)) return undefined;
     this.#next++;
     return e;
   }

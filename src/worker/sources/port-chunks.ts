@@ -85,10 +85,11 @@ export class PortChunks {
 
   /**
    * The time of this port's next recorded stop before its chunk k (all that are left: k =
-   * length), taken; undefined when none. A seek tells again those from its first chunk on.
+   * length) and, with `untilUs`, at or before that time, taken; undefined when none. A seek
+   * tells again those from its first chunk on.
    */
-  takeStop(k: number): number | undefined {
-    return this.#stops.take(k < this.length ? this.#chunk(k) : Number.POSITIVE_INFINITY)?.timeUs;
+  takeStop(k: number, untilUs?: number): number | undefined {
+    return this.#stops.take(k < this.length ? this.#chunk(k) : Number.POSITIVE_INFINITY, untilUs)?.timeUs;
   }
 
   /** The stops not told yet are those from the cursor's chunk on. */

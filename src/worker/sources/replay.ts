@@ -328,6 +328,10 @@ export class ReplaySource {
   #feedWindow(clockUs: number, budgetMs: number, started: number): boolean {
     let unclocked = 0;
     for (const c of this.#chunks) {
+      // A stop recorded before the port's next chunk is told once the clock has reached it, not
+      // only when that chunk comes (the adapter was away meanwhile: no silence of the link's).
+      if (c.nextByte === 0)
+        for (let t = c.takeStop(c.next, clockUs); t !== undefined; t = c.takeStop(c.next, clockUs)) this.#onStop(c.port, t);
       while (c.next < c.length) {
         if (++unclocked === CLOCK_EVERY_CHUNKS) {
           unclocked = 0;
