@@ -21,8 +21,7 @@ import { crcFollows } from '../../capture/crc32.js';
 import { recordTimeUs, type SlicedFile } from '../../capture/record-walk.js';
 import { readLastTotals } from '../../capture/capture-index.js';
 import { capturePorts } from '../../capture/facts.js';
-import { type CaptureSpan, captureSpan, SpanTally } from '../../report/capture-span.js';
-import { TIME_BACK_TOLERANCE_US, timeInLine } from '../../capture/time-rule.js';
+import { captureSpan } from '../../report/capture-span.js';
 
 /**
  * The largest file the page reads whole (raw bytes, a Saleae export, a .sscap that is damaged or
@@ -66,7 +65,7 @@ export class CaptureFile {
     /** The first and last recorded time, from the file's first and last records. */
     readonly startUs: number,
     readonly endUs: number,
-    /** Every port with data, from the index of a file closed with one that checks out; null without. */
+    /** Every port with data (the index's last segment and the records after it, or the whole file read at open); null: not known before a walk. */
     readonly ports: number[] | null,
   ) {}
 
@@ -107,13 +106,13 @@ export class CaptureFile {
   }
 
   /**
-   * The window of records starting at `offset` (a record's start): up to `bytes` (WINDOW_BYTES,
-   * or what a seek will feed, up to MOST_WINDOW_BYTES) of whole records, more when one record is
-   * longer.
+   * The window of records starting at `offset` (a record's start): up to `length` bytes
+   * (WINDOW_BYTES, or what a seek will feed, up to MOST_WINDOW_BYTES) of whole records, more when
+   * one record is longer.
    */
-  async window(offset: number, bytes = WINDOW_BYTES): Promise<CaptureWindow> {
+  async window(offset: number, length = WINDOW_BYTES): Promise<CaptureWindow> {
     const size = this.file.size;
-    const first = Number.isFinite(bytes) ? Math.min(MOST_WINDOW_BYTES, Math.max(WINDOW_BYTES, Math.ceil(bytes))) : WINDOW_BYTES;
+    const first = Number.isFinite(length) ? Math.min(MOST_WINDOW_BYTES, Math.max(WINDOW_BYTES, Math.ceil(length))) : WINDOW_BYTES;
     for (let want = first; ; want *= 2) {
       const bytes = await read(this.file, offset, want);
       const view = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
@@ -172,47 +171,8 @@ export class CaptureFile {
       if (found === null || found.timeUs > timeUs) hi = mid;
       else lo = found.offset;
     }
-    return lo === this.recordsFrom ? lo : ((await this.recordNear(lo))?.offset ?? this.recordsFrom);
-  }
-}
-
-/**
- * What a walk of a file's records finds that decides whether its windows play it as recorded:
- * every time in line (time-rule.ts: a reader steps over none, so a window's times are the
- * whole file's), no damage, and its span (the rule every surface starts and ends a capture at).
- */
-export class WalkCheck {
-  inLine = true;
-  damaged = false;
-  readonly #span = new SpanTally();
-  /** The last data record's time, and the latest event since it (an event must come no later than the data after it). */
-  readonly #at = new Float64Array([Number.NaN, Number.NaN]);
-
-  /**
-   * A data record whose payload is `view`'s bytes [start, end) (a RecordSink's): its time read
-   * here, not handed over (a double handed to a call not inlined is boxed, a record at a time).
-   */
-  data(view: DataView, start: number, end: number): void {
-    const timeUs = recordTimeUs(view, start);
-    const count = end - start;
-    const at = this.#at;
-    if (!timeInLine(at[0] ?? Number.NaN, timeUs) || (at[1] ?? Number.NaN) > timeUs + TIME_BACK_TOLERANCE_US) this.inLine = false;
-    at[0] = timeUs;
-    at[1] = Number.NaN;
-    if (count > 0) this.#span.chunk(timeUs, count);
-  }
-
-  /** An event recorded at `timeUs` (NaN: unknown, as a reader keeps it). */
-  event(timeUs: number): void {
-    if (Number.isNaN(timeUs)) return;
-    const at = this.#at;
-    if (!timeInLine(at[0] ?? Number.NaN, timeUs)) this.inLine = false;
-    if (!(timeUs <= (at[1] ?? Number.NaN))) at[1] = timeUs;
-    this.#span.event(timeUs);
-  }
-
-  get span(): CaptureSpan {
-    return this.#span.span;
+    // `lo` is the records' start or a record found checked.
+    return lo;
   }
 }
 

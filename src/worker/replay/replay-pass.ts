@@ -19,6 +19,9 @@ import { recordedStops, StopCursor } from '../../report/doctor-events.js';
 import { failsafeAsRead, failsafesOf, overviewBinUs, sumOverview } from './overview.js';
 import type { Overview } from '../protocol.js';
 
+/** The capture is decoded for this long at a time, then messages and playback go through. */
+export const PASS_SLICE_MS = 40;
+
 /** Capture time between two checkpoints: 1440 of them a day, each about 10 kB a port. */
 const CHECKPOINT_US = 60e6;
 /**
@@ -225,14 +228,7 @@ export class ReplayPass {
 
   /** The first checkpoint taken after `targetUs`'s data: where a seek to it has fed all it will. */
   checkpointAfter(targetUs: number): Checkpoint | undefined {
-    let lo = 0;
-    let hi = this.checkpoints.length;
-    while (lo < hi) {
-      const mid = (lo + hi) >>> 1;
-      if ((this.checkpoints[mid]?.fedUntilUs ?? Number.POSITIVE_INFINITY) < targetUs) lo = mid + 1;
-      else hi = mid;
-    }
-    return this.checkpoints[lo];
+    return this.checkpoints[this.#countWhere((fedUntilUs) => fedUntilUs < targetUs)];
   }
 
   /**
@@ -241,14 +237,19 @@ export class ReplayPass {
    */
   checkpointFor(targetUs: number, historyUs: number): Checkpoint | undefined {
     const before = targetUs - historyUs;
+    return this.checkpoints[this.#countWhere((fedUntilUs) => fedUntilUs <= before) - 1];
+  }
+
+  /** How many checkpoints from the first have a `fedUntilUs` that passes `test` (one that holds for a prefix of them), by bisection. */
+  #countWhere(test: (fedUntilUs: number) => boolean): number {
     let lo = 0;
     let hi = this.checkpoints.length;
     while (lo < hi) {
       const mid = (lo + hi) >>> 1;
-      if ((this.checkpoints[mid]?.fedUntilUs ?? Number.POSITIVE_INFINITY) <= before) lo = mid + 1;
+      if (test(this.checkpoints[mid]?.fedUntilUs ?? Number.POSITIVE_INFINITY)) lo = mid + 1;
       else hi = mid;
     }
-    return this.checkpoints[lo - 1];
+    return lo;
   }
 
   /**

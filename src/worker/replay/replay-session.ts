@@ -18,19 +18,18 @@ import { CaptureFormatError, type Capture, type CaptureIssue, type CaptureMeta }
 import { capturePorts } from '../../capture/facts.js';
 import { readCapture } from '../../capture/sniff.js';
 import { truncatedRecord } from '../../capture/reader.js';
-import { recordTimeUs, walkDataRecords } from '../../capture/record-walk.js';
 import { FRAME_PERIOD_11MS_US } from '../../decoder/spec.js';
 import { captureSpan } from '../../report/capture-span.js';
 import { timingJitterUs } from '../../report/capture-pass.js';
-import { stopsPort } from '../../report/doctor-events.js';
 import type { Batcher } from '../batcher.js';
 import type { Diagnosis } from '../diagnosis.js';
 import { type Host, notice } from '../host.js';
 import { overviewOf } from './overview.js';
 import type { ReplayStatus } from '../protocol.js';
 import type { Driver, SourceRegistry } from '../registry.js';
-import { type Checkpoint, ReplayPass } from './replay-pass.js';
-import { CaptureFile, WalkCheck, tooLargeToReadWhole } from './capture-file.js';
+import { type Checkpoint, PASS_SLICE_MS, ReplayPass } from './replay-pass.js';
+import { CaptureFile, tooLargeToReadWhole } from './capture-file.js';
+import { walkFile } from './file-walk.js';
 import { OverviewSender } from './overview-sender.js';
 import { type ReplayData, type ReplayPosition, ReplaySource } from '../sources/replay.js';
 
@@ -43,10 +42,6 @@ const SEEK_HISTORY_US = 60e6;
  * before the target instead (the link figures then count from there until the decode gets there).
  */
 const FRESH_SEEK_US = 15 * 60e6;
-/** The capture is decoded for this long at a time, then messages and playback go through. */
-const PASS_SLICE_MS = 40;
-/** A file is walked this much at a time (read ahead while the last is decoded). */
-const WALK_SLICE_BYTES = 4 << 20;
 
 export interface ReplayParts {
   host: Host;
@@ -55,15 +50,13 @@ export interface ReplayParts {
   batcher: Batcher;
 }
 
-/** What was opened: the file itself, or the capture read whole from it. */
-type Opened = { file: CaptureFile; ports: number[] } | { capture: Capture };
-
 export class ReplaySession implements Driver {
   readonly kind = 'replay';
   readonly source: ReplaySource;
   readonly #p: ReplayParts;
   readonly #blob: Blob;
-  readonly #opened: Opened;
+  /** What was opened: the capture read whole, or the file itself. */
+  readonly #opened: ReplayData;
   #lastStatusMs = Number.NEGATIVE_INFINITY;
   /** The capture's decode for the overview and the checkpoints (null: the overview came at once, seeks decode afresh). */
   #pass: ReplayPass | null = null;
@@ -161,41 +154,7 @@ export class ReplaySession implements Driver {
     const { host, registry } = parts;
     const sender = playing === null ? new OverviewSender(host) : playing.#sender;
     const replaced = (): boolean => token !== ReplaySession.#opens || (playing === null ? registry.driver !== undefined : playing.#stopped);
-    const check = new WalkCheck();
-    const utf8 = new TextDecoder();
-    let yieldedMs = host.clock.now();
-    let walked: Awaited<ReturnType<typeof walkDataRecords>> = null;
-    try {
-      walked = await walkDataRecords(
-        blob,
-        (bytes, view, start, end, port, at) => {
-          check.data(view, start, end);
-          pass.feedRecord(bytes, view, start, end, port, at);
-        },
-        {
-          checked: () => true,
-          events: (bytes, view, start, end, port) => {
-            const atUs = recordTimeUs(view, start);
-            check.event(atUs);
-            // A recorded stop ("device lost") is the adapter's absence, not the link's (LinkMonitor.stopped).
-            if (stopsPort(utf8.decode(bytes.subarray(start, end)))) pass.stopped(port, atUs);
-          },
-          goOn: async () => {
-            if (sender.due()) sender.offer(pass.overview());
-            // Playback and messages go through every PASS_SLICE_MS.
-            if (host.clock.now() - yieldedMs >= PASS_SLICE_MS) {
-              await new Promise<void>((resolve) => host.clock.after(0, resolve));
-              yieldedMs = host.clock.now();
-            }
-            return !replaced();
-          },
-          sliceBytes: WALK_SLICE_BYTES,
-        },
-      );
-    } catch (error) {
-      if (!(error instanceof CaptureFormatError)) throw error;
-      check.damaged = true;
-    }
+    const { walked, check } = await walkFile(blob, pass, sender, host.clock, replaced);
     if (replaced()) return;
     const span = check.span;
     if (walked === null || !check.inLine || span.startUs !== file.startUs || span.endUs !== file.endUs) {
@@ -219,7 +178,7 @@ export class ReplaySession implements Driver {
   private constructor(
     readonly name: string,
     blob: Blob,
-    opened: Opened,
+    opened: ReplayData,
     parts: ReplayParts,
     issues: readonly CaptureIssue[],
     /** Without recorded timing, the receiver's frame period its bytes are paced at. */
@@ -232,9 +191,8 @@ export class ReplaySession implements Driver {
     this.#issues = issues;
     this.#sender = sender;
     const { host, registry } = parts;
-    const data: ReplayData = opened;
     this.source = new ReplaySource(
-      data,
+      opened,
       (port, bytes, time, _atUs, fedAtMs) => registry.get(port)?.engine.push(bytes, time, host.timeOriginMs + fedAtMs),
       () => {
         parts.batcher.flush();
