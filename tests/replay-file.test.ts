@@ -187,3 +187,47 @@ describe('a recorded unplug in a replay at 1x', () => {
     }
   });
 });
+
+describe('a file that cannot be read on', () => {
+  it('ends the replay with the windows read, each fed once', async () => {
+    /** Reads from `failFrom` on fail once `armed` (the file gone while it plays); `readTo`: the furthest read since. */
+    class FailingBlob extends Blob {
+      armed = false;
+      readTo = 0;
+      constructor(
+        parts: BlobPart[],
+        readonly failFrom: number,
+      ) {
+        super(parts);
+      }
+      override slice(start?: number, end?: number, type?: string): Blob {
+        const inner = super.slice(start, end, type);
+        if (this.armed && (start ?? 0) < this.failFrom) this.readTo = Math.max(this.readTo, end ?? this.size);
+        if (!this.armed || (start ?? 0) < this.failFrom) return inner;
+        return Object.assign(inner, { arrayBuffer: () => Promise.reject(new Error('NotReadableError')) });
+      }
+    }
+    const failFrom = 2 * WINDOW_BYTES;
+    const blob = new FailingBlob([FILE.slice()], failFrom);
+    const clock = new FakeClock();
+    const r = openReplay(clock);
+    await r.send({ type: 'replay-open', name: 'gone.sscap', file: blob }, { type: 'replay-pause' });
+    await r.walked();
+    blob.armed = true;
+    await r.send({ type: 'replay-seek', timeUs: 0 }, { type: 'replay-speed', speed: 0 }, { type: 'replay-play' });
+    for (let guard = 0; guard < 10_000 && r.of('replay').at(-1)?.replay?.ended !== true; guard++) {
+      clock.advance(10);
+      await new Promise((resolve) => setTimeout(resolve, 0));
+    }
+    expect(r.of('replay').at(-1)?.replay?.ended).toBe(true);
+    // What the windows read hold, port by port: fed once, nothing after.
+    expect(blob.readTo).toBeGreaterThanOrEqual(failFrom);
+    const readable = readCapture(FILE.slice(0, blob.readTo));
+    for (const port of capturePorts(readable)) {
+      const fed = r.worker.registry.get(port)?.engine.decoder.stats.bytes ?? 0;
+      const held = [...captureChunks(readable, port)].reduce((n, c) => n + c.bytes.length, 0);
+      expect(fed).toBeGreaterThan(0);
+      expect(fed).toBeLessThanOrEqual(held);
+    }
+  });
+});

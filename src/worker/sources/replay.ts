@@ -177,8 +177,10 @@ export class ReplaySource {
         if (this.#next === reading) this.#next = w;
       },
       () => {
-        // The file could not be read on: the replay ends with what was read.
-        if (this.#next === reading) this.#next = { ...this.#window, last: true, offset: this.#window.end };
+        // The file could not be read on: the replay ends with the window playing, the last read.
+        if (this.#next !== reading) return;
+        this.#next = null;
+        this.#window = { ...this.#window, last: true };
       },
     );
   }
