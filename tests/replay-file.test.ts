@@ -124,6 +124,30 @@ describe('a capture replayed from its file', () => {
     expectAsDecodedWhole(r, cut);
   });
 
+  it("keeps judging an external remote's link when it takes the internal remote's resolution", async () => {
+    // Three internal remotes with gaps of their own beside an external remote that starts later:
+    // the external one is given the internal remote's key at whatever moment the first batch is
+    // sent (a window's end here); its decoder stays locked, so its link must go on uninterrupted.
+    const S = 1e6;
+    const port = (p: number, seed: number, kind: string, fromUs: number, toUs: number, gaps: [number, number][] = []) => {
+      const a = simulate({ ...preset(kind as never), seed }, toUs - fromUs);
+      return usbChunks(a.bytes, a.timesUs)
+        .map((c) => ({ type: 'data' as const, bytes: c.bytes, timeUs: c.timeUs + fromUs, port: p }))
+        .filter((c) => !gaps.some(([x, y]) => c.timeUs >= x && c.timeUs < y));
+    };
+    const records = [
+      ...port(0, 1, 'dsmx-11ms-2048-internal', 0, 180 * S, [[100 * S, 170 * S]]),
+      ...port(1, 2, 'dsmx-11ms-2048-external', 30 * S, 180 * S),
+      ...port(2, 3, 'dsmx-11ms-2048-internal', 0, 180 * S, [[60 * S, 90 * S]]),
+      ...port(3, 4, 'dsmx-11ms-2048-internal', 0, 180 * S, [[120 * S, 150 * S]]),
+    ].sort((x, y) => x.timeUs - y.timeUs || x.port - y.port);
+    const bytes = encodeCapture({ baudRate: 115200 }, records);
+    const r = await playToEnd(bytes, 'four.sscap');
+    expect('file' in (r.worker.replay?.of() ?? {})).toBe(true);
+    expect(decodedWhole(readCapture(bytes), 1).link.lostFrames).toBeGreaterThan(0);
+    expectAsDecodedWhole(r, bytes);
+  });
+
   it('reads a damaged file whole, every intact record kept, the damage said', async () => {
     const damaged = FILE.slice();
     const at = Math.floor(damaged.length / 2);

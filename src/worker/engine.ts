@@ -136,8 +136,10 @@ export class Engine {
    * counts nothing for the time in between (no hold, failsafe or missed frame).
    */
   setResolution(resolution: 'auto' | 1024 | 2048, nowUs: number, by: 'user' | 'internal-remote' = 'user'): void {
+    const locked = this.decoder.format.locked;
     this.decoder.setResolution(resolution, by);
-    this.link.interrupt(nowUs);
+    // A decoder that stays locked reads the same frames on: nothing paused, nothing to leave uncounted.
+    if (!locked || !this.decoder.format.locked) this.link.interrupt(nowUs);
     this.#mismatch = null;
     this.#changed = true;
   }
