@@ -20,12 +20,27 @@ function file(): Uint8Array {
   return encodeCapture({ baudRate: 115200 }, records);
 }
 
-async function walk(bytes: Uint8Array, sliceBytes?: number, checked = true) {
+/**
+ * `readAhead` slices asked for at once, each answered after a delay of its own (as reads on
+ * another thread may be), so that a later slice often arrives before an earlier one.
+ */
+function unevenReads(bytes: Uint8Array) {
+  let n = 0;
+  const blob = new Blob([bytes.slice()]);
+  return {
+    size: blob.size,
+    slice: (start: number, end: number) => blob.slice(start, end),
+    view: (start: number, end: number) =>
+      new Promise<Uint8Array>((resolve) => setTimeout(() => resolve(bytes.slice(start, end)), (n++ * 7) % 5)),
+  };
+}
+
+async function walk(bytes: Uint8Array, sliceBytes?: number, checked = true, readAhead?: number) {
   const got: { bytes: number[]; timeUs: number; port: number }[] = [];
   const walked = await walkDataRecords(
-    new Blob([bytes.slice()]),
+    readAhead === undefined ? new Blob([bytes.slice()]) : unevenReads(bytes),
     (b, view, start, end, port) => got.push({ bytes: Array.from(b.subarray(start, end)), timeUs: recordTimeUs(view, start), port }),
-    { ...(sliceBytes === undefined ? {} : { sliceBytes }), checked: () => checked },
+    { ...(sliceBytes === undefined ? {} : { sliceBytes }), checked: () => checked, ...(readAhead === undefined ? {} : { readAhead }) },
   );
   return { walked, got };
 }
@@ -39,13 +54,14 @@ describe('walking the data records of an intact capture', () => {
     port: capture.chunkPorts[i],
   }));
 
-  it('hands over the chunks parseCapture reads, in order, with their counts, for any slice size', async () => {
+  it('hands over the chunks parseCapture reads, in order, with their counts, for any slice size and reads ahead', async () => {
     expect(capture.issues).toEqual([]);
     expect(want.length).toBe(600);
-    for (const slice of [1, 17, 100, 4096, undefined]) {
-      const { walked, got } = await walk(bytes, slice);
-      expect({ slice, walked }).toEqual({
+    for (const [slice, ahead] of [[1], [17], [100], [4096], [undefined], [17, 3], [100, 2], [4096, 4]]) {
+      const { walked, got } = await walk(bytes, slice, true, ahead);
+      expect({ slice, ahead, walked }).toEqual({
         slice,
+        ahead,
         walked: {
           chunks: 600,
           dataBytes: capture.bytes.length,

@@ -34,9 +34,9 @@ export interface SlicedFile {
   readonly size: number;
   slice(start: number, end: number): { arrayBuffer(): Promise<ArrayBuffer> };
   /**
-   * Bytes [start, end) without a copy, where the file holds them in memory already (a file
-   * arriving in pieces): the walk reads through this when it is there. (Not `bytes`: a Blob's
-   * own `bytes()` reads the whole of it.)
+   * Bytes [start, end) read another way (on another thread: src/worker/replay/slice-reader.ts):
+   * the walk reads through this when it is there. (Not `bytes`: a Blob's own `bytes()` reads the
+   * whole of it.)
    */
   view?(start: number, end: number): Promise<Uint8Array>;
 }
@@ -89,6 +89,8 @@ export interface WalkOptions {
   runs?: (bytes: Uint8Array, view: DataView, from: number, to: number) => void;
   /** Read at a time (tests). Default 16 MiB. */
   sliceBytes?: number;
+  /** Slices asked for ahead of the one walked. Default 1. */
+  readAhead?: number;
 }
 
 /**
@@ -99,7 +101,7 @@ export interface WalkOptions {
  *   checked fails its CRC (the file is not intact: parseCapture salvages it)
  */
 export async function walkDataRecords(file: SlicedFile, sink: RecordSink, options: WalkOptions = {}): Promise<WalkedRecords | null> {
-  const { goOn = () => true, checked = () => false, events, runs, sliceBytes = SLICE_BYTES } = options;
+  const { goOn = () => true, checked = () => false, events, runs, sliceBytes = SLICE_BYTES, readAhead = 1 } = options;
   const eventsChecked = options.eventsChecked === true || events !== undefined;
   const size = file.size;
   const read = async (from: number, length: number): Promise<Uint8Array> => {
@@ -119,16 +121,21 @@ export async function walkDataRecords(file: SlicedFile, sink: RecordSink, option
     issues,
   );
   if (issues.length > 0) throw new CaptureFormatError(`the capture's header is damaged: ${issues[0]?.message ?? ''}`);
-  /** File offset of bytes[0], and how far the file is read (the next slice is read while this one is walked). */
+  /** File offset of bytes[0], and how far the file is asked for (the next slices are read while this one is walked). */
   let at = 0;
   let readTo = bytes.length;
+  const inFlight: Promise<Uint8Array>[] = [];
   const ahead = (): Promise<Uint8Array> | null => {
-    if (readTo >= size) return null;
-    const next = read(readTo, sliceBytes);
-    // A walk that stops or fails before it needs the slice leaves no unhandled rejection.
-    next.catch(() => undefined);
-    return next;
+    while (inFlight.length < readAhead && readTo < size) {
+      const slice = read(readTo, sliceBytes);
+      // A walk that stops or fails before it needs the slice leaves no unhandled rejection.
+      slice.catch(() => undefined);
+      inFlight.push(slice);
+      readTo = Math.min(size, readTo + sliceBytes);
+    }
+    return inFlight.shift() ?? null;
   };
+  let moreAt = readTo;
   let next = ahead();
   /** A slice to go on with, after the record joined across its start. */
   let queued: { bytes: Uint8Array; at: number; p: number } | null = null;
@@ -152,21 +159,21 @@ export async function walkDataRecords(file: SlicedFile, sink: RecordSink, option
     }
     if (!(await goOn(at + p))) return null;
     const more = await next;
-    const moreAt = readTo;
-    readTo += more.length;
+    const slicedAt = moreAt;
+    moreAt += more.length;
     next = ahead();
     const rest = n - p;
     const total = rest === 0 ? 0 : straddling(bytes, p, rest, more);
     if (rest === 0) {
       bytes = more;
-      at = moreAt;
+      at = slicedAt;
     } else if (total - rest <= more.length) {
       // The record not yet whole at the end of this slice, joined with its end from the next
       // (a few dozen bytes, not the next slice copied); the next slice goes on after it.
       const record = new Uint8Array(total);
       record.set(bytes.subarray(p));
       record.set(more.subarray(0, total - rest), rest);
-      queued = { bytes: more, at: moreAt, p: total - rest };
+      queued = { bytes: more, at: slicedAt, p: total - rest };
       bytes = record;
       at += p;
     } else {

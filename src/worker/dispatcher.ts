@@ -16,6 +16,7 @@ import { Recorder } from './recorder.js';
 import { SourceRegistry } from './registry.js';
 import { ReplaySession } from './replay/replay-session.js';
 import { tooLargeToReadWhole } from './replay/capture-file.js';
+import { READ_HERE, type SliceReaderMaker } from './replay/slice-reader.js';
 import { type ReportMaker, WORKER_REPORT_MAKER, report } from './report.js';
 import type { ReportRequest } from './report-worker.js';
 import { setResolution, shareResolution, tellMismatch } from './resolution.js';
@@ -26,6 +27,8 @@ import { SerialPorts } from './sources/serial-ports.js';
 export interface DispatcherOptions {
   findPort?: (identity: PortIdentity) => Promise<SerialPort | undefined>;
   makeReport?: ReportMaker;
+  /** How a replay's walk reads its file: on this thread unless told (worker.ts: a reader worker). */
+  readSlices?: SliceReaderMaker;
 }
 
 export class Dispatcher {
@@ -37,6 +40,7 @@ export class Dispatcher {
   readonly serial: SerialPorts;
   readonly sink: LiveSink;
   readonly #makeReport: ReportMaker;
+  readonly #readSlices: SliceReaderMaker;
 
   constructor(
     readonly host: Host,
@@ -76,6 +80,7 @@ export class Dispatcher {
       findPort: options.findPort,
     });
     this.#makeReport = options.makeReport ?? WORKER_REPORT_MAKER;
+    this.#readSlices = options.readSlices ?? READ_HERE;
   }
 
   /** A message from the page: queued behind those before it. */
@@ -160,6 +165,7 @@ export class Dispatcher {
           registry,
           diagnosis: this.diagnosis,
           batcher: this.batcher,
+          readSlices: this.#readSlices,
         });
         break;
       case 'replay-play':

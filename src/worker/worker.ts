@@ -7,13 +7,18 @@
 import { Dispatcher } from './dispatcher.js';
 import { BROWSER_CLOCK } from './host.js';
 import type { ToWorker } from './protocol.js';
+import { READ_HERE, READ_IN_WORKER } from './replay/slice-reader.js';
 
 const scope = self as unknown as DedicatedWorkerGlobalScope;
-const worker = new Dispatcher({
-  post: (message, transfer = []) => scope.postMessage(message, transfer),
-  clock: BROWSER_CLOCK,
-  timeOriginMs: performance.timeOrigin,
-});
+const worker = new Dispatcher(
+  {
+    post: (message, transfer = []) => scope.postMessage(message, transfer),
+    clock: BROWSER_CLOCK,
+    timeOriginMs: performance.timeOrigin,
+  },
+  // A worker that cannot start one of its own reads a replayed file itself.
+  { readSlices: typeof Worker === 'undefined' ? READ_HERE : READ_IN_WORKER },
+);
 
 scope.addEventListener('message', (event: MessageEvent<ToWorker>) => worker.receive(event.data));
 navigator.serial?.addEventListener('connect', () => worker.serial.connected());

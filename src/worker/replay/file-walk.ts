@@ -12,9 +12,11 @@ import { stopsPort } from '../../report/doctor-events.js';
 import type { Clock } from '../host.js';
 import type { OverviewSender } from './overview-sender.js';
 import { PASS_SLICE_MS, type ReplayPass } from './replay-pass.js';
+import type { SliceReaderMaker } from './slice-reader.js';
 
-/** A file is walked this much at a time (read ahead while the last is decoded). */
+/** A file is walked this much at a time, the next two read (slice-reader.ts) while one is decoded. */
 const WALK_SLICE_BYTES = 4 << 20;
+const WALK_READ_AHEAD = 2;
 
 /**
  * What a walk of a file's records finds that decides whether its windows play it as recorded:
@@ -58,11 +60,13 @@ export class WalkCheck {
 
 /**
  * Walks `file`'s records into `pass`, sending its overview through `sender` as it grows, until
- * the end or `stopped()`; `walked` null when it stopped or found damage (`check.damaged`).
+ * the end or `stopped()`; `walked` null when it stopped or found damage (`check.damaged`). The
+ * file is read through a reader `readSlices` makes, let go at the end.
  * @throws what reading the file throws, but a damaged record
  */
 export async function walkFile(
   file: Blob,
+  readSlices: SliceReaderMaker,
   pass: ReplayPass,
   sender: OverviewSender,
   clock: Pick<Clock, 'now' | 'after'>,
@@ -72,9 +76,10 @@ export async function walkFile(
   const utf8 = new TextDecoder();
   let yieldedMs = clock.now();
   let walked: WalkedRecords | null = null;
+  const reader = readSlices(file);
   try {
     walked = await walkDataRecords(
-      file,
+      { size: file.size, slice: (start, end) => file.slice(start, end), view: (start, end) => reader.read(start, end) },
       (bytes, view, start, end, port, at) => {
         check.data(view, start, end);
         pass.feedRecord(bytes, view, start, end, port, at);
@@ -97,11 +102,14 @@ export async function walkFile(
           return !stopped();
         },
         sliceBytes: WALK_SLICE_BYTES,
+        readAhead: WALK_READ_AHEAD,
       },
     );
   } catch (error) {
     if (!(error instanceof CaptureFormatError)) throw error;
     check.damaged = true;
+  } finally {
+    reader.close();
   }
   return { walked, check };
 }

@@ -30,6 +30,7 @@ import type { Driver, SourceRegistry } from '../registry.js';
 import { type Checkpoint, PASS_SLICE_MS, ReplayPass } from './replay-pass.js';
 import { CaptureFile, tooLargeToReadWhole } from './capture-file.js';
 import { walkFile } from './file-walk.js';
+import type { SliceReaderMaker } from './slice-reader.js';
 import { OverviewSender } from './overview-sender.js';
 import { type ReplayData, type ReplayPosition, ReplaySource } from '../sources/replay.js';
 
@@ -48,6 +49,8 @@ export interface ReplayParts {
   registry: SourceRegistry;
   diagnosis: Diagnosis;
   batcher: Batcher;
+  /** How the walk reads the file (slice-reader.ts). */
+  readSlices: SliceReaderMaker;
 }
 
 export class ReplaySession implements Driver {
@@ -154,7 +157,7 @@ export class ReplaySession implements Driver {
     const { host, registry } = parts;
     const sender = playing === null ? new OverviewSender(host) : playing.#sender;
     const replaced = (): boolean => token !== ReplaySession.#opens || (playing === null ? registry.driver !== undefined : playing.#stopped);
-    const { walked, check } = await walkFile(blob, pass, sender, host.clock, replaced);
+    const { walked, check } = await walkFile(blob, parts.readSlices, pass, sender, host.clock, replaced);
     if (replaced()) return;
     const span = check.span;
     if (walked === null || !check.inLine || span.startUs !== file.startUs || span.endUs !== file.endUs) {
