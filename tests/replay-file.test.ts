@@ -6,6 +6,7 @@
  */
 import { describe, expect, it } from 'vitest';
 import { capturePorts } from '../src/capture/facts.js';
+import { captureSpan } from '../src/report/capture-span.js';
 import { readCapture } from '../src/capture/sniff.js';
 import { encodeCapture } from '../src/capture/writer.js';
 import { WINDOW_BYTES } from '../src/worker/replay/capture-file.js';
@@ -253,5 +254,13 @@ describe('a file that cannot be read on', () => {
       expect(fed).toBeGreaterThan(0);
       expect(fed).toBeLessThanOrEqual(held);
     }
+    // What follows the last record read is not known: no silence is judged there, and the user is told.
+    const lastReadUs = r.worker.replay?.source.playsToUs ?? Number.NaN;
+    expect(lastReadUs).toBeLessThanOrEqual(captureSpan(readable).endUs);
+    expect(lastReadUs).toBeLessThan(captureSpan(readCapture(FILE)).endUs - 60e6);
+    const late = r.batches().flatMap((b) => b.batch.episodes.filter((e) => !(e.startUs < lastReadUs)));
+    expect(late).toEqual([]);
+    expect(r.of('replay').at(-1)?.replay?.issues).toEqual([expect.stringContaining('could not be read past')]);
+    expect(r.of('notice').map((n) => n.title)).toContain('gone.sscap: the file could not be read on');
   });
 });

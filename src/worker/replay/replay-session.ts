@@ -13,7 +13,7 @@
  * over) is read whole and salvaged, and plays from memory; seeks start from the same decode's
  * checkpoints where it has recorded times.
  */
-import { plural } from '../../report/report-text.js';
+import { formatClock, plural } from '../../report/report-text.js';
 import { CaptureFormatError, type Capture, type CaptureIssue, type CaptureMeta } from '../../capture/model.js';
 import { capturePorts } from '../../capture/facts.js';
 import { readCapture } from '../../capture/sniff.js';
@@ -68,6 +68,8 @@ export class ReplaySession implements Driver {
   #stopped = false;
   /** What was skipped reading the file (a recording cut off inside its last record). */
   #issues: readonly CaptureIssue[];
+  /** The file could not be read on while it played (`ReplayOptions.onReadFailed`), said so. */
+  #readFailure: string | null = null;
 
   /**
    * Opens `file` and starts playing it, every source before it closed; null (the user told why)
@@ -202,10 +204,10 @@ export class ReplaySession implements Driver {
         if (host.clock.now() - this.#lastStatusMs >= STATUS_MS) this.status();
       },
       () => {
-        // The end: every link is judged at the capture's last recorded time, and stays so.
+        // The end: every link is judged at the capture's last recorded time (or the last read), and stays so.
         const r = this.source;
         for (const s of registry.list()) {
-          s.engine.end(r.recordedTiming ? r.endUs : Number.NaN);
+          s.engine.end(r.recordedTiming ? r.playsToUs : Number.NaN);
           s.state = 'ended';
         }
         parts.batcher.flush();
@@ -216,6 +218,17 @@ export class ReplaySession implements Driver {
         clock: host.clock,
         onStop: (port, atUs) => registry.get(port)?.engine.interrupt(atUs),
         onWindow: (w) => parts.diagnosis.replayEvents(w.capture.events),
+        onReadFailed: (error, lastUs) => {
+          const why = error instanceof Error ? error.message : String(error);
+          this.#readFailure = `The file could not be read past ${formatClock(lastUs - this.source.startUs)} (${why}): the replay ends there.`;
+          notice(
+            host,
+            'error',
+            `${name}: the file could not be read on`,
+            `${this.#readFailure} Nothing after it is shown or judged. Open the file again to read it from there.`,
+          );
+          this.status();
+        },
       },
     );
   }
@@ -416,7 +429,7 @@ export class ReplaySession implements Driver {
         playing: r.playing,
         speed: r.speed,
         frames,
-        issues: this.#issues.map((i) => i.message),
+        issues: [...this.#issues.map((i) => i.message), ...(this.#readFailure === null ? [] : [this.#readFailure])],
         recordedTiming: r.recordedTiming,
         ended: r.ended,
         reading: false,

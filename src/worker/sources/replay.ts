@@ -29,6 +29,8 @@ export interface ReplayOptions {
   onStop?: (port: number, atUs: number) => void;
   /** A window of a file's records starts to play (its recorded events go to the doctor). */
   onWindow?: (window: CaptureWindow) => void;
+  /** The file could not be read on (`error`): the replay ends at `lastUs`, the last record read (`playsToUs`). */
+  onReadFailed?: (error: unknown, lastUs: number) => void;
 }
 
 /**
@@ -88,6 +90,8 @@ export class ReplaySource {
   readonly #clock: ReplayClock;
   readonly #onStop: (port: number, atUs: number) => void;
   readonly #onWindow: (window: CaptureWindow) => void;
+  readonly #onReadFailed: (error: unknown, lastUs: number) => void;
+  #playsToUs: number;
   #clockUs: number;
   #wallMs = 0;
   #speed = 1;
@@ -113,6 +117,7 @@ export class ReplaySource {
     this.#clock = options.clock ?? BROWSER_CLOCK;
     this.#onStop = options.onStop ?? (() => {});
     this.#onWindow = options.onWindow ?? (() => {});
+    this.#onReadFailed = options.onReadFailed ?? (() => {});
     if ('capture' in data) {
       const { capture } = data;
       this.#file = null;
@@ -148,6 +153,15 @@ export class ReplaySource {
     }
     this.#windowEndUs = captureSpan(this.#window.capture).endUs;
     this.#clockUs = this.startUs;
+    this.#playsToUs = this.endUs;
+  }
+
+  /**
+   * Where the replay ends, and every link is judged: the capture's last recorded time, or the
+   * last record read where the file could not be read on (what follows is unknown, not silence).
+   */
+  get playsToUs(): number {
+    return this.#playsToUs;
   }
 
   #chunksOf(capture: Capture): PortChunks[] {
@@ -162,6 +176,8 @@ export class ReplaySource {
     const span = captureSpan(window.capture);
     this.#windowEndUs = Number.isFinite(span.endUs) ? span.endUs : this.#windowEndUs;
     this.#next = null;
+    // A window read: the file reads again (after a failure, a seek read it).
+    this.#playsToUs = this.endUs;
     this.#onWindow(window);
     this.#readAhead();
   }
@@ -176,11 +192,13 @@ export class ReplaySource {
       (w) => {
         if (this.#next === reading) this.#next = w;
       },
-      () => {
+      (error: unknown) => {
         // The file could not be read on: the replay ends with the window playing, the last read.
         if (this.#next !== reading) return;
         this.#next = null;
         this.#window = { ...this.#window, last: true };
+        this.#playsToUs = Math.max(this.startUs, Math.min(this.endUs, this.#windowEndUs));
+        this.#onReadFailed(error, this.#playsToUs);
       },
     );
   }
@@ -388,15 +406,15 @@ export class ReplaySource {
     if (this.#speed === 0) {
       // As fast as possible, in slices so the worker stays responsive; the clock follows the data.
       done = this.#feedUntil(Infinity, SLICE_MS);
-      if (Number.isFinite(this.#lastFedUs)) this.#clockUs = Math.min(this.endUs, Math.max(this.#clockUs, this.#lastFedUs));
+      if (Number.isFinite(this.#lastFedUs)) this.#clockUs = Math.min(this.#playsToUs, Math.max(this.#clockUs, this.#lastFedUs));
     } else {
       // A stall (a long task, a background tab) must not jump the clock past silent data: that
       // would show a hold or failsafe that is not in the capture. Nor does it run past the end,
       // nor past the records read (the next window not read yet).
-      const readUntil = this.#waitingForWindow() ? Math.max(this.#clockUs, this.#windowEndUs) : this.endUs;
+      const readUntil = this.#waitingForWindow() ? Math.max(this.#clockUs, this.#windowEndUs) : this.#playsToUs;
       const step = Math.min(nowMs - this.#wallMs, MAX_STEP_MS) * 1000 * this.#speed;
-      this.#clockUs = Math.min(this.endUs, readUntil, this.#clockUs + step);
-      done = this.#feedUntil(this.#clockUs, SLICE_MS) && this.#clockUs >= this.endUs;
+      this.#clockUs = Math.min(this.#playsToUs, readUntil, this.#clockUs + step);
+      done = this.#feedUntil(this.#clockUs, SLICE_MS) && this.#clockUs >= this.#playsToUs;
     }
     this.#wallMs = nowMs;
     if (done) {
@@ -406,10 +424,10 @@ export class ReplaySource {
     this.onTick(this.#clockUs);
   }
 
-  /** The end: the clock stops at the capture's last recorded time, never past it. */
+  /** The end: the clock stops at the capture's last recorded time (`playsToUs`), never past it. */
   #finish(): void {
     for (const c of this.#chunks) for (let t = c.takeStop(c.length); t !== undefined; t = c.takeStop(c.length)) this.#onStop(c.port, t);
-    this.#clockUs = this.endUs;
+    this.#clockUs = this.#playsToUs;
     this.#ended = true;
     this.pause();
     this.onTick(this.#clockUs);
