@@ -6,6 +6,7 @@ import { describe, expect, it } from 'vitest';
 import { encodeCapture } from '../src/capture/writer.js';
 import { parseCapture } from '../src/capture/reader.js';
 import { recordTimeUs, walkDataRecords } from '../src/capture/record-walk.js';
+import { CaptureFormatError } from '../src/capture/model.js';
 
 /** Data records of 1–40 bytes (one of 3000) on three ports, an event every 50, one record far bigger than a slice. */
 function file(): Uint8Array {
@@ -70,6 +71,18 @@ describe('walking the data records of an intact capture', () => {
       });
       expect(got).toEqual(want);
     }
+  });
+
+  it('refuses a read that gives fewer bytes than asked: the slices after it would leave a hole', async () => {
+    let reads = 0;
+    const short = {
+      size: bytes.length,
+      slice: (start: number, end: number) => new Blob([bytes.slice(start, end)]),
+      view: async (start: number, end: number) => bytes.slice(start, ++reads === 3 ? end - 1 : end),
+    };
+    const walking = walkDataRecords(short, () => {}, { sliceBytes: 1000, readAhead: 2 });
+    await expect(walking).rejects.toThrow('a read of the file gave 999 bytes of 1000');
+    await expect(walking).rejects.not.toBeInstanceOf(CaptureFormatError);
   });
 
   it('stops when asked between slices', async () => {

@@ -213,25 +213,37 @@ describe('a recorded unplug in a replay at 1x', () => {
   });
 });
 
+/** Plays on (the fake clock) until the replay says it ended. */
+async function playOn(r: ReturnType<typeof openReplay>, clock: FakeClock): Promise<void> {
+  for (let guard = 0; guard < 10_000 && r.of('replay').at(-1)?.replay?.ended !== true; guard++) {
+    clock.advance(10);
+    await new Promise((resolve) => setTimeout(resolve, 0));
+  }
+  expect(r.of('replay').at(-1)?.replay?.ended).toBe(true);
+}
+
+/** Reads from `failFrom` (up to `failTo`) on fail once `armed` (the file gone while it plays); `readTo`: the furthest read since. */
+class FailingBlob extends Blob {
+  armed = false;
+  readTo = 0;
+  constructor(
+    parts: BlobPart[],
+    readonly failFrom: number,
+    readonly failTo = Number.POSITIVE_INFINITY,
+  ) {
+    super(parts);
+  }
+  override slice(start?: number, end?: number, type?: string): Blob {
+    const inner = super.slice(start, end, type);
+    const failing = this.armed && (start ?? 0) >= this.failFrom && (start ?? 0) < this.failTo;
+    if (this.armed && !failing) this.readTo = Math.max(this.readTo, end ?? this.size);
+    if (!failing) return inner;
+    return Object.assign(inner, { arrayBuffer: () => Promise.reject(new Error('NotReadableError')) });
+  }
+}
+
 describe('a file that cannot be read on', () => {
   it('ends the replay with the windows read, each fed once', async () => {
-    /** Reads from `failFrom` on fail once `armed` (the file gone while it plays); `readTo`: the furthest read since. */
-    class FailingBlob extends Blob {
-      armed = false;
-      readTo = 0;
-      constructor(
-        parts: BlobPart[],
-        readonly failFrom: number,
-      ) {
-        super(parts);
-      }
-      override slice(start?: number, end?: number, type?: string): Blob {
-        const inner = super.slice(start, end, type);
-        if (this.armed && (start ?? 0) < this.failFrom) this.readTo = Math.max(this.readTo, end ?? this.size);
-        if (!this.armed || (start ?? 0) < this.failFrom) return inner;
-        return Object.assign(inner, { arrayBuffer: () => Promise.reject(new Error('NotReadableError')) });
-      }
-    }
     const failFrom = 2 * WINDOW_BYTES;
     const blob = new FailingBlob([FILE.slice()], failFrom);
     const clock = new FakeClock();
@@ -262,5 +274,51 @@ describe('a file that cannot be read on', () => {
     expect(late).toEqual([]);
     expect(r.of('replay').at(-1)?.replay?.issues).toEqual([expect.stringContaining('could not be read past')]);
     expect(r.of('notice').map((n) => n.title)).toContain('gone.sscap: the file could not be read on');
+  });
+
+  it('reads the file again on a seek, plays on to its end, and no longer says it could not', async () => {
+    const blob = new FailingBlob([FILE.slice()], 2 * WINDOW_BYTES);
+    const clock = new FakeClock();
+    const r = openReplay(clock);
+    await r.send({ type: 'replay-open', name: 'gone.sscap', file: blob }, { type: 'replay-pause' });
+    await r.walked();
+    blob.armed = true;
+    await r.send({ type: 'replay-seek', timeUs: 0 }, { type: 'replay-speed', speed: 0 }, { type: 'replay-play' });
+    await playOn(r, clock);
+    const source = r.worker.replay?.source;
+    expect(source?.playsToUs).toBeLessThan(source?.endUs ?? 0);
+    // The file is readable again: a seek reads it.
+    blob.armed = false;
+    await r.send({ type: 'replay-seek', timeUs: 0 }, { type: 'replay-play' });
+    await playOn(r, clock);
+    expect(source?.playsToUs).toBe(source?.endUs);
+    expect(r.of('replay').at(-1)?.replay?.issues).toEqual([]);
+  });
+
+  it('leaves neither the clock nor a link past the last record read when a read fails inside a seek', async () => {
+    const blob = new FailingBlob([FILE.slice()], 2 * WINDOW_BYTES, 3 * WINDOW_BYTES);
+    const clock = new FakeClock();
+    const r = openReplay(clock);
+    await r.send({ type: 'replay-open', name: 'gone.sscap', file: blob }, { type: 'replay-pause' });
+    await r.walked();
+    blob.armed = true;
+    // Another resolution than the walk's: the seek starts afresh, its history read window by window.
+    await r.send({ type: 'set-resolution', resolution: 2048 });
+    const from = r.batches().length;
+    await r.send({ type: 'replay-seek', timeUs: 11 * 60e6 });
+    const lastReadUs = r.worker.replay?.source.playsToUs ?? Number.NaN;
+    expect(lastReadUs).toBeLessThan(11 * 60e6);
+    // Paused, a batch is sent (the resolution already in force chosen again).
+    await r.send({ type: 'set-resolution', resolution: 2048 });
+    clock.advance(1000);
+    await new Promise((resolve) => setTimeout(resolve, 0));
+    expect(r.of('replay').at(-1)?.replay?.positionUs).toBeLessThanOrEqual(lastReadUs);
+    const judged = r
+      .batches(from)
+      .map((b) => b.batch.nowUs)
+      .filter(Number.isFinite);
+    expect(Math.max(...judged)).toBeLessThanOrEqual(lastReadUs);
+    expect(r.batches(from).flatMap((b) => b.batch.episodes.filter((e) => !(e.startUs < lastReadUs)))).toEqual([]);
+    expect(r.of('notice').map((n) => n.title)).toEqual(['gone.sscap: the file could not be read on']);
   });
 });

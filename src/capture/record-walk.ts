@@ -106,7 +106,10 @@ export async function walkDataRecords(file: SlicedFile, sink: RecordSink, option
   const size = file.size;
   const read = async (from: number, length: number): Promise<Uint8Array> => {
     const to = Math.min(size, from + length);
-    return file.view === undefined ? new Uint8Array(await file.slice(from, to).arrayBuffer()) : file.view(from, to);
+    const bytes = file.view === undefined ? new Uint8Array(await file.slice(from, to).arrayBuffer()) : await file.view(from, to);
+    // The slices asked for ahead follow on from this one: a short read would leave a hole.
+    if (bytes.length !== to - from) throw new Error(`a read of the file gave ${bytes.length} bytes of ${to - from} at ${from}`);
+    return bytes;
   };
   // The first read holds the whole header, as long as its fixed part says it is.
   const fixed = await read(0, HEADER_FIXED_SIZE);

@@ -217,7 +217,11 @@ export class ReplaySession implements Driver {
         untimedPeriodUs: this.periodUs,
         clock: host.clock,
         onStop: (port, atUs) => registry.get(port)?.engine.interrupt(atUs),
-        onWindow: (w) => parts.diagnosis.replayEvents(w.capture.events),
+        onWindow: (w) => {
+          // A window read: the file reads again (a seek after a failure).
+          this.#readFailure = null;
+          parts.diagnosis.replayEvents(w.capture.events);
+        },
         onReadFailed: (error, lastUs) => {
           const why = error instanceof Error ? error.message : String(error);
           this.#readFailure = `The file could not be read past ${formatClock(lastUs - this.source.startUs)} (${why}): the replay ends there.`;
@@ -225,7 +229,7 @@ export class ReplaySession implements Driver {
             host,
             'error',
             `${name}: the file could not be read on`,
-            `${this.#readFailure} Nothing after it is shown or judged. Open the file again to read it from there.`,
+            `${this.#readFailure} Nothing after it is shown or judged. A seek reads the file again.`,
           );
           this.status();
         },

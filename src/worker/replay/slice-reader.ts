@@ -26,17 +26,17 @@ export const READ_HERE: SliceReaderMaker = (file) => ({
 export type SliceRequest = { file: Blob } | { id: number; start: number; end: number };
 export type SliceReply = { id: number; bytes: ArrayBuffer } | { id: number; error: string };
 
-/** Reads in a worker of its own (the browser's). */
+/**
+ * Reads in a worker of its own (the browser's). Should that worker fail (it cannot start, or
+ * stops), the reads asked for and every one after are made here instead.
+ */
 export const READ_IN_WORKER: SliceReaderMaker = (file) => {
   const worker = new Worker(new URL('./slice-reader-worker.ts', import.meta.url), { type: 'module', name: 'satscope-file-reader' });
-  const waiting = new Map<number, { resolve: (bytes: Uint8Array) => void; reject: (error: Error) => void }>();
+  type Waiting = { start: number; end: number; resolve: (bytes: Uint8Array) => void; reject: (error: Error) => void };
+  const waiting = new Map<number, Waiting>();
   let nextId = 0;
-  let failed: Error | null = null;
-  const failAll = (error: Error) => {
-    failed = error;
-    for (const w of waiting.values()) w.reject(error);
-    waiting.clear();
-  };
+  let here: SliceReader | null = null;
+  let closed = false;
   worker.addEventListener('message', (event: MessageEvent<SliceReply>) => {
     const reply = event.data;
     const w = waiting.get(reply.id);
@@ -44,20 +44,29 @@ export const READ_IN_WORKER: SliceReaderMaker = (file) => {
     if ('bytes' in reply) w?.resolve(new Uint8Array(reply.bytes));
     else w?.reject(new Error(reply.error));
   });
-  worker.addEventListener('error', (event) => failAll(new Error(event.message || 'the file reader stopped')));
+  worker.addEventListener('error', () => {
+    worker.terminate();
+    const reader = READ_HERE(file);
+    here = reader;
+    for (const w of waiting.values()) reader.read(w.start, w.end).then(w.resolve, w.reject);
+    waiting.clear();
+  });
   worker.postMessage({ file } satisfies SliceRequest);
   return {
-    read: (start, end) =>
-      failed !== null
-        ? Promise.reject(failed)
-        : new Promise((resolve, reject) => {
-            const id = nextId++;
-            waiting.set(id, { resolve, reject });
-            worker.postMessage({ id, start, end } satisfies SliceRequest);
-          }),
+    read: (start, end) => {
+      if (closed) return Promise.reject(new Error('the file reader was let go'));
+      if (here !== null) return here.read(start, end);
+      return new Promise((resolve, reject) => {
+        const id = nextId++;
+        waiting.set(id, { start, end, resolve, reject });
+        worker.postMessage({ id, start, end } satisfies SliceRequest);
+      });
+    },
     close: () => {
+      closed = true;
       worker.terminate();
-      failAll(new Error('the file reader was let go'));
+      for (const w of waiting.values()) w.reject(new Error('the file reader was let go'));
+      waiting.clear();
     },
   };
 };

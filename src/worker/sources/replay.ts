@@ -198,6 +198,8 @@ export class ReplaySource {
         this.#next = null;
         this.#window = { ...this.#window, last: true };
         this.#playsToUs = Math.max(this.startUs, Math.min(this.endUs, this.#windowEndUs));
+        // A tick (or a seek) may have moved the clock past the records read: nothing is judged there.
+        this.#clockUs = Math.min(this.#clockUs, this.#playsToUs);
         this.#onReadFailed(error, this.#playsToUs);
       },
     );
@@ -288,7 +290,7 @@ export class ReplaySource {
         this.#enter(window);
         if (from === undefined) for (const c of this.#chunks) c.seekTo(history);
         while (!this.#feedUntil(target, Infinity) && this.#waitingForWindow()) {
-          await this.#next;
+          await this.#windowRead();
           if (seeking !== this.#seeks) return;
         }
       } finally {
@@ -297,11 +299,16 @@ export class ReplaySource {
     }
     const done = this.#feedUntil(target, Infinity);
     this.#wallMs = this.#clock.now();
-    if (done && target >= this.endUs) {
+    if (done && target >= this.#playsToUs) {
       this.#finish();
       return;
     }
     this.onTick(this.#clockUs);
+  }
+
+  /** Waits for the next window's read; one that cannot be read ends the replay at the last record read (#readAhead). */
+  async #windowRead(): Promise<void> {
+    if (this.#next instanceof Promise) await this.#next.catch(() => undefined);
   }
 
   /** Every chunk of the window is fed and the next is still being read. */
