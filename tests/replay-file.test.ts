@@ -242,21 +242,23 @@ class FailingBlob extends Blob {
   }
 }
 
+/** The long capture opened and walked from a FailingBlob, then armed: its reads from `failFrom` on fail. */
+async function failingReplay(failFrom: number, failTo?: number) {
+  const blob = new FailingBlob([FILE.slice()], failFrom, failTo);
+  const clock = new FakeClock();
+  const r = openReplay(clock);
+  await r.send({ type: 'replay-open', name: 'gone.sscap', file: blob }, { type: 'replay-pause' });
+  await r.walked();
+  blob.armed = true;
+  return { blob, clock, r };
+}
+
 describe('a file that cannot be read on', () => {
   it('ends the replay with the windows read, each fed once', async () => {
     const failFrom = 2 * WINDOW_BYTES;
-    const blob = new FailingBlob([FILE.slice()], failFrom);
-    const clock = new FakeClock();
-    const r = openReplay(clock);
-    await r.send({ type: 'replay-open', name: 'gone.sscap', file: blob }, { type: 'replay-pause' });
-    await r.walked();
-    blob.armed = true;
+    const { blob, clock, r } = await failingReplay(failFrom);
     await r.send({ type: 'replay-seek', timeUs: 0 }, { type: 'replay-speed', speed: 0 }, { type: 'replay-play' });
-    for (let guard = 0; guard < 10_000 && r.of('replay').at(-1)?.replay?.ended !== true; guard++) {
-      clock.advance(10);
-      await new Promise((resolve) => setTimeout(resolve, 0));
-    }
-    expect(r.of('replay').at(-1)?.replay?.ended).toBe(true);
+    await playOn(r, clock);
     // What the windows read hold, port by port: fed once, nothing after.
     expect(blob.readTo).toBeGreaterThanOrEqual(failFrom);
     const readable = readCapture(FILE.slice(0, blob.readTo));
@@ -277,12 +279,7 @@ describe('a file that cannot be read on', () => {
   });
 
   it('reads the file again on a seek, plays on to its end, and no longer says it could not', async () => {
-    const blob = new FailingBlob([FILE.slice()], 2 * WINDOW_BYTES);
-    const clock = new FakeClock();
-    const r = openReplay(clock);
-    await r.send({ type: 'replay-open', name: 'gone.sscap', file: blob }, { type: 'replay-pause' });
-    await r.walked();
-    blob.armed = true;
+    const { blob, clock, r } = await failingReplay(2 * WINDOW_BYTES);
     await r.send({ type: 'replay-seek', timeUs: 0 }, { type: 'replay-speed', speed: 0 }, { type: 'replay-play' });
     await playOn(r, clock);
     const source = r.worker.replay?.source;
@@ -296,12 +293,7 @@ describe('a file that cannot be read on', () => {
   });
 
   it('leaves neither the clock nor a link past the last record read when a read fails inside a seek', async () => {
-    const blob = new FailingBlob([FILE.slice()], 2 * WINDOW_BYTES, 3 * WINDOW_BYTES);
-    const clock = new FakeClock();
-    const r = openReplay(clock);
-    await r.send({ type: 'replay-open', name: 'gone.sscap', file: blob }, { type: 'replay-pause' });
-    await r.walked();
-    blob.armed = true;
+    const { clock, r } = await failingReplay(2 * WINDOW_BYTES, 3 * WINDOW_BYTES);
     // Another resolution than the walk's: the seek starts afresh, its history read window by window.
     await r.send({ type: 'set-resolution', resolution: 2048 });
     const from = r.batches().length;
