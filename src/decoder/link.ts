@@ -58,11 +58,7 @@ import { copyEpisodes, type LinkCheckpoint } from './checkpoint.js';
 export class LinkMonitor {
   readonly #holdOption: number | undefined;
   readonly #failsafeAfterUs: number;
-  /**
-   * Starts as NaN so that V8 keeps it as a double even when the option is a whole number: the
-   * jitter in force is this or the measured one, and a whole-number field beside a double made
-   * optimised code box the double every frame (16 bytes a frame).
-   */
+  /** The jitter in force until one is measured; a double from the start (NaN), as the measured one is (bench/README.md). */
   readonly #jitterPrior: number = NaN;
   readonly #onMissed: LinkOptions['onMissed'];
   #state: LinkState = 'waiting';
