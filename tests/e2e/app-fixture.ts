@@ -5,6 +5,7 @@
 import { closeSync, existsSync, mkdirSync, openSync, writeFileSync, writeSync } from 'node:fs';
 import { join, resolve } from 'node:path';
 import type { Browser, Page } from 'playwright-core';
+import { expect } from 'vitest';
 import { CaptureWriter } from '../../src/capture/writer.js';
 import { Simulator } from '../../src/simulator/simulator.js';
 import { preset } from '../../src/simulator/presets.js';
@@ -138,6 +139,15 @@ export async function barValues(page: Page): Promise<Record<string, number>> {
   return page.$$eval('.channels [role="meter"]', (bars) =>
     Object.fromEntries(bars.map((b) => [b.getAttribute('aria-label'), Number(b.getAttribute('aria-valuenow') ?? NaN)])),
   );
+}
+
+/**
+ * Waits until the bars show each of `channels` at its `lastUs`: the bars are drawn on the
+ * animation frame after the last batch, which the status pill ("(end)") may announce first.
+ */
+export async function barsShow(page: Page, channels: readonly { name: string; lastUs: number }[]): Promise<void> {
+  const want = Object.fromEntries(channels.map((c) => [c.name, c.lastUs]));
+  await expect.poll(() => barValues(page), { timeout: 5000 }).toMatchObject(want);
 }
 
 /** Writes chunks as a .sscap file (as the recorder would), for replay tests. */

@@ -25,6 +25,7 @@ import {
   SHARED_CAPTURES,
   SHOTS as SHOTS_DIR,
   barValues,
+  barsShow,
   browserUnavailable,
   moreFrames,
   shot,
@@ -114,8 +115,7 @@ describe.skipIf(skip !== null)('the page', () => {
     await replayFile(page, file);
     await playToEnd(page);
     await page.locator('.channels').nth(1).waitFor();
-    const bars = await barValues(page);
-    for (const c of expected.channels) expect(bars[c.name], c.name).toBe(c.lastUs);
+    await barsShow(page, expected.channels);
     await expect(page.getByTestId('protocol').textContent()).resolves.toBe('DSMX 11 ms');
     await expect(page.getByTestId('count-frames').textContent()).resolves.toBe(String(expected.decoder.frames));
     await shot(page, 'replay-px4-xplus');
@@ -284,12 +284,12 @@ describe.skipIf(skip !== null)('the page', () => {
     await replayFile(page, path);
     await playToEnd(page);
     await page.getByTestId('remote-R').waitFor();
-    // The bars are drawn on the next animation frame after the last batch: wait for it (at full
-    // speed the end can show before a channel sent only now and then was ever drawn).
-    const check = async (expected: typeof expectA) => {
-      const want = Object.fromEntries(expected.channels.filter((ch) => ch.id < 12).map((c) => [c.name, c.lastUs]));
-      await expect.poll(async () => barValues(page), { timeout: 5000 }).toMatchObject(want);
-    };
+    // At full speed the end can show before a channel sent only now and then was ever drawn.
+    const check = (expected: typeof expectA) =>
+      barsShow(
+        page,
+        expected.channels.filter((ch) => ch.id < 12),
+      );
     await check(expectA);
     await page.getByTestId('remote-R').click();
     await page.locator('.panel h2', { hasText: 'remote R' }).waitFor();
@@ -416,8 +416,7 @@ describe.skipIf(skip !== null)('the page', () => {
     await page.getByTestId('remote-B').click();
     await page.locator('.panel h2', { hasText: 'remote B' }).waitFor();
     await expect(page.getByTestId('resolution').textContent()).resolves.toMatch(/^1024/);
-    const bars = await barValues(page);
-    for (const c of expectB.channels) expect(bars[c.name], c.name).toBe(c.lastUs);
+    await barsShow(page, expectB.channels);
     await page.context().close();
   });
 
@@ -430,8 +429,7 @@ describe.skipIf(skip !== null)('the page', () => {
     await replayFile(page, path);
     await page.locator('[data-testid="source-status"]', { hasText: '(end)' }).waitFor({ timeout: 10_000 });
     await page.locator('.channels').nth(1).waitFor();
-    const bars = await barValues(page);
-    for (const c of expected.channels) expect(bars[c.name], c.name).toBe(c.lastUs);
+    await barsShow(page, expected.channels);
     expect(errors).toEqual([]);
     await page.context().close();
   });

@@ -18,7 +18,7 @@ import { summarizeCapture } from '../../src/report/summary.js';
 import { preset } from '../../src/simulator/presets.js';
 import { simulate } from '../../src/simulator/simulator.js';
 import { perByteCapture } from '../feeds.js';
-import { SHARED_CAPTURES, barValues, browserUnavailable, shot, startSerialApp, type SerialAppSession } from './app-fixture.js';
+import { SHARED_CAPTURES, barsShow, browserUnavailable, shot, startSerialApp, type SerialAppSession } from './app-fixture.js';
 import type { StaticServer } from './harness/browser.js';
 import { loadCpus } from './harness/load.js';
 import { fakeSerialUnsupportedReason, monotonicUs, type FakeSerialPort } from './harness/pty-serial.js';
@@ -87,9 +87,11 @@ describe.skipIf(skip !== null)('a receiver on a serial port', () => {
       await load.stop();
     }
     await linkState(page, 'Live');
-    const bars = await barValues(page);
     const expected = summarizeCapture(importRaw(stream.bytes.subarray(0, half)));
-    for (const c of expected.channels.filter((ch) => ch.id < 12)) expect(bars[c.name], c.name).toBe(c.lastUs);
+    await barsShow(
+      page,
+      expected.channels.filter((ch) => ch.id < 12),
+    );
     // A clean capture at real pace through the adapter, both cores busy: no missed frame however
     // the bytes were batched on the way (the receiver's own fade counter does not move), and no
     // hold but the one the end of the feed starts.
