@@ -60,6 +60,25 @@ async function linkState(page: Page, state: string, timeout = 10_000): Promise<v
   await page.getByTestId('link-state').filter({ hasText: state }).waitFor({ timeout });
 }
 
+/**
+ * Records every change of the link state from now on, stamped with the wall clock as it happens
+ * in the page; the function returned reads them. (A state can be over before a test looks: the
+ * end of a feed is a hold some 50 ms later.)
+ */
+async function watchLinkStates(page: Page): Promise<() => Promise<{ text: string; ms: number }[]>> {
+  await page.evaluate(() => {
+    const w = window as unknown as { __states: { text: string; ms: number }[] };
+    const el = document.querySelector('[data-testid="link-state"]')!;
+    w.__states = [];
+    new MutationObserver(() => w.__states.push({ text: el.textContent ?? '', ms: Date.now() })).observe(el, {
+      subtree: true,
+      childList: true,
+      characterData: true,
+    });
+  });
+  return () => page.evaluate(() => (window as unknown as { __states: { text: string; ms: number }[] }).__states);
+}
+
 describe.skipIf(skip !== null)('a receiver on a serial port', () => {
   it('connects, shows live bars, records, survives an unplug with the recording intact, and reconnects', async () => {
     const stream = receiverStream();
@@ -80,13 +99,14 @@ describe.skipIf(skip !== null)('a receiver on a serial port', () => {
     await page.getByRole('button', { name: '● Record' }).click();
     await page.getByRole('button', { name: 'Stop recording' }).waitFor();
     const half = Math.floor(stream.bytes.length / 2 / 16) * 16;
+    const states = await watchLinkStates(page);
     const load = loadCpus();
     try {
       await fake.writePaced(stream.bytes.subarray(0, half), stream.timesUs.subarray(0, half));
     } finally {
       await load.stop();
     }
-    await linkState(page, 'Live');
+    await expect.poll(async () => (await states()).map((s) => s.text)).toContain('Live');
     const expected = summarizeCapture(importRaw(stream.bytes.subarray(0, half)));
     await barsShow(
       page,
@@ -116,8 +136,9 @@ describe.skipIf(skip !== null)('a receiver on a serial port', () => {
     // Plug back in: picked up again with no prompt; the rest of the capture arrives.
     await fake.reconnect();
     await page.getByTestId('source-status').filter({ hasText: 'at 115200 baud' }).waitFor({ timeout: 5000 });
+    const lostAt = (await states()).length;
     await fake.writePaced(stream.bytes.subarray(half), stream.timesUs.subarray(half));
-    await linkState(page, 'Live');
+    await expect.poll(async () => (await states()).slice(lostAt).map((s) => s.text)).toContain('Live');
     const pageEpisodes = await page.locator('.link dd').nth(1).textContent();
     // Back: the doctor names the time the adapter was away.
     const away = page.locator('.diagnosis .finding[data-code="adapter-away"]');
@@ -162,17 +183,7 @@ describe.skipIf(skip !== null)('a receiver on a serial port', () => {
     await page.goto(server.url('/'));
     await page.getByRole('button', { name: 'Serial port' }).click();
     await page.getByTestId('source-status').filter({ hasText: 'at 115200 baud' }).waitFor();
-    // Every change of the link state, stamped with the wall clock as it happens in the page.
-    await page.evaluate(() => {
-      const w = window as unknown as { __states: { text: string; ms: number }[] };
-      const el = document.querySelector('[data-testid="link-state"]')!;
-      w.__states = [];
-      new MutationObserver(() => w.__states.push({ text: el.textContent ?? '', ms: Date.now() })).observe(el, {
-        subtree: true,
-        childList: true,
-        characterData: true,
-      });
-    });
+    const linkStates = await watchLinkStates(page);
 
     const load = loadCpus();
     let paced: Awaited<ReturnType<FakeSerialPort['writePaced']>>;
@@ -191,8 +202,7 @@ describe.skipIf(skip !== null)('a receiver on a serial port', () => {
     // once the frames that follow show none was missed: the count settles on the truth.
     await expect.poll(() => page.locator('.link dd').nth(1).textContent(), { timeout: 5000 }).toBe('3 holds · 2 failsafes');
     const fedUntilMs = wallMs(lastByteUs);
-    const states = await page.evaluate(() => (window as unknown as { __states: { text: string; ms: number }[] }).__states);
-    const whileFed = states.filter((s) => s.ms < fedUntilMs);
+    const whileFed = (await linkStates()).filter((s) => s.ms < fedUntilMs);
     // Each true episode (two holds, then the long hold's failsafe) shows as that state on the
     // page within 1 s of its true start.
     for (const e of truth.episodes) {
