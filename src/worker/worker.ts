@@ -7,7 +7,7 @@
 import { Dispatcher } from './dispatcher.js';
 import { BROWSER_CLOCK } from './host.js';
 import type { ToWorker } from './protocol.js';
-import { READ_HERE, READ_IN_WORKER } from './replay/slice-reader.js';
+import { READ_IN_WORKER } from './replay/slice-reader.js';
 
 const scope = self as unknown as DedicatedWorkerGlobalScope;
 const worker = new Dispatcher(
@@ -16,8 +16,7 @@ const worker = new Dispatcher(
     clock: BROWSER_CLOCK,
     timeOriginMs: performance.timeOrigin,
   },
-  // A worker that cannot start one of its own reads a replayed file itself.
-  { readSlices: typeof Worker === 'undefined' ? READ_HERE : READ_IN_WORKER },
+  { readSlices: READ_IN_WORKER },
 );
 
 scope.addEventListener('message', (event: MessageEvent<ToWorker>) => worker.receive(event.data));

@@ -68,8 +68,6 @@ export class ReplaySession implements Driver {
   #stopped = false;
   /** What was skipped reading the file (a recording cut off inside its last record). */
   #issues: readonly CaptureIssue[];
-  /** The file could not be read on while it played (`ReplayOptions.onReadFailed`), said so. */
-  #readFailure: string | null = null;
 
   /**
    * Opens `file` and starts playing it, every source before it closed; null (the user told why)
@@ -217,19 +215,13 @@ export class ReplaySession implements Driver {
         untimedPeriodUs: this.periodUs,
         clock: host.clock,
         onStop: (port, atUs) => registry.get(port)?.engine.interrupt(atUs),
-        onWindow: (w) => {
-          // A window read: the file reads again (a seek after a failure).
-          this.#readFailure = null;
-          parts.diagnosis.replayEvents(w.capture.events);
-        },
-        onReadFailed: (error, lastUs) => {
-          const why = error instanceof Error ? error.message : String(error);
-          this.#readFailure = `The file could not be read past ${formatClock(lastUs - this.source.startUs)} (${why}): the replay ends there.`;
+        onWindow: (w) => parts.diagnosis.replayEvents(w.capture.events),
+        onReadFailed: () => {
           notice(
             host,
             'error',
             `${name}: the file could not be read on`,
-            `${this.#readFailure} Nothing after it is shown or judged. A seek reads the file again.`,
+            `${this.#readFailure() ?? ''} Nothing after it is shown or judged. A seek reads the file again.`,
           );
           this.status();
         },
@@ -262,6 +254,15 @@ export class ReplaySession implements Driver {
   /** Where the capture's first chunk is. */
   get #first(): ReplayPosition {
     return { chunk: 0, offset: 'file' in this.#opened ? this.#opened.file.recordsFrom : 0 };
+  }
+
+  /** The file could not be read on while it played, in words (null: it reads). */
+  #readFailure(): string | null {
+    const r = this.source;
+    const failed = r.readFailure;
+    if (failed === null) return null;
+    const why = failed.error instanceof Error ? failed.error.message : String(failed.error);
+    return `The file could not be read past ${formatClock(failed.lastUs - r.startUs)} (${why}): the replay ends there.`;
   }
 
   /** What reading the file skipped, told once known. */
@@ -433,7 +434,7 @@ export class ReplaySession implements Driver {
         playing: r.playing,
         speed: r.speed,
         frames,
-        issues: [...this.#issues.map((i) => i.message), ...(this.#readFailure === null ? [] : [this.#readFailure])],
+        issues: [...this.#issues.map((i) => i.message), this.#readFailure()].filter((i) => i !== null),
         recordedTiming: r.recordedTiming,
         ended: r.ended,
         reading: false,

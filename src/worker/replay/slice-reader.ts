@@ -27,10 +27,11 @@ export type SliceRequest = { file: Blob } | { id: number; start: number; end: nu
 export type SliceReply = { id: number; bytes: ArrayBuffer } | { id: number; error: string };
 
 /**
- * Reads in a worker of its own (the browser's). Should that worker fail (it cannot start, or
- * stops), the reads asked for and every one after are made here instead.
+ * Reads in a worker of its own (the browser's). Where a worker cannot start another, or that
+ * worker fails (it cannot load, or stops), the reads asked for and every one after are made here.
  */
 export const READ_IN_WORKER: SliceReaderMaker = (file) => {
+  if (typeof Worker === 'undefined') return READ_HERE(file);
   const worker = new Worker(new URL('./slice-reader-worker.ts', import.meta.url), { type: 'module', name: 'satscope-file-reader' });
   type Waiting = { start: number; end: number; resolve: (bytes: Uint8Array) => void; reject: (error: Error) => void };
   const waiting = new Map<number, Waiting>();

@@ -91,7 +91,8 @@ export class ReplaySource {
   readonly #onStop: (port: number, atUs: number) => void;
   readonly #onWindow: (window: CaptureWindow) => void;
   readonly #onReadFailed: (error: unknown, lastUs: number) => void;
-  #playsToUs: number;
+  /** Why the file could not be read on, and the last record read (null: it reads). */
+  #readFailure: { error: unknown; lastUs: number } | null = null;
   #clockUs: number;
   #wallMs = 0;
   #speed = 1;
@@ -153,7 +154,6 @@ export class ReplaySource {
     }
     this.#windowEndUs = captureSpan(this.#window.capture).endUs;
     this.#clockUs = this.startUs;
-    this.#playsToUs = this.endUs;
   }
 
   /**
@@ -161,7 +161,12 @@ export class ReplaySource {
    * last record read where the file could not be read on (what follows is unknown, not silence).
    */
   get playsToUs(): number {
-    return this.#playsToUs;
+    return this.#readFailure?.lastUs ?? this.endUs;
+  }
+
+  /** The file could not be read on (`ReplayOptions.onReadFailed`): why, and the last record read; null while it reads. */
+  get readFailure(): { error: unknown; lastUs: number } | null {
+    return this.#readFailure;
   }
 
   #chunksOf(capture: Capture): PortChunks[] {
@@ -177,7 +182,7 @@ export class ReplaySource {
     this.#windowEndUs = Number.isFinite(span.endUs) ? span.endUs : this.#windowEndUs;
     this.#next = null;
     // A window read: the file reads again (after a failure, a seek read it).
-    this.#playsToUs = this.endUs;
+    this.#readFailure = null;
     this.#onWindow(window);
     this.#readAhead();
   }
@@ -197,10 +202,11 @@ export class ReplaySource {
         if (this.#next !== reading) return;
         this.#next = null;
         this.#window = { ...this.#window, last: true };
-        this.#playsToUs = Math.max(this.startUs, Math.min(this.endUs, this.#windowEndUs));
+        const lastUs = Math.max(this.startUs, Math.min(this.endUs, this.#windowEndUs));
+        this.#readFailure = { error, lastUs };
         // A tick (or a seek) may have moved the clock past the records read: nothing is judged there.
-        this.#clockUs = Math.min(this.#clockUs, this.#playsToUs);
-        this.#onReadFailed(error, this.#playsToUs);
+        this.#clockUs = Math.min(this.#clockUs, lastUs);
+        this.#onReadFailed(error, lastUs);
       },
     );
   }
@@ -299,7 +305,7 @@ export class ReplaySource {
     }
     const done = this.#feedUntil(target, Infinity);
     this.#wallMs = this.#clock.now();
-    if (done && target >= this.#playsToUs) {
+    if (done && target >= this.playsToUs) {
       this.#finish();
       return;
     }
@@ -413,15 +419,15 @@ export class ReplaySource {
     if (this.#speed === 0) {
       // As fast as possible, in slices so the worker stays responsive; the clock follows the data.
       done = this.#feedUntil(Infinity, SLICE_MS);
-      if (Number.isFinite(this.#lastFedUs)) this.#clockUs = Math.min(this.#playsToUs, Math.max(this.#clockUs, this.#lastFedUs));
+      if (Number.isFinite(this.#lastFedUs)) this.#clockUs = Math.min(this.playsToUs, Math.max(this.#clockUs, this.#lastFedUs));
     } else {
       // A stall (a long task, a background tab) must not jump the clock past silent data: that
       // would show a hold or failsafe that is not in the capture. Nor does it run past the end,
       // nor past the records read (the next window not read yet).
-      const readUntil = this.#waitingForWindow() ? Math.max(this.#clockUs, this.#windowEndUs) : this.#playsToUs;
+      const readUntil = this.#waitingForWindow() ? Math.max(this.#clockUs, this.#windowEndUs) : this.playsToUs;
       const step = Math.min(nowMs - this.#wallMs, MAX_STEP_MS) * 1000 * this.#speed;
-      this.#clockUs = Math.min(this.#playsToUs, readUntil, this.#clockUs + step);
-      done = this.#feedUntil(this.#clockUs, SLICE_MS) && this.#clockUs >= this.#playsToUs;
+      this.#clockUs = Math.min(this.playsToUs, readUntil, this.#clockUs + step);
+      done = this.#feedUntil(this.#clockUs, SLICE_MS) && this.#clockUs >= this.playsToUs;
     }
     this.#wallMs = nowMs;
     if (done) {
@@ -434,7 +440,7 @@ export class ReplaySource {
   /** The end: the clock stops at the capture's last recorded time (`playsToUs`), never past it. */
   #finish(): void {
     for (const c of this.#chunks) for (let t = c.takeStop(c.length); t !== undefined; t = c.takeStop(c.length)) this.#onStop(c.port, t);
-    this.#clockUs = this.#playsToUs;
+    this.#clockUs = this.playsToUs;
     this.#ended = true;
     this.pause();
     this.onTick(this.#clockUs);
