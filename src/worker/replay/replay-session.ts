@@ -261,8 +261,9 @@ export class ReplaySession implements Driver {
     const r = this.source;
     const failed = r.readFailure;
     if (failed === null) return null;
-    const why = failed.error instanceof Error ? failed.error.message : String(failed.error);
-    return `The file could not be read past ${formatClock(failed.lastUs - r.startUs)} (${why}): the replay ends there.`;
+    // The browser's own words for a file changed or moved since it was opened say little: its name for the error is enough.
+    const why = failed.error instanceof Error ? failed.error.name : String(failed.error);
+    return `The file could not be read past ${formatClock(failed.lastUs - r.startUs)}: it was changed, moved or removed since it was opened (${why}). The replay ends there.`;
   }
 
   /** What reading the file skipped, told once known. */
