@@ -245,13 +245,16 @@ export class FrameLedger {
     if (!Number.isFinite(this.#refUs)) return 0;
     const p = this.#period;
     // No later window will look at the frames after the last window's most punctual one: even
-    // the least late of them is the evidence there will be.
+    // the least late of them is the evidence there will be, beyond the delivery jitter measured
+    // (an adapter that hands frames over in batches delivers its last batch when its timer
+    // runs out, that much late).
     let tailMin = Infinity;
     for (let i = 0; i < Math.min(TAIL_FRAMES, this.#tailCount); i++) {
       const late = (this.#tailUs[i] ?? NaN) - this.#refUs - ((this.#tailSlot[i] ?? NaN) - this.#refSlot) * p;
       if (late < tailMin) tailMin = late;
     }
-    const after = Number.isFinite(tailMin) ? Math.max(0, Math.round((tailMin - this.#winMinL) / p)) : 0;
+    const jitter = Number.isFinite(this.jitterUs) ? this.jitterUs : 0;
+    const after = Number.isFinite(tailMin) ? Math.max(0, Math.round((tailMin - this.#winMinL - jitter) / p)) : 0;
     const gapFrom = this.#winGapFromUs;
     const gapTo = this.#winGapToUs;
     let n = this.#winFrames > 1 ? this.#close(missed) : 0;

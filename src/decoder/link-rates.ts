@@ -2,9 +2,14 @@
  * The link's rates over recent frames: the frame period (and, without a system byte, the 11 or
  * 22 ms it snaps to) over the last 32 gap-free intervals, and the fade rate over the last ~512
  * frames. The link monitor (link.ts) owns one and feeds it every timed frame.
+ *
+ * Without a system byte the period is snapped only once the window's timing can tell 11 from
+ * 22 ms: an adapter that delivers in batches dates a frame late by up to the longest interval
+ * it leaves, so the mean interval is known only to that over the periods in the window, and a
+ * mean closer than that to the boundary between the two decides nothing yet.
  */
 import type { LinkCheckpoint } from './checkpoint.js';
-import { nominalPeriodOf } from './link-rules.js';
+import { nominalPeriodOf, PERIOD_SNAP_US } from './link-rules.js';
 import type { LinkStats } from './link-types.js';
 import { FRAME_PERIOD_11MS_US } from './spec.js';
 
@@ -47,29 +52,19 @@ export class LinkRates {
     // Period: the span of the last 32 gap-free intervals, which averages out chunk jitter.
     const times = this.#periodTimes;
     const count = this.#periodCount;
+    const slot = count < PERIOD_WINDOW ? count : this.#periodOldest;
+    times[slot] = t;
     if (count < PERIOD_WINDOW) {
       if (count === 0) this.#periodOldest = 0;
-      times[count] = t;
       this.#periodCount = count + 1;
     } else {
-      const oldest = this.#periodOldest;
-      times[oldest] = t;
-      this.#periodOldest = oldest === PERIOD_WINDOW - 1 ? 0 : oldest + 1;
+      this.#periodOldest = slot === PERIOD_WINDOW - 1 ? 0 : slot + 1;
     }
     if (this.#periodCount >= 9) {
-      if (snap && (!Number.isFinite(s.nominalPeriodUs) || this.#periodCount === PERIOD_WINDOW)) {
-        // Without a system byte: snap the mean interval to 11 or 22 ms, first over 8 intervals,
-        // then again over every full window, so a few frames missing early do not stick. A
-        // window that a delivery burst crowds (frames a stall held back, dated together) is
-        // faster than any system sends: it says nothing of the period.
-        const mean = (t - (times[this.#periodOldest] ?? NaN)) / (this.#periodCount - 1);
-        if (!(mean < BURST_MEAN_US)) s.nominalPeriodUs = nominalPeriodOf(mean);
-      }
+      if (snap && (!Number.isFinite(s.nominalPeriodUs) || this.#periodCount === PERIOD_WINDOW)) this.#snap(slot, s);
       // Whole periods in the span, so that a missed frame (one interval two periods long) does
       // not bias it, and chunk-time jitter averages out.
-      const newest =
-        this.#periodCount < PERIOD_WINDOW ? this.#periodCount - 1 : this.#periodOldest === 0 ? PERIOD_WINDOW - 1 : this.#periodOldest - 1;
-      const span = (times[newest] ?? NaN) - (times[this.#periodOldest] ?? NaN);
+      const span = t - (times[this.#periodOldest] ?? NaN);
       s.periodUs = span / Math.max(1, Math.round(span / s.nominalPeriodUs));
     }
     // Fade rate over a window of recent frames.
@@ -83,6 +78,29 @@ export class LinkRates {
     const oldest = this.#rateCount < RATE_WINDOW ? 0 : this.#rateNext;
     const span = t - (this.#rateTimes[oldest] ?? NaN);
     s.fadeRate = span > 0 ? (((fades[i] ?? 0) - (fades[oldest] ?? 0)) / span) * 1e6 : 0;
+  }
+
+  /**
+   * Without a system byte: the nominal period from the mean interval of the window ending at
+   * `newest`. It is decided only where the mean interval is further from the 11/22 ms boundary than the lateness
+   * the window's longest interval allows, and again over every full window, so that a few frames
+   * missing early do not stick. A window that a delivery burst crowds (frames a stall held back,
+   * dated together) is faster than any system sends: it says nothing of the period.
+   */
+  #snap(newest: number, s: LinkStats): void {
+    const times = this.#periodTimes;
+    const oldest = this.#periodOldest;
+    const periods = this.#periodCount - 1;
+    const mean = ((times[newest] ?? NaN) - (times[oldest] ?? NaN)) / periods;
+    if (mean < BURST_MEAN_US) return;
+    let longest = 0;
+    for (let k = 1, i = oldest; k < this.#periodCount; k++) {
+      const next = i === PERIOD_WINDOW - 1 ? 0 : i + 1;
+      const interval = (times[next] ?? NaN) - (times[i] ?? NaN);
+      if (interval > longest) longest = interval;
+      i = next;
+    }
+    if (Math.abs(mean - PERIOD_SNAP_US) > longest / periods) s.nominalPeriodUs = nominalPeriodOf(mean);
   }
 
   /** The windows as they stand (copies), for `LinkMonitor.checkpoint()`. */

@@ -8,7 +8,7 @@ import { FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US } from './spec.js';
 /** §7.1 has no hold threshold: a gap shorter than this (and 2.5 periods) is never a hold. */
 export const HOLD_MIN_US = 40_000;
 /** Mean intervals below this are an 11 ms system, above a 22 ms one. */
-const PERIOD_SNAP_US = 16_500;
+export const PERIOD_SNAP_US = 16_500;
 /** 11 or 22 ms: the system period a mean frame interval belongs to. */
 export function nominalPeriodOf(meanIntervalUs: number): number {
   return meanIntervalUs < PERIOD_SNAP_US ? FRAME_PERIOD_11MS_US : FRAME_PERIOD_22MS_US;

@@ -334,15 +334,13 @@ export class StallJudge {
   }
 
   /**
-   * The period a run of frames the counter says were lost is timed at: the system byte's; where
-   * the period is only estimated, the shortest (an estimate read twice too long made every run a
-   * hold); where none is known at all (an external remote read in batches longer than its
-   * frames' spacing), the longest: a hold goes only where no period makes the run one.
+   * The period a run of frames the counter says were lost is timed at: the system byte's, or
+   * the one the frames' timing decided (link-rates.ts snaps only where it can tell 11 from 22
+   * ms); where none is known yet, the longest: a hold goes only where no period makes the run one.
    */
   #runPeriodUs(): number {
     const p = this.#stats.nominalPeriodUs;
-    if (this.#monitor.periodKnown()) return p;
-    return Number.isFinite(p) ? FRAME_PERIOD_11MS_US : FRAME_PERIOD_22MS_US;
+    return Number.isFinite(p) ? p : FRAME_PERIOD_22MS_US;
   }
 
   /**

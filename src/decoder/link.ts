@@ -37,7 +37,7 @@
  * - Fades are the decoder's `fadesDelta`: the decoder already leaves out counter jumps it cannot
  *   attribute to the receiver (`DecoderStats.fadeJumps`).
  */
-import { FAILSAFE_TIMEOUT_US, FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US, systemInfo } from './spec.js';
+import { FAILSAFE_TIMEOUT_US, FRAME_PERIOD_11MS_US, systemInfo } from './spec.js';
 import type { DecodedFrame } from './types.js';
 import { EpisodeLog } from './episode-log.js';
 import type { LinkEpisode } from './episode.js';
@@ -222,7 +222,9 @@ export class LinkMonitor {
         if (gap > s.longestGapUs) s.longestGapUs = gap;
         const p = s.nominalPeriodUs;
         if (Number.isFinite(p) && isFrameInterval(gap, p, this.jitterUs)) this.#lastInterval = gap;
-        if (gap > 3 * (Number.isFinite(p) ? p : FRAME_PERIOD_22MS_US)) this.#rates.clearPeriod();
+        // A silence the delivery jitter does not explain ends the period window. Before the
+        // period is known nothing does: the snap weighs the window's gaps itself (link-rates.ts).
+        if (Number.isFinite(p) && gap > 3 * p && gap > this.holdAfterUs) this.#rates.clearPeriod();
       }
       this.#lastUs = t;
       this.#rates.measure(t, fades, s, !Number.isFinite(this.#systemPeriod));
