@@ -351,6 +351,13 @@ describe('every surface tells the same story about the same bytes', () => {
           expect(Math.abs(live.missedFrames! - reference.missedFrames!)).toBeLessThanOrEqual(1);
           live.missedFrames = reference.missedFrames;
         }
+        // Bytes with a silence inside them are no frame where each byte has its own time; a
+        // live adapter's chunk times cannot show the silence, so the live view may read a frame
+        // damage stitched across one: only those frames, which an untimed read also gives.
+        const untimed = summarizeCapture({ ...capture, timing: 'none', byteTimesUs: undefined }).link.frames;
+        expect(live.frames).toBeGreaterThanOrEqual(reference.frames);
+        expect(live.frames).toBeLessThanOrEqual(Math.max(reference.frames, untimed));
+        if (live.frames !== reference.frames) live.frames = reference.frames;
         expectAgree(live, reference, 20_000);
       });
 

@@ -1,6 +1,6 @@
 /**
- * Acquisition: where frames start, and how to read them, from the bytes alone (no sync byte,
- * no timing). The second of the decoder's three parts: plain functions over the decoder's
+ * Acquisition: where frames start, and how to read them, from the bytes (no sync byte; timing
+ * only where each byte has its own time: no frame has a silence inside it). The second of the decoder's three parts: plain functions over the decoder's
  * `Core` that read its window and, in `acquire`, take the lock.
  *
  * It reads four frames from each of the next 48 start offsets under both resolutions and under
@@ -55,6 +55,18 @@ const ACQUIRE_COMMIT = 2 * FRAME_SIZE;
  * invented from filler); 4 changes no test.
  */
 const EVIDENCE_BYTES = 3;
+
+/**
+ * A frame's bytes leave the receiver back to back: 16 bytes with a silence of this much inside
+ * them are no frame, where the bytes have times of their own (a logic analyser's). Frames are
+ * 9.6 ms apart or more; flight stacks end a frame on a silence of 5 ms.
+ */
+const SILENCE_IN_FRAME_US = 3_000;
+
+/** Whether the 16 bytes at `o` have a silence inside them (`SILENCE_IN_FRAME_US`): then they are no frame. */
+export function silenceInside(d: Core, o: number): boolean {
+  return d.w.silenceWithin(o, FRAME_SIZE, SILENCE_IN_FRAME_US);
+}
 
 /** A start acquisition may lock on: its score (-1: none), shift from the head and resolution; `filler`: see bestStart. */
 interface Best {
@@ -197,7 +209,11 @@ function layoutInChain(d: Core, layout: number, o: number, frames: number, resol
 function chainsInto(d: Core, a: number, b: number, resolution: Resolution, internal: boolean, system: number): boolean {
   const buf = d.w.buf;
   const layout = slotLayout(buf, a, resolution);
-  if (layout === INVALID || !layoutInChain(d, layout, b, Math.min(ACQUIRE_FRAMES, Math.floor((d.w.tail - b) / FRAME_SIZE)), resolution))
+  if (
+    layout === INVALID ||
+    silenceInside(d, a) ||
+    !layoutInChain(d, layout, b, Math.min(ACQUIRE_FRAMES, Math.floor((d.w.tail - b) / FRAME_SIZE)), resolution)
+  )
     return false;
   if (internal) {
     const mode = d.s.opts.headerMode === 'rssi' ? B0_RSSI_FORCED : d.s.opts.headerMode === 'fades' ? B0_FADES : B0_UNKNOWN;
@@ -326,7 +342,7 @@ function scoreChain(d: Core, o: number, resolution: Resolution, frames: number, 
   for (let k = 0; k < frames; k++) {
     const f = o + k * FRAME_SIZE;
     if (buf[f] === 0) zeroByte0 = true;
-    if (slotLayout(buf, f, resolution) === INVALID) {
+    if (slotLayout(buf, f, resolution) === INVALID || silenceInside(d, f)) {
       chainI = Math.min(chainI, k);
       chainE = Math.min(chainE, k);
       break;

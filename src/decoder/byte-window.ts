@@ -5,7 +5,8 @@
  * kept (`base + index`). Times are kept per pushed chunk, not per byte: each chunk's end offset
  * and its time (or NaN), and per-byte times only for chunks pushed with them. A byte's time is
  * its own, or its chunk's time less one byte time (86.8 µs at 115200 baud) for each byte after
- * it in the chunk (`byteInChunkUs`, the one rule for when a byte arrived).
+ * it in the chunk (`byteInChunkUs`, the one rule for when a byte arrived). Bytes pushed
+ * without times of their own have NaN in the per-byte times, once any chunk came with them.
  */
 import { byteInChunkUs } from './spec.js';
 
@@ -126,7 +127,7 @@ export class ByteWindow {
     if (byteTimes !== null) {
       if (times === null) this.#byteTimes = times = new Float64Array(this.buf.length);
       times.set(whole ? byteTimes : byteTimes.subarray(start, end), at);
-    }
+    } else if (times !== null) times.fill(Number.NaN, at, at + n);
     if (this.#chunkTail === this.#chunkEnds.length) this.#roomForChunk();
     const i = this.#chunkTail++;
     this.#chunkEnds[i] = this.base + at + n;
@@ -213,6 +214,19 @@ export class ByteWindow {
         return;
       }
     }
+  }
+
+  /**
+   * Whether two bytes next to each other among the `n` from buffer index `o`, both with times
+   * of their own (per-byte times: a logic analyser's), came more than `gapUs` apart. Chunk times
+   * say nothing of this (an adapter may hold a frame's last bytes back a while).
+   */
+  silenceWithin(o: number, n: number, gapUs: number): boolean {
+    const t = this.#byteTimes;
+    if (t === null) return false;
+    const end = Math.min(o + n, this.tail);
+    for (let i = o + 1; i < end; i++) if ((t[i] as number) - (t[i - 1] as number) > gapUs) return true;
+    return false;
   }
 
   /** Forgets the records of chunks that end at or before stream offset `x` (keeps the last one); returns the first kept. */

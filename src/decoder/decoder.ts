@@ -1,9 +1,10 @@
 /**
  * The push decoder: bytes in (`push`), frames out (`next`). It finds frames without a sync
- * byte and without trusting timing, infers the stream's format, and never throws on bytes.
+ * byte and without trusting chunk timing, infers the stream's format, and never throws on bytes.
  *
- * Content alone decides where a frame starts, so the result is identical however the bytes are
- * chunked and whatever times come with them. A frame is emitted only on evidence. The decoder
+ * Content decides where a frame starts, so the result is identical however the bytes are
+ * chunked and whatever chunk times come with them; per-byte times add one rule (16 bytes with a
+ * silence inside are no frame). A frame is emitted only on evidence. The decoder
  * is three parts over one state record (state.ts):
  *
  * - byte-window.ts: the bytes held and when they arrived;

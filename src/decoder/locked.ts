@@ -19,7 +19,7 @@
  * an unlock into an acquisition, which itself consumes or locks with frames it has confirmed
  * (emitted unconditionally): so it always returns after bounded work.
  */
-import { acquire, chainStartsAt } from './acquire.js';
+import { acquire, chainStartsAt, silenceInside } from './acquire.js';
 import { NEED_MORE } from './byte0.js';
 import { byteAt, type FrameSlots, INVALID, readFrame, showSlots, slotLayout } from './frame.js';
 import { formatOf, setReason } from './format.js';
@@ -62,7 +62,12 @@ function steadyStep(d: Core): DecodedFrame | null {
   }
   const layout = s.stagedLayout;
   const buf = w.buf;
-  if (!knownLayout(s, layout) || !continues(s, byteAt(buf, o), byteAt(buf, o + 1), byteAt(buf, n), byteAt(buf, n + 1))) return null;
+  if (
+    !knownLayout(s, layout) ||
+    !continues(s, byteAt(buf, o), byteAt(buf, o + 1), byteAt(buf, n), byteAt(buf, n + 1)) ||
+    silenceInside(d, n)
+  )
+    return null;
   const next = readFrame(buf, w.buf32, n, s.resolution, s.shown);
   if (next === INVALID) return null;
   const slots = s.staged;
@@ -85,7 +90,8 @@ function lockedStep(d: Core): DecodedFrame | null | undefined {
     return undefined;
   }
   const at = w.base + o;
-  const layout = at === s.stagedAt ? s.stagedLayout : slotLayout(w.buf, o, s.resolution);
+  // Bytes with a silence inside them (where each byte has its own time) are no frame.
+  const layout = at === s.stagedAt ? s.stagedLayout : silenceInside(d, o) ? INVALID : slotLayout(w.buf, o, s.resolution);
   if (at < s.confirmedUntil && layout !== INVALID) return emit(d, o, layout);
   if (layout !== INVALID && countMoved(d, o, layout)) rereadExternal(d, o);
   // A staged frame is known to continue the last one: it was checked when it was staged.
@@ -103,7 +109,7 @@ function lockedStep(d: Core): DecodedFrame | null | undefined {
       discard(d, o, avail, 'end-of-stream');
       return undefined;
     }
-    const next = follows(d, o, o + FRAME_SIZE) ? stageNext(d, o, layout) : INVALID;
+    const next = follows(d, o, o + FRAME_SIZE) && !silenceInside(d, o + FRAME_SIZE) ? stageNext(d, o, layout) : INVALID;
     if (next !== INVALID) {
       if (knownLayout(s, layout)) return emitStaged(d, o, layout, next);
       // A new layout: make sure no frame that continues the stream starts inside this one.
