@@ -1,6 +1,8 @@
 /**
  * Stick motion: where each channel is at a given time, from the scenario's motions (held, a
- * sine, a random walk, steps), on the link's position scale.
+ * sine, a random walk, steps), on the link's position scale. A channel can be held where a
+ * user puts it (`override`, a slider or a gamepad when driving a flight controller) and kept
+ * under a ceiling (`ceiling`, the throttle limit no scenario may exceed).
  */
 import { MASK_1024_SXPOS, MASK_2048_SXPOS } from '../decoder/spec.js';
 import type { Prng } from './prng.js';
@@ -12,6 +14,10 @@ export class StickMotion {
   private readonly rng: Prng;
   private readonly walk = new Float64Array(20);
   private readonly walkIds: number[] = [];
+  /** % travel a channel is held at instead of its motion (NaN: none). */
+  private readonly overrides = new Float64Array(20).fill(Number.NaN);
+  /** The most % travel a channel may reach (Infinity: none). */
+  private readonly ceilings = new Float64Array(20).fill(Number.POSITIVE_INFINITY);
 
   /** `rng` drives the random walks (the simulator's motion stream). */
   constructor(motion: readonly ChannelMotion[], rng: Prng) {
@@ -25,9 +31,22 @@ export class StickMotion {
     });
   }
 
+  /** Holds channel `id` at `percent` travel instead of its motion; null gives it back its motion. */
+  override(id: number, percent: number | null): void {
+    this.overrides[id] = percent ?? Number.NaN;
+  }
+
+  /** Keeps channel `id` at or below `percent` travel whatever moves it; null lifts the ceiling. */
+  ceiling(id: number, percent: number | null): void {
+    this.ceilings[id] = percent ?? Number.POSITIVE_INFINITY;
+  }
+
   /** Position of channel `id` on the link's scale (0–1023 or 0–2047), ±100 % = 341/1707 in 2048. */
   position(id: number, tau: number, resolution: number): number {
-    const p = this.percent(id, tau);
+    const held = this.overrides[id] ?? Number.NaN;
+    const wanted = Number.isNaN(held) ? this.percent(id, tau) : held;
+    const top = this.ceilings[id] ?? Number.POSITIVE_INFINITY;
+    const p = wanted > top ? top : wanted;
     const max = resolution === 2048 ? MASK_2048_SXPOS : MASK_1024_SXPOS;
     const v = Math.round(resolution / 2 + (p * resolution) / 300);
     return v < 0 ? 0 : v > max ? max : v;

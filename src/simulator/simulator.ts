@@ -7,6 +7,7 @@
  * frame when ground truth is off.
  */
 import {
+  CHANNEL_COUNT,
   EMPTY_SLOT,
   FAILSAFE_TIMEOUT_US,
   FRAME_SIZE,
@@ -209,6 +210,23 @@ export class Simulator {
       t = Math.min(t + chunkUs, endUs);
       yield this.generate(t);
     }
+  }
+
+  /**
+   * Holds channel `id` (0–19) at `percent` travel (±100 % is the normal stick range, ±150 % the
+   * full one) from the next frame on, instead of its scenario motion; null gives the motion back.
+   */
+  setChannel(id: number, percent: number | null): void {
+    checkChannelId(id);
+    if (percent !== null && !Number.isFinite(percent)) throw new RangeError(`percent must be a finite number, got ${percent}`);
+    this.motion.override(id, percent);
+  }
+
+  /** Keeps channel `id` (0–19) at or below `percent` travel from the next frame on, however it moves; null lifts it. */
+  setCeiling(id: number, percent: number | null): void {
+    checkChannelId(id);
+    if (percent !== null && !Number.isFinite(percent)) throw new RangeError(`percent must be a finite number, got ${percent}`);
+    this.motion.ceiling(id, percent);
   }
 
   /** Ground truth recorded since the last call (empty when truth is off). */
@@ -441,6 +459,11 @@ export class Simulator {
     this.produced += n;
     if (this.truthOn) this.truthNoise.push({ offset, length: n, timeUs: t0 });
   }
+}
+
+function checkChannelId(id: number): void {
+  if (!Number.isInteger(id) || id < 0 || id >= CHANNEL_COUNT)
+    throw new RangeError(`channel id must be an integer 0–${CHANNEL_COUNT - 1}, got ${id}`);
 }
 
 /**
