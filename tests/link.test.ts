@@ -421,6 +421,22 @@ describe('LinkMonitor: breaks the receiver explains', () => {
     }
   });
 
+  it('a count that jumped across a dropout by what the decoder left out: the frames due in the silence are missed', () => {
+    // A 1.5 s dropout takes an 8-bit count from 40 to 176: the decoder cannot tell that from
+    // another remote's count and counts no fade (fadesDelta 0); the silence still held 135 frames.
+    const link = new LinkMonitor();
+    run(link, 0, 1_000_000, 40, 0);
+    const resume = 990_000 + 1_496_000;
+    link.frame({ ...frame(resume, 0, 0xb2, 176), remote: 'internal' } as DecodedFrame);
+    run(link, resume + 11_000, resume + 500_000, 176, 0);
+    expect(link.stats).toMatchObject({ holds: 1, failsafes: 1, restarts: 0, missedFrames: 135 });
+    // A count that moved by its delta is the receiver's own evidence: nothing is added to it.
+    const counted = new LinkMonitor();
+    run(counted, 0, 1_000_000, 40, 0);
+    counted.frame({ ...frame(resume, 136, 0xb2, 176), remote: 'internal' } as DecodedFrame);
+    expect(counted.stats.missedFrames).toBe(136);
+  });
+
   it('a counter that wraps in a silence, or falls after a short break, is no restart', () => {
     const link = new LinkMonitor();
     const c = run(link, 0, 1_000_000, 200, 1);
@@ -436,10 +452,11 @@ describe('LinkMonitor: breaks the receiver explains', () => {
       const link = new LinkMonitor({ jitterUs: 16_000 });
       const retracted: number[] = [];
       run(link, 0, 1_000_000, 40, 1);
-      // The frames of the silence all come at its end, dated a frame time apart; the count moved on as they were sent.
+      // The frames of the silence all come at its end, dated a frame time apart; the count stays
+      // the last frame's (90 frames from 40, a fade each): the receiver lost none.
       const burst = Math.round(stall / 11_000);
       const end = 990_000 + stall;
-      const c = (40 + 91) % 256;
+      const c = (40 + 90) % 256;
       link.update(end - 1);
       for (let k = 0; k < burst; k++)
         link.frame({ ...frame(end - (burst - 1 - k) * 1_389, 0, 0xb2, c), remote: 'internal' } as DecodedFrame);

@@ -1,8 +1,9 @@
 /**
  * Receiver restarts: after a silence of `RESTART_MIN_GAP_US` or more, a fade counter that fell
  * by more than a wrap explains started again from 0 at power-up. Its count then says nothing
- * about the silence: the link monitor (link.ts), which owns a watch, keeps the hold and counts
- * the frames due in the silence as missed.
+ * about the silence, nor does one that moved by what the decoder could not attribute: the link
+ * monitor (link.ts), which owns a watch, keeps the hold and counts the frames due in the silence
+ * as missed.
  */
 import type { LinkCheckpoint } from './checkpoint.js';
 import type { LinkRestart, LinkStats } from './link-types.js';
@@ -46,10 +47,11 @@ export class RestartWatch {
   }
 
   /**
-   * Whether `frame` ends a silence of `gapUs` with a restarted counter (recorded, and counted in
-   * `s.restarts`); returns the frames due in the silence (0: no restart). A wrap in the
-   * silence adds about as many as were due: a fall further from that than 8 frames, or half of
-   * them, is no wrap.
+   * The frames due in a silence of `gapUs` that `frame` ends where its count cannot account for
+   * them (0 where it can): a restarted counter (recorded, and counted in `s.restarts`), or one
+   * that moved by a count the decoder left out (a 1.5 s dropout takes an 8-bit count from 40 to
+   * 176, which the decoder cannot tell from another remote's). A wrap in the silence adds about
+   * as many as were due: a fall further from that than 8 frames, or half of them, is no wrap.
    */
   frame(frame: DecodedFrame, gapUs: number, s: LinkStats): number {
     const count = frame.fades;
@@ -60,8 +62,9 @@ export class RestartWatch {
     const modulus = frame.remote === 'internal' ? 256 : 65536;
     this.#evidence = (count - prev + modulus) % modulus === frame.fadesDelta ? true : null;
     const p = s.nominalPeriodUs;
-    if (!(count < prev) || !(gapUs >= RESTART_MIN_GAP_US) || !Number.isFinite(p)) return 0;
+    if (!(gapUs >= RESTART_MIN_GAP_US) || !Number.isFinite(p)) return 0;
     const due = Math.max(0, Math.round(gapUs / p) - 1);
+    if (!(count < prev)) return this.#evidence === null ? Math.max(1, due) : 0;
     const wrapped = (count - prev + modulus) % modulus;
     if (Math.abs(wrapped - due) <= Math.max(8, 0.5 * due)) return 0;
     s.restarts++;

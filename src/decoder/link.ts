@@ -236,7 +236,8 @@ export class LinkMonitor {
     if (this.#counting) {
       s.missedBasis = 'fade-counter';
       if (restartDue > 0) {
-        // The restarted counter does not count the silence: the frames due in it are missed.
+        // A counter that restarted, or moved by what the decoder could not attribute, does not
+        // count the silence: the frames due in it are missed.
         const p = s.nominalPeriodUs;
         s.missedFrames += restartDue;
         this.#onMissed?.(t - gap + p, t, restartDue, p);
