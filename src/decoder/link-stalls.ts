@@ -229,11 +229,12 @@ export class StallJudge {
 
   /**
    * The receiver's counter says it lost the `fades` frames between the frame before (at `last`)
-   * and the frame at `t`, which came less than a hold after it (else a hold ended here): they
-   * were in a row, its own line silent for fades + 1 periods, which only a stall can have hid
-   * from the adapter (the frames before delivered late and together). The episodes the silence
-   * was are added: a hold where none ended with this frame (`ended`), a failsafe where the hold
-   * that ended did not become one. Neither waits to be judged: the counter is the evidence.
+   * and the frame at `t`: they were in a row, its own line silent for fades + 1 periods. Where
+   * no hold ended with this frame (`ended`), the adapter saw a shorter silence (a stall hid it:
+   * the frames before delivered late and together) or did not call it a hold (its threshold
+   * grows with the delivery jitter a stall measured): the hold is added. Where the hold that
+   * ended did not become a failsafe and the receiver's silence reached one, the failsafe is.
+   * Neither waits to be judged: the counter is the evidence.
    * After a break in the monitor's view (`last` NaN: the start, an interrupt), the count spans
    * time it did not see: nothing is added.
    */
@@ -242,10 +243,10 @@ export class StallJudge {
     const m = this.#monitor;
     const p = s.nominalPeriodUs;
     const silence = (fades + 1) * p;
-    // A hold's worth more than the adapter saw: a silence a stall hid, not the same one seen
-    // (nor a run a wrong period estimate stretches).
+    // A hold's worth of the receiver's own silence (not a run a wrong period estimate stretches);
+    // beside a hold that ended here, a hold's worth more than the adapter saw.
     if (!m.periodKnown() || !Number.isFinite(silence) || !Number.isFinite(t) || !Number.isFinite(last)) return;
-    if (!(silence - (t - last) > m.counterHoldUs())) return;
+    if (!((ended === null ? silence : silence - (t - last)) > m.counterHoldUs())) return;
     // When the receiver's first missing frame was due.
     const rxStartUs = t - fades * p;
     let hold = ended;
