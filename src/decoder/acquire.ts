@@ -12,7 +12,7 @@
  * (runs of 0xFF are frames of seven empty slots) never locks. The winning chain's frames are
  * emitted as they stand (`confirmedUntil`).
  */
-import { byteAt, channelEvidence, countZeroWords, INVALID, layoutChannels, slotLayout } from './frame.js';
+import { byteAt, channelEvidence, countZeroWords, INVALID, layoutChannels, phaseBitsAfterFirst, slotLayout } from './frame.js';
 import { formatOf, setReason } from './format.js';
 import {
   B0_FADES,
@@ -387,6 +387,7 @@ function scoreChain(d: Core, o: number, resolution: Resolution, frames: number, 
   let fell = false;
   let channels = 0;
   let zeroWords = 0;
+  let phaseBits = 0;
   let recurring = 0;
   let layout1 = INVALID;
   let layout2 = INVALID;
@@ -403,6 +404,7 @@ function scoreChain(d: Core, o: number, resolution: Resolution, frames: number, 
     layout1 = layout;
     channels |= layoutChannels(layout);
     zeroWords += countZeroWords(buf, f);
+    if (resolution === 2048) phaseBits += phaseBitsAfterFirst(buf, f, layout);
   }
   if (!internal && readsInternalLate(d, o, resolution, length)) {
     d.chain.lateRefused = true;
@@ -422,6 +424,9 @@ function scoreChain(d: Core, o: number, resolution: Resolution, frames: number, 
   score += recurring;
   // Zero words (0x0000) in slots are rarer in real frames than in a shifted reading. Unpinned.
   score -= zeroWords;
+  // A phase bit past a frame's first slot: a reading shifted off the frames (an external
+  // remote's count, which reads as a slot, makes such a reading chain as well as the real one).
+  score -= 2 * phaseBits;
   // A frame skipped over for a damaged header makes the chain weaker. Unpinned.
   if (skipped >= 0) score -= 5;
   if (internal) {

@@ -120,6 +120,21 @@ export function slotLayout(b: Uint8Array, o: number, resolution: Resolution): nu
   return layout;
 }
 
+/**
+ * In the valid 2048-mode frame at `o` (its layout `layout`): the slots after the first that carry
+ * an ordinary channel (0–11) with bit 15, the phase bit, set. Transmitters set it on a frame's
+ * first slot (X-Plus words carry it for X+5 to X+8, §8.6): elsewhere it marks bytes read off the
+ * frames' alignment (the first slot of a frame read as a later one).
+ */
+export function phaseBitsAfterFirst(b: Uint8Array, o: number, layout: number): number {
+  let n = 0;
+  for (let i = 1; i < SLOTS_PER_FRAME; i++) {
+    const code = (layout >> (CODE_BITS * i)) & CODE_MASK;
+    if (code <= MAX_NORMAL_CHANNEL && (byteAt(b, o + 2 + 2 * i) & 0x80) !== 0) n++;
+  }
+  return n;
+}
+
 /** Bit mask (bit n = channel n, normal channels 0–11 only) of the channels in a valid layout. */
 export function layoutChannels(layout: number): number {
   let mask = 0;
