@@ -1,0 +1,230 @@
+/**
+ * Grading a flight controller's reading of what Drive sent: which of its channels follows which
+ * receiver channel, how far its values are from the spec's (§9: 903 + 0.583 × position µs in
+ * 2048 mode, 1.166 in 1024), how long a step takes to reach it, and when it reports the receiver
+ * lost and back. The readings are the flight controller's own (MSP_RC and its arming-disable
+ * flags, or MAVLink RC_CHANNELS and its failsafe state) on the player's clock; what cannot be
+ * told from them is said so, never guessed.
+ */
+import { CHANNEL_NAMES, servoToMicros } from '../decoder/spec.js';
+import type { DriveWrite } from './player.js';
+
+/** What the flight controller said at a moment (µs on the player's clock). */
+export interface FcReading {
+  atUs: number;
+  /** Its channels, µs, in its own order. */
+  channels: readonly number[];
+  /** Whether it reports the receiver lost (RXLOSS, RC_LINK, RC failsafe); null when it does not say. */
+  rxLoss: boolean | null;
+}
+
+/** One graded check. */
+export interface DriveCheck {
+  id: 'channel-map' | 'values' | 'latency' | 'failsafe';
+  /** What the spec or the link needs, with its section. */
+  expects: string;
+  /** What the flight controller did, measured. */
+  found: string;
+  verdict: 'pass' | 'fail' | 'unknown';
+}
+
+/** A receiver channel's value as sent at each frame: [time of the frame, µs by the spec]. */
+type Track = [number, number][];
+
+/** The channels each frame sent, by receiver channel ID (0–11), in time order. */
+function tracks(sent: readonly DriveWrite[]): Map<number, Track> {
+  const out = new Map<number, Track>();
+  for (const w of sent) {
+    const f = w.frame;
+    if (f === null || f.damage !== null) continue;
+    for (const c of f.channels) {
+      if (c.id > 11) continue;
+      let t = out.get(c.id);
+      if (t === undefined) out.set(c.id, (t = []));
+      t.push([w.atUs, servoToMicros(c.pos, f.resolution)]);
+    }
+  }
+  return out;
+}
+
+/** The value a track had at `atUs` (its last frame at or before it), NaN before its first. */
+function valueAt(track: Track, atUs: number): number {
+  let lo = 0;
+  let hi = track.length - 1;
+  if (hi < 0 || (track[0] as [number, number])[0] > atUs) return Number.NaN;
+  while (lo < hi) {
+    const mid = (lo + hi + 1) >> 1;
+    if ((track[mid] as [number, number])[0] <= atUs) lo = mid;
+    else hi = mid - 1;
+  }
+  return (track[lo] as [number, number])[1];
+}
+
+function correlation(a: readonly number[], b: readonly number[]): number {
+  const n = a.length;
+  let ma = 0;
+  let mb = 0;
+  for (let i = 0; i < n; i++) {
+    ma += a[i] as number;
+    mb += b[i] as number;
+  }
+  ma /= n;
+  mb /= n;
+  let sab = 0;
+  let saa = 0;
+  let sbb = 0;
+  for (let i = 0; i < n; i++) {
+    const x = (a[i] as number) - ma;
+    const y = (b[i] as number) - mb;
+    sab += x * y;
+    saa += x * x;
+    sbb += y * y;
+  }
+  return saa > 0 && sbb > 0 ? sab / Math.sqrt(saa * sbb) : Number.NaN;
+}
+
+const median = (xs: number[]): number => {
+  const s = xs.slice().sort((a, b) => a - b);
+  return s.length === 0 ? Number.NaN : (s[(s.length - 1) >> 1] as number);
+};
+
+/** The result of grading: each check, and the map found (the flight controller's channel index → the receiver channel ID it follows). */
+export interface DriveGrade {
+  checks: DriveCheck[];
+  map: Map<number, number>;
+}
+
+/**
+ * Grades `readings` against `sent`. The flight controller is expected to read the receiver's
+ * channels 0–3 (throttle, aileron, elevator, rudder) as its throttle, roll, pitch and yaw in
+ * the order `expectedMap` gives (its channel index → receiver channel ID; Betaflight and iNav
+ * with `map TAER1234`: roll 1, pitch 2, yaw 3, throttle 0).
+ */
+export function gradeDrive(
+  sent: readonly DriveWrite[],
+  readings: readonly FcReading[],
+  expectedMap: readonly number[] = [1, 2, 3, 0],
+): DriveGrade {
+  const byId = tracks(sent);
+  const live = readings.filter((r) => r.rxLoss !== true);
+  const checks: DriveCheck[] = [];
+  // Which receiver channel each of the flight controller's channels follows: the best
+  // correlation over the readings while the link was up, among channels that moved.
+  const map = new Map<number, number>();
+  const fcCount = Math.max(0, ...readings.map((r) => r.channels.length));
+  for (let j = 0; j < fcCount; j++) {
+    const fc = live.map((r) => r.channels[j] ?? Number.NaN);
+    let best = Number.NaN;
+    let bestId = -1;
+    for (const [id, track] of byId) {
+      const sentAt = live.map((r) => valueAt(track, r.atUs));
+      const ok = sentAt.map((v, i) => Number.isFinite(v) && Number.isFinite(fc[i] as number));
+      const c = correlation(
+        fc.filter((_, i) => ok[i]),
+        sentAt.filter((_, i) => ok[i]),
+      );
+      if (c > 0.9 && !(c <= best)) {
+        best = c;
+        bestId = id;
+      }
+    }
+    if (bestId >= 0) map.set(j, bestId);
+  }
+  const name = (id: number | undefined) => (id === undefined ? 'nothing that moved' : (CHANNEL_NAMES[id] ?? `channel ${id}`));
+  const wrong = expectedMap
+    .map((id, j) => (map.get(j) === id ? null : `its channel ${j + 1} follows ${name(map.get(j))}, not ${name(id)}`))
+    .filter((x) => x !== null);
+  const unseen = expectedMap.filter((_, j) => !map.has(j)).length;
+  checks.push({
+    id: 'channel-map',
+    expects: `Channels 1-4 read as ${expectedMap.map((id) => name(id)).join(', ')} (§8.5: the receiver's channel IDs name them).`,
+    found: map.size === 0 ? 'No channel followed any stick that moved.' : `${wrong.length === 0 ? 'As expected' : wrong.join('; ')}.`,
+    verdict: unseen === expectedMap.length ? 'unknown' : wrong.length === 0 ? 'pass' : 'fail',
+  });
+  // How far its values are from the spec's, over the mapped channels.
+  const errors: number[] = [];
+  for (const [j, id] of map) {
+    const track = byId.get(id) as Track;
+    for (const r of live) {
+      const want = valueAt(track, r.atUs);
+      const got = r.channels[j];
+      if (Number.isFinite(want) && got !== undefined) errors.push(got - want);
+    }
+  }
+  if (errors.length === 0)
+    checks.push({ id: 'values', expects: 'Values as §9 converts them.', found: 'No reading to compare.', verdict: 'unknown' });
+  else {
+    const worst = errors.reduce((a, e) => (Math.abs(e) > Math.abs(a) ? e : a), 0);
+    checks.push({
+      id: 'values',
+      expects: 'Each value as §9 converts it (903 + 0.583 × position µs at 2048, 1.166 at 1024), within 2 µs.',
+      found: `Off by ${Math.round(median(errors))} µs (median), ${Math.round(worst)} µs at the most, over ${errors.length} readings.`,
+      verdict: Math.abs(worst) <= 2 ? 'pass' : 'fail',
+    });
+  }
+  checks.push(latency(byId, map, live));
+  checks.push(failsafe(sent, readings));
+  return { checks, map };
+}
+
+/** From a step in a sent channel (over 200 µs from one frame to the next) to the first reading closer to the new value than the old. */
+function latency(byId: Map<number, Track>, map: Map<number, number>, live: readonly FcReading[]): DriveCheck {
+  const lags: number[] = [];
+  for (const [j, id] of map) {
+    const track = byId.get(id) as Track;
+    for (let i = 1; i < track.length; i++) {
+      const [t, v] = track[i] as [number, number];
+      const before = (track[i - 1] as [number, number])[1];
+      if (Math.abs(v - before) < 200) continue;
+      const r = live.find(
+        (x) => x.atUs >= t && Math.abs((x.channels[j] ?? Number.NaN) - v) < Math.abs((x.channels[j] ?? Number.NaN) - before),
+      );
+      if (r !== undefined) lags.push(r.atUs - t);
+    }
+  }
+  const gaps = live.slice(1).map((r, i) => r.atUs - (live[i] as FcReading).atUs);
+  const poll = median(gaps);
+  if (lags.length === 0)
+    return {
+      id: 'latency',
+      expects: 'A step reaches the flight controller within a frame or two.',
+      found: 'No step was sent and read.',
+      verdict: 'unknown',
+    };
+  const ms = (us: number) => `${(us / 1000).toFixed(1)} ms`;
+  return {
+    id: 'latency',
+    expects: 'A step reaches the flight controller within a frame or two.',
+    found: `${lags.length} steps: ${ms(median(lags))} median, ${ms(Math.max(...lags))} at the most (read every ${ms(poll)}, so to within that).`,
+    verdict: 'pass',
+  };
+}
+
+/** Each silence of the sent frames over 100 ms: when the flight controller said the receiver was lost, and back. */
+function failsafe(sent: readonly DriveWrite[], readings: readonly FcReading[]): DriveCheck {
+  const frames = sent.filter((w) => w.frame !== null).map((w) => w.atUs);
+  const said = readings.filter((r) => r.rxLoss !== null);
+  const expects =
+    "Receiver lost reported within the stack's timeout after frames stop (§7.1: hold, failsafe after 1 s), and back once they return.";
+  if (said.length === 0)
+    return { id: 'failsafe', expects, found: 'The flight controller does not report its receiver state here.', verdict: 'unknown' };
+  const parts: string[] = [];
+  let missed = 0;
+  for (let i = 1; i < frames.length; i++) {
+    const last = frames[i - 1] as number;
+    const next = frames[i] as number;
+    if (next - last < 100_000) continue;
+    const lost = said.find((r) => r.atUs > last && r.atUs < next && r.rxLoss === true);
+    const back = said.find((r) => r.atUs >= next && r.rxLoss === false);
+    const gap = `${((next - last) / 1000).toFixed(0)} ms silence`;
+    if (lost === undefined) {
+      if (next - last >= 1_000_000) missed++;
+      parts.push(`${gap}: not reported`);
+    } else
+      parts.push(
+        `${gap}: lost after ${((lost.atUs - last) / 1000).toFixed(0)} ms, back ${back === undefined ? 'never' : `after ${((back.atUs - next) / 1000).toFixed(0)} ms`}`,
+      );
+  }
+  if (parts.length === 0) return { id: 'failsafe', expects, found: 'No silence was sent.', verdict: 'unknown' };
+  return { id: 'failsafe', expects, found: `${parts.join('; ')}.`, verdict: missed > 0 ? 'fail' : 'pass' };
+}

@@ -1,0 +1,98 @@
+/**
+ * A flight controller's Spektrum input, as Betaflight documents and implements it (src/main/rx/
+ * spektrum.c, rx.c): bytes frame by silence (a gap over 5 ms starts a frame; its 16th byte
+ * completes it), the resolution is the user's setting (no detection), channel IDs 12 and over
+ * and 0xFFFF slots are dropped, the value is 988 + v/2 µs (2048) or 988 + v (1024), channels
+ * are remapped by `rcmap` (AETR order inside: roll, pitch, yaw, throttle, aux…), and RXLOSS is
+ * set 100 ms after the last frame and cleared after `recoveryMs` of frames again. For tests of
+ * Drive's grading, and the browser test's fake flight controller.
+ */
+import { BYTE_TIME_US } from '../src/decoder/spec.js';
+
+export interface FakeFcOptions {
+  /** The serialrx_provider setting. */
+  resolution: 1024 | 2048;
+  /** `map` as the CLI sets it (default "TAER1234", what a Spektrum user sets). */
+  map?: string;
+  recoveryMs?: number;
+}
+
+/** What the flight controller reads at a moment: its channels (µs, its own order), and RXLOSS. */
+export interface FcState {
+  atUs: number;
+  channels: number[];
+  rxLoss: boolean;
+}
+
+/** Betaflight's frame gap (SPEKTRUM_NEEDED_FRAME_INTERVAL). */
+const FRAME_GAP_US = 5_000;
+/** rx.c: a frame must come within 100 ms, else the signal is lost. */
+const SIGNAL_TIMEOUT_US = 100_000;
+
+export class FakeFc {
+  readonly #shift: number;
+  readonly #mask: number;
+  readonly #count: number;
+  readonly #rcmap: number[];
+  readonly #recoveryUs: number;
+  readonly #raw: number[];
+  readonly #frame = new Uint8Array(16);
+  #pos = 0;
+  #lastByteUs = Number.NEGATIVE_INFINITY;
+  #lastFrameUs = Number.NEGATIVE_INFINITY;
+  #goodSinceUs = Number.NaN;
+  #rxLoss = true;
+
+  constructor(options: FakeFcOptions) {
+    const bits11 = options.resolution === 2048;
+    this.#shift = bits11 ? 3 : 2;
+    this.#mask = bits11 ? 0x07 : 0x03;
+    this.#count = bits11 ? 12 : 7;
+    this.#raw = new Array(this.#count).fill(0);
+    // rcmap[i]: the receiver channel that feeds internal channel i (A, E, R, T, aux 1–4).
+    const map = (options.map ?? 'TAER1234').toUpperCase();
+    this.#rcmap = ['A', 'E', 'R', 'T', '1', '2', '3', '4'].map((c) => map.indexOf(c));
+    this.#recoveryUs = (options.recoveryMs ?? 500) * 1000;
+  }
+
+  /** A byte on the line at `atUs`. */
+  byte(b: number, atUs: number): void {
+    if (atUs - this.#lastByteUs > FRAME_GAP_US) this.#pos = 0;
+    this.#lastByteUs = atUs;
+    if (this.#pos < 16) this.#frame[this.#pos++] = b;
+    if (this.#pos === 16) {
+      this.#pos = 17; // the rest up to the next gap is ignored
+      this.#decode(atUs);
+    }
+  }
+
+  /** Bytes written at `atUs`, back to back. */
+  write(bytes: Uint8Array, atUs: number): void {
+    for (let i = 0; i < bytes.length; i++) this.byte(bytes[i] as number, atUs + i * BYTE_TIME_US);
+  }
+
+  /** What MSP_RC and the arming-disable flags say at `atUs`. */
+  state(atUs: number): FcState {
+    if (atUs - this.#lastFrameUs > SIGNAL_TIMEOUT_US) {
+      this.#rxLoss = true;
+      this.#goodSinceUs = Number.NaN;
+    } else if (this.#rxLoss && atUs - this.#goodSinceUs >= this.#recoveryUs) this.#rxLoss = false;
+    const us = (v: number) => (this.#shift === 3 ? 988 + v / 2 : 988 + v);
+    const channels: number[] = [];
+    for (let i = 0; i < this.#count; i++) {
+      const raw = i < this.#rcmap.length ? (this.#rcmap[i] as number) : i;
+      channels.push(Math.trunc(us(this.#raw[raw] ?? 0)));
+    }
+    return { atUs, channels, rxLoss: this.#rxLoss };
+  }
+
+  #decode(atUs: number): void {
+    const f = this.#frame;
+    for (let b = 3; b < 16; b += 2) {
+      const id = 0x0f & ((f[b - 1] as number) >> this.#shift);
+      if (id < this.#count && id < 12) this.#raw[id] = (((f[b - 1] as number) & this.#mask) << 8) | (f[b] as number);
+    }
+    if (Number.isNaN(this.#goodSinceUs)) this.#goodSinceUs = atUs;
+    this.#lastFrameUs = atUs;
+  }
+}
