@@ -157,15 +157,18 @@ describe('Saleae CSV', () => {
     `Time [s],Value,Parity Error,Framing Error\n${Array.from(sim.bytes.subarray(0, 4000), (b, i) => `${bad(i) ?? (sim.timesUs[i]! / 1e6).toFixed(9)},0x${b.toString(16).padStart(2, '0')},,`).join('\n')}\n`;
   const clean = readCapture(new TextEncoder().encode(rows(() => null)));
 
-  it('one row at 1e18 s: every byte kept, dated at the next byte in line, said once', () => {
-    const capture = readCapture(new TextEncoder().encode(rows((i) => (i === 1000 ? '1e18' : null))));
-    expect(capture.bytes).toEqual(clean.bytes);
-    const want = clean.byteTimesUs!.slice();
-    want[1000] = want[1001]!;
-    expect(capture.byteTimesUs).toEqual(want);
-    expect(badTimes(capture).map((i) => i.message)).toEqual([expect.stringMatching(/^port 0: 1 of 4000 byte times jump out of line/)]);
-    expect(figures(capture)).toEqual(figures(clean));
-  });
+  for (const bad of ['1e18', '-Infinity', 'NaN', 'Infinity', 'soon']) {
+    it(`one row at ${bad} s: every byte kept, dated at the next byte in line, said once`, () => {
+      const capture = readCapture(new TextEncoder().encode(rows((i) => (i === 1000 ? bad : null))));
+      expect(capture.bytes).toEqual(clean.bytes);
+      const want = clean.byteTimesUs!.slice();
+      want[1000] = want[1001]!;
+      expect(capture.byteTimesUs).toEqual(want);
+      expect(capture.issues.map((i) => i.kind)).toEqual(['bad-time']);
+      expect(badTimes(capture).map((i) => i.message)).toEqual([expect.stringMatching(/^port 0: 1 of 4000 byte times jump out of line/)]);
+      expect(figures(capture)).toEqual(figures(clean));
+    });
+  }
 
   it('every row absurd: read untimed, not stretched over the absurd span', () => {
     const capture = readCapture(new TextEncoder().encode(rows((i) => `${1e15 * (i % 2 ? 1 : -1)}`)));

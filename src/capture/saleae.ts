@@ -350,13 +350,11 @@ export function importSaleaeCsv(input: string | Uint8Array): Capture {
     const te = fields.ends[cols.time] ?? 0;
     let ns = secondsToNs(bytes, ts, te);
     if (Number.isNaN(ns)) {
+      // A time that is no number of seconds (-Infinity, NaN, text) still dates a good byte:
+      // kept, NaN, for the time rule to step over and report (`bad-time`) as any jump.
       const text = fields.text(cols.time);
-      const seconds = DECIMAL_NUMBER.test(text) ? Number(text) : NaN;
-      if (!Number.isFinite(seconds)) {
-        issue('malformed-row', lineNo, ls, le, `time ${quote(text)} is not a number of seconds`);
-        continue;
-      }
-      ns = Math.round(seconds * 1e9);
+      const seconds = DECIMAL_NUMBER.test(text) || /^[+-]?Infinity$/.test(text) ? Number(text) : NaN;
+      ns = Number.isFinite(seconds) ? Math.round(seconds * 1e9) : seconds;
     }
     const value = byteValue(bytes, fields.starts[cols.value] ?? 0, fields.ends[cols.value] ?? 0);
     if (value < 0) {
