@@ -236,6 +236,23 @@ describe("another protocol's bytes in a raw file or a logic analyser's export", 
   });
 });
 
+describe('a resolution forced that fits no frame', () => {
+  it('is the setting to change, never "no satellite" and wiring advice', () => {
+    for (const [name, forced] of [
+      ['dsm2-22ms-1024-internal', 2048],
+      ['dsmx-11ms-2048-internal', 1024],
+    ] as const) {
+      const s = simulate({ ...preset(name), seed: 5 }, 2 * SECOND);
+      const found = doctorCapture(importRaw(s.bytes), { resolution: forced }).findings;
+      expect(
+        found.map((f) => f.code),
+        name,
+      ).toEqual(['forced-option']);
+      expect(found[0]?.evidence[0]?.text).toMatch(new RegExp(`they are ${forced === 2048 ? 1024 : 2048}-resolution frames`));
+    }
+  });
+});
+
 describe('a Spektrum stream', () => {
   it('is never said to be missing: every preset, raw, per-byte and recorded', () => {
     const said: string[] = [];

@@ -12,6 +12,7 @@ import { capturePorts } from '../capture/facts.js';
 import { SpektrumDecoder } from '../decoder/decoder.js';
 import { captureSpan } from '../report/capture-span.js';
 import { reportHtml } from '../report/report-html.js';
+import { noFramesHint } from '../report/report-text.js';
 import { summarizeCapture } from '../report/summary.js';
 import { threadedReport } from './report-threads.js';
 import { parseCommandLine, UsageError, type Args } from './args.js';
@@ -176,7 +177,7 @@ async function decode(input: Iterable<{ bytes: Uint8Array; time: Time }>, args: 
   const s = decoder.stats;
   if (s.frames === 0) {
     process.stderr.write(
-      `satscope: ${args.file}: no Spektrum frames found in ${s.bytes} bytes on port ${port} (is this the satellite's DATA line at 115200 baud?)\n`,
+      `satscope: ${args.file}: no Spektrum frames found in ${s.bytes} bytes on port ${port} (${noFramesHint(decoder.format)})\n`,
     );
     return 1;
   }

@@ -1,7 +1,7 @@
 /** Text forms of frames and summaries for the CLI. */
 import type { HealthReport, ReportFinding } from '../report/report-types.js';
 import type { CaptureSummary } from '../report/summary.js';
-import { formatClock, plural } from '../report/report-text.js';
+import { formatClock, noFramesHint, plural } from '../report/report-text.js';
 import type { CaptureTiming } from '../capture/model.js';
 import { systemInfo } from '../decoder/spec.js';
 
@@ -37,7 +37,7 @@ export function formatSummary(s: CaptureSummary, name: string, ports: readonly n
   if (timed && Number.isFinite(s.durationUs)) add('Duration', `${(s.durationUs / 1e6).toFixed(3)} s`);
   const f = s.format;
   if (!f.locked && s.decoder.frames === 0) {
-    add('Frames', `none found in ${s.bytes} bytes`);
+    add('Frames', `none found in ${s.bytes} bytes (${noFramesHint(f)})`);
     return lines.join('\n');
   }
   const sys = f.system === null ? undefined : systemInfo(f.system);

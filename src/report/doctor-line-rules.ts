@@ -23,7 +23,7 @@ import {
   type PortState,
 } from './doctor-state.js';
 import type { AddFinding, Confidence, ConfirmProbe, Evidence, RuleContext } from './doctor-types.js';
-import { formatDuration, plural } from './report-text.js';
+import { formatDuration, noFramesHint, plural } from './report-text.js';
 import { absencesUntil } from './absences.js';
 
 export const NOTHING_TODO = [
@@ -445,6 +445,22 @@ export function noSatelliteFinding(p: PortState, v: LineVerdict, now: number, ct
   const windowBytes = p.bins.sum(M_BYTES, fromS, toS);
   const whole = windowBytes === p.bytes;
   const amount = whole ? plural(p.bytes, 'byte') : `${plural(p.bytes, 'byte')} (${plural(windowBytes, 'byte')} ${windowText(p, now, ctx)})`;
+  const format = p.source?.decoder.format;
+  if (format?.withheld === 'forced') {
+    // Frames that an option set by hand does not fit: the setting is wrong, not the wiring.
+    add({
+      code: 'forced-option',
+      ports: [p.port],
+      severity: 'problem',
+      confidence: 'certain',
+      title: `${p.label}: the resolution set reads none of its frames`,
+      evidence: [{ text: `${amount}: ${noFramesHint(format)}.`, timeUs: null }],
+      todo: ['Set the resolution to Auto (satscope: leave out --resolution): the decoder finds the one the frames have.'],
+      settings: [],
+      confirm: null,
+    });
+    return;
+  }
   add({
     code: 'no-satellite',
     ports: [p.port],

@@ -38,6 +38,7 @@ export type DoctorCode =
   | 'weakest-remote'
   | 'fades-together'
   // The setup is wrong
+  | 'forced-option'
   | 'internal-count'
   | 'resolution-mismatch'
   | 'rebind'

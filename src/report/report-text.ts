@@ -33,6 +33,20 @@ export function formatDuration(us: number): string {
 }
 
 export const plural = (n: number, one: string, many = `${one}s`): string => `${n} ${n === 1 ? one : many}`;
+
+/**
+ * Why bytes gave no Spektrum frame, as the decoder's format says it (every surface words it so):
+ * an option forced that fits none of the frames there are, filler, or else the question to ask.
+ */
+export function noFramesHint(format: { withheld: 'filler' | 'forced' | null; forcedMismatch: 1024 | 2048 | null }): string {
+  if (format.withheld === 'forced') {
+    return format.forcedMismatch !== null
+      ? `the resolution forced reads none of them: they are ${format.forcedMismatch}-resolution frames; leave the resolution on auto`
+      : 'the options forced read none of them; leave them on auto';
+  }
+  if (format.withheld === 'filler') return "they are filler (runs of 0xFF or 0x00), no transmitter's frames";
+  return "is this the satellite's DATA line at 115200 baud?";
+}
 export const pctText = (ratio: number): string => `${(ratio * 100).toFixed(ratio < 0.001 && ratio > 0 ? 3 : ratio < 0.1 ? 2 : 1)} %`;
 export const rate = (x: number): string => (x === 0 ? '0' : x >= 10 ? x.toFixed(0) : x.toFixed(1));
 
