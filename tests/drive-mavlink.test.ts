@@ -19,6 +19,7 @@ import {
   requestMessageInterval,
   SENSOR_RC_RECEIVER,
 } from '../src/drive/mavlink.js';
+import { concatBytes } from './bytes.js';
 
 const hex = (b: Uint8Array) => Array.from(b, (x) => x.toString(16).padStart(2, '0')).join(' ');
 
@@ -30,16 +31,6 @@ function parseAll(bytes: Uint8Array, step = bytes.length): { messages: MavlinkMe
     for (let m = parser.next(); m; m = parser.next()) messages.push(m);
   }
   return { messages, parser };
-}
-
-function concat(parts: Uint8Array[]): Uint8Array {
-  const out = new Uint8Array(parts.reduce((a, p) => a + p.length, 0));
-  let at = 0;
-  for (const p of parts) {
-    out.set(p, at);
-    at += p.length;
-  }
-  return out;
 }
 
 /** RC_CHANNELS as an autopilot sends it (sysid 1, compid 1). */
@@ -88,7 +79,7 @@ describe('MAVLink framing', () => {
           })();
           signed[hb.length - 2] = extra & 0xff;
           signed[hb.length - 1] = extra >> 8;
-          const bytes = concat([
+          const bytes = concatBytes([
             noise.map((b) => (b === 0xfd || b === 0xfe ? 0 : b)),
             attitude,
             rcChannels(us, 200),
@@ -125,7 +116,7 @@ describe('MAVLink framing', () => {
     );
     const bad = rcChannels([1500], 10);
     bad[12] = (bad[12] as number) ^ 4;
-    const { messages, parser } = parseAll(concat([bad, rcChannels([1500], 10)]));
+    const { messages, parser } = parseAll(concatBytes([bad, rcChannels([1500], 10)]));
     expect(messages).toHaveLength(1);
     expect(parser.stats.badChecks).toBe(1);
   });
