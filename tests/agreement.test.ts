@@ -654,6 +654,56 @@ describe('the doctor states what info and the report state', () => {
       truth: nothingLost,
     },
     {
+      name: 'dropouts of 1.2-2 s whose count jumps past what the decoder attributes, recorded and per-byte',
+      captures: () =>
+        [1_200_000, 1_500_000, 2_000_000].flatMap((durationUs, i) => {
+          const s = simulate(
+            {
+              ...preset('dsmx-11ms-2048-internal'),
+              seed: 30 + i,
+              fades: { start: 40, lossRate: 0, randomRate: 0 },
+              dropouts: [{ atUs: 1.5e6, durationUs }],
+            },
+            5e6,
+          );
+          return [
+            { name: `${durationUs / 1000} ms .sscap`, capture: sscap(usbChunks(s.bytes, s.timesUs)) },
+            { name: `${durationUs / 1000} ms per-byte`, capture: perByteCapture(s) },
+          ];
+        }),
+      // A hold and a failsafe, and the frames due in the silence missed (the receiver lost them).
+      truth: (capture) => {
+        const { link, episodes } = summarizeCapture(capture);
+        const hold = episodes.find((e) => e.kind === 'hold');
+        const silence = (episodes.at(-1)?.endUs ?? 0) - (hold?.lastFrameUs ?? 0);
+        const due = Math.round(silence / 11_000) - 1;
+        return link.holds === 1 && link.failsafes === 1 && Math.abs(link.missedFrames - due) <= 2
+          ? []
+          : [`${link.holds} holds, ${link.failsafes} failsafes, ${link.missedFrames} missed where ${due} were due`];
+      },
+    },
+    {
+      name: 'a USB stall, then real dropouts the counter counts (100-500 ms)',
+      captures: () =>
+        [100_000, 250_000, 500_000].map((durationUs, i) => {
+          const s = simulate(
+            {
+              ...preset('dsmx-11ms-2048-internal'),
+              seed: 40 + i,
+              fades: { lossRate: 0, randomRate: 0 },
+              dropouts: [{ atUs: 6e6, durationUs }],
+            },
+            9e6,
+          );
+          return { name: `${durationUs / 1000} ms after a 300 ms stall`, capture: sscap(heldBack(s, 300_000, 20e6, 2e6)) };
+        }),
+      // The stall raised the delivery jitter; the dropout is a hold all the same.
+      truth: (capture) => {
+        const { link } = summarizeCapture(capture);
+        return link.holds === 1 && link.failsafes === 0 ? [] : [`${link.holds} holds, ${link.failsafes} failsafes`];
+      },
+    },
+    {
       name: 'USB stalls: frames held back and delivered at once, on receivers with and without a counter',
       captures: () =>
         STALLS.map((c) => {
