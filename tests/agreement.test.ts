@@ -31,7 +31,7 @@ import type { DoctorFinding } from '../src/report/doctor-types.js';
 import { formatClock } from '../src/report/report-text.js';
 import { healthReport } from '../src/report/report.js';
 import { summarizeCapture } from '../src/report/summary.js';
-import { linkTiming } from '../src/report/capture-pass.js';
+import { timingJitterUs } from '../src/report/capture-pass.js';
 import { preset } from '../src/simulator/presets.js';
 import { simulate } from '../src/simulator/simulator.js';
 import { Diagnosis } from '../src/worker/diagnosis.js';
@@ -148,7 +148,7 @@ function fromReport(capture: Capture): Story {
  */
 function fromReplay(capture: Capture, speed: number, seekAtUs?: number): Story {
   const clock = new SimulatedClock();
-  let engine = new Engine({ resolution: 'auto', ...linkTiming(capture.timing) });
+  let engine = new Engine({ resolution: 'auto', jitterUs: timingJitterUs(capture.timing) });
   let ended = false;
   const r: ReplaySource = new ReplaySource(
     { capture },
@@ -167,7 +167,7 @@ function fromReplay(capture: Capture, speed: number, seekAtUs?: number): Story {
   r.play();
   if (seekAtUs !== undefined) {
     clock.run(() => ended || r.positionUs >= seekAtUs);
-    engine = new Engine({ resolution: 'auto', ...linkTiming(capture.timing) });
+    engine = new Engine({ resolution: 'auto', jitterUs: timingJitterUs(capture.timing) });
     r.seek(r.startUs + (r.endUs - r.startUs) / 4);
     r.play();
   }
@@ -195,7 +195,7 @@ function stalled(chunks: { bytes: Uint8Array; timeUs: number }[], maxUs: number,
 /** The live engine: the bytes in 16 ms USB chunks at the capture's pace, the page's ticks between them. */
 function fromLive(capture: Capture, stallUs = 0): { story: Story; holdAfterUs: number } {
   const times = capture.byteTimesUs!;
-  const engine = new Engine({ resolution: 'auto', jitterUs: linkTiming('per-chunk').jitterUs });
+  const engine = new Engine({ resolution: 'auto', jitterUs: timingJitterUs('per-chunk') });
   const chunks = stallUs > 0 ? stalled(usbChunks(capture.bytes, times), stallUs) : usbChunks(capture.bytes, times);
   let last = chunks[0]?.timeUs ?? 0;
   for (const c of chunks) {
@@ -467,7 +467,7 @@ function doctorDisagreements(capture: Capture): string[] {
 function replayDoctorSays(capture: Capture): DoctorFinding[] {
   const clock = new SimulatedClock();
   const posts: FromWorker[] = [];
-  const engine = new Engine({ resolution: 'auto', ...linkTiming(capture.timing) });
+  const engine = new Engine({ resolution: 'auto', jitterUs: timingJitterUs(capture.timing) });
   let ended = false;
   const r: ReplaySource = new ReplaySource(
     { capture },

@@ -26,7 +26,7 @@ import { doctorEvent } from '../src/report/doctor-events.js';
 import { healthReport } from '../src/report/report.js';
 import { resolutionKey } from '../src/report/resolution-key.js';
 import { summarizeCapture } from '../src/report/summary.js';
-import { linkTiming } from '../src/report/capture-pass.js';
+import { timingJitterUs } from '../src/report/capture-pass.js';
 import { SLICE_BYTES } from '../src/report/capture-pass.js';
 import { preset } from '../src/simulator/presets.js';
 import { simulate } from '../src/simulator/simulator.js';
@@ -35,7 +35,7 @@ import { perByteCapture, usbChunks } from './feeds.js';
 /** One port decoded alone with `resolution`: its decoder and its link monitor, finished at the capture's end. */
 function decodeAlone(capture: Capture, port: number, resolution: 'auto' | Resolution, from: 'user' | 'internal-remote') {
   const decoder = new SpektrumDecoder({ resolution, resolutionFrom: from });
-  const link = new LinkMonitor(linkTiming(capture.timing));
+  const link = new LinkMonitor({ jitterUs: timingJitterUs(capture.timing) });
   for (const chunk of captureChunks(capture, port)) {
     decoder.push(chunk.bytes, chunk.time);
     for (let f = decoder.next(); f; f = decoder.next()) link.frame(f);
@@ -92,7 +92,7 @@ function separatePasses(capture: Capture) {
       const { resolution, from } = chosen.get(port) ?? { resolution: 'auto', from: 'user' };
       const source = {
         decoder: new SpektrumDecoder({ resolution, resolutionFrom: from }),
-        link: new LinkMonitor(linkTiming(capture.timing)),
+        link: new LinkMonitor({ jitterUs: timingJitterUs(capture.timing) }),
       };
       const name = capture.meta.ports?.[port]?.name;
       doctor.attach(port, { ...source, label: typeof name === 'string' && name !== '' ? name : `Port ${port}` });
@@ -270,7 +270,7 @@ describe('the frame period statistics', () => {
   /** The ordinary intervals the link monitor saw, every one, sorted: what the report's figures are taken over. */
   function fromEveryInterval(capture: Capture) {
     const decoder = new SpektrumDecoder();
-    const link = new LinkMonitor(linkTiming(capture.timing));
+    const link = new LinkMonitor({ jitterUs: timingJitterUs(capture.timing) });
     const intervals: number[] = [];
     const take = () => {
       for (let f = decoder.next(); f; f = decoder.next()) {

@@ -13,9 +13,6 @@ import { SourceRegistry } from '../src/worker/registry.js';
 import { usbChunks } from './feeds.js';
 import { fakeHost } from './worker-fakes.js';
 
-/** Link timing with no delivery jitter assumed (the tests feed their own times). */
-const NO_JITTER = { jitterUs: 0, wireTimes: false };
-
 function setup() {
   const fake = fakeHost();
   const diagnosis = new Diagnosis(
@@ -27,7 +24,7 @@ function setup() {
   const registry = new SourceRegistry(fake.host, diagnosis, { closing: async () => undefined, empty: () => undefined });
   let flushes = 0;
   const batcher = new Batcher(fake.host, registry, () => flushes++);
-  const source = registry.add('demo', 0, 'Demo', NO_JITTER);
+  const source = registry.add('demo', 0, 'Demo', 0);
   const sim = simulate({ ...preset('dsmx-11ms-2048-internal'), seed: 4 }, 2_000_000);
   const chunks = usbChunks(sim.bytes, sim.timesUs, 1_000);
   return { ...fake, registry, batcher, source, chunks, flushes: () => flushes };
@@ -131,8 +128,8 @@ describe('the batcher', () => {
       stop: async () => undefined,
       release: async () => undefined,
     });
-    const a = registry.add('replay', 0, 'A', NO_JITTER);
-    const b = registry.add('replay', 1, 'B', NO_JITTER);
+    const a = registry.add('replay', 0, 'A', 0);
+    const b = registry.add('replay', 1, 'B', 0);
     expect(source.engine).not.toBe(a.engine);
     for (const s of [a, b]) s.engine.push(chunks[0]!.bytes, chunks[0]!.timeUs, 0);
     batcher.flush();

@@ -4,9 +4,6 @@ import { Diagnosis } from '../src/worker/diagnosis.js';
 import { type Driver, type Source, SourceRegistry } from '../src/worker/registry.js';
 import { fakeHost } from './worker-fakes.js';
 
-/** Link timing with no delivery jitter assumed (the tests feed their own times). */
-const NO_JITTER = { jitterUs: 0, wireTimes: false };
-
 /** A driver that notes what it was asked. */
 function fakeDriver(kind: Driver['kind'], log: string[]): Driver {
   return {
@@ -44,7 +41,7 @@ function setup() {
 describe('the source registry', () => {
   it('gives each new source the lowest free id and its remote label, and the page a fresh decode for it', () => {
     const { registry, of } = setup();
-    const ids = [0, 1, 2, 3, 4].map(() => registry.add('serial', registry.freeId(), 'port', NO_JITTER));
+    const ids = [0, 1, 2, 3, 4].map(() => registry.add('serial', registry.freeId(), 'port', 0));
     expect(ids.map((s) => [s.id, s.label])).toEqual([
       [0, 'A'],
       [1, 'B'],
@@ -59,8 +56,8 @@ describe('the source registry', () => {
   it('frees a removed source’s id for the next one, through its driver, and says when none is left', async () => {
     const { registry, log } = setup();
     await registry.use(fakeDriver('serial', log));
-    registry.add('serial', registry.freeId(), 'a', NO_JITTER);
-    registry.add('serial', registry.freeId(), 'b', NO_JITTER);
+    registry.add('serial', registry.freeId(), 'a', 0);
+    registry.add('serial', registry.freeId(), 'b', 0);
     await registry.remove(0);
     expect(log).toEqual(['serial release 0']);
     expect(registry.freeId()).toBe(0);
@@ -74,7 +71,7 @@ describe('the source registry', () => {
     const { registry, of } = setup();
     registry.send();
     expect(of('sources')).toHaveLength(1);
-    const s = registry.add('demo', 0, 'Demo', NO_JITTER);
+    const s = registry.add('demo', 0, 'Demo', 0);
     registry.send();
     registry.send();
     expect(of('sources')).toHaveLength(2);
@@ -90,8 +87,8 @@ describe('the source registry', () => {
     const { registry, log, posts } = setup();
     const demo = fakeDriver('demo', log);
     await registry.use(demo);
-    registry.add('demo', 0, 'a', NO_JITTER);
-    registry.add('demo', 1, 'b', NO_JITTER);
+    registry.add('demo', 0, 'a', 0);
+    registry.add('demo', 1, 'b', 0);
     await registry.use(demo); // the same driver: nothing closes
     expect(log).toEqual([]);
     posts.length = 0;

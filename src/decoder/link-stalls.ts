@@ -35,8 +35,6 @@ export interface StallMonitor {
   counterHoldUs(): number;
   /** Whether the frame period is the system byte's (known for sure), not an estimate from intervals. */
   periodKnown(): boolean;
-  /** The times are the line's own (`LinkOptions.wireTimes`): no silence is a delivery stall. */
-  readonly wireTimes: boolean;
   readonly failsafeAfterUs: number;
   add(kind: 'hold' | 'failsafe', startUs: number, lastFrameUs: number): LinkEpisode;
 }
@@ -317,8 +315,6 @@ export class StallJudge {
    * controller, on the receiver's own line, had its frames).
    */
   #judge(e: LinkEpisode, run: number | null, missed: number): boolean {
-    // On the line's own times a silence is the flight controller's too.
-    if (this.#monitor.wireTimes) return false;
     // With the receiver's counter, the hold was the link's where a run of frames it lost is a
     // hold's silence itself (lost frames scattered over a silence the adapter made are no hold
     // on the receiver's line).

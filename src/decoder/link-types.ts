@@ -39,12 +39,6 @@ export interface LinkOptions {
    */
   jitterUs?: number;
   /**
-   * The times are the receiver's line's own (a logic analyser's, per byte): a silence in them is
-   * one the flight controller saw too, never bytes an adapter held back, so no hold is withdrawn
-   * as a delivery stall. Default false (a serial adapter's chunk times).
-   */
-  wireTimes?: boolean;
-  /**
    * Called when frames are found missing: `count` frames that were due from `fromUs` on,
    * one period apart, none after `toUs`. For binned series (`LinkSeries`).
    */

@@ -126,7 +126,6 @@ export class LinkMonitor {
       counterHoldUs: () => this.#holdOption ?? holdThresholdUs(this.#stats.nominalPeriodUs, this.#jitterPrior),
       periodKnown: () => Number.isFinite(this.#systemPeriod) && this.#stats.nominalPeriodUs === this.#systemPeriod,
       failsafeAfterUs: this.#failsafeAfterUs,
-      wireTimes: options.wireTimes ?? false,
       add: (kind, startUs, lastFrameUs) => this.#add(kind, startUs, lastFrameUs),
     });
   }

@@ -46,13 +46,9 @@ export interface DecodeCaptureOptions extends DecoderOptions {
   doctorJudgedAtEnd?: boolean;
 }
 
-/**
- * What a capture's timing tells the link monitor: the delivery jitter to assume until it is
- * measured (USB batching for chunk times, none otherwise), and whether the times are the line's
- * own (a logic analyser's per-byte times: no silence in them is an adapter's delivery stall).
- */
-export function linkTiming(timing: CaptureTiming): { jitterUs: number; wireTimes: boolean } {
-  return { jitterUs: timing === 'per-chunk' ? USB_CHUNK_JITTER_US : 0, wireTimes: timing === 'per-byte' };
+/** The delivery jitter to assume for a capture's timing until it is measured: USB batching for chunk times, none for a logic analyser's. */
+export function timingJitterUs(timing: CaptureTiming): number {
+  return timing === 'per-chunk' ? USB_CHUNK_JITTER_US : 0;
 }
 
 /**
@@ -122,7 +118,7 @@ export function decodeCapture(
   const end = endUs ?? span.endUs;
   const decoder = new SpektrumDecoder(decoderOptions);
   const series = new LinkSeries(binUs, originUs ?? span.startUs);
-  const link = monitorWithSeries(linkTiming(capture.timing), series);
+  const link = monitorWithSeries({ jitterUs: timingJitterUs(capture.timing) }, series);
   if (doctor !== undefined && capture.timing === 'none')
     throw new TypeError('decodeCapture: a doctor needs a timed capture (doctorCapture gives an untimed one a clock)');
   const events = portEvents(capture, port);

@@ -12,7 +12,7 @@ import { chunkFirstByteUs, type Capture, type CaptureKind, type CaptureTiming } 
 import { Doctor } from './doctor.js';
 import type { DoctorCode, DoctorFinding, Severity } from './doctor-types.js';
 import { doctorEvent, stopsPort } from './doctor-events.js';
-import { linkTiming, SLICE_BYTES } from './capture-pass.js';
+import { SLICE_BYTES, timingJitterUs } from './capture-pass.js';
 import { captureSpan } from './capture-span.js';
 import { portResolutions } from './resolution-key.js';
 
@@ -157,7 +157,7 @@ export function doctorCapture(capture: Capture, options: DoctorCaptureOptions = 
       resolution: setting?.resolution ?? options.resolution ?? 'auto',
       resolutionFrom: setting?.from ?? 'user',
     });
-    const link = new LinkMonitor(linkTiming(capture.timing));
+    const link = new LinkMonitor({ jitterUs: timingJitterUs(capture.timing) });
     sources.set(port, { decoder, link });
     const label = names?.[port]?.name;
     doctor.attach(port, { decoder, link, label: typeof label === 'string' && label !== '' ? label : `Port ${port}` });

@@ -14,7 +14,7 @@ import type { Capture } from '../capture/model.js';
 import { SpektrumDecoder } from '../decoder/decoder.js';
 import type { DecoderCheckpoint, LinkCheckpoint } from '../decoder/checkpoint.js';
 import type { Resolution } from '../decoder/spec.js';
-import { linkTiming } from './capture-pass.js';
+import { timingJitterUs } from './capture-pass.js';
 import { Doctor } from './doctor.js';
 import type { PortCheckpoint } from './doctor-state.js';
 import type { DoctorOptions } from './doctor-types.js';
@@ -77,7 +77,7 @@ export function adoptPortMessage(capture: Capture, message: PortReadingMessage, 
   decoder.restore(message.decoder);
   const series = new LinkSeries(REPORT_BIN_US, job.originUs);
   series.restore(message.series);
-  const link = monitorWithSeries(linkTiming(capture.timing), series);
+  const link = monitorWithSeries({ jitterUs: timingJitterUs(capture.timing) }, series);
   link.restore(message.link);
   if (doctor !== undefined) {
     if (message.doctor === null) throw new TypeError(`port ${job.port}'s reading was made without a doctor`);

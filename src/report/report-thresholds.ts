@@ -98,7 +98,7 @@ export const MAX_LISTED_HOLDS = 200;
 
 /**
  * How late a chunk-timed frame is assumed to arrive from USB batching alone until the link
- * monitor has measured the delivery jitter on the capture itself, µs (`linkTiming`). Missed
+ * monitor has measured the delivery jitter on the capture itself, µs (`timingJitterUs`). Missed
  * frames, holds and the period statistics all come from `LinkMonitor`; this is its prior.
  */
 export const CHUNK_TIMING_ALLOWANCE_US = USB_CHUNK_JITTER_US;

@@ -4,7 +4,7 @@
  * Built with a `Host` (post and clock), so the whole worker runs in Node with fakes; worker.ts
  * gives it the browser's.
  */
-import { linkTiming } from '../report/capture-pass.js';
+import { USB_CHUNK_JITTER_US } from '../decoder/spec.js';
 import { Batcher } from './batcher.js';
 import { bind } from './binding.js';
 import { Diagnosis } from './diagnosis.js';
@@ -242,7 +242,7 @@ export class Dispatcher {
     });
     await registry.use(demo);
     for (let i = 0; i < demo.remotes; i++) {
-      const s = registry.add('demo', i, i === 0 ? 'Demo remote (internal, DSMX 11 ms)' : 'Demo remote (external)', linkTiming('per-chunk'));
+      const s = registry.add('demo', i, i === 0 ? 'Demo remote (internal, DSMX 11 ms)' : 'Demo remote (external)', USB_CHUNK_JITTER_US);
       s.state = 'reading';
     }
     demo.start();

@@ -20,8 +20,6 @@ export interface EngineOptions {
   resolution: 'auto' | 1024 | 2048;
   /** The delivery jitter to assume until it is measured (see LinkMonitor's `jitterUs`). */
   jitterUs: number;
-  /** The times are the line's own (see LinkMonitor's `wireTimes`). Default false. */
-  wireTimes?: boolean;
 }
 
 /**
@@ -77,7 +75,6 @@ export class Engine {
     // A live view may run for days: keep the newest episodes (the page shows ten minutes).
     this.link = new LinkMonitor({
       jitterUs: options.jitterUs,
-      wireTimes: options.wireTimes,
       maxEpisodes: 1000,
       // Missing frames due before the settled buckets go into the oldest one still open.
       onMissed: (from, to, n, p) => {

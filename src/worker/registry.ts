@@ -101,14 +101,14 @@ export class SourceRegistry {
   }
 
   /** A new source with a fresh decode; the page is told its decode starts. */
-  add(kind: SourceKind, id: number, name: string, timing: { jitterUs: number; wireTimes: boolean }): Source {
+  add(kind: SourceKind, id: number, name: string, jitterUs: number): Source {
     const source: Source = {
       id,
       kind,
       label: REMOTE_LABELS[id] ?? `R${id}`,
       state: 'opening',
       name,
-      engine: new Engine({ resolution: this.resolution, ...timing }),
+      engine: new Engine({ resolution: this.resolution, jitterUs }),
     };
     this.#sources.set(id, source);
     this.diagnosis.attach(id, source.engine, source.label);

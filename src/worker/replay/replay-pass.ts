@@ -14,7 +14,7 @@ import type { Capture } from '../../capture/model.js';
 import { recordTimeUs } from '../../capture/record-walk.js';
 import { RECORD_HEADER_SIZE } from '../../capture/layout.js';
 import { LinkSeries, monitorWithSeries } from '../../report/series.js';
-import { linkTiming } from '../../report/capture-pass.js';
+import { timingJitterUs } from '../../report/capture-pass.js';
 import { recordedStops, StopCursor } from '../../report/doctor-events.js';
 import { failsafeAsRead, failsafesOf, overviewBinUs, sumOverview } from './overview.js';
 import type { Overview } from '../protocol.js';
@@ -114,7 +114,7 @@ export class ReplayPass {
     const p: PortPass = {
       port,
       decoder: new SpektrumDecoder({ resolution: this.resolution }),
-      link: monitorWithSeries(linkTiming(this.#capture?.timing ?? 'per-chunk'), series),
+      link: monitorWithSeries({ jitterUs: timingJitterUs(this.#capture?.timing ?? 'per-chunk') }, series),
       series,
     };
     this.#byPort[port] = p;

@@ -20,7 +20,7 @@ import { readCapture } from '../../capture/sniff.js';
 import { truncatedRecord } from '../../capture/reader.js';
 import { FRAME_PERIOD_11MS_US } from '../../decoder/spec.js';
 import { captureSpan } from '../../report/capture-span.js';
-import { linkTiming } from '../../report/capture-pass.js';
+import { timingJitterUs } from '../../report/capture-pass.js';
 import type { Batcher } from '../batcher.js';
 import type { Diagnosis } from '../diagnosis.js';
 import { type Host, notice } from '../host.js';
@@ -343,7 +343,7 @@ export class ReplaySession implements Driver {
     registry.clear();
     diagnosis.replayReset(r.startUs);
     for (const port of ports) {
-      const s = registry.add('replay', port, `${this.name}${ports.length > 1 ? ` port ${port}` : ''}`, linkTiming(this.#timing));
+      const s = registry.add('replay', port, `${this.name}${ports.length > 1 ? ` port ${port}` : ''}`, timingJitterUs(this.#timing));
       // The label the remote had when it was recorded.
       const saved = this.#meta.ports?.[port]?.name;
       if (typeof saved === 'string' && saved !== '') s.label = saved;

@@ -4,7 +4,7 @@
  * every RECONNECT_MS and on the browser's 'connect' event, so a replugged adapter comes back as
  * the same remote (same label, same port in the recording) without a prompt.
  */
-import { linkTiming } from '../../report/capture-pass.js';
+import { USB_CHUNK_JITTER_US } from '../../decoder/spec.js';
 import type { Batcher } from '../batcher.js';
 import type { Diagnosis } from '../diagnosis.js';
 import { type Host, notice, nowUs } from '../host.js';
@@ -99,7 +99,7 @@ export class SerialPorts implements Driver {
       return this.#reopen(lost, port);
     }
     const id = registry.freeId();
-    const source = registry.add('serial', id, describePort(port), linkTiming('per-chunk'));
+    const source = registry.add('serial', id, describePort(port), USB_CHUNK_JITTER_US);
     source.identity = identity;
     source.signals = signals;
     const now = (): number => nowUs(host);
