@@ -5,6 +5,9 @@ import { LinkMonitor } from '../src/decoder/link.js';
 import { HOLD_MIN_US } from '../src/decoder/link-rules.js';
 import type { DecodedFrame } from '../src/decoder/types.js';
 import { LinkSeries, monitorWithSeries } from '../src/report/series.js';
+import { summarizeCapture } from '../src/report/summary.js';
+import { simulate } from '../src/simulator/simulator.js';
+import { perByteCapture } from './feeds.js';
 
 /** A stand-in frame: only what the monitor reads. `fades: null` is a receiver without a counter. */
 function frame(timeUs: number, fadesDelta = 0, system: number | null = 0xb2, fades: number | null = 0): DecodedFrame {
@@ -435,6 +438,27 @@ describe('LinkMonitor: breaks the receiver explains', () => {
     run(counted, 0, 1_000_000, 40, 0);
     counted.frame({ ...frame(resume, 136, 0xb2, 176), remote: 'internal' } as DecodedFrame);
     expect(counted.stats.missedFrames).toBe(136);
+  });
+
+  it('counts each frame lost in a dropout once, whatever the count did: wrapped, jumped, or began in an RSSI-like band', () => {
+    // A review's cases: a count of 200 (byte 0 not yet told from RSSI, so no count before the
+    // silence) counted the frames twice; one that wrapped across 1.5 s (150 -> 31) counted none.
+    for (const [start, atUs, durationUs] of [
+      [200, 2e6, 3e5],
+      [200, 2e6, 1e6],
+      [150, 2e6, 1.5e6],
+      [250, 2e6, 1.5e6],
+      [40, 2e6, 1.5e6],
+      [100, 2e6, 2.5e6],
+    ] as const) {
+      const sim = simulate(
+        { system: 0xb2, remote: 'internal', channels: 7, fades: { start, lossRate: 0, randomRate: 0 }, dropouts: [{ atUs, durationUs }] },
+        6e6,
+        { truth: true },
+      );
+      const truth = (sim.truth?.gaps ?? []).reduce((n, g) => n + g.missedFrames, 0);
+      expect(summarizeCapture(perByteCapture(sim)).link.missedFrames, `${start}, ${durationUs / 1000} ms`).toBe(truth);
+    }
   });
 
   it('a counter that wraps in a silence, or falls after a short break, is no restart', () => {

@@ -60,13 +60,16 @@ export class RestartWatch {
     const prev = this.#prevCount;
     this.#prevCount = count;
     const modulus = frame.remote === 'internal' ? 256 : 65536;
-    this.#evidence = (count - prev + modulus) % modulus === frame.fadesDelta ? true : null;
+    // No count before this one (none yet, or byte 0 not yet read as one): no evidence either way.
+    this.#evidence = Number.isNaN(prev) ? false : (count - prev + modulus) % modulus === frame.fadesDelta ? true : null;
     const p = s.nominalPeriodUs;
     if (!(gapUs >= RESTART_MIN_GAP_US) || !Number.isFinite(p)) return 0;
     const due = Math.max(0, Math.round(gapUs / p) - 1);
-    if (!(count < prev)) return this.#evidence === null ? Math.max(1, due) : 0;
+    // A count the decoder left out (moved on, or wrapped) says nothing of the silence.
+    const unattributed = this.#evidence === null ? Math.max(1, due) : 0;
+    if (!(count < prev)) return unattributed;
     const wrapped = (count - prev + modulus) % modulus;
-    if (Math.abs(wrapped - due) <= Math.max(8, 0.5 * due)) return 0;
+    if (Math.abs(wrapped - due) <= Math.max(8, 0.5 * due)) return unattributed;
     s.restarts++;
     this.#restarts.push({ timeUs: frame.timeUs, from: prev, to: count, gapUs });
     if (this.#restarts.length > RESTARTS_KEPT) this.#restarts.shift();
