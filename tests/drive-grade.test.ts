@@ -4,6 +4,7 @@
  * §9's, the time a step takes to reach it, and when it reports the receiver lost and back.
  */
 import { describe, expect, it } from 'vitest';
+import { servoToMicros } from '../src/decoder/spec.js';
 import { builtinScenarios } from '../src/drive/builtins.js';
 import { type FcReading, gradeDrive } from '../src/drive/grade.js';
 import { DrivePlayer, type DriveWrite } from '../src/drive/player.js';
@@ -67,6 +68,47 @@ describe('grading a flight controller', () => {
     expect(after.length).toBeGreaterThanOrEqual(2);
     for (const a of after) expect(a).toBeGreaterThanOrEqual(100);
     for (const a of after) expect(a).toBeLessThanOrEqual(130);
+  });
+
+  it('passes a flight controller that reads exactly by §9 however late it reads, and fails one too slow or stuck', () => {
+    // A flight controller that converts by §9 exactly, `lagUs` behind, read every 20 ms.
+    const exact = (name: string, lagUs: number, loss: (t: number, sentNow: boolean) => boolean | null = (_, on) => !on) => {
+      const scenario = builtinScenarios({ system: 0xb2, remote: 'internal', channels: 12 }).find((x) => x.name === name) as DriveScenario;
+      const sent = new DrivePlayer(scenario).writesUntil(Number.POSITIVE_INFINITY);
+      const frames = sent.filter((w) => w.frame !== null);
+      const readings: FcReading[] = [];
+      const last = new Map<number, number>();
+      let k = 0;
+      for (let t = 0; t < (sent.at(-1)?.atUs ?? 0) + 2e6; t += 20_000) {
+        for (; k < frames.length && (frames[k] as DriveWrite).atUs <= t - lagUs; k++) {
+          const f = (frames[k] as DriveWrite).frame;
+          for (const c of f?.channels ?? []) last.set(c.id, servoToMicros(c.pos, f?.resolution ?? 2048));
+        }
+        const on = k > 0 && t - lagUs - ((frames[k - 1] as DriveWrite).atUs ?? 0) < 100_000;
+        readings.push({ atUs: t, channels: [1, 2, 3, 0].map((id) => last.get(id) ?? 1500), rxLoss: loss(t, on) });
+      }
+      return gradeDrive(sent, readings);
+    };
+    for (const lag of [0, 50_000]) {
+      const g = exact('steps', lag);
+      expect(check(g, 'values')?.verdict, `${lag}`).toBe('pass');
+      expect(check(g, 'latency')?.verdict, `${lag}`).toBe('pass');
+    }
+    expect(check(exact('steps', 100_000), 'latency')?.verdict).toBe('fail');
+    // Stuck in RXLOSS after the first silence; or never live at all.
+    expect(
+      check(
+        exact('dropouts', 0, (t, on) => t > 3.2e6 || !on),
+        'failsafe',
+      )?.verdict,
+    ).toBe('fail');
+    expect(
+      check(
+        exact('dropouts', 0, () => true),
+        'failsafe',
+      ),
+    ).toMatchObject({ verdict: 'fail', found: expect.stringMatching(/never reported the receiver live/) });
+    expect(check(exact('dropouts', 0), 'failsafe')?.verdict).toBe('pass');
   });
 
   it('says unknown where the flight controller tells nothing', () => {

@@ -88,6 +88,10 @@ const median = (xs: number[]): number => {
   return s.length === 0 ? Number.NaN : (s[(s.length - 1) >> 1] as number);
 };
 
+/** The longest delay a channel is looked for at when its order is found, and the step between the delays tried. */
+const MAX_LAG_US = 300_000;
+const LAG_STEP_US = 25_000;
+
 /** The result of grading: each check, and the map found (the flight controller's channel index → the receiver channel ID it follows). */
 export interface DriveGrade {
   checks: DriveCheck[];
@@ -117,15 +121,18 @@ export function gradeDrive(
     let best = Number.NaN;
     let bestId = -1;
     for (const [id, track] of byId) {
-      const sentAt = live.map((r) => valueAt(track, r.atUs));
-      const ok = sentAt.map((v, i) => Number.isFinite(v) && Number.isFinite(fc[i] as number));
-      const c = correlation(
-        fc.filter((_, i) => ok[i]),
-        sentAt.filter((_, i) => ok[i]),
-      );
-      if (c > 0.9 && !(c <= best)) {
-        best = c;
-        bestId = id;
+      // At the flight controller's own delay, whatever it is (up to MAX_LAG_US).
+      for (let lag = 0; lag <= MAX_LAG_US; lag += LAG_STEP_US) {
+        const sentAt = live.map((r) => valueAt(track, r.atUs - lag));
+        const ok = sentAt.map((v, i) => Number.isFinite(v) && Number.isFinite(fc[i] as number));
+        const c = correlation(
+          fc.filter((_, i) => ok[i]),
+          sentAt.filter((_, i) => ok[i]),
+        );
+        if (c > 0.9 && !(c <= best)) {
+          best = c;
+          bestId = id;
+        }
       }
     }
     if (bestId >= 0) map.set(j, bestId);
@@ -141,14 +148,15 @@ export function gradeDrive(
     found: map.size === 0 ? 'No channel followed any stick that moved.' : `${wrong.length === 0 ? 'As expected' : wrong.join('; ')}.`,
     verdict: unseen === expectedMap.length ? 'unknown' : wrong.length === 0 ? 'pass' : 'fail',
   });
-  // How far its values are from the spec's, over the mapped channels.
+  // How far its values are from the spec's, over the mapped channels, where the value sent had
+  // stood still for `STEADY_US` (a reading of a moving stick measures the latency too).
   const errors: number[] = [];
   for (const [j, id] of map) {
     const track = byId.get(id) as Track;
     for (const r of live) {
       const want = valueAt(track, r.atUs);
       const got = r.channels[j];
-      if (Number.isFinite(want) && got !== undefined) errors.push(got - want);
+      if (Number.isFinite(want) && got !== undefined && steady(track, r.atUs, want)) errors.push(got - want);
     }
   }
   if (errors.length === 0)
@@ -165,6 +173,21 @@ export function gradeDrive(
   checks.push(latency(byId, map, live));
   checks.push(failsafe(sent, readings));
   return { checks, map };
+}
+
+/** How long a value sent must have stood still for a reading to measure the flight controller's scale. */
+const STEADY_US = 200_000;
+
+/** Whether `track` held `value` for the `STEADY_US` before `atUs` (every frame in it within 1 µs). */
+function steady(track: Track, atUs: number, value: number): boolean {
+  if (!(valueAt(track, atUs - STEADY_US) === value)) return false;
+  for (let i = track.length - 1; i >= 0; i--) {
+    const [t, v] = track[i] as [number, number];
+    if (t > atUs) continue;
+    if (t < atUs - STEADY_US) return true;
+    if (Math.abs(v - value) > 1) return false;
+  }
+  return true;
 }
 
 /** From a step in a sent channel (over 200 µs from one frame to the next) to the first reading closer to the new value than the old. */
@@ -184,19 +207,14 @@ function latency(byId: Map<number, Track>, map: Map<number, number>, live: reado
   }
   const gaps = live.slice(1).map((r, i) => r.atUs - (live[i] as FcReading).atUs);
   const poll = median(gaps);
-  if (lags.length === 0)
-    return {
-      id: 'latency',
-      expects: 'A step reaches the flight controller within a frame or two.',
-      found: 'No step was sent and read.',
-      verdict: 'unknown',
-    };
+  const expects = 'A step reaches the flight controller within two frames (44 ms at 22 ms), told to within its reading interval.';
+  if (lags.length === 0) return { id: 'latency', expects, found: 'No step was sent and read.', verdict: 'unknown' };
   const ms = (us: number) => `${(us / 1000).toFixed(1)} ms`;
   return {
     id: 'latency',
-    expects: 'A step reaches the flight controller within a frame or two.',
+    expects,
     found: `${lags.length} steps: ${ms(median(lags))} median, ${ms(Math.max(...lags))} at the most (read every ${ms(poll)}, so to within that).`,
-    verdict: 'pass',
+    verdict: median(lags) <= 2 * 22_000 + poll ? 'pass' : 'fail',
   };
 }
 
@@ -210,6 +228,10 @@ function failsafe(sent: readonly DriveWrite[], readings: readonly FcReading[]): 
     return { id: 'failsafe', expects, found: 'The flight controller does not report its receiver state here.', verdict: 'unknown' };
   const parts: string[] = [];
   let missed = 0;
+  if (!said.some((r) => r.rxLoss === false)) {
+    return { id: 'failsafe', expects, found: 'It never reported the receiver live: it read none of the frames.', verdict: 'fail' };
+  }
+  const lastFrame = frames.at(-1) ?? Number.NaN;
   for (let i = 1; i < frames.length; i++) {
     const last = frames[i - 1] as number;
     const next = frames[i] as number;
@@ -218,12 +240,16 @@ function failsafe(sent: readonly DriveWrite[], readings: readonly FcReading[]): 
     const back = said.find((r) => r.atUs >= next && r.rxLoss === false);
     const gap = `${((next - last) / 1000).toFixed(0)} ms silence`;
     if (lost === undefined) {
+      // A silence past a second that it never reported.
       if (next - last >= 1_000_000) missed++;
       parts.push(`${gap}: not reported`);
-    } else
-      parts.push(
-        `${gap}: lost after ${((lost.atUs - last) / 1000).toFixed(0)} ms, back ${back === undefined ? 'never' : `after ${((back.atUs - next) / 1000).toFixed(0)} ms`}`,
-      );
+      continue;
+    }
+    // Still lost with frames coming for 2 s after the silence: it did not come back.
+    if (back === undefined && lastFrame - next >= 2_000_000) missed++;
+    parts.push(
+      `${gap}: lost after ${((lost.atUs - last) / 1000).toFixed(0)} ms, back ${back === undefined ? 'never' : `after ${((back.atUs - next) / 1000).toFixed(0)} ms`}`,
+    );
   }
   if (parts.length === 0) return { id: 'failsafe', expects, found: 'No silence was sent.', verdict: 'unknown' };
   return { id: 'failsafe', expects, found: `${parts.join('; ')}.`, verdict: missed > 0 ? 'fail' : 'pass' };
