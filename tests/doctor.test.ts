@@ -23,6 +23,7 @@ import { noiseSignal, receiveAs, uartReceive, type UartResult } from '../src/sim
 import { preset } from '../src/simulator/presets.js';
 import { simulate } from '../src/simulator/simulator.js';
 import type { Scenario } from '../src/simulator/scenario.js';
+import { perByteCapture, recording } from './feeds.js';
 import { concatBytes } from './bytes.js';
 
 const SECOND = 1_000_000;
@@ -705,5 +706,24 @@ describe.skipIf(!existsSync(px4))('the real PX4 captures', () => {
       const end = capture.byteTimesUs![capture.byteTimesUs!.length - 1]!;
       expect([name, ...s.findings(end).map((f) => f.code)]).toEqual([name, ...want]);
     }
+  });
+});
+
+describe('gaps the receiver did not lose', () => {
+  it('on a logic analyser are no USB adapter: damage or a cut capture, said so', () => {
+    // 200 ms cut out of a clean per-byte capture whose counter stands still.
+    const s = simulate({ ...preset('dsmx-11ms-2048-internal'), seed: 4, fades: { start: 40, lossRate: 0, randomRate: 0 } }, 5e6);
+    const keep: number[] = [];
+    s.timesUs.forEach((t, i) => {
+      if (t < 2e6 || t >= 2.2e6) keep.push(i);
+    });
+    const bytes = Uint8Array.from(keep, (i) => s.bytes[i] as number);
+    const timesUs = Float64Array.from(keep, (i) => s.timesUs[i] as number);
+    const wire = doctorCapture(perByteCapture({ bytes, timesUs })).findings.find((f) => f.code === 'delivery-stall');
+    expect(wire?.title).toMatch(/gaps in the frames read that the link did not lose/);
+    expect(JSON.stringify(wire)).not.toMatch(/USB|adapter or the computer/);
+    // Through an adapter the same gap is one it may have held back.
+    const adapter = doctorCapture(recording([{ bytes, timesUs }])).findings.find((f) => f.code === 'delivery-stall');
+    expect(adapter?.title).toMatch(/reached the computer late/);
   });
 });

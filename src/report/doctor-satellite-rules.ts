@@ -289,20 +289,29 @@ export function satelliteFindings(p: PortState, now: number, ctx: RuleContext, a
     });
   }
   if (s.stalls > 0 && ctx.timed) {
+    const silences = `${plural(s.stalls, 'silence')}, the longest ${formatDuration(s.longestStallUs)}`;
+    const sent = s.missedBasis === 'fade-counter' ? "the receiver's fade counter did not move" : 'the frames came afterwards, all at once';
+    // A logic analyser's times are the line's own: no adapter held anything back there.
     add({
       code: 'delivery-stall',
       ports: [p.port],
       severity: 'info',
       confidence: 'likely',
-      title: `${p.label}: frames reached the computer late (the link lost none of them)`,
+      title: ctx.precise
+        ? `${p.label}: gaps in the frames read that the link did not lose`
+        : `${p.label}: frames reached the computer late (the link lost none of them)`,
       evidence: [
         {
-          text: `${plural(s.stalls, 'silence')}, the longest ${formatDuration(s.longestStallUs)}, ${s.stalls === 1 ? 'was' : 'were'} the USB adapter or the computer holding frames back: ${s.missedBasis === 'fade-counter' ? "the receiver's fade counter did not move" : 'the frames came afterwards, all at once'}. Not counted as holds or failsafes: the flight controller, on the receiver's own line, had them in time.`,
+          text: ctx.precise
+            ? `${silences}, between frames read, ${s.stalls === 1 ? 'is' : 'are'} no loss of the link: ${sent}. On a logic analyser's capture no adapter holds bytes back: frames were lost to damage beside the gap, or the capture was cut there. Not counted as holds or failsafes.`
+            : `${silences}, ${s.stalls === 1 ? 'was' : 'were'} the USB adapter or the computer holding frames back: ${sent}. Not counted as holds or failsafes: the flight controller, on the receiver's own line, had them in time.`,
           timeUs: null,
         },
       ],
       todo: [
-        'For a recording that shows only the link: a USB port without a hub, no other program reading the port, the computer kept from sleeping or throttling USB; an FTDI adapter with a lower latency timer.',
+        ctx.precise
+          ? "Look at the gaps in Inspect frames: damaged bytes there are the line's (noise, a loose connection); a gap with no bytes at all is a cut in the capture."
+          : 'For a recording that shows only the link: a USB port without a hub, no other program reading the port, the computer kept from sleeping or throttling USB; an FTDI adapter with a lower latency timer.',
       ],
       settings: [],
       confirm: null,
