@@ -5,9 +5,10 @@
  */
 import { describe, expect, it } from 'vitest';
 import { doctorCapture } from '../src/report/doctor-capture.js';
+import { summarizeCapture } from '../src/report/summary.js';
 import { preset } from '../src/simulator/presets.js';
 import { simulate } from '../src/simulator/simulator.js';
-import { recording } from './feeds.js';
+import { perByteCapture, recording } from './feeds.js';
 
 const SYSTEMS = [0x01, 0x12, 0xa2, 0xb2];
 // External counts whose low byte is a system byte: 0x0012, 0x00A2, 0x00B2, 0x01B2, 0x01A2, 0x0112.
@@ -61,5 +62,43 @@ describe('the doctor on a header that reads both ways', () => {
     expect(count?.confidence).toBe('possible');
     expect(count?.severity).toBe('warning');
     expect(count?.evidence.map((e) => e.text).join(' ')).toMatch(/may be an external remote/);
+  });
+});
+
+describe('the period of a header that reads both ways', () => {
+  // A count that reads as a system byte of the other period: 0x12 and 0xB2 say 11 ms, 0x01 and 0xA2 say 22 ms.
+  const CASES = [
+    { system: 0x01, start: 18 },
+    { system: 0xa2, start: 178 },
+    { system: 0x12, start: 1 },
+    { system: 0xb2, start: 162 },
+  ];
+
+  it('comes from the frames once their timing refutes the count read as a system byte', () => {
+    for (const { system, start } of CASES) {
+      // The count never moves: the bytes read as an internal remote all through.
+      const sim = external(system, start, 0);
+      const nominal = system === 0x01 || system === 0xa2 ? 22_000 : 11_000;
+      for (const [feed, capture] of [
+        ['16 ms chunks', recording([sim])],
+        ['1 ms chunks', recording([sim], true, 1_000)],
+        ['per byte', perByteCapture(sim)],
+      ] as const) {
+        const { link } = summarizeCapture(capture);
+        const where = `system 0x${system.toString(16)}, count ${start}, ${feed}`;
+        expect(link.nominalPeriodUs, where).toBe(nominal);
+        expect(link.missedFrames, where).toBe(0);
+      }
+    }
+  });
+
+  it("stays the system byte's where frames are lost but those between come a period apart", () => {
+    // An internal 11 ms remote losing half its frames: its mean interval is 22 ms.
+    const sim = simulate({ system: 0xb2, remote: 'internal', channels: 7, seed: 3, fades: { lossRate: 0.5, randomRate: 0 } }, 3_000_000);
+    for (const capture of [recording([sim]), perByteCapture(sim)]) {
+      const { link } = summarizeCapture(capture);
+      expect(link.nominalPeriodUs).toBe(11_000);
+      expect(link.missedFrames).toBeGreaterThan(100);
+    }
   });
 });

@@ -93,6 +93,8 @@ export interface LinkCheckpoint {
   readonly periodTimes: Float64Array;
   readonly periodCount: number;
   readonly periodOldest: number;
+  readonly periodStated: number;
+  readonly periodRefuted: boolean;
   readonly systemByte: number;
   readonly rateTimes: Float64Array;
   readonly rateFades: Float64Array;

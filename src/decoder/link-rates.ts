@@ -7,6 +7,11 @@
  * 22 ms: an adapter that delivers in batches dates a frame late by up to the longest interval
  * it leaves, so the mean interval is known only to that over the periods in the window, and a
  * mean closer than that to the boundary between the two decides nothing yet.
+ *
+ * A system byte states the period, until the frames refute it: a window whose timing snaps to the
+ * other period, not one of whose intervals fits the stated one (an external remote whose fade
+ * count reads as a system byte, or a receiver whose byte lies). Missed frames do not refute it:
+ * the receiver counts them, and the frames between them come a period apart.
  */
 import type { LinkCheckpoint } from './checkpoint.js';
 import { nominalPeriodOf, PERIOD_SNAP_US } from './link-rules.js';
@@ -21,12 +26,13 @@ const RATE_WINDOW = 512;
 /** What of a `LinkCheckpoint` is the rates'. */
 type RatesCheckpoint = Pick<
   LinkCheckpoint,
-  'periodTimes' | 'periodCount' | 'periodOldest' | 'rateTimes' | 'rateFades' | 'rateCount' | 'rateNext'
+  'periodTimes' | 'periodCount' | 'periodOldest' | 'periodStated' | 'periodRefuted' | 'rateTimes' | 'rateFades' | 'rateCount' | 'rateNext'
 >;
 
 /**
  * The period and fade-rate windows: each frame taken (`measure`) sets `periodUs`, `fadeRate`
- * and, while no system byte gives it, `nominalPeriodUs` in the monitor's stats.
+ * and, while no system byte states it (or the frames refuted what one stated), `nominalPeriodUs`
+ * in the monitor's stats.
  */
 export class LinkRates {
   /** The last frame times without a gap, a ring: `#periodCount` of them, the oldest at `#periodOldest` once it is full. */
@@ -37,6 +43,16 @@ export class LinkRates {
   readonly #rateFades = new Float64Array(RATE_WINDOW);
   #rateCount = 0;
   #rateNext = 0;
+  /** The period the system byte states (NaN: none), and whether the frames' timing refuted it. */
+  #stated = NaN;
+  #refuted = false;
+
+  /** A system byte states the period `periodUs` (NaN: none does now): it is the nominal period until refuted. */
+  state(periodUs: number, s: LinkStats): void {
+    this.#stated = periodUs;
+    this.#refuted = false;
+    s.nominalPeriodUs = periodUs;
+  }
 
   /** Forgets the period window's frames (after a gap or an interruption: no interval spans it). */
   clearPeriod(): void {
@@ -44,11 +60,22 @@ export class LinkRates {
   }
 
   /**
-   * The period and fade-rate windows take the frame at `t` (and, when `snap`: no system byte
-   * gives the period, the nominal period is snapped, which the frame's own rules read), and the
-   * figures in `s` follow.
+   * The period and fade-rate windows take the frame at `t` (and, where no system byte states
+   * the period or the frames refuted it, the nominal period is snapped, which the frame's own
+   * rules read), and the figures in `s` follow.
    */
-  measure(t: number, fadesDelta: number, s: LinkStats, snap: boolean): void {
+  measure(t: number, fadesDelta: number, s: LinkStats): void {
+    // Fade rate over a window of recent frames.
+    const i = this.#rateNext;
+    const fades = this.#rateFades;
+    const prev = this.#rateCount === 0 ? 0 : (fades[i === 0 ? RATE_WINDOW - 1 : i - 1] ?? 0);
+    this.#rateTimes[i] = t;
+    fades[i] = prev + fadesDelta;
+    this.#rateNext = i === RATE_WINDOW - 1 ? 0 : i + 1;
+    if (this.#rateCount < RATE_WINDOW) this.#rateCount++;
+    const oldest = this.#rateCount < RATE_WINDOW ? 0 : this.#rateNext;
+    const rateSpan = t - (this.#rateTimes[oldest] ?? NaN);
+    s.fadeRate = rateSpan > 0 ? (((fades[i] ?? 0) - (fades[oldest] ?? 0)) / rateSpan) * 1e6 : 0;
     // Period: the span of the last 32 gap-free intervals, which averages out chunk jitter.
     const times = this.#periodTimes;
     const count = this.#periodCount;
@@ -61,38 +88,58 @@ export class LinkRates {
       this.#periodOldest = slot === PERIOD_WINDOW - 1 ? 0 : slot + 1;
     }
     if (this.#periodCount >= 9) {
-      if (snap && (!Number.isFinite(s.nominalPeriodUs) || this.#periodCount === PERIOD_WINDOW)) this.#snap(slot, s);
+      if (!Number.isFinite(this.#stated) || this.#refuted) {
+        if (!Number.isFinite(s.nominalPeriodUs) || this.#periodCount === PERIOD_WINDOW)
+          s.nominalPeriodUs = this.#snap(slot, s.nominalPeriodUs);
+      } else if ((slot & 7) === 0) {
+        // Every eighth frame: the stated period is weighed against the window's timing.
+        this.#refute(slot, s);
+      }
       // Whole periods in the span, so that a missed frame (one interval two periods long) does
       // not bias it, and chunk-time jitter averages out.
       const span = t - (times[this.#periodOldest] ?? NaN);
       s.periodUs = span / Math.max(1, Math.round(span / s.nominalPeriodUs));
     }
-    // Fade rate over a window of recent frames.
-    const i = this.#rateNext;
-    const fades = this.#rateFades;
-    const prev = this.#rateCount === 0 ? 0 : (fades[i === 0 ? RATE_WINDOW - 1 : i - 1] ?? 0);
-    this.#rateTimes[i] = t;
-    fades[i] = prev + fadesDelta;
-    this.#rateNext = i === RATE_WINDOW - 1 ? 0 : i + 1;
-    if (this.#rateCount < RATE_WINDOW) this.#rateCount++;
-    const oldest = this.#rateCount < RATE_WINDOW ? 0 : this.#rateNext;
-    const span = t - (this.#rateTimes[oldest] ?? NaN);
-    s.fadeRate = span > 0 ? (((fades[i] ?? 0) - (fades[oldest] ?? 0)) / span) * 1e6 : 0;
+  }
+
+  /**
+   * The stated period is refuted where the window's timing snaps to the other one, not one of its
+   * intervals fits the stated period, and, if the frames came slower than stated, the receiver's
+   * counter did not count the frames that would then be lost.
+   */
+  #refute(newest: number, s: LinkStats): void {
+    const other = this.#snap(newest, NaN);
+    const stated = this.#stated;
+    if (!(other !== stated) || Number.isNaN(other)) return;
+    if (other > stated) {
+      const fades = this.#rateFades;
+      const last = this.#rateNext === 0 ? RATE_WINDOW - 1 : this.#rateNext - 1;
+      const first = (last - (this.#periodCount - 1) + RATE_WINDOW) % RATE_WINDOW;
+      if ((fades[last] ?? 0) !== (fades[first] ?? 0)) return;
+    }
+    const times = this.#periodTimes;
+    for (let k = 1, i = this.#periodOldest; k < this.#periodCount; k++) {
+      const next = i === PERIOD_WINDOW - 1 ? 0 : i + 1;
+      if (Math.abs((times[next] ?? NaN) - (times[i] ?? NaN) - stated) <= stated / 4) return;
+      i = next;
+    }
+    this.#refuted = true;
+    s.nominalPeriodUs = other;
   }
 
   /**
    * Without a system byte: the nominal period from the mean interval of the window ending at
-   * `newest`. It is decided only where the mean interval is further from the 11/22 ms boundary than the lateness
+   * `newest` (else `current`). It is decided only where the mean interval is further from the 11/22 ms boundary than the lateness
    * the window's longest interval allows, and again over every full window, so that a few frames
    * missing early do not stick. A window that a delivery burst crowds (frames a stall held back,
    * dated together) is faster than any system sends: it says nothing of the period.
    */
-  #snap(newest: number, s: LinkStats): void {
+  #snap(newest: number, current: number): number {
     const times = this.#periodTimes;
     const oldest = this.#periodOldest;
     const periods = this.#periodCount - 1;
     const mean = ((times[newest] ?? NaN) - (times[oldest] ?? NaN)) / periods;
-    if (mean < BURST_MEAN_US) return;
+    if (mean < BURST_MEAN_US) return current;
     let longest = 0;
     for (let k = 1, i = oldest; k < this.#periodCount; k++) {
       const next = i === PERIOD_WINDOW - 1 ? 0 : i + 1;
@@ -100,7 +147,7 @@ export class LinkRates {
       if (interval > longest) longest = interval;
       i = next;
     }
-    if (Math.abs(mean - PERIOD_SNAP_US) > longest / periods) s.nominalPeriodUs = nominalPeriodOf(mean);
+    return Math.abs(mean - PERIOD_SNAP_US) > longest / periods ? nominalPeriodOf(mean) : current;
   }
 
   /** The windows as they stand (copies), for `LinkMonitor.checkpoint()`. */
@@ -109,6 +156,8 @@ export class LinkRates {
       periodTimes: this.#periodTimes.slice(),
       periodCount: this.#periodCount,
       periodOldest: this.#periodOldest,
+      periodStated: this.#stated,
+      periodRefuted: this.#refuted,
       rateTimes: this.#rateTimes.slice(),
       rateFades: this.#rateFades.slice(),
       rateCount: this.#rateCount,
@@ -121,6 +170,8 @@ export class LinkRates {
     this.#periodTimes.set(cp.periodTimes);
     this.#periodCount = cp.periodCount;
     this.#periodOldest = cp.periodOldest;
+    this.#stated = cp.periodStated;
+    this.#refuted = cp.periodRefuted;
     this.#rateTimes.set(cp.rateTimes);
     this.#rateFades.set(cp.rateFades);
     this.#rateCount = cp.rateCount;

@@ -189,12 +189,18 @@ export class LinkMonitor {
       s.rssi = frame.rssi;
       if (!(s.minRssi <= frame.rssi)) s.minRssi = frame.rssi;
     }
-    if (frame.system !== null && frame.system !== this.#systemByte) {
+    if (frame.system === null && this.#systemByte !== -1) {
+      // The frames are an external remote's after all (re-read, or a rebind): the byte the period
+      // was taken from was a fade count, and its period is no evidence; timing decides it again.
+      this.#systemByte = -1;
+      this.#systemPeriod = NaN;
+      this.#rates.state(NaN, s);
+    } else if (frame.system !== null && frame.system !== this.#systemByte) {
       const info = systemInfo(frame.system);
       if (info) {
         this.#systemByte = frame.system;
         this.#systemPeriod = info.periodUs;
-        s.nominalPeriodUs = this.#systemPeriod;
+        this.#rates.state(info.periodUs, s);
       }
     }
     const last = this.#lastUs;
@@ -227,7 +233,7 @@ export class LinkMonitor {
         if (Number.isFinite(p) && gap > 3 * p && gap > this.holdAfterUs) this.#rates.clearPeriod();
       }
       this.#lastUs = t;
-      this.#rates.measure(t, fades, s, !Number.isFinite(this.#systemPeriod));
+      this.#rates.measure(t, fades, s);
       this.#ledger.frame(t, s.nominalPeriodUs, this.#missed);
       this.#stalls.confirm(this.#ledger);
       s.deliveryDelayUs = this.#ledger.delayUs;
