@@ -11,6 +11,7 @@ import type { WindowEnd } from './axes.js';
 import { onFrame, wake } from './frame-loop.js';
 import { Live } from './live.js';
 import type { DiagnosisStatus } from '../worker/protocol.js';
+import type { DriveStatus } from '../worker/drive.js';
 
 export interface Notice {
   id: number;
@@ -40,6 +41,8 @@ export const inspection = signal<InspectEntry[] | null>(null);
 export const bindLog = signal<BindProgress[]>([]);
 /** The doctor's findings for the session or the replay position (null: none yet). */
 export const diagnosis = signal<DiagnosisStatus | null>(null);
+/** The drive under way, or the last one (null: none this session). */
+export const drive = signal<DriveStatus | null>(null);
 
 const IDLE: SourceStatus = {
   id: -1,
@@ -217,6 +220,9 @@ function receive(message: FromWorker): void {
       break;
     case 'diagnosis':
       diagnosis.value = message.diagnosis;
+      break;
+    case 'drive':
+      drive.value = message.drive;
       break;
     default: {
       const never: never = message;

@@ -32,6 +32,16 @@ function step(note: string, seconds: number, rx?: Scenario): DriveStep {
   return rx === undefined ? { note, durationUs: seconds * S } : { note, durationUs: seconds * S, receiver: rx };
 }
 
+/** The user's own sticks (sliders, keys, a gamepad: `DrivePlayer.setChannel`) over a receiver at rest, for up to an hour. */
+export function manualScenario(base: DriveReceiver): DriveScenario {
+  if (systemInfo(base.system) === undefined) throw new TypeError(`system must be 0x01, 0x12, 0xA2 or 0xB2, got ${base.system}`);
+  return {
+    name: 'manual',
+    title: 'The sticks as the page sets them: sliders, keys or a gamepad.',
+    steps: [step('Sticks from the page', 3600, receiver(base))],
+  };
+}
+
 /** Every built-in scenario for `base`, in the order the page lists them. */
 export function builtinScenarios(base: DriveReceiver): DriveScenario[] {
   const info = systemInfo(base.system);

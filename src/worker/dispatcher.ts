@@ -7,6 +7,7 @@
 import { USB_CHUNK_JITTER_US } from '../decoder/spec.js';
 import { Batcher } from './batcher.js';
 import { bind } from './binding.js';
+import { DriveSession } from './drive.js';
 import { Diagnosis } from './diagnosis.js';
 import { type Host, notice, nowUs } from './host.js';
 import { type LiveSink, liveSink } from './live.js';
@@ -39,6 +40,7 @@ export class Dispatcher {
   readonly batcher: Batcher;
   readonly serial: SerialPorts;
   readonly sink: LiveSink;
+  readonly drive: DriveSession;
   readonly #makeReport: ReportMaker;
   readonly #readSlices: SliceReaderMaker;
 
@@ -79,13 +81,17 @@ export class Dispatcher {
       enqueue: (task) => this.queue.enqueue(task),
       findPort: options.findPort,
     });
+    this.drive = new DriveSession(host, this.registry, this.serial);
     this.#makeReport = options.makeReport ?? WORKER_REPORT_MAKER;
     this.#readSlices = options.readSlices ?? READ_HERE;
   }
 
   /** A message from the page: queued behind those before it. */
   receive(message: ToWorker): void {
-    this.queue.enqueue(() => this.handle(message));
+    // Stopping a drive and its sticks cannot wait for a command under way.
+    if (message.type === 'drive-stop') this.drive.stop('stopped by the user');
+    else if (message.type === 'drive-channel') this.drive.setChannel(message.id, message.percent);
+    else this.queue.enqueue(() => this.handle(message));
   }
 
   /** The replay being played, if the session is one. */
@@ -179,6 +185,15 @@ export class Dispatcher {
         break;
       case 'replay-seek':
         await this.replay?.seek(message.timeUs);
+        break;
+      case 'drive-start':
+        await this.drive.start(message);
+        break;
+      case 'drive-stop':
+        this.drive.stop('stopped by the user');
+        break;
+      case 'drive-channel':
+        this.drive.setChannel(message.id, message.percent);
         break;
       case 'set-resolution':
         setResolution(registry, message.resolution);

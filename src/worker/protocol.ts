@@ -8,6 +8,7 @@ import type { FormatInfo } from '../decoder/types.js';
 import type { LinkState, MissedBasis } from '../decoder/link-types.js';
 import type { InspectEntry } from './inspector.js';
 import type { ConfirmProbe, DoctorFinding } from '../report/doctor-types.js';
+import type { DriveRequest, DriveStatus } from './drive.js';
 
 /** How the page names a port it was granted: its place in getPorts() and its USB IDs. */
 export interface PortIdentity {
@@ -49,6 +50,12 @@ export type ToWorker =
   | { type: 'set-resolution'; resolution: 'auto' | 1024 | 2048 }
   /** Listen briefly at a finding's other line setting to confirm it, then return to 115200. */
   | { type: 'diagnosis-confirm'; source: number; probe: ConfirmProbe }
+  /** Write a satellite's stream to the port's TX (a flight controller's satellite pad), and read the port as a source. */
+  | ({ type: 'drive-start' } & DriveRequest)
+  /** Stop writing at once (not queued behind other commands): the flight controller sees the link lost. */
+  | { type: 'drive-stop' }
+  /** Hold a channel at `percent` travel while driving (null: back to the scenario); not queued. */
+  | { type: 'drive-channel'; id: number; percent: number | null }
   // Exports of what the page shows.
   /**
    * One remote's decoded frames (of the capture being replayed, or of the live session's
@@ -224,7 +231,8 @@ export type FromWorker =
   | { type: 'overview'; overview: Overview }
   | { type: 'bind'; progress: BindProgress }
   | { type: 'inspection'; source: number; entries: InspectEntry[] }
-  | { type: 'diagnosis'; diagnosis: DiagnosisStatus };
+  | { type: 'diagnosis'; diagnosis: DiagnosisStatus }
+  | { type: 'drive'; drive: DriveStatus };
 
 /** The doctor's findings (src/report), sent when they change, at most 4× a second. */
 export interface DiagnosisStatus {

@@ -1,0 +1,194 @@
+/**
+ * Drive: the worker writes a satellite's stream to a port's TX (the adapter wired to a flight
+ * controller's satellite pad), on the worker's own timers, so a hidden tab does not slow it.
+ * The port is opened as an ordinary source too, so that with its TX wired to its own RX (the
+ * loopback self-test) the page decodes what it sends with SatScope's decoder.
+ *
+ * The frames come from the drive library (src/drive): the scenario's player and the write
+ * schedule (a frame only after 6 ms of silence, the newest frame when late). Stopping (the
+ * user, the scenario's end, a write that fails) stops the stream at once: the flight controller
+ * sees the link lost, as it would in the air.
+ */
+import { builtinScenarios, type DriveReceiver, manualScenario } from '../drive/builtins.js';
+import { DrivePlayer } from '../drive/player.js';
+import { type DriveScenario, parseDriveScenario } from '../drive/scenario.js';
+import { type DriveTimingStats, WriteSchedule } from '../drive/schedule.js';
+import { CHANNEL_COUNT, channelResolution, servoToMicros } from '../decoder/spec.js';
+import { type Host, notice } from './host.js';
+import type { PortIdentity } from './protocol.js';
+import type { SerialPorts } from './sources/serial-ports.js';
+import type { SourceRegistry } from './registry.js';
+
+/** How often the page is told where the drive is, ms. */
+const STATUS_MS = 250;
+/** A timer that wakes within this of a write's time (the ms clock's rounding) finds it due, µs. */
+const WAKE_TOLERANCE_US = 1;
+
+/** What the page asks the worker to drive. */
+export interface DriveRequest {
+  port: PortIdentity;
+  receiver: DriveReceiver;
+  /** A built-in scenario's name ('manual' for the page's sticks alone), or a scenario as JSON. */
+  scenario: string;
+  /** The most travel channel 0 (throttle) may reach, % (−100 … 100). */
+  throttleCeilingPercent: number;
+}
+
+/** What the page is told of the drive. */
+export interface DriveStatus {
+  state: 'driving' | 'ended' | 'stopped' | 'failed';
+  name: string;
+  title: string;
+  steps: { note: string; startUs: number; endUs: number }[];
+  /** Where the scenario is, µs from its start, and its length. */
+  positionUs: number;
+  durationUs: number;
+  step: number;
+  /** The newest frame written: its header and the channel values it carried (µs by channel id, NaN: not in it). */
+  sent: { system: number | null; remote: 'internal' | 'external'; resolution: 1024 | 2048; us: number[] } | null;
+  timing: DriveTimingStats;
+  /** Why it stopped, in words (null while driving). */
+  reason: string | null;
+  /** The source reading the same port (the loopback self-test), or null. */
+  source: number | null;
+}
+
+/** The scenario a request names: a built-in for its receiver, or the user's own JSON. @throws TypeError saying what is wrong */
+export function requestedScenario(r: DriveRequest): DriveScenario {
+  const text = r.scenario.trim();
+  if (text.startsWith('{')) return parseDriveScenario(text);
+  if (text === 'manual') return manualScenario(r.receiver);
+  const found = builtinScenarios(r.receiver).find((s) => s.name === text);
+  if (found === undefined) throw new TypeError(`no built-in scenario is called "${text}"`);
+  return found;
+}
+
+/** One drive at a time: started, its writes timed, stopped. */
+export class DriveSession {
+  #player: DrivePlayer | null = null;
+  #schedule: WriteSchedule | null = null;
+  #writer: WritableStreamDefaultWriter<Uint8Array> | null = null;
+  #startMs = 0;
+  #timer: unknown;
+  #statusTimer: unknown;
+  #sent: DriveStatus['sent'] = null;
+  #state: DriveStatus['state'] = 'stopped';
+  #reason: string | null = null;
+  #source: number | null = null;
+
+  constructor(
+    readonly host: Host,
+    readonly registry: SourceRegistry,
+    readonly serial: SerialPorts,
+  ) {}
+
+  get driving(): boolean {
+    return this.#state === 'driving';
+  }
+
+  /** Opens the port (as a source, for the loopback) and starts writing the scenario. */
+  async start(r: DriveRequest): Promise<void> {
+    this.stop('a new drive started');
+    let scenario: DriveScenario;
+    try {
+      scenario = requestedScenario(r);
+    } catch (error) {
+      notice(this.host, 'error', 'The scenario cannot be driven', (error as Error).message);
+      return;
+    }
+    if (!(await this.serial.open(r.port))) return;
+    const port = await this.serial.find(r.port);
+    const source = this.registry.list().find((s) => port !== undefined && s.serial?.port === port);
+    if (source === undefined || port === undefined || port.writable === null) {
+      notice(this.host, 'error', 'The port cannot be written', 'The adapter was opened, but the browser gives no way to write to it.');
+      return;
+    }
+    const writer = port.writable.getWriter();
+    this.#writer = writer;
+    this.#source = source.id;
+    this.#player = new DrivePlayer(scenario, { throttleCeilingPercent: r.throttleCeilingPercent });
+    this.#schedule = new WriteSchedule(this.#player);
+    this.#sent = null;
+    this.#state = 'driving';
+    this.#reason = null;
+    this.#startMs = this.host.clock.now();
+    this.#tick();
+    this.#statusTimer = this.host.clock.every(STATUS_MS, () => this.#post());
+    this.#post();
+  }
+
+  /** A channel held by the page (slider, key, gamepad) from the next frame on; null gives it back to the scenario. */
+  setChannel(id: number, percent: number | null): void {
+    if (!Number.isInteger(id) || id < 0 || id >= CHANNEL_COUNT) return;
+    this.#player?.setChannel(id, percent === null ? null : Math.max(-150, Math.min(150, percent)));
+  }
+
+  /** Stops writing now (the flight controller sees the link lost). */
+  stop(reason: string, state: 'stopped' | 'ended' | 'failed' = 'stopped'): void {
+    if (this.#player === null) return;
+    this.host.clock.cancel(this.#timer);
+    this.host.clock.cancel(this.#statusTimer);
+    this.#timer = undefined;
+    this.#statusTimer = undefined;
+    const writer = this.#writer;
+    this.#writer = null;
+    // Bytes already handed to the port go out; none after this.
+    writer?.releaseLock();
+    this.#state = state;
+    this.#reason = reason;
+    this.#post();
+    this.#player = null;
+    this.#schedule = null;
+  }
+
+  #nowUs(): number {
+    return (this.host.clock.now() - this.#startMs) * 1000;
+  }
+
+  /** Writes what is due, then sleeps until the next write is. */
+  #tick(): void {
+    const schedule = this.#schedule;
+    const writer = this.#writer;
+    if (schedule === null || writer === null) return;
+    const now = this.#nowUs();
+    const due = now + WAKE_TOLERANCE_US;
+    for (let w = schedule.take(due); w !== null; w = schedule.take(due)) {
+      writer.write(w.bytes).catch((error: unknown) => {
+        if (this.#writer === writer) this.stop(`the adapter could not be written (${String(error)}): unplugged?`, 'failed');
+      });
+      if (w.frame !== null) {
+        const us = new Array<number>(CHANNEL_COUNT).fill(Number.NaN);
+        for (const c of w.frame.channels)
+          if (c.id < CHANNEL_COUNT) us[c.id] = servoToMicros(c.pos, channelResolution(c.id, w.frame.resolution));
+        this.#sent = { system: w.frame.system, remote: w.frame.remote, resolution: w.frame.resolution, us };
+      }
+    }
+    const next = schedule.nextDueUs();
+    if (Number.isNaN(next)) {
+      this.stop('the scenario ended', 'ended');
+      return;
+    }
+    this.#timer = this.host.clock.after(Math.max(0, (next - now) / 1000), () => this.#tick());
+  }
+
+  #post(): void {
+    const player = this.#player;
+    const schedule = this.#schedule;
+    if (player === null || schedule === null) return;
+    const position = Math.min(this.#nowUs(), player.durationUs);
+    const status: DriveStatus = {
+      state: this.#state,
+      name: player.scenario.name,
+      title: player.scenario.title,
+      steps: player.steps.map((s) => ({ note: s.note, startUs: s.startUs, endUs: s.endUs })),
+      positionUs: position,
+      durationUs: player.durationUs,
+      step: player.stepAt(position).index,
+      sent: this.#sent,
+      timing: schedule.stats,
+      reason: this.#reason,
+      source: this.#source,
+    };
+    this.host.post({ type: 'drive', drive: status });
+  }
+}
