@@ -7,7 +7,7 @@ import type { DecodedFrame } from '../src/decoder/types.js';
 import { LinkSeries, monitorWithSeries } from '../src/report/series.js';
 import { summarizeCapture } from '../src/report/summary.js';
 import { simulate } from '../src/simulator/simulator.js';
-import { perByteCapture } from './feeds.js';
+import { perByteCapture, recording } from './feeds.js';
 
 /** A stand-in frame: only what the monitor reads. `fades: null` is a receiver without a counter. */
 function frame(timeUs: number, fadesDelta = 0, system: number | null = 0xb2, fades: number | null = 0): DecodedFrame {
@@ -234,6 +234,38 @@ describe('LinkMonitor: missed means missed', () => {
     for (const t of times) link.frame(bare(t));
     link.finish(times.at(-1)! + 2_000);
     expect(link.stats).toMatchObject({ missedBasis: 'frame-count', missedFrames: lost.size, lostFrames: lost.size, holds: 0 });
+  });
+
+  it("without a counter, counts a dropout in a stream's last half second whole, through USB batches up to 88 ms, never more", () => {
+    // A clone (00 00 header, fades 0): the ledger is the only basis. Dropouts of 1–20 frames end
+    // 60–600 ms before the stream does: no later window confirms them, only the frames after them.
+    const wrong: string[] = [];
+    for (const lost of [1, 3, 9, 14, 20])
+      for (const beforeEndUs of [60_000, 100_000, 200_000, 450_000, 600_000]) {
+        const endUs = 5_000_000;
+        const sim = simulate(
+          {
+            system: 0xb2,
+            header: 'zero',
+            fades: { lossRate: 0, randomRate: 0 },
+            dropouts: [{ atUs: endUs - beforeEndUs - lost * 11_000, durationUs: lost * 11_000 }],
+          },
+          endUs,
+          { truth: true },
+        );
+        const truth = sim.truth!.gaps.reduce((n, g) => n + g.missedFrames, 0);
+        expect(truth).toBe(lost);
+        for (const windowUs of [1_000, 16_000, 64_000, 88_000, 0]) {
+          const { link } = summarizeCapture(windowUs === 0 ? perByteCapture(sim) : recording([sim], true, windowUs));
+          expect(link.missedBasis).toBe('frame-count');
+          // 88 ms batches deliver the last frames a period late by their timer (8 frames a batch, all
+          // of one phase): a dropout that ends in that batch cannot be told from that lateness.
+          const told = !(windowUs === 88_000 && beforeEndUs < 100_000);
+          if (told ? link.missedFrames !== truth : link.missedFrames > truth)
+            wrong.push(`${lost} lost ${beforeEndUs / 1000} ms before the end, ${windowUs / 1000 || 'per-byte'}: ${link.missedFrames}`);
+        }
+      }
+    expect(wrong).toEqual([]);
   });
 
   it('places missing frames where they were due, for the binned series', () => {

@@ -29,6 +29,7 @@ export interface LedgerCheckpoint {
   readonly period: number;
   readonly refUs: number;
   readonly refSlot: number;
+  readonly refLateUs: number;
   readonly slot: number;
   readonly lastUs: number;
   readonly winStartUs: number;

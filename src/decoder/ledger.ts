@@ -5,11 +5,20 @@
  * (link.ts) owns one.
  */
 import type { LedgerCheckpoint } from './checkpoint.js';
+import { BYTE_TIME_US } from './spec.js';
 
 /** The shortest window over which frames received are counted against frames expected, µs. */
 export const LEDGER_WINDOW_US = 500_000;
-/** At the end of a stream, the least late of this many last frames tells what is missing after the last window's most punctual frame. */
+/** At the end of a stream, the least late of this many last frames tells, beyond the delivery jitter, what is missing after the last window's most punctual frame. */
 const TAIL_FRAMES = 4;
+/** The last frames kept for the end of the stream: a whole delivery of an adapter that batches them (up to 170 ms of 11 ms frames) and the frame before it. */
+const TAIL_KEPT = 16;
+/**
+ * How much later than a frame the reference may have come and the frame still count what it
+ * shows missing: half the 15 byte times by which a frame a later delivery vouches for is less
+ * late than a period (see `finish`).
+ */
+const VOUCHED_MARGIN_US = 7.5 * BYTE_TIME_US;
 /** Delivery jitter is the largest spread of the last this many windows. */
 const JITTER_WINDOWS = 8;
 
@@ -24,6 +33,12 @@ export class FrameLedger {
   #period = NaN;
   #refUs = NaN;
   #refSlot = 0;
+  /**
+   * How late the reference came against the schedule before it, less the frames counted missing
+   * there (negative where it came early, or a window's rounding counted a frame for its
+   * lateness); NaN until a window has closed on this schedule.
+   */
+  #refLateUs = NaN;
   #slot = 0;
   #lastUs = NaN;
   /**
@@ -39,8 +54,8 @@ export class FrameLedger {
   #winMinUs = NaN;
   #winMaxL = -Infinity;
   /** The last frames' times and slots (a ring), for the end of the stream. */
-  readonly #tailUs = new Float64Array(TAIL_FRAMES);
-  readonly #tailSlot = new Float64Array(TAIL_FRAMES);
+  readonly #tailUs = new Float64Array(TAIL_KEPT);
+  readonly #tailSlot = new Float64Array(TAIL_KEPT);
   #tailCount = 0;
   #winSumL = 0;
   #winGapUs = 0;
@@ -99,6 +114,7 @@ export class FrameLedger {
       this.#period = period;
       this.#refUs = t;
       this.#refSlot = this.#slot = 0;
+      this.#refLateUs = NaN;
       this.#lastUs = t;
       this.#tailCount = 0;
       this.#openWindow(t);
@@ -115,6 +131,7 @@ export class FrameLedger {
       this.#winSumL -= late * this.#winFrames;
       this.#refUs = t;
       this.#refSlot = this.#slot;
+      this.#refLateUs += late;
       late = 0;
     }
     if (gap > this.#winGapUs) {
@@ -138,15 +155,15 @@ export class FrameLedger {
       this.#winMinSlot = slot;
       this.#winMinUs = t;
     }
-    this.#tailUs[this.#tailCount % TAIL_FRAMES] = t;
-    this.#tailSlot[this.#tailCount % TAIL_FRAMES] = slot;
+    this.#tailUs[this.#tailCount % TAIL_KEPT] = t;
+    this.#tailSlot[this.#tailCount % TAIL_KEPT] = slot;
     this.#tailCount++;
   }
 
-  /** Closes the window: confirms what even its most punctual frame says is missing. */
-  #close(missed: (fromUs: number, toUs: number, count: number) => void): number {
+  /** Closes the window: confirms what even its most punctual frame says is missing (at most `most`). */
+  #close(missed: (fromUs: number, toUs: number, count: number) => void, most = Infinity): number {
     const p = this.#period;
-    const k = Math.max(0, Math.round(this.#winMinL / p));
+    const k = Math.max(0, Math.min(most, Math.round(this.#winMinL / p)));
     if (k > 0 && Number.isFinite(this.#winGapFromUs)) missed(this.#winGapFromUs + p, this.#winGapToUs, k);
     else if (k > 0) missed(this.#winMinUs - k * p, this.#winMinUs, k);
     // The most punctual frame is the schedule from now on (this also follows clock drift).
@@ -170,7 +187,11 @@ export class FrameLedger {
     this.closedPunctualUs = this.#winMinUs;
     this.#refUs = this.#winMinUs;
     this.#refSlot = this.#winMinSlot + k;
+    this.#refLateUs = this.#winMinL - k * p;
     this.#slot += k;
+    // The last frames after the most punctual one move with it.
+    for (let i = 0; i < TAIL_KEPT; i++)
+      if ((this.#tailSlot[i] ?? NaN) > this.#winMinSlot) this.#tailSlot[i] = (this.#tailSlot[i] ?? NaN) + k;
     // The next window starts at its own first frame: one that began at this frame would close
     // on the frames of a delivery burst alone after a stall longer than a window, all late,
     // and count the frames the burst brought as missing.
@@ -184,6 +205,7 @@ export class FrameLedger {
       period: this.#period,
       refUs: this.#refUs,
       refSlot: this.#refSlot,
+      refLateUs: this.#refLateUs,
       slot: this.#slot,
       lastUs: this.#lastUs,
       winStartUs: this.#winStartUs,
@@ -215,6 +237,7 @@ export class FrameLedger {
     this.#period = cp.period;
     this.#refUs = cp.refUs;
     this.#refSlot = cp.refSlot;
+    this.#refLateUs = cp.refLateUs;
     this.#slot = cp.slot;
     this.#lastUs = cp.lastUs;
     this.#winStartUs = cp.winStartUs;
@@ -244,20 +267,38 @@ export class FrameLedger {
   finish(endUs: number, graceUs: number, missed: (fromUs: number, toUs: number, count: number) => void): number {
     if (!Number.isFinite(this.#refUs)) return 0;
     const p = this.#period;
-    // No later window will look at the frames after the last window's most punctual one: even
-    // the least late of them is the evidence there will be, beyond the delivery jitter measured
-    // (an adapter that hands frames over in batches delivers its last batch when its timer
-    // runs out, that much late).
+    // No later window will look at the frames after the reference (the last window's most
+    // punctual frame), and the open window's most punctual one may have come in the last
+    // delivery, late by the adapter's timer: what is missing since the reference is what these
+    // frames prove. The least late of the last of them proves what is beyond the delivery jitter
+    // measured. A frame the next one came a delivery after (further apart than the bytes of one
+    // delivery put them) proves more: the adapter handed it over before that next frame was
+    // sent, a period after it, so it is less late than a period less its own 15 last bytes, and
+    // what it shows missing holds to the period, rounded down; the last such frame is the
+    // latest evidence.
     let tailMin = Infinity;
-    for (let i = 0; i < Math.min(TAIL_FRAMES, this.#tailCount); i++) {
-      const late = (this.#tailUs[i] ?? NaN) - this.#refUs - ((this.#tailSlot[i] ?? NaN) - this.#refSlot) * p;
-      if (late < tailMin) tailMin = late;
+    let vouched = Number.NEGATIVE_INFINITY;
+    for (let back = Math.min(TAIL_KEPT, this.#tailCount); back >= 1; back--) {
+      const i = (this.#tailCount - back) % TAIL_KEPT;
+      const slot = this.#tailSlot[i] ?? NaN;
+      if (!(slot > this.#refSlot)) continue;
+      const t = this.#tailUs[i] ?? NaN;
+      const late = t - this.#refUs - (slot - this.#refSlot) * p;
+      if (back <= TAIL_FRAMES && late < tailMin) tailMin = late;
+      if (back > 1 && (this.#tailUs[(i + 1) % TAIL_KEPT] ?? NaN) - t > p / 2) vouched = late;
     }
     const jitter = Number.isFinite(this.jitterUs) ? this.jitterUs : 0;
-    const after = Number.isFinite(tailMin) ? Math.max(0, Math.round((tailMin - this.#winMinL - jitter) / p)) : 0;
+    const beyondJitter = Number.isFinite(tailMin) ? Math.round((tailMin - jitter) / p) : 0;
+    // Against the later of the reference and the schedule before it (a window's rounding may have
+    // counted a frame for the reference's lateness), and only on a schedule a window has
+    // confirmed: frames timed against a period just taken up may be another's.
+    const byVouched = Number.isFinite(this.#refLateUs) ? Math.floor((vouched + Math.min(0, this.#refLateUs) + VOUCHED_MARGIN_US) / p) : 0;
+    const shown = Math.max(0, byVouched, beyondJitter);
     const gapFrom = this.#winGapFromUs;
     const gapTo = this.#winGapToUs;
-    let n = this.#winFrames > 1 ? this.#close(missed) : 0;
+    let n = this.#winFrames > 1 ? this.#close(missed, shown) : 0;
+    // The rest are after the window's most punctual frame: in its largest gap.
+    const after = shown - n;
     if (after > 0) missed(Number.isFinite(gapFrom) ? gapFrom + p : this.#lastUs, Number.isFinite(gapTo) ? gapTo : this.#lastUs, after);
     n += after;
     const silence = endUs - this.#lastUs;
