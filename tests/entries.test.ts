@@ -20,7 +20,9 @@ describe('package entries in a bundle', () => {
     // needs evidence of a channel, forced options never pick the alignment and an ambiguous
     // header is said and re-read: 0.9 kB; 16.9 kB since a silence is dated by the frame that
     // ends it and judged by the counter over the burst after it: 0.5 kB; 17.0 kB since an
-    // acquisition pass that finds no start is not scored again: 0.1 kB, 3.5x on noise).
-    expect(sizes.satscope.gzip).toBeLessThan(17.5 * 1024);
+    // acquisition pass that finds no start is not scored again: 0.1 kB, 3.5x on noise; 17.7 kB
+    // since a system byte's period is refuted by the frames' timing and a stream's end counts
+    // what its last deliveries vouch for: 0.3 kB).
+    expect(sizes.satscope.gzip).toBeLessThan(18 * 1024);
   }, 60_000);
 });
