@@ -1,13 +1,14 @@
 /**
  * Drive in the worker, in Node: a stand-in port whose TX is kept (with the fake clock's time of
  * each write) and, for the loopback self-test, wired back to its own RX. What is written must
- * be frames of 16 bytes with at least 6 ms of silence before each, decode in SatScope's decoder
+ * be frames of 16 bytes with at least 8 ms of silence before each, decode in SatScope's decoder
  * to the frames the scenario meant, stop at once when told, and never push the throttle past
  * the ceiling.
  */
 import { describe, expect, it } from 'vitest';
 import { SpektrumDecoder } from '../src/decoder/decoder.js';
 import { BYTE_TIME_US, servoToPercent } from '../src/decoder/spec.js';
+import { MIN_SILENCE_US } from '../src/drive/schedule.js';
 import { Dispatcher } from '../src/worker/dispatcher.js';
 import type { DriveStatus } from '../src/worker/drive.js';
 import type { ToWorker } from '../src/worker/protocol.js';
@@ -114,7 +115,7 @@ describe('driving a flight controller from the worker', () => {
     for (let i = 1; i < frames.length; i++) {
       const gap = (frames[i]?.atMs ?? 0) - (frames[i - 1]?.atMs ?? 0);
       expect(gap).toBeCloseTo(11, 1);
-      expect(gap - (16 * BYTE_TIME_US) / 1000).toBeGreaterThanOrEqual(6);
+      expect(gap - (16 * BYTE_TIME_US) / 1000).toBeGreaterThanOrEqual(MIN_SILENCE_US / 1000);
     }
     const decoded = decodeWrites(port.writes);
     expect(decoded.length).toBe(frames.length);
@@ -124,9 +125,11 @@ describe('driving a flight controller from the worker', () => {
     // The status the page last got (every 250 ms): the schedule's own account of the same writes.
     expect(s?.timing.frames).toBeGreaterThan(frames.length - 25);
     expect(s?.timing.skipped).toBe(0);
-    expect(s?.timing.minSilenceUs).toBeGreaterThanOrEqual(6_000);
+    expect(s?.timing.minSilenceUs).toBeGreaterThanOrEqual(MIN_SILENCE_US);
     expect(Math.abs((s?.timing.interval?.p50 ?? 0) - 11_000)).toBeLessThanOrEqual(100);
     expect(s?.sent?.system).toBe(0xb2);
+    // Every channel's newest value, though a frame of a pair carries half of them.
+    expect(s?.sent?.us.filter(Number.isFinite).length).toBe(8);
   });
 
   it('stops at once when told, not behind a command under way, and says why', async () => {

@@ -11,8 +11,12 @@
 import { BYTE_TIME_US } from '../decoder/spec.js';
 import type { DrivePlayer, DriveWrite } from './player.js';
 
-/** The silence a frame always has before it: above the 5 ms every flight stack ends a frame on, µs. */
-export const MIN_SILENCE_US = 6_000;
+/**
+ * The silence a frame always has before it, µs: the 5 ms every flight stack ends a frame on, and
+ * 3 ms for the way from a write to the wire (a browser's serial service and the OS add that
+ * much jitter, measured through Chromium and a pty). An 11 ms frame slot leaves 9.6 ms.
+ */
+export const MIN_SILENCE_US = 8_000;
 /** A noise write later than this is left out: it belongs between two frames, not on one. */
 const NOISE_LATE_US = 1_000;
 /** Frame intervals are counted in bins of 0.1 ms up to 200 ms; longer ones in the last bin. */

@@ -5,7 +5,7 @@
  * loopback self-test) the page decodes what it sends with SatScope's decoder.
  *
  * The frames come from the drive library (src/drive): the scenario's player and the write
- * schedule (a frame only after 6 ms of silence, the newest frame when late). Stopping (the
+ * schedule (a frame only after 8 ms of silence, the newest frame when late). Stopping (the
  * user, the scenario's end, a write that fails) stops the stream at once: the flight controller
  * sees the link lost, as it would in the air.
  */
@@ -23,6 +23,8 @@ import type { SourceRegistry } from './registry.js';
 const STATUS_MS = 250;
 /** A timer that wakes within this of a write's time (the ms clock's rounding) finds it due, µs. */
 const WAKE_TOLERANCE_US = 1;
+/** Writes a drive lets be on their way to the port at once (see `#tick`). */
+const MAX_WRITING = 2;
 
 /** What the page asks the worker to drive. */
 export interface DriveRequest {
@@ -44,7 +46,7 @@ export interface DriveStatus {
   positionUs: number;
   durationUs: number;
   step: number;
-  /** The newest frame written: its header and the channel values it carried (µs by channel id, NaN: not in it). */
+  /** The newest frame written: its header, and each channel's newest value written under it (µs by channel id, NaN: none). */
   sent: { system: number | null; remote: 'internal' | 'external'; resolution: 1024 | 2048; us: number[] } | null;
   timing: DriveTimingStats;
   /** Why it stopped, in words (null while driving). */
@@ -75,6 +77,8 @@ export class DriveSession {
   #state: DriveStatus['state'] = 'stopped';
   #reason: string | null = null;
   #source: number | null = null;
+  /** Writes on their way to the port. */
+  #writing = 0;
 
   constructor(
     readonly host: Host,
@@ -132,6 +136,7 @@ export class DriveSession {
     this.#statusTimer = undefined;
     const writer = this.#writer;
     this.#writer = null;
+    this.#writing = 0;
     // Bytes already handed to the port go out; none after this.
     writer?.releaseLock();
     this.#state = state;
@@ -145,22 +150,38 @@ export class DriveSession {
     return (this.host.clock.now() - this.#startMs) * 1000;
   }
 
-  /** Writes what is due, then sleeps until the next write is. */
+  /**
+   * Writes what is due, then sleeps until the next write is. At most `MAX_WRITING` writes are on
+   * their way at a time (a browser takes some ms to say a write is done, and the schedule must
+   * not wait for that): a port that stalls (unplugged, or a driver that holds writes) never has
+   * a queue of frames to send back to back, which a flight controller reads as one broken frame.
+   */
   #tick(): void {
     const schedule = this.#schedule;
     const writer = this.#writer;
-    if (schedule === null || writer === null) return;
+    if (schedule === null || writer === null || this.#writing >= MAX_WRITING) return;
     const now = this.#nowUs();
-    const due = now + WAKE_TOLERANCE_US;
-    for (let w = schedule.take(due); w !== null; w = schedule.take(due)) {
-      writer.write(w.bytes).catch((error: unknown) => {
-        if (this.#writer === writer) this.stop(`the adapter could not be written (${String(error)}): unplugged?`, 'failed');
-      });
-      if (w.frame !== null) {
-        const us = new Array<number>(CHANNEL_COUNT).fill(Number.NaN);
-        for (const c of w.frame.channels)
-          if (c.id < CHANNEL_COUNT) us[c.id] = servoToMicros(c.pos, channelResolution(c.id, w.frame.resolution));
-        this.#sent = { system: w.frame.system, remote: w.frame.remote, resolution: w.frame.resolution, us };
+    const w = schedule.take(now + WAKE_TOLERANCE_US);
+    if (w !== null) {
+      this.#writing++;
+      writer.write(w.bytes).then(
+        () => {
+          // A tick that found the port's hands full left no timer: this write's end wakes it.
+          if (this.#writing-- === MAX_WRITING && this.#writer === writer) this.#tick();
+        },
+        (error: unknown) => {
+          this.#writing--;
+          if (this.#writer === writer) this.stop(`the adapter could not be written (${String(error)}): unplugged?`, 'failed');
+        },
+      );
+      const f = w.frame;
+      if (f !== null) {
+        // Each channel's newest value: frames in pairs carry half the channels each.
+        const before = this.#sent;
+        const same = before !== null && before.system === f.system && before.remote === f.remote && before.resolution === f.resolution;
+        const us = same ? before.us : new Array<number>(CHANNEL_COUNT).fill(Number.NaN);
+        for (const c of f.channels) if (c.id < CHANNEL_COUNT) us[c.id] = servoToMicros(c.pos, channelResolution(c.id, f.resolution));
+        this.#sent = { system: f.system, remote: f.remote, resolution: f.resolution, us };
       }
     }
     const next = schedule.nextDueUs();
@@ -168,6 +189,7 @@ export class DriveSession {
       this.stop('the scenario ended', 'ended');
       return;
     }
+    this.host.clock.cancel(this.#timer);
     this.#timer = this.host.clock.after(Math.max(0, (next - now) / 1000), () => this.#tick());
   }
 

@@ -24,6 +24,7 @@ import { Traces } from '../Traces/index.js';
 import './style.css';
 
 const BindPanel = lazy(() => import('../Bind/index.js').then((m) => m.BindPanel));
+const DrivePanel = lazy(() => import('../Drive/index.js').then((m) => m.DrivePanel));
 const InspectorPanel = lazy(() => import('../InspectorPanel/index.js').then((m) => m.InspectorPanel));
 
 const NORMAL = [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11];
@@ -39,6 +40,8 @@ const findingsHint = computed(() => {
 });
 /** Whether the bind panel is open. */
 export const binding = signal(false);
+/** Whether the drive panel is open. */
+export const driving = signal(false);
 
 export function App({ granted }: { granted: SerialPort[] }) {
   const [dragging, setDragging] = useState(false);
@@ -81,12 +84,23 @@ export function App({ granted }: { granted: SerialPort[] }) {
         onBind={() => {
           binding.value = !binding.value;
         }}
+        onDrive={() => {
+          driving.value = !driving.value;
+        }}
       />
       {binding.value ? (
         <BindPanel
           granted={granted}
           onClose={() => {
             binding.value = false;
+          }}
+        />
+      ) : null}
+      {driving.value ? (
+        <DrivePanel
+          granted={granted}
+          onClose={() => {
+            driving.value = false;
           }}
         />
       ) : null}

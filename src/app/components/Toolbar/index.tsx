@@ -122,7 +122,7 @@ const recRecovered = computed(() => {
 });
 const recError = computed(() => recording.value?.error ?? null);
 
-export function Toolbar({ granted, onBind }: { granted: SerialPort[]; onBind(): void }) {
+export function Toolbar({ granted, onBind, onDrive }: { granted: SerialPort[]; onBind(): void; onDrive(): void }) {
   const [exported, setExported] = useState(false);
   const list = sources.value;
   const kind = list[0]?.kind;
@@ -220,6 +220,9 @@ export function Toolbar({ granted, onBind }: { granted: SerialPort[]; onBind(): 
         </button>
         <button type="button" onClick={onBind} title="Put a satellite into bind mode through the adapter (spec §7.2)">
           Bind…
+        </button>
+        <button type="button" onClick={onDrive} title="Send a satellite's stream from the adapter's TX to a flight controller">
+          Drive…
         </button>
         <input
           ref={setCaptureInput}

@@ -1,0 +1,146 @@
+/**
+ * Drive through Chromium's real WebSerial: the page writes a DSMX 11 ms satellite to the pty
+ * standing in for the adapter, another tab in front, and the test reads it as a flight
+ * controller's UART would: bytes grouped by the silence between them (the pty has no wire: a
+ * group is what one read of the pty returned, so the reader's own lateness merges frames too).
+ * The page keeps 8 ms of silence before every frame by its clock; at the pty every group must be
+ * whole frames, hardly ever two (merged), at 11 ms. What the test reads it writes back (the
+ * loopback self-test): the page decodes it as a receiver. Escape stops the stream at once.
+ * SATSCOPE_DRIVE_SECONDS sets how long it drives (default 30; docs/drive.md quotes a 600 s run);
+ * the distribution is printed.
+ */
+import type { Browser } from 'playwright-core';
+import { afterAll, beforeAll, describe, expect, it } from 'vitest';
+import { SpektrumDecoder } from '../../src/decoder/decoder.js';
+import { BYTE_TIME_US } from '../../src/decoder/spec.js';
+import { MIN_SILENCE_US } from '../../src/drive/schedule.js';
+import { browserUnavailable, shot, startSerialApp, type SerialAppSession } from './app-fixture.js';
+import { fakeSerialUnsupportedReason, type FakeSerialPort } from './harness/pty-serial.js';
+
+const skip = browserUnavailable() ?? fakeSerialUnsupportedReason();
+if (skip !== null) console.warn(`skipping the Drive tests: ${skip}`);
+const SECONDS = Number(process.env.SATSCOPE_DRIVE_SECONDS ?? 30);
+
+let rig: SerialAppSession | undefined;
+let fake: FakeSerialPort;
+let browser: Browser;
+
+beforeAll(async () => {
+  if (skip !== null) return;
+  rig = await startSerialApp();
+  ({ fake, browser } = rig);
+});
+
+afterAll(async () => {
+  await rig?.close();
+});
+
+/** Bytes as they came, grouped into bursts by a silence of 3 ms or more: one burst is what a flight controller reads as one frame. */
+function bursts(chunks: { bytes: Uint8Array; tUs: number }[]): { startUs: number; endUs: number; length: number }[] {
+  const out: { startUs: number; endUs: number; length: number }[] = [];
+  for (const c of chunks) {
+    // A chunk's arrival is its last byte's: its first left the wire (length - 1) bytes earlier.
+    const startUs = c.tUs - (c.bytes.length - 1) * BYTE_TIME_US;
+    const last = out[out.length - 1];
+    if (last !== undefined && startUs - last.endUs < 3000) {
+      last.endUs = c.tUs;
+      last.length += c.bytes.length;
+    } else out.push({ startUs, endUs: c.tUs, length: c.bytes.length });
+  }
+  return out;
+}
+
+const quantile = (sorted: number[], q: number) => sorted[Math.min(sorted.length - 1, Math.floor(q * sorted.length))] ?? Number.NaN;
+
+describe.skipIf(skip !== null)('driving a flight controller through the adapter', () => {
+  it(
+    `writes ${SECONDS} s of DSMX 11 ms from a background tab, frame by frame, and reads it back through the loopback`,
+    async () => {
+      const context = await browser.newContext({ viewport: { width: 1280, height: 1000 } });
+      const page = await context.newPage();
+      const errors: string[] = [];
+      page.on('pageerror', (e) => errors.push(e.message));
+      await page.goto(rig!.server.url('/'));
+      await page.getByRole('button', { name: 'Drive…' }).click();
+      const panel = page.getByRole('region', { name: 'Drive a flight controller' });
+      await panel.waitFor();
+      // Nothing is sent before the user says the propellers are off.
+      const startButton = panel.getByRole('button', { name: '▶ Start driving' });
+      expect(await startButton.isDisabled()).toBe(true);
+      await panel.getByLabel('The propellers are off').check();
+
+      const chunks: { bytes: Uint8Array; tUs: number }[] = [];
+      const decoder = new SpektrumDecoder();
+      let decoded = 0;
+      const stop = fake.onData((bytes, tUs) => {
+        chunks.push({ bytes: bytes.slice(), tUs });
+        decoder.push(bytes, tUs);
+        for (let f = decoder.next(); f !== undefined; f = decoder.next()) decoded++;
+        // The loopback: the adapter's TX wired to its own RX.
+        if (process.env.SATSCOPE_DRIVE_ECHO !== '0') void fake.write(bytes);
+      });
+      await startButton.click();
+      await panel.getByTestId('drive-state').filter({ hasText: 'Sending “manual”' }).waitFor();
+      // The tab goes to the background: another one in front.
+      const other = await context.newPage();
+      await other.goto('about:blank');
+      await other.bringToFront();
+      const hidden = await page.evaluate(() => document.visibilityState);
+      await new Promise((r) => setTimeout(r, SECONDS * 1000));
+      await page.bringToFront();
+      await shot(page, 'drive-desktop-light');
+      await page.emulateMedia({ colorScheme: 'dark' });
+      await page.setViewportSize({ width: 390, height: 900 });
+      await shot(page, 'drive-phone-dark');
+      const echo = process.env.SATSCOPE_DRIVE_ECHO !== '0';
+      const loop = echo ? await panel.getByTestId('drive-loopback').textContent() : null;
+      const timing = await panel.getByTestId('drive-timing').textContent();
+      await page.keyboard.press('Escape');
+      await panel.getByTestId('drive-state').filter({ hasText: 'Stopped: stopped by the user' }).waitFor();
+      const atStop = chunks.length;
+      await new Promise((r) => setTimeout(r, 300));
+      stop();
+      // Escape stopped it: at most a write already on its way after it.
+      expect(chunks.length - atStop).toBeLessThanOrEqual(1);
+
+      const b = bursts(chunks);
+      const lengths = new Map<number, number>();
+      for (const x of b) lengths.set(x.length, (lengths.get(x.length) ?? 0) + 1);
+      const intervals = b
+        .slice(1)
+        .map((x, i) => x.startUs - (b[i]?.startUs ?? 0))
+        .sort((p, q) => p - q);
+      const silences = b
+        .slice(1)
+        .map((x, i) => x.startUs - (b[i]?.endUs ?? 0))
+        .sort((p, q) => p - q);
+      const report = {
+        hidden,
+        groups: b.length,
+        lengths: Object.fromEntries(lengths),
+        intervalMs: [0, 0.01, 0.5, 0.99, 1].map((q) => +(quantile(intervals, q) / 1000).toFixed(2)),
+        shortestSilenceMs: +((silences[0] ?? 0) / 1000).toFixed(2),
+        decoded,
+        loop,
+        timing,
+      };
+      console.log(`drive through the pty: ${JSON.stringify(report)}`);
+      const frames = b.reduce((n, x) => n + x.length / 16, 0);
+      expect(frames).toBeGreaterThan((SECONDS * 1e6) / 11_000 - 50);
+      // Whole frames only: nothing split or cut short, and hardly ever two read as one.
+      expect([...lengths.keys()].every((n) => n % 16 === 0)).toBe(true);
+      expect(frames - (lengths.get(16) ?? 0)).toBeLessThanOrEqual(frames * 0.02);
+      expect(Math.abs(quantile(intervals, 0.5) - 11_000)).toBeLessThanOrEqual(1000);
+      // The page's own account: the silence it kept by its clock, and few frames skipped.
+      expect(timing).toMatch(new RegExp(`shortest silence before a frame ${(MIN_SILENCE_US / 1000).toFixed(1)} ms`));
+      const skipped = Number(/; (\d+) skipped/.exec(timing ?? '')?.[1] ?? Number.NaN);
+      expect(skipped).toBeLessThanOrEqual(frames * 0.1);
+      expect(decoded).toBeGreaterThanOrEqual(frames - 1);
+      // The page read its own frames back: none broken (bytes before the decoder locked on may be set aside).
+      if (echo) expect(loop).toMatch(/read back \d+ frames.*; 0 broken, 0 resyncs/);
+      expect(errors).toEqual([]);
+      await context.close();
+    },
+    (SECONDS + 60) * 1000,
+  );
+});
