@@ -4,6 +4,7 @@
  * the frames intended; the schedule keeps a silence of over 5 ms before every frame however
  * late its timer wakes, and never sends a backlog.
  */
+import { readFileSync } from 'node:fs';
 import { describe, expect, it } from 'vitest';
 import { SpektrumDecoder } from '../src/decoder/decoder.js';
 import { BYTE_TIME_US } from '../src/decoder/spec.js';
@@ -58,6 +59,17 @@ function expectExact(scenario: DriveScenario, writes: readonly DriveWrite[]): nu
 }
 
 describe('drive scenarios', () => {
+  it('the example in docs/drive.md is a scenario, and plays as it says', () => {
+    const doc = readFileSync(new URL('../docs/drive.md', import.meta.url), 'utf8');
+    const json = /```json\n([\s\S]*?)```/.exec(doc)?.[1] ?? '';
+    const s = parseDriveScenario(json);
+    expect(s.steps.map((st) => st.receiver === undefined)).toEqual([false, true, false]);
+    const writes = new DrivePlayer(s).writesUntil(8_000_000);
+    // Frames in the first 3 s and the last 3 s, none in the 1.5 s between.
+    expect(writes.some((w) => w.atUs > 3_000_000 && w.atUs < 4_500_000)).toBe(false);
+    expect(writes.filter((w) => w.atUs >= 4_500_000).length).toBeGreaterThan(250);
+  });
+
   it('every built-in scenario for every receiver decodes to exactly the frames sent', () => {
     let scenarios = 0;
     for (const rx of RECEIVERS) {

@@ -12,6 +12,7 @@ import { onFrame, wake } from './frame-loop.js';
 import { Live } from './live.js';
 import type { DiagnosisStatus } from '../worker/protocol.js';
 import type { DriveStatus } from '../worker/drive.js';
+import type { FcStatus } from '../worker/fc.js';
 
 export interface Notice {
   id: number;
@@ -43,6 +44,8 @@ export const bindLog = signal<BindProgress[]>([]);
 export const diagnosis = signal<DiagnosisStatus | null>(null);
 /** The drive under way, or the last one (null: none this session). */
 export const drive = signal<DriveStatus | null>(null);
+/** What the flight controller being driven says it read (null: its port not opened). */
+export const fc = signal<FcStatus | null>(null);
 
 const IDLE: SourceStatus = {
   id: -1,
@@ -223,6 +226,9 @@ function receive(message: FromWorker): void {
       break;
     case 'drive':
       drive.value = message.drive;
+      break;
+    case 'fc':
+      fc.value = message.fc;
       break;
     default: {
       const never: never = message;

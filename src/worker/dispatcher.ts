@@ -8,6 +8,7 @@ import { USB_CHUNK_JITTER_US } from '../decoder/spec.js';
 import { Batcher } from './batcher.js';
 import { bind } from './binding.js';
 import { DriveSession } from './drive.js';
+import { FcReader } from './fc.js';
 import { Diagnosis } from './diagnosis.js';
 import { type Host, notice, nowUs } from './host.js';
 import { type LiveSink, liveSink } from './live.js';
@@ -41,6 +42,7 @@ export class Dispatcher {
   readonly serial: SerialPorts;
   readonly sink: LiveSink;
   readonly drive: DriveSession;
+  readonly fc: FcReader;
   readonly #makeReport: ReportMaker;
   readonly #readSlices: SliceReaderMaker;
 
@@ -82,6 +84,7 @@ export class Dispatcher {
       findPort: options.findPort,
     });
     this.drive = new DriveSession(host, this.registry, this.serial);
+    this.fc = new FcReader(host, (identity) => this.serial.find(identity));
     this.#makeReport = options.makeReport ?? WORKER_REPORT_MAKER;
     this.#readSlices = options.readSlices ?? READ_HERE;
   }
@@ -194,6 +197,12 @@ export class Dispatcher {
         break;
       case 'drive-channel':
         this.drive.setChannel(message.id, message.percent);
+        break;
+      case 'fc-open':
+        await this.fc.open(message.port);
+        break;
+      case 'fc-close':
+        await this.fc.close();
         break;
       case 'set-resolution':
         setResolution(registry, message.resolution);

@@ -9,6 +9,7 @@ import type { LinkState, MissedBasis } from '../decoder/link-types.js';
 import type { InspectEntry } from './inspector.js';
 import type { ConfirmProbe, DoctorFinding } from '../report/doctor-types.js';
 import type { DriveRequest, DriveStatus } from './drive.js';
+import type { FcStatus } from './fc.js';
 
 /** How the page names a port it was granted: its place in getPorts() and its USB IDs. */
 export interface PortIdentity {
@@ -56,6 +57,9 @@ export type ToWorker =
   | { type: 'drive-stop' }
   /** Hold a channel at `percent` travel while driving (null: back to the scenario); not queued. */
   | { type: 'drive-channel'; id: number; percent: number | null }
+  /** Read a flight controller's own view over MSP on its USB port (while driving it). */
+  | { type: 'fc-open'; port: PortIdentity }
+  | { type: 'fc-close' }
   // Exports of what the page shows.
   /**
    * One remote's decoded frames (of the capture being replayed, or of the live session's
@@ -232,7 +236,8 @@ export type FromWorker =
   | { type: 'bind'; progress: BindProgress }
   | { type: 'inspection'; source: number; entries: InspectEntry[] }
   | { type: 'diagnosis'; diagnosis: DiagnosisStatus }
-  | { type: 'drive'; drive: DriveStatus };
+  | { type: 'drive'; drive: DriveStatus }
+  | { type: 'fc'; fc: FcStatus };
 
 /** The doctor's findings (src/report), sent when they change, at most 4× a second. */
 export interface DiagnosisStatus {

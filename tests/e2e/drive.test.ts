@@ -126,7 +126,8 @@ describe.skipIf(skip !== null)('driving a flight controller through the adapter'
       };
       console.log(`drive through the pty: ${JSON.stringify(report)}`);
       const frames = b.reduce((n, x) => n + x.length / 16, 0);
-      expect(frames).toBeGreaterThan((SECONDS * 1e6) / 11_000 - 50);
+      // Frames the worker skipped (its timer late) are no frames: at most a tenth (below).
+      expect(frames).toBeGreaterThan(((SECONDS * 1e6) / 11_000) * 0.9);
       // Whole frames only: nothing split or cut short, and hardly ever two read as one.
       expect([...lengths.keys()].every((n) => n % 16 === 0)).toBe(true);
       expect(frames - (lengths.get(16) ?? 0)).toBeLessThanOrEqual(frames * 0.02);

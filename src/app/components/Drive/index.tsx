@@ -21,6 +21,7 @@ import {
 } from '../../../decoder/spec.js';
 import { identify, pickPort, portLabel, serialUnavailable } from '../../serial.js';
 import { drive, liveOf, notify, send } from '../../store.js';
+import { FcView } from './fc.js';
 import './style.css';
 
 const SYSTEMS = [SYSTEM_DSMX_11MS_2048, SYSTEM_DSMX_22MS_2048, SYSTEM_DSM2_11MS_2048, SYSTEM_DSM2_22MS_1024];
@@ -43,7 +44,8 @@ export function DrivePanel({ granted, onClose }: { granted: SerialPort[]; onClos
         send({ type: 'drive-stop' });
         return;
       }
-      if (e.key === 'Escape' && !e.defaultPrevented) onClose();
+      // Otherwise Escape closes the panel, unless it is closing a menu (the menu's own Escape).
+      if (e.key === 'Escape' && document.querySelector('.menu-pop:not([hidden])') === null) onClose();
     };
     document.addEventListener('keydown', key, true);
     return () => document.removeEventListener('keydown', key, true);
@@ -293,6 +295,7 @@ export function DrivePanel({ granted, onClose }: { granted: SerialPort[]; onClos
           ) : null}
         </div>
       ) : null}
+      <FcView ports={ports} resolution={info?.resolution ?? 2048} />
       <fieldset class="drive-sticks" disabled={!driving}>
         <legend>Sticks (held while set; the scenario moves the others)</legend>
         {Array.from({ length: receiver.channels }, (_, id) => (
