@@ -5,6 +5,8 @@
  */
 import { describe, expect, it } from 'vitest';
 import { doctorCapture } from '../src/report/doctor-capture.js';
+import { LinkMonitor } from '../src/decoder/link.js';
+import type { DecodedFrame } from '../src/decoder/types.js';
 import { summarizeCapture } from '../src/report/summary.js';
 import { preset } from '../src/simulator/presets.js';
 import { simulate } from '../src/simulator/simulator.js';
@@ -100,5 +102,45 @@ describe('the period of a header that reads both ways', () => {
       expect(link.nominalPeriodUs).toBe(11_000);
       expect(link.missedFrames).toBeGreaterThan(100);
     }
+  });
+
+  /** A frame as the link monitor reads it: time, system byte, and byte 0 (a fade count, or null: RSSI mode). */
+  const frame = (timeUs: number, system: number, fades: number | null) =>
+    ({ timeUs, fadesDelta: 0, system, rssi: null, fades }) as unknown as DecodedFrame;
+
+  it('is refuted however the adapter dates the frames, 8 to 16 ms chunks', () => {
+    for (const chunk of [8_000, 12_000, 13_000, 16_000]) {
+      const m = new LinkMonitor();
+      // An external 22 ms remote whose count reads as 0xB2 (DSMX 11 ms), each frame dated at its chunk's end.
+      for (let i = 0; i < 400; i++) m.frame(frame(Math.ceil((1000 + i * 22_000 + 1400) / chunk) * chunk, 0xb2, 0));
+      m.finish(1000 + 400 * 22_000 + chunk);
+      expect(m.stats.nominalPeriodUs, `${chunk / 1000} ms chunks`).toBe(22_000);
+      expect(m.stats.missedFrames, `${chunk / 1000} ms chunks`).toBe(0);
+    }
+  });
+
+  it('is not refuted by frames lost at random, nor where byte 0 is no fade count (RSSI mode)', () => {
+    let seed = 7;
+    const random = () => (seed = (seed * 1103515245 + 12345) & 0x7fffffff) / 0x7fffffff;
+    for (const fades of [0, null]) {
+      const m = new LinkMonitor();
+      let lost = 0;
+      for (let i = 0; i < 600; i++) {
+        // A true DSMX 11 ms receiver losing 45 % of its frames for 1.5 s, in 16 ms USB chunks.
+        if (i >= 200 && i < 340 && random() < 0.45) {
+          lost++;
+          continue;
+        }
+        m.frame(frame(Math.ceil((1000 + i * 11_000 + 1400) / 16_000) * 16_000, 0xb2, fades));
+        expect(m.stats.nominalPeriodUs).toBe(11_000);
+      }
+      m.finish(1000 + 600 * 11_000 + 16_000);
+      expect(m.stats.missedFrames, `byte 0 ${fades === null ? 'RSSI' : 'fades'}`).toBe(lost);
+    }
+    // Every other frame lost for a second, RSSI mode: no counter to rule the loss out.
+    const m = new LinkMonitor();
+    for (let i = 0; i < 300; i++) if (!(i >= 100 && i < 200 && i % 2 === 1)) m.frame(frame(1000 + i * 11_000, 0xb2, null));
+    m.finish(1000 + 300 * 11_000);
+    expect(m.stats.missedFrames).toBe(50);
   });
 });

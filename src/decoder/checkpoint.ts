@@ -96,6 +96,8 @@ export interface LinkCheckpoint {
   readonly periodOldest: number;
   readonly periodStated: number;
   readonly periodRefuted: boolean;
+  readonly periodAgainst: number;
+  readonly periodCounted: number;
   readonly systemByte: number;
   readonly rateTimes: Float64Array;
   readonly rateFades: Float64Array;

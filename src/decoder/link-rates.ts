@@ -8,10 +8,10 @@
  * it leaves, so the mean interval is known only to that over the periods in the window, and a
  * mean closer than that to the boundary between the two decides nothing yet.
  *
- * A system byte states the period, until the frames refute it: a window whose timing snaps to the
- * other period, not one of whose intervals fits the stated one (an external remote whose fade
- * count reads as a system byte, or a receiver whose byte lies). Missed frames do not refute it:
- * the receiver counts them, and the frames between them come a period apart.
+ * A system byte states the period, until the frames refute it: a window whose mean interval is
+ * the other period's (an external remote whose fade count reads as a system byte, or a receiver
+ * whose byte lies). Frames lost at random do not refute it (the mean falls between the two), nor
+ * do frames lost where the receiver's counter counts them.
  */
 import type { LinkCheckpoint } from './checkpoint.js';
 import { nominalPeriodOf, PERIOD_SNAP_US } from './link-rules.js';
@@ -22,11 +22,25 @@ const PERIOD_WINDOW = 33;
 /** A mean frame interval below this (0.8 × 11 ms) is no system's period: frames a delivery burst brought together. */
 const BURST_MEAN_US = 0.8 * FRAME_PERIOD_11MS_US;
 const RATE_WINDOW = 512;
+/** Checks in a row that must refute a stated period: every eighth frame, so two windows' worth. */
+const REFUTING_CHECKS = 5;
+/** A window's mean interval this close to a period (or closer than its lateness allows) is that period's, µs. */
+const MEAN_FIT_US = 500;
 
 /** What of a `LinkCheckpoint` is the rates'. */
 type RatesCheckpoint = Pick<
   LinkCheckpoint,
-  'periodTimes' | 'periodCount' | 'periodOldest' | 'periodStated' | 'periodRefuted' | 'rateTimes' | 'rateFades' | 'rateCount' | 'rateNext'
+  | 'periodTimes'
+  | 'periodCount'
+  | 'periodOldest'
+  | 'periodStated'
+  | 'periodRefuted'
+  | 'periodAgainst'
+  | 'periodCounted'
+  | 'rateTimes'
+  | 'rateFades'
+  | 'rateCount'
+  | 'rateNext'
 >;
 
 /**
@@ -46,11 +60,16 @@ export class LinkRates {
   /** The period the system byte states (NaN: none), and whether the frames' timing refuted it. */
   #stated = NaN;
   #refuted = false;
+  /** Checks in a row (every eighth frame) whose window refuted the stated period. */
+  #against = 0;
+  /** Frames in a row whose byte 0 was a fade count. */
+  #counted = 0;
 
   /** A system byte states the period `periodUs` (NaN: none does now): it is the nominal period until refuted. */
   state(periodUs: number, s: LinkStats): void {
     this.#stated = periodUs;
     this.#refuted = false;
+    this.#against = 0;
     s.nominalPeriodUs = periodUs;
   }
 
@@ -60,11 +79,12 @@ export class LinkRates {
   }
 
   /**
-   * The period and fade-rate windows take the frame at `t` (and, where no system byte states
-   * the period or the frames refuted it, the nominal period is snapped, which the frame's own
-   * rules read), and the figures in `s` follow.
+   * The period and fade-rate windows take the frame at `t` (`counted`: its byte 0 is a fade
+   * count; and, where no system byte states the period or the frames refuted it, the nominal
+   * period is snapped, which the frame's own rules read), and the figures in `s` follow.
    */
-  measure(t: number, fadesDelta: number, s: LinkStats): void {
+  measure(t: number, fadesDelta: number, s: LinkStats, counted: boolean): void {
+    this.#counted = counted ? Math.min(this.#counted + 1, PERIOD_WINDOW) : 0;
     // Fade rate over a window of recent frames.
     const i = this.#rateNext;
     const fades = this.#rateFades;
@@ -103,43 +123,49 @@ export class LinkRates {
   }
 
   /**
-   * The stated period is refuted where the window's timing snaps to the other one, not one of its
-   * intervals fits the stated period, and, if the frames came slower than stated, the receiver's
-   * counter did not count the frames that would then be lost.
+   * The stated period is refuted where, over two windows' worth of checks, each window's mean
+   * interval is the other period's, to within the lateness its longest interval allows (a
+   * receiver losing frames at random averages between the two), and, if the frames came slower
+   * than stated, the receiver's fade counter did not count the frames that would then be lost.
    */
   #refute(newest: number, s: LinkStats): void {
-    const other = this.#snap(newest, NaN);
     const stated = this.#stated;
-    if (!(other !== stated) || Number.isNaN(other)) return;
-    if (other > stated) {
+    const other = stated > FRAME_PERIOD_11MS_US ? FRAME_PERIOD_11MS_US : 2 * FRAME_PERIOD_11MS_US;
+    const { mean, longest, periods } = this.#window(newest);
+    let against = mean >= BURST_MEAN_US && Math.abs(mean - other) <= Math.max(MEAN_FIT_US, longest / periods);
+    if (against && other > stated) {
+      // Slower than stated: only a fade counter that counts every frame of the window, and did
+      // not move, rules out the frames lost between them (RSSI mode has no counter).
       const fades = this.#rateFades;
       const last = this.#rateNext === 0 ? RATE_WINDOW - 1 : this.#rateNext - 1;
       const first = (last - (this.#periodCount - 1) + RATE_WINDOW) % RATE_WINDOW;
-      if ((fades[last] ?? 0) !== (fades[first] ?? 0)) return;
+      against = this.#counted >= this.#periodCount && (fades[last] ?? 0) === (fades[first] ?? 0);
     }
-    const times = this.#periodTimes;
-    for (let k = 1, i = this.#periodOldest; k < this.#periodCount; k++) {
-      const next = i === PERIOD_WINDOW - 1 ? 0 : i + 1;
-      if (Math.abs((times[next] ?? NaN) - (times[i] ?? NaN) - stated) <= stated / 4) return;
-      i = next;
-    }
+    this.#against = against ? this.#against + 1 : 0;
+    if (this.#against < REFUTING_CHECKS) return;
     this.#refuted = true;
     s.nominalPeriodUs = other;
   }
 
   /**
    * Without a system byte: the nominal period from the mean interval of the window ending at
-   * `newest` (else `current`). It is decided only where the mean interval is further from the 11/22 ms boundary than the lateness
-   * the window's longest interval allows, and again over every full window, so that a few frames
-   * missing early do not stick. A window that a delivery burst crowds (frames a stall held back,
-   * dated together) is faster than any system sends: it says nothing of the period.
+   * `newest` (else `current`). It is decided only where the mean interval is further from the
+   * 11/22 ms boundary than the lateness the window's longest interval allows, and again over
+   * every full window, so that a few frames missing early do not stick. A window that a delivery
+   * burst crowds (frames a stall held back, dated together) is faster than any system sends: it
+   * says nothing of the period.
    */
   #snap(newest: number, current: number): number {
+    const { mean, longest, periods } = this.#window(newest);
+    if (mean < BURST_MEAN_US) return current;
+    return Math.abs(mean - PERIOD_SNAP_US) > longest / periods ? nominalPeriodOf(mean) : current;
+  }
+
+  /** The period window ending at `newest`: its mean and longest interval, and how many intervals. */
+  #window(newest: number): { mean: number; longest: number; periods: number } {
     const times = this.#periodTimes;
     const oldest = this.#periodOldest;
     const periods = this.#periodCount - 1;
-    const mean = ((times[newest] ?? NaN) - (times[oldest] ?? NaN)) / periods;
-    if (mean < BURST_MEAN_US) return current;
     let longest = 0;
     for (let k = 1, i = oldest; k < this.#periodCount; k++) {
       const next = i === PERIOD_WINDOW - 1 ? 0 : i + 1;
@@ -147,7 +173,7 @@ export class LinkRates {
       if (interval > longest) longest = interval;
       i = next;
     }
-    return Math.abs(mean - PERIOD_SNAP_US) > longest / periods ? nominalPeriodOf(mean) : current;
+    return { mean: ((times[newest] ?? NaN) - (times[oldest] ?? NaN)) / periods, longest, periods };
   }
 
   /** The windows as they stand (copies), for `LinkMonitor.checkpoint()`. */
@@ -158,6 +184,8 @@ export class LinkRates {
       periodOldest: this.#periodOldest,
       periodStated: this.#stated,
       periodRefuted: this.#refuted,
+      periodAgainst: this.#against,
+      periodCounted: this.#counted,
       rateTimes: this.#rateTimes.slice(),
       rateFades: this.#rateFades.slice(),
       rateCount: this.#rateCount,
@@ -172,6 +200,8 @@ export class LinkRates {
     this.#periodOldest = cp.periodOldest;
     this.#stated = cp.periodStated;
     this.#refuted = cp.periodRefuted;
+    this.#against = cp.periodAgainst;
+    this.#counted = cp.periodCounted;
     this.#rateTimes.set(cp.rateTimes);
     this.#rateFades.set(cp.rateFades);
     this.#rateCount = cp.rateCount;

@@ -233,7 +233,7 @@ export class LinkMonitor {
         if (Number.isFinite(p) && gap > 3 * p && gap > this.holdAfterUs) this.#rates.clearPeriod();
       }
       this.#lastUs = t;
-      this.#rates.measure(t, fades, s);
+      this.#rates.measure(t, fades, s, frame.fades !== null);
       this.#ledger.frame(t, s.nominalPeriodUs, this.#missed);
       this.#stalls.confirm(this.#ledger);
       s.deliveryDelayUs = this.#ledger.delayUs;
