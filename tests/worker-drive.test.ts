@@ -192,4 +192,46 @@ describe('driving a flight controller from the worker', () => {
     expect(link?.missedFrames).toBe(0);
     expect(link?.nominalPeriodUs).toBe(11_000);
   });
+
+  it("keeps going through a scenario's silences: a rebind runs to its end, frames after the silent step", async () => {
+    const { send, run, port, status } = setup();
+    await send({ type: 'drive-start', port: PORT, receiver: DSMX_11, scenario: 'rebind', throttleCeilingPercent: 100 });
+    await run(6000);
+    expect(status()?.state).toBe('driving');
+    await run(6000);
+    expect(status()).toMatchObject({ state: 'ended', reason: 'the scenario ended' });
+    // 5 s as bound, 1.5 s silent, 5 s in the other format.
+    const after = port.writes.filter((w) => w.atMs > 1000 + 6_600);
+    expect(after.length).toBeGreaterThan(200);
+    expect(port.writes.filter((w) => w.atMs > 1000 + 5_100 && w.atMs < 1000 + 6_400)).toEqual([]);
+  });
+
+  it('a stop sent while the start is still opening the port wins', async () => {
+    const { worker, run, port, status } = setup();
+    worker.receive({ type: 'drive-start', port: PORT, receiver: DSMX_11, scenario: 'manual', throttleCeilingPercent: 100 });
+    worker.receive({ type: 'drive-stop' });
+    await worker.queue.idle();
+    await run(300);
+    expect(port.writes).toEqual([]);
+    expect(status()?.state).not.toBe('driving');
+  });
+
+  it('sends the sticks the page holds from the first frame of a new drive', async () => {
+    const { send, run, port } = setup();
+    await send({ type: 'drive-start', port: PORT, receiver: DSMX_11, scenario: 'manual', throttleCeilingPercent: 100, held: { 1: 100 } });
+    await run(60);
+    const first = decodeWrites(port.writes).find((f) => f.positions.has(1));
+    expect(servoToPercent(first?.positions.get(1) ?? 0, 2048)).toBeCloseTo(100, 0);
+  });
+
+  it('stops when its port is closed from the page', async () => {
+    const { send, run, port, status } = setup();
+    await send({ type: 'drive-start', port: PORT, receiver: DSMX_11, scenario: 'manual', throttleCeilingPercent: 100 });
+    await run(200);
+    await send({ type: 'serial-close', source: status()?.source ?? -1 });
+    const before = port.writes.length;
+    await run(300);
+    expect(port.writes.length).toBe(before);
+    expect(status()).toMatchObject({ state: 'stopped', reason: 'its port was closed' });
+  });
 });

@@ -7,6 +7,7 @@
  */
 import { describe, expect, it } from 'vitest';
 import { MSP, MspParser, encodeMsp } from '../src/drive/msp.js';
+import { driveReportHtml } from '../src/drive/report.js';
 import { Dispatcher } from '../src/worker/dispatcher.js';
 import type { FcStatus } from '../src/worker/fc.js';
 import type { ToWorker } from '../src/worker/protocol.js';
@@ -154,5 +155,53 @@ describe("the flight controller's own view while driving it", () => {
       rxLoss: null,
       replies: 0,
     });
+  });
+
+  it('grades a built-in scenario against what the flight controller read, and the report says it', async () => {
+    // Betaflight set to AETR1234 while Spektrum sends throttle first: its roll follows the throttle.
+    const { send, run, of } = setup(2048, 'AETR1234');
+    await send({ type: 'fc-open', port: FC_USB });
+    await run(300);
+    await send({
+      type: 'drive-start',
+      port: ADAPTER,
+      receiver: { system: 0xb2, remote: 'internal', channels: 4 },
+      scenario: 'sweep',
+      throttleCeilingPercent: 100,
+    });
+    await run(19_000);
+    const done = of('drive').at(-1)?.drive;
+    expect(done?.state).toBe('ended');
+    const checks = Object.fromEntries((done?.checks ?? []).map((c) => [c.id, c]));
+    expect(checks['channel-map']?.verdict).toBe('fail');
+    expect(checks['channel-map']?.found).toMatch(/its channel 1 follows Throttle/);
+    expect(done?.gradeNote).toMatch(/Graded on \d+ readings/);
+    const html = driveReportHtml({
+      date: '2026-11-29T00:00:00Z',
+      scenario: { name: done?.name ?? '', title: done?.title ?? '' },
+      receiver: done!.receiver,
+      timing: done!.timing,
+      fc: { variant: 'BTFL', provider: 'SPEKTRUM2048' },
+      checks: done?.checks ?? [],
+      notes: [],
+    });
+    expect(html).toContain('map TAER1234');
+    expect(html).not.toMatch(/<script|https?:\/\//);
+  });
+
+  it('does not grade a drive the flight controller was not read during, and says so', async () => {
+    const { send, run, of } = setup(2048);
+    await send({
+      type: 'drive-start',
+      port: ADAPTER,
+      receiver: { system: 0xb2, remote: 'internal', channels: 4 },
+      scenario: 'dropouts',
+      throttleCeilingPercent: 100,
+    });
+    await run(500);
+    await send({ type: 'drive-stop' });
+    const done = of('drive').at(-1)?.drive;
+    expect(done?.checks).toBeNull();
+    expect(done?.gradeNote).toMatch(/not read during the drive/);
   });
 });

@@ -159,7 +159,8 @@ export function send(message: ToWorker, transfer: Transferable[] = []): void {
   worker?.postMessage(message, transfer);
 }
 
-function download(name: string, mime: string, data: ArrayBuffer): void {
+/** Saves `data` as a file the browser downloads. */
+export function download(name: string, mime: string, data: ArrayBuffer): void {
   const url = URL.createObjectURL(new Blob([data], { type: mime }));
   const a = document.createElement('a');
   a.href = url;

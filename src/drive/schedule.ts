@@ -19,6 +19,8 @@ import type { DrivePlayer, DriveWrite } from './player.js';
 export const MIN_SILENCE_US = 8_000;
 /** A noise write later than this is left out: it belongs between two frames, not on one. */
 const NOISE_LATE_US = 1_000;
+/** How far ahead of now the player is asked for writes: a period's worth, so the next write's time is known before it is due, µs. */
+const LOOK_AHEAD_US = 25_000;
 /** Frame intervals are counted in bins of 0.1 ms up to 200 ms; longer ones in the last bin. */
 const BIN_US = 100;
 const BINS = 2001;
@@ -60,6 +62,8 @@ export class WriteSchedule {
   #minSilence = Number.POSITIVE_INFINITY;
   #minInterval = Number.POSITIVE_INFINITY;
   #maxInterval = 0;
+  /** The player has handed out its writes up to here, µs. */
+  #filledUs = 0;
 
   constructor(player: DrivePlayer, options: { minSilenceUs?: number; byteTimeUs?: number } = {}) {
     this.#player = player;
@@ -67,11 +71,14 @@ export class WriteSchedule {
     this.#byteTimeUs = options.byteTimeUs ?? BYTE_TIME_US;
   }
 
-  /** When the next write can be made, µs (NaN when the scenario has ended and all is written). */
+  /**
+   * When the next write can be made, or when to look again (a silence of the scenario: nothing
+   * to write yet), µs; NaN once the scenario has ended and all is written.
+   */
   nextDueUs(): number {
-    if (this.#pending.length === 0) this.#fill(Number.isFinite(this.#lastEndUs) ? this.#lastEndUs : 0);
+    if (this.#pending.length === 0) this.#fill(Math.max(this.#filledUs, Number.isFinite(this.#lastEndUs) ? this.#lastEndUs : 0));
     const next = this.#pending[0];
-    if (next === undefined) return Number.NaN;
+    if (next === undefined) return this.#player.done ? Number.NaN : this.#filledUs;
     return next.frame !== null ? Math.max(next.atUs, this.#lastEndUs + this.#minSilenceUs) : next.atUs;
   }
 
@@ -135,9 +142,9 @@ export class WriteSchedule {
   }
 
   #fill(nowUs: number): void {
-    // A period's worth ahead, so that the next write's time is known before it is due.
     if (this.#pending.length > 0 && (this.#pending[this.#pending.length - 1] as DriveWrite).atUs > nowUs) return;
-    for (const w of this.#player.writesUntil(nowUs + 25_000)) this.#pending.push(w);
+    this.#filledUs = Math.max(this.#filledUs, nowUs + LOOK_AHEAD_US);
+    for (const w of this.#player.writesUntil(this.#filledUs)) this.#pending.push(w);
   }
 
   #wrote(nowUs: number, length: number): void {

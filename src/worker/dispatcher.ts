@@ -83,8 +83,8 @@ export class Dispatcher {
       enqueue: (task) => this.queue.enqueue(task),
       findPort: options.findPort,
     });
-    this.drive = new DriveSession(host, this.registry, this.serial);
     this.fc = new FcReader(host, (identity) => this.serial.find(identity));
+    this.drive = new DriveSession(host, this.registry, this.serial, (sinceMs) => this.fc.readingsSince(sinceMs));
     this.#makeReport = options.makeReport ?? WORKER_REPORT_MAKER;
     this.#readSlices = options.readSlices ?? READ_HERE;
   }
@@ -92,9 +92,12 @@ export class Dispatcher {
   /** A message from the page: queued behind those before it. */
   receive(message: ToWorker): void {
     // Stopping a drive and its sticks cannot wait for a command under way.
-    if (message.type === 'drive-stop') this.drive.stop('stopped by the user');
+    if (message.type === 'drive-stop') this.drive.cancel();
     else if (message.type === 'drive-channel') this.drive.setChannel(message.id, message.percent);
-    else this.queue.enqueue(() => this.handle(message));
+    else if (message.type === 'drive-start') {
+      const ticket = this.drive.request();
+      this.queue.enqueue(() => this.drive.start(message, ticket));
+    } else this.queue.enqueue(() => this.handle(message));
   }
 
   /** The replay being played, if the session is one. */
@@ -105,6 +108,15 @@ export class Dispatcher {
 
   async handle(message: ToWorker): Promise<void> {
     const { host, registry, recorder } = this;
+    // A drive holds its port's writer: a command that closes the port stops the drive first.
+    const closes =
+      message.type === 'close-all' ||
+      message.type === 'demo-stop' ||
+      message.type === 'demo-start' ||
+      message.type === 'replay-open' ||
+      message.type === 'bind' ||
+      (message.type === 'serial-close' && message.source === this.drive.source);
+    if (closes && this.drive.source !== null) this.drive.stop('its port was closed');
     switch (message.type) {
       case 'serial-open':
         await this.serial.open(message.port);
@@ -193,7 +205,7 @@ export class Dispatcher {
         await this.drive.start(message);
         break;
       case 'drive-stop':
-        this.drive.stop('stopped by the user');
+        this.drive.cancel();
         break;
       case 'drive-channel':
         this.drive.setChannel(message.id, message.percent);

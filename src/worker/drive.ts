@@ -10,10 +10,12 @@
  * sees the link lost, as it would in the air.
  */
 import { builtinScenarios, type DriveReceiver, manualScenario } from '../drive/builtins.js';
-import { DrivePlayer } from '../drive/player.js';
+import { type DriveCheck, gradeDrive } from '../drive/grade.js';
+import { DrivePlayer, type DriveWrite } from '../drive/player.js';
 import { type DriveScenario, parseDriveScenario } from '../drive/scenario.js';
 import { type DriveTimingStats, WriteSchedule } from '../drive/schedule.js';
 import { CHANNEL_COUNT, channelResolution, servoToMicros } from '../decoder/spec.js';
+import type { FcTimedReading } from './fc.js';
 import { type Host, notice } from './host.js';
 import type { PortIdentity } from './protocol.js';
 import type { SerialPorts } from './sources/serial-ports.js';
@@ -23,6 +25,8 @@ import type { SourceRegistry } from './registry.js';
 const STATUS_MS = 250;
 /** A timer that wakes within this of a write's time (the ms clock's rounding) finds it due, µs. */
 const WAKE_TOLERANCE_US = 1;
+/** A scenario up to this long keeps what it wrote, to grade the flight controller's reading against, µs. */
+const MAX_GRADED_US = 2 * 60e6;
 /** Writes a drive lets be on their way to the port at once (see `#tick`). */
 const MAX_WRITING = 2;
 
@@ -34,6 +38,8 @@ export interface DriveRequest {
   scenario: string;
   /** The most travel channel 0 (throttle) may reach, % (−100 … 100). */
   throttleCeilingPercent: number;
+  /** Channels the page holds from the first frame on (slider values, % by channel id). */
+  held?: Record<number, number>;
 }
 
 /** What the page is told of the drive. */
@@ -53,6 +59,11 @@ export interface DriveStatus {
   reason: string | null;
   /** The source reading the same port (the loopback self-test), or null. */
   source: number | null;
+  /** The receiver the drive was made for. */
+  receiver: DriveReceiver;
+  /** Once it stopped: the flight controller's reading graded (null: not graded, `gradeNote` says why). */
+  checks: DriveCheck[] | null;
+  gradeNote: string | null;
 }
 
 /** The scenario a request names: a built-in for its receiver, or the user's own JSON. @throws TypeError saying what is wrong */
@@ -77,21 +88,41 @@ export class DriveSession {
   #state: DriveStatus['state'] = 'stopped';
   #reason: string | null = null;
   #source: number | null = null;
-  /** Writes on their way to the port. */
-  #writing = 0;
+  /** Writes on their way to the port, counted per drive (a stopped drive's writes settle later). */
+  #writing = { count: 0 };
+  /** Starts asked for (each gets the next number when it arrives), and the last a stop cancelled. */
+  #requested = 0;
+  #cancelled = 0;
+  /** What was written, while the scenario is short enough to grade (null: not kept). */
+  #written: DriveWrite[] | null = null;
+  #receiver: DriveReceiver | null = null;
+  #checks: DriveCheck[] | null = null;
+  #gradeNote: string | null = null;
 
   constructor(
     readonly host: Host,
     readonly registry: SourceRegistry,
     readonly serial: SerialPorts,
+    /** The flight controller's readings since a time on the worker's clock (ms), if its port is read. */
+    readonly fcReadings: (sinceMs: number) => FcTimedReading[] = () => [],
   ) {}
 
-  get driving(): boolean {
-    return this.#state === 'driving';
+  /** The source whose port the drive writes (null: none). */
+  get source(): number | null {
+    return this.#player === null ? null : this.#source;
   }
 
-  /** Opens the port (as a source, for the loopback) and starts writing the scenario. */
-  async start(r: DriveRequest): Promise<void> {
+  /** A start has arrived (before it waits its turn): its number, for `start`. */
+  request(): number {
+    return ++this.#requested;
+  }
+
+  /**
+   * Opens the port (as a source, for the loopback) and starts writing the scenario: unless a
+   * stop came after start number `ticket` arrived, even while it waited its turn or the port.
+   */
+  async start(r: DriveRequest, ticket = this.request()): Promise<void> {
+    if (ticket <= this.#cancelled) return;
     this.stop('a new drive started');
     let scenario: DriveScenario;
     try {
@@ -100,8 +131,9 @@ export class DriveSession {
       notice(this.host, 'error', 'The scenario cannot be driven', (error as Error).message);
       return;
     }
-    if (!(await this.serial.open(r.port))) return;
+    if (!(await this.serial.open(r.port)) || ticket <= this.#cancelled) return;
     const port = await this.serial.find(r.port);
+    if (ticket <= this.#cancelled) return;
     const source = this.registry.list().find((s) => port !== undefined && s.serial?.port === port);
     if (source === undefined || port === undefined || port.writable === null) {
       notice(this.host, 'error', 'The port cannot be written', 'The adapter was opened, but the browser gives no way to write to it.');
@@ -111,8 +143,14 @@ export class DriveSession {
     this.#writer = writer;
     this.#source = source.id;
     this.#player = new DrivePlayer(scenario, { throttleCeilingPercent: r.throttleCeilingPercent });
+    for (const [id, percent] of Object.entries(r.held ?? {})) this.setChannel(Number(id), percent);
+    this.#writing = { count: 0 };
     this.#schedule = new WriteSchedule(this.#player);
     this.#sent = null;
+    this.#receiver = r.receiver;
+    this.#written = this.#player.durationUs <= MAX_GRADED_US ? [] : null;
+    this.#checks = null;
+    this.#gradeNote = null;
     this.#state = 'driving';
     this.#reason = null;
     this.#startMs = this.host.clock.now();
@@ -127,6 +165,12 @@ export class DriveSession {
     this.#player?.setChannel(id, percent === null ? null : Math.max(-150, Math.min(150, percent)));
   }
 
+  /** The user's stop: writing stops now, and no start asked for before it begins. */
+  cancel(): void {
+    this.#cancelled = this.#requested;
+    this.stop('stopped by the user');
+  }
+
   /** Stops writing now (the flight controller sees the link lost). */
   stop(reason: string, state: 'stopped' | 'ended' | 'failed' = 'stopped'): void {
     if (this.#player === null) return;
@@ -136,11 +180,11 @@ export class DriveSession {
     this.#statusTimer = undefined;
     const writer = this.#writer;
     this.#writer = null;
-    this.#writing = 0;
     // Bytes already handed to the port go out; none after this.
     writer?.releaseLock();
     this.#state = state;
     this.#reason = reason;
+    this.#grade();
     this.#post();
     this.#player = null;
     this.#schedule = null;
@@ -159,18 +203,20 @@ export class DriveSession {
   #tick(): void {
     const schedule = this.#schedule;
     const writer = this.#writer;
-    if (schedule === null || writer === null || this.#writing >= MAX_WRITING) return;
+    const writing = this.#writing;
+    if (schedule === null || writer === null || writing.count >= MAX_WRITING) return;
     const now = this.#nowUs();
     const w = schedule.take(now + WAKE_TOLERANCE_US);
     if (w !== null) {
-      this.#writing++;
+      writing.count++;
+      this.#written?.push(w);
       writer.write(w.bytes).then(
         () => {
           // A tick that found the port's hands full left no timer: this write's end wakes it.
-          if (this.#writing-- === MAX_WRITING && this.#writer === writer) this.#tick();
+          if (writing.count-- === MAX_WRITING && this.#writer === writer) this.#tick();
         },
         (error: unknown) => {
-          this.#writing--;
+          writing.count--;
           if (this.#writer === writer) this.stop(`the adapter could not be written (${String(error)}): unplugged?`, 'failed');
         },
       );
@@ -193,6 +239,31 @@ export class DriveSession {
     this.#timer = this.host.clock.after(Math.max(0, (next - now) / 1000), () => this.#tick());
   }
 
+  /**
+   * The flight controller's reading of what was written, graded (drive/grade.ts), once the drive
+   * stopped. Its readings are put on the player's clock as they were answered: the latency found
+   * includes the time an answer takes, half a reading interval at the most.
+   */
+  #grade(): void {
+    const written = this.#written;
+    this.#written = null;
+    if (written === null) {
+      this.#gradeNote = 'Not graded: a scenario over 2 minutes (the sticks alone run an hour) keeps no record of what it sent.';
+      return;
+    }
+    const readings = this.fcReadings(this.#startMs).map((r) => ({
+      atUs: (r.atMs - this.#startMs) * 1000,
+      channels: r.channels,
+      rxLoss: r.rxLoss,
+    }));
+    if (readings.length === 0) {
+      this.#gradeNote = "Not graded: the flight controller's USB port was not read during the drive.";
+      return;
+    }
+    this.#checks = gradeDrive(written, readings).checks;
+    this.#gradeNote = `Graded on ${readings.length} readings of the flight controller's channels.`;
+  }
+
   #post(): void {
     const player = this.#player;
     const schedule = this.#schedule;
@@ -210,6 +281,9 @@ export class DriveSession {
       timing: schedule.stats,
       reason: this.#reason,
       source: this.#source,
+      receiver: this.#receiver ?? { system: 0, remote: 'internal', channels: 0 },
+      checks: this.#checks,
+      gradeNote: this.#gradeNote,
     };
     this.host.post({ type: 'drive', drive: status });
   }

@@ -1,9 +1,9 @@
 /**
  * The flight controller's own view, while Drive sends it a satellite: its USB port, opened in
  * the worker beside the adapter, asked over MSP (Betaflight and iNav) what it decoded. It is
- * asked its flight stack and receiver setting once, its channels 20 times a second and its
- * status (armed, and the arming-disable flags that say RX loss) 4 times a second; the page is
- * told what it answered, and nothing it did not. MAVLink (ArduPilot, PX4) is read by the
+ * asked its flight stack and receiver setting once, its status (armed, and the arming-disable
+ * flags that say RX loss) and channels 20 times a second; the page is told what it answered,
+ * 4 times a second, and nothing it did not. MAVLink (ArduPilot, PX4) is read by the
  * library (src/drive/mavlink.ts) but not asked here yet.
  */
 import { BAUD_RATE } from '../decoder/spec.js';
@@ -23,11 +23,20 @@ import { type Host, notice } from './host.js';
 import type { PortIdentity } from './protocol.js';
 import { describePort, openProblem } from './sources/serial.js';
 
-/** How often the flight controller is asked for its channels, and its status, ms. */
-const RC_EVERY_MS = 50;
-const STATUS_EVERY_MS = 250;
+/** How often the flight controller is asked for its status and channels, and the page told, ms. */
+const ASK_EVERY_MS = 50;
+const POST_EVERY_MS = 250;
 /** No reply for this long: the page is told the flight controller is silent, ms. */
 const SILENT_MS = 1000;
+/** Channel readings kept for grading a drive: 20 minutes of them. */
+const MAX_READINGS = 24_000;
+
+/** One MSP_RC answer, with the receiver state it had last said, on the worker's clock (ms). */
+export interface FcTimedReading {
+  atMs: number;
+  channels: number[];
+  rxLoss: boolean | null;
+}
 
 /** What the flight controller said about itself and its receiver, as the page shows it. */
 export interface FcStatus {
@@ -61,6 +70,7 @@ export class FcReader {
   #status: FcStatus | null = null;
   #done: Promise<void> = Promise.resolve();
   #openedMs = Number.NaN;
+  #readings: FcTimedReading[] = [];
 
   constructor(
     readonly host: Host,
@@ -95,6 +105,7 @@ export class FcReader {
     this.#port = port;
     this.#writer = port.writable.getWriter();
     this.#parser = new MspParser();
+    this.#readings = [];
     this.#status = {
       state: 'opening',
       port: describePort(port),
@@ -114,14 +125,22 @@ export class FcReader {
     this.#ask(MSP.RX_CONFIG);
     const clock = this.host.clock;
     this.#timers.push(
-      clock.every(RC_EVERY_MS, () => this.#ask(MSP.RC)),
-      clock.every(STATUS_EVERY_MS, () => {
+      clock.every(ASK_EVERY_MS, () => {
+        // Its status as often as its channels: when it says the receiver lost is timed to that.
         this.#ask(this.#status?.variant === 'INAV' ? MSP.INAV_STATUS : MSP.STATUS_EX);
+        this.#ask(MSP.RC);
+      }),
+      clock.every(POST_EVERY_MS, () => {
         if (this.#status?.variant === null) this.#ask(MSP.FC_VARIANT);
         this.#post();
       }),
     );
     this.#post();
+  }
+
+  /** The channel readings answered from `sinceMs` on (the worker's clock), oldest first. */
+  readingsSince(sinceMs: number): FcTimedReading[] {
+    return this.#readings.filter((r) => r.atMs >= sinceMs);
   }
 
   /** Stops asking and closes the port. */
@@ -190,6 +209,8 @@ export class FcReader {
         }
         case MSP.RC:
           s.channels = readRc(m.payload);
+          if (this.#readings.length === MAX_READINGS) this.#readings.splice(0, MAX_READINGS / 2);
+          this.#readings.push({ atMs: s.lastReplyMs, channels: s.channels, rxLoss: s.rxLoss });
           break;
         case MSP.STATUS_EX: {
           const st = readBetaflightStatus(m.payload);

@@ -9,7 +9,7 @@
  * past the ceiling set here; Escape or Space stops at once (so does closing the tab or
  * unplugging the adapter): the flight controller sees its link lost, as in the air.
  */
-import { useEffect, useMemo, useState } from 'preact/hooks';
+import { useEffect, useMemo, useRef, useState } from 'preact/hooks';
 import { builtinScenarios, type DriveReceiver, manualScenario } from '../../../drive/builtins.js';
 import {
   CHANNEL_NAMES,
@@ -20,7 +20,8 @@ import {
   systemInfo,
 } from '../../../decoder/spec.js';
 import { identify, pickPort, portLabel, serialUnavailable } from '../../serial.js';
-import { drive, liveOf, notify, send } from '../../store.js';
+import { type DriveReport, driveReportHtml, fixFor } from '../../../drive/report.js';
+import { download, drive, fc, liveOf, notify, send } from '../../store.js';
 import { FcView } from './fc.js';
 import './style.css';
 
@@ -33,19 +34,42 @@ const clock = (us: number) => {
   return `${Math.floor(s / 60)}:${(s % 60).toFixed(1).padStart(4, '0')}`;
 };
 
+/** Saves the conformance report of a drive that stopped, with what the flight controller said of itself. */
+function save(status: NonNullable<typeof drive.value>, format: 'html' | 'json'): void {
+  const f = fc.peek();
+  const report: DriveReport = {
+    date: new Date().toISOString(),
+    scenario: { name: status.name, title: status.title },
+    receiver: status.receiver,
+    timing: status.timing,
+    fc: f === null ? null : { variant: f.variant, provider: f.provider },
+    checks: status.checks ?? [],
+    notes: status.gradeNote === null ? [] : [status.gradeNote],
+  };
+  const text = format === 'html' ? driveReportHtml(report) : `${JSON.stringify(report, null, 2)}\n`;
+  const data = new TextEncoder().encode(text).buffer as ArrayBuffer;
+  download(`satscope-drive-${status.name}.${format}`, format === 'html' ? 'text/html' : 'application/json', data);
+}
+
 export function DrivePanel({ granted, onClose }: { granted: SerialPort[]; onClose(): void }) {
   const status = drive.value;
   const driving = status?.state === 'driving';
-  // Escape or Space stops a drive at once, wherever the focus is; Escape closes the panel otherwise.
+  // A start asked for and not answered yet: Escape or Space stops it too.
+  const starting = useRef(false);
+  if (status !== null) starting.current = false;
+  // Escape or Space stops a drive at once, wherever the focus is; Escape otherwise closes the
+  // panel when the focus is in it (or nowhere), not a menu or another panel's field.
   useEffect(() => {
     const key = (e: KeyboardEvent) => {
-      if (drive.peek()?.state === 'driving' && (e.key === 'Escape' || e.key === ' ')) {
+      if ((drive.peek()?.state === 'driving' || starting.current) && (e.key === 'Escape' || e.key === ' ')) {
         e.preventDefault();
+        starting.current = false;
         send({ type: 'drive-stop' });
         return;
       }
-      // Otherwise Escape closes the panel, unless it is closing a menu (the menu's own Escape).
-      if (e.key === 'Escape' && document.querySelector('.menu-pop:not([hidden])') === null) onClose();
+      const at = document.activeElement;
+      const here = at === null || at === document.body || at.closest('.drive') !== null;
+      if (e.key === 'Escape' && here && document.querySelector('.menu-pop:not([hidden])') === null) onClose();
     };
     document.addEventListener('keydown', key, true);
     return () => document.removeEventListener('keydown', key, true);
@@ -80,15 +104,18 @@ export function DrivePanel({ granted, onClose }: { granted: SerialPort[]; onClos
       setPicked([...picked, port]);
       setChoice(ports.length);
     }
+    // The sticks the user holds go with the new drive from its first frame.
+    drive.value = null;
+    starting.current = true;
+    setPropsOff(false);
     send({
       type: 'drive-start',
       port: await identify(port),
       receiver,
       scenario: scenario === MINE ? mine : scenario,
       throttleCeilingPercent: ceiling,
+      held,
     });
-    // The sticks the user holds carry over to the new drive.
-    for (const [id, percent] of Object.entries(held)) send({ type: 'drive-channel', id: Number(id), percent });
   };
 
   const hold = (id: number, percent: number | null) => {
@@ -106,7 +133,7 @@ export function DrivePanel({ granted, onClose }: { granted: SerialPort[]; onClos
     <section class="drive panel" aria-label="Drive a flight controller">
       <div class="drive-head">
         <h2>Drive a flight controller</h2>
-        <button type="button" class="link" onClick={onClose}>
+        <button type="button" class="link" onClick={onClose} disabled={driving} title={driving ? 'Stop the drive first' : undefined}>
           Close
         </button>
       </div>
@@ -251,7 +278,7 @@ export function DrivePanel({ granted, onClose }: { granted: SerialPort[]; onClos
           {status.sent !== null ? (
             <>
               <p class="drive-note">
-                Sending now:{' '}
+                {driving ? 'Sending now' : 'Last sent'}:{' '}
                 {status.sent.remote === 'internal'
                   ? `internal remote, system byte 0x${(status.sent.system ?? 0).toString(16).toUpperCase()}`
                   : 'external remote'}
@@ -295,6 +322,49 @@ export function DrivePanel({ granted, onClose }: { granted: SerialPort[]; onClos
           ) : null}
         </div>
       ) : null}
+      {status !== null && status.state !== 'driving' && (status.checks !== null || status.gradeNote !== null) ? (
+        <div class="drive-grade" role="region" aria-label="Conformance">
+          <h3>How the flight controller read it</h3>
+          {status.gradeNote !== null ? <p class="drive-note">{status.gradeNote}</p> : null}
+          {status.checks !== null ? (
+            <>
+              <div class="table-scroll" tabIndex={0} role="region" aria-label="Checks">
+                <table class="drive-checks">
+                  <thead>
+                    <tr>
+                      <th>Check</th>
+                      <th>What it should do</th>
+                      <th>What it did</th>
+                      <th>Verdict</th>
+                    </tr>
+                  </thead>
+                  <tbody>
+                    {status.checks.map((c) => (
+                      <tr key={c.id} class={c.verdict}>
+                        <th>{c.id}</th>
+                        <td>{c.expects}</td>
+                        <td>
+                          {c.found}
+                          {fixFor(c, status) !== null ? <div class="drive-fix">{fixFor(c, status)}</div> : null}
+                        </td>
+                        <td class="verdict">{c.verdict}</td>
+                      </tr>
+                    ))}
+                  </tbody>
+                </table>
+              </div>
+              <div class="drive-go">
+                <button type="button" onClick={() => save(status, 'html')}>
+                  Save report (HTML)
+                </button>
+                <button type="button" onClick={() => save(status, 'json')}>
+                  Save report (JSON)
+                </button>
+              </div>
+            </>
+          ) : null}
+        </div>
+      ) : null}
       <FcView ports={ports} resolution={info?.resolution ?? 2048} />
       <fieldset class="drive-sticks" disabled={!driving}>
         <legend>Sticks (held while set; the scenario moves the others)</legend>
@@ -309,7 +379,7 @@ export function DrivePanel({ granted, onClose }: { granted: SerialPort[]; onClos
               aria-label={`${CHANNEL_NAMES[id]} stick, %`}
               onInput={(e) => hold(id, Number((e.currentTarget as HTMLInputElement).value))}
             />
-            <span class="num">{held[id] === undefined ? 'scenario' : `${held[id]} %`}</span>
+            <span class="num">{held[id] === undefined ? 'scenario' : `${id === 0 ? Math.min(held[id] ?? 0, ceiling) : held[id]} %`}</span>
             {held[id] !== undefined ? (
               <button type="button" class="link" onClick={() => hold(id, null)}>
                 release
