@@ -126,6 +126,12 @@ describe('drive scenarios', () => {
   });
 });
 
+const ONE_HOUR = {
+  name: 'hour',
+  title: 'An hour of DSMX 11 ms.',
+  steps: [{ note: 'on', durationUs: 3600e6, receiver: { system: 0xb2, remote: 'internal', channels: 8 } }],
+};
+
 describe('the write schedule', () => {
   /** Runs `scenario` through a schedule whose timer wakes `lateUs()` after it asked. */
   function run(scenario: DriveScenario, lateUs: () => number): { written: { at: number; w: DriveWrite }[]; schedule: WriteSchedule } {
@@ -178,5 +184,15 @@ describe('the write schedule', () => {
         ),
       ).toBeLessThanOrEqual(3 * (scenario.steps.length - 1) + 3 * s.skipped);
     }
+  });
+
+  it('a writer that slept an hour skips what fell due, a second at a time, and sends the newest frame', () => {
+    const player = new DrivePlayer(parseDriveScenario(JSON.stringify(ONE_HOUR)));
+    const schedule = new WriteSchedule(player);
+    expect(schedule.take(1_000)?.frame).not.toBeNull();
+    const w = schedule.take(3_000e6);
+    expect(w?.frame).not.toBeNull();
+    expect(w?.atUs).toBeGreaterThan(3_000e6 - 11_000);
+    expect(schedule.stats.skipped).toBeGreaterThan(270_000);
   });
 });

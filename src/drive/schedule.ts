@@ -21,6 +21,8 @@ export const MIN_SILENCE_US = 8_000;
 const NOISE_LATE_US = 1_000;
 /** How far ahead of now the player is asked for writes: a period's worth, so the next write's time is known before it is due, µs. */
 const LOOK_AHEAD_US = 25_000;
+/** A writer this far behind skips the writes due in steps of this, µs. */
+const SKIP_STEP_US = 1_000_000;
 /** Frame intervals are counted in bins of 0.1 ms up to 200 ms; longer ones in the last bin. */
 const BIN_US = 100;
 const BINS = 2001;
@@ -143,6 +145,12 @@ export class WriteSchedule {
 
   #fill(nowUs: number): void {
     if (this.#pending.length > 0 && (this.#pending[this.#pending.length - 1] as DriveWrite).atUs > nowUs) return;
+    // A writer that slept long (a machine suspended) skips what fell due meanwhile a second at a
+    // time, so that the frames it will never send are not all held at once.
+    while (this.#filledUs < nowUs - SKIP_STEP_US) {
+      this.#filledUs += SKIP_STEP_US;
+      for (const w of this.#player.writesUntil(this.#filledUs)) if (w.frame !== null) this.#skipped++;
+    }
     this.#filledUs = Math.max(this.#filledUs, nowUs + LOOK_AHEAD_US);
     for (const w of this.#player.writesUntil(this.#filledUs)) this.#pending.push(w);
   }
