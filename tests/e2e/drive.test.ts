@@ -4,7 +4,8 @@
  * controller's UART would: bytes grouped by the silence between them (the pty has no wire: a
  * group is what one read of the pty returned, so the reader's own lateness merges frames too).
  * The page keeps 8 ms of silence before every frame by its clock; at the pty every group must be
- * whole frames, hardly ever two (merged), at 11 ms. What the test reads it writes back (the
+ * whole frames, in 11 ms slots (frames read together are printed, not judged). What the test
+ * reads it writes back (the
  * loopback self-test): the page decodes it as a receiver. Escape stops the stream at once.
  * SATSCOPE_DRIVE_SECONDS sets how long it drives (default 30; docs/drive.md quotes a 600 s run);
  * the distribution is printed.
@@ -54,14 +55,15 @@ const quantile = (sorted: number[], q: number) => sorted[Math.min(sorted.length 
 
 describe.skipIf(skip !== null)('driving a flight controller through the adapter', () => {
   it(
-    `writes ${SECONDS} s of DSMX 11 ms from a background tab, frame by frame, and reads it back through the loopback`,
+    `writes ${SECONDS} s of DSMX 11 ms frame by frame, another tab in front, and reads it back through the loopback`,
     async () => {
       const context = await browser.newContext({ viewport: { width: 1280, height: 1000 } });
       const page = await context.newPage();
       const errors: string[] = [];
       page.on('pageerror', (e) => errors.push(e.message));
       await page.goto(rig!.server.url('/'));
-      await page.getByRole('button', { name: 'Drive…' }).click();
+      await page.getByRole('button', { name: 'More ways to connect' }).click();
+      await page.getByRole('button', { name: 'Drive a flight controller…' }).click();
       const panel = page.getByRole('region', { name: 'Drive a flight controller' });
       await panel.waitFor();
       // Nothing is sent before the user says the propellers are off.
@@ -88,10 +90,17 @@ describe.skipIf(skip !== null)('driving a flight controller through the adapter'
       const hidden = await page.evaluate(() => document.visibilityState);
       await new Promise((r) => setTimeout(r, SECONDS * 1000));
       await page.bringToFront();
-      await shot(page, 'drive-desktop-light');
-      await page.emulateMedia({ colorScheme: 'dark' });
-      await page.setViewportSize({ width: 390, height: 900 });
-      await shot(page, 'drive-phone-dark');
+      // The panel at both widths and in both themes, to look at.
+      for (const [width, scheme] of [
+        [1280, 'light'],
+        [1280, 'dark'],
+        [390, 'light'],
+        [390, 'dark'],
+      ] as const) {
+        await page.setViewportSize({ width, height: 900 });
+        await page.emulateMedia({ colorScheme: scheme });
+        await shot(page, `drive-${width < 600 ? 'phone' : 'desktop'}-${scheme}`);
+      }
       const echo = process.env.SATSCOPE_DRIVE_ECHO !== '0';
       const loop = echo ? await panel.getByTestId('drive-loopback').textContent() : null;
       const timing = await panel.getByTestId('drive-timing').textContent();
@@ -128,10 +137,14 @@ describe.skipIf(skip !== null)('driving a flight controller through the adapter'
       const frames = b.reduce((n, x) => n + x.length / 16, 0);
       // Frames the worker skipped (its timer late) are no frames: at most a tenth (below).
       expect(frames).toBeGreaterThan(((SECONDS * 1e6) / 11_000) * 0.9);
-      // Whole frames only: nothing split or cut short, and hardly ever two read as one.
+      // Whole frames only: nothing split or cut short.
       expect([...lengths.keys()].every((n) => n % 16 === 0)).toBe(true);
-      expect(frames - (lengths.get(16) ?? 0)).toBeLessThanOrEqual(frames * 0.02);
-      expect(Math.abs(quantile(intervals, 0.5) - 11_000)).toBeLessThanOrEqual(1000);
+      // Frames read in one piece with the next are reported, not judged: the pty's reader cannot
+      // tell its own lateness (hundreds of ms under load) from the page's.
+      // The slots kept: over the drive, frames written plus frames skipped come 11 ms apart.
+      const span = (b.at(-1)?.startUs ?? 0) - (b[0]?.startUs ?? 0);
+      const skippedNow = Number(/; (\d+) skipped/.exec(timing ?? '')?.[1] ?? Number.NaN);
+      expect(Math.abs(span / (frames + skippedNow - 1) - 11_000)).toBeLessThanOrEqual(330);
       // The page's own account: the silence it kept by its clock, and few frames skipped.
       expect(timing).toMatch(new RegExp(`shortest silence before a frame ${(MIN_SILENCE_US / 1000).toFixed(1)} ms`));
       const skipped = Number(/; (\d+) skipped/.exec(timing ?? '')?.[1] ?? Number.NaN);

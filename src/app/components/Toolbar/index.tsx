@@ -181,6 +181,16 @@ export function Toolbar({ granted, onBind, onDrive }: { granted: SerialPort[]; o
                   Any serial port…
                 </button>
                 <p class="hint">Connect receiver lists USB-serial adapters (FTDI, CP210x, CH340, PL2303…). This lists every serial port.</p>
+                <button
+                  type="button"
+                  onClick={() => {
+                    close();
+                    onDrive();
+                  }}
+                >
+                  Drive a flight controller…
+                </button>
+                <p class="hint">The adapter's TX plays a satellite to a flight controller, and its own reading is graded.</p>
                 {kind === 'serial' ? (
                   <button
                     type="button"
@@ -220,9 +230,6 @@ export function Toolbar({ granted, onBind, onDrive }: { granted: SerialPort[]; o
         </button>
         <button type="button" onClick={onBind} title="Put a satellite into bind mode through the adapter (spec §7.2)">
           Bind…
-        </button>
-        <button type="button" onClick={onDrive} title="Send a satellite's stream from the adapter's TX to a flight controller">
-          Drive…
         </button>
         <input
           ref={setCaptureInput}
