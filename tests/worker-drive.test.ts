@@ -12,52 +12,23 @@ import { MIN_SILENCE_US } from '../src/drive/schedule.js';
 import { Dispatcher } from '../src/worker/dispatcher.js';
 import type { DriveStatus } from '../src/worker/drive.js';
 import type { ToWorker } from '../src/worker/protocol.js';
-import { fakeHost } from './worker-fakes.js';
+import { StandInPort, fakeHost } from './worker-fakes.js';
 
-/** A SerialPort stand-in whose writes are kept with their time; `loopback`: what it writes comes back on its RX. */
-class TxPort {
-  readonly writes: { atMs: number; bytes: Uint8Array }[] = [];
-  #readable: ReadableStream<Uint8Array> | null = null;
-  #writable: WritableStream<Uint8Array> | null = null;
-  #rx: ReadableStreamDefaultController<Uint8Array> | undefined;
-  constructor(
-    readonly now: () => number,
-    readonly loopback = false,
-  ) {}
-  async open(): Promise<void> {
-    this.#readable = new ReadableStream<Uint8Array>({
-      start: (c) => {
-        this.#rx = c;
-      },
-    });
-    this.#writable = new WritableStream<Uint8Array>({
-      write: (bytes) => {
-        this.writes.push({ atMs: this.now(), bytes: bytes.slice() });
-        if (this.loopback) this.#rx?.enqueue(bytes.slice());
-      },
-    });
-  }
-  get readable(): ReadableStream<Uint8Array> | null {
-    return this.#readable;
-  }
-  get writable(): WritableStream<Uint8Array> | null {
-    return this.#writable;
-  }
-  async close(): Promise<void> {
-    this.#readable = null;
-    this.#writable = null;
-  }
-  async setSignals(): Promise<void> {}
-  getInfo(): SerialPortInfo {
-    return { usbVendorId: 0x0403, usbProductId: 0x6001 };
-  }
+/** The adapter: its writes kept with the fake clock's time; `loopback`: what it writes comes back on its RX. */
+function txPort(now: () => number, loopback: boolean) {
+  const writes: { atMs: number; bytes: Uint8Array }[] = [];
+  const port = new StandInPort(0x0403, (bytes, p) => {
+    writes.push({ atMs: now(), bytes });
+    if (loopback) p.reply(bytes.slice());
+  });
+  return Object.assign(port, { writes });
 }
 
 const PORT = { index: 0, usbVendorId: 0x0403, usbProductId: 0x6001 };
 
 function setup(loopback = false) {
   const fake = fakeHost();
-  const port = new TxPort(() => fake.clock.now(), loopback);
+  const port = txPort(() => fake.clock.now(), loopback);
   const worker = new Dispatcher(fake.host, { findPort: async () => port as unknown as SerialPort });
   const send = async (...messages: ToWorker[]): Promise<void> => {
     for (const m of messages) worker.receive(m);

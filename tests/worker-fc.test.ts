@@ -12,43 +12,7 @@ import { Dispatcher } from '../src/worker/dispatcher.js';
 import type { FcStatus } from '../src/worker/fc.js';
 import type { ToWorker } from '../src/worker/protocol.js';
 import { FakeFc } from './fake-fc.js';
-import { fakeHost } from './worker-fakes.js';
-
-/** A stand-in SerialPort: `onWrite` sees what the page writes; `reply` puts bytes on its RX. */
-class StandInPort {
-  #rx: ReadableStreamDefaultController<Uint8Array> | undefined;
-  #readable: ReadableStream<Uint8Array> | null = null;
-  #writable: WritableStream<Uint8Array> | null = null;
-  constructor(
-    readonly vid: number,
-    readonly onWrite: (bytes: Uint8Array, port: StandInPort) => void,
-  ) {}
-  async open(): Promise<void> {
-    this.#readable = new ReadableStream<Uint8Array>({
-      start: (c) => {
-        this.#rx = c;
-      },
-    });
-    this.#writable = new WritableStream<Uint8Array>({ write: (bytes) => this.onWrite(bytes.slice(), this) });
-  }
-  reply(bytes: Uint8Array): void {
-    this.#rx?.enqueue(bytes);
-  }
-  get readable(): ReadableStream<Uint8Array> | null {
-    return this.#readable;
-  }
-  get writable(): WritableStream<Uint8Array> | null {
-    return this.#writable;
-  }
-  async close(): Promise<void> {
-    this.#readable = null;
-    this.#writable = null;
-  }
-  async setSignals(): Promise<void> {}
-  getInfo(): SerialPortInfo {
-    return { usbVendorId: this.vid, usbProductId: 1 };
-  }
-}
+import { StandInPort, fakeHost } from './worker-fakes.js';
 
 const le16 = (values: number[]) => new Uint8Array(values.flatMap((v) => [v & 0xff, v >> 8]));
 

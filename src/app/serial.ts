@@ -67,6 +67,25 @@ export async function pickPort(filters: SerialPortFilter[]): Promise<SerialPort 
   }
 }
 
+/**
+ * The port a panel's choice names, or (none chosen) the one the user picks now from every port;
+ * null, with the reason told the user, when Web Serial is missing or nothing was picked.
+ */
+export async function chosenPort(port: SerialPort | undefined): Promise<SerialPort | null> {
+  const missing = serialUnavailable();
+  if (missing !== null) {
+    notify('error', missing.title, missing.detail);
+    return null;
+  }
+  if (port !== undefined) return port;
+  const answer = await pickPort([]);
+  if ('problem' in answer) {
+    notify('warning', answer.problem.title, answer.problem.detail);
+    return null;
+  }
+  return answer;
+}
+
 export function portLabel(port: SerialPort): string {
   return portName(port.getInfo());
 }

@@ -11,8 +11,8 @@ import { useEffect, useMemo, useState } from 'preact/hooks';
 import { BIND_MODES, type PowerLine, type PowerPolarity } from '../../../bind/index.js';
 import wiringSvg from '../../../bind/wiring.svg?raw';
 import wiringDoc from '../../../../docs/bind-wiring.md?raw';
-import { identify, pickPort, portLabel, serialUnavailable } from '../../serial.js';
-import { bindLog, notify, send } from '../../store.js';
+import { chosenPort, identify, portLabel } from '../../serial.js';
+import { bindLog, send } from '../../store.js';
 import { bindPreview, plainStep, sincePowerOn } from './preview.js';
 import './style.css';
 
@@ -59,19 +59,9 @@ export function BindPanel({ granted, onClose }: { granted: SerialPort[]; onClose
   const optionLabel = (i: number) => (labels.filter((l) => l === labels[i]).length > 1 ? `${labels[i]} (${i + 1})` : labels[i]);
 
   const start = async () => {
-    const missing = serialUnavailable();
-    if (missing !== null) {
-      notify('error', missing.title, missing.detail);
-      return;
-    }
-    let chosen = port;
-    if (chosen === undefined) {
-      const answer = await pickPort([]);
-      if ('problem' in answer) {
-        notify('warning', answer.problem.title, answer.problem.detail);
-        return;
-      }
-      chosen = answer;
+    const chosen = await chosenPort(port);
+    if (chosen === null) return;
+    if (chosen !== port) {
       // Show this port's plan from now on: it is the one the worker runs.
       const known = ports.indexOf(chosen);
       if (known >= 0) setChoice(known);

@@ -4,8 +4,8 @@
  * is armed and whether it reports the receiver lost. Only what it answered is shown.
  */
 import { useState } from 'preact/hooks';
-import { identify, pickPort, portLabel } from '../../serial.js';
-import { fc, notify, send } from '../../store.js';
+import { chosenPort, identify, portLabel } from '../../serial.js';
+import { fc, send } from '../../store.js';
 
 /** The flight controller's channel order (Betaflight and iNav after their channel map). */
 const FC_NAMES = ['Roll', 'Pitch', 'Yaw', 'Throttle', 'Aux 1', 'Aux 2', 'Aux 3', 'Aux 4', 'Aux 5', 'Aux 6', 'Aux 7', 'Aux 8'];
@@ -16,16 +16,8 @@ export function FcView({ ports, resolution }: { ports: SerialPort[]; resolution:
   const s = fc.value;
   const open = s !== null && s.state !== 'closed';
   const start = async () => {
-    let port = ports[choice];
-    if (port === undefined) {
-      const answer = await pickPort([]);
-      if ('problem' in answer) {
-        notify('warning', answer.problem.title, answer.problem.detail);
-        return;
-      }
-      port = answer;
-    }
-    send({ type: 'fc-open', port: await identify(port) });
+    const port = await chosenPort(ports[choice]);
+    if (port !== null) send({ type: 'fc-open', port: await identify(port) });
   };
   const expected = resolution === 2048 ? 'SPEKTRUM2048' : 'SPEKTRUM1024';
   return (

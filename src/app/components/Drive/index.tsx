@@ -19,9 +19,9 @@ import {
   SYSTEM_DSMX_22MS_2048,
   systemInfo,
 } from '../../../decoder/spec.js';
-import { identify, pickPort, portLabel, serialUnavailable } from '../../serial.js';
+import { chosenPort, identify, portLabel } from '../../serial.js';
 import { type DriveReport, driveReportHtml, fixFor } from '../../../drive/report.js';
-import { download, drive, fc, liveOf, notify, send } from '../../store.js';
+import { download, drive, fc, liveOf, send } from '../../store.js';
 import { FcView } from './fc.js';
 import './style.css';
 
@@ -88,19 +88,9 @@ export function DrivePanel({ granted, onClose }: { granted: SerialPort[]; onClos
   const chosen = scenarios.find((s) => s.name === scenario);
 
   const start = async () => {
-    const missing = serialUnavailable();
-    if (missing !== null) {
-      notify('error', missing.title, missing.detail);
-      return;
-    }
-    let port = ports[choice];
-    if (port === undefined) {
-      const answer = await pickPort([]);
-      if ('problem' in answer) {
-        notify('warning', answer.problem.title, answer.problem.detail);
-        return;
-      }
-      port = answer;
+    const port = await chosenPort(ports[choice]);
+    if (port === null) return;
+    if (!ports.includes(port)) {
       setPicked([...picked, port]);
       setChoice(ports.length);
     }
