@@ -9,10 +9,8 @@ import { describe, expect, it } from 'vitest';
 import { SpektrumDecoder } from '../src/decoder/decoder.js';
 import { BYTE_TIME_US, servoToPercent } from '../src/decoder/spec.js';
 import { MIN_SILENCE_US } from '../src/drive/schedule.js';
-import { Dispatcher } from '../src/worker/dispatcher.js';
 import type { DriveStatus } from '../src/worker/drive.js';
-import type { ToWorker } from '../src/worker/protocol.js';
-import { StandInPort, fakeHost } from './worker-fakes.js';
+import { StandInPort, fakeHost, portRig } from './worker-fakes.js';
 
 /** The adapter: its writes kept with the fake clock's time; `loopback`: what it writes comes back on its RX. */
 function txPort(now: () => number, loopback: boolean) {
@@ -29,18 +27,7 @@ const PORT = { index: 0, usbVendorId: 0x0403, usbProductId: 0x6001 };
 function setup(loopback = false) {
   const fake = fakeHost();
   const port = txPort(() => fake.clock.now(), loopback);
-  const worker = new Dispatcher(fake.host, { findPort: async () => port as unknown as SerialPort });
-  const send = async (...messages: ToWorker[]): Promise<void> => {
-    for (const m of messages) worker.receive(m);
-    await worker.queue.idle();
-  };
-  /** Moves the clock on `ms`, in 1 ms steps with the promises between them settled (reads, writes). */
-  const run = async (ms: number): Promise<void> => {
-    for (let i = 0; i < ms; i++) {
-      fake.clock.advance(1);
-      await new Promise((r) => setImmediate(r));
-    }
-  };
+  const { worker, send, run } = portRig(fake, async () => port as unknown as SerialPort);
   const status = (): DriveStatus | undefined => fake.of('drive').at(-1)?.drive;
   return { ...fake, port, worker, send, run, status };
 }

@@ -1,7 +1,7 @@
 /** A fake clock and host for driving the worker's parts in Node: time moves only when a test says. */
 import type { Clock, Host } from '../src/worker/host.js';
 import { Dispatcher } from '../src/worker/dispatcher.js';
-import type { Batch, FromWorker, ToWorker } from '../src/worker/protocol.js';
+import type { Batch, FromWorker, PortIdentity, ToWorker } from '../src/worker/protocol.js';
 import type { ReplayClock } from '../src/worker/sources/replay.js';
 
 interface Timer {
@@ -151,6 +151,25 @@ export function openReplay(clock: FakeClock = new FakeClock()) {
     throw new Error('the walk did not end');
   };
   return { ...fake, worker, send, walked };
+}
+
+/**
+ * The whole worker over stand-in ports (`findPort` finds them): commands sent and waited for,
+ * and the fake clock moved on in 1 ms steps with the promises between them settled (reads, writes).
+ */
+export function portRig(fake: ReturnType<typeof fakeHost>, findPort: (identity: PortIdentity) => Promise<SerialPort | undefined>) {
+  const worker = new Dispatcher(fake.host, { findPort });
+  const send = async (...messages: ToWorker[]): Promise<void> => {
+    for (const m of messages) worker.receive(m);
+    await worker.queue.idle();
+  };
+  const run = async (ms: number): Promise<void> => {
+    for (let i = 0; i < ms; i++) {
+      fake.clock.advance(1);
+      await new Promise((r) => setImmediate(r));
+    }
+  };
+  return { worker, send, run };
 }
 
 /** A stand-in SerialPort: `onWrite` sees what the page writes; `reply` puts bytes on its RX. */

@@ -8,11 +8,9 @@
 import { describe, expect, it } from 'vitest';
 import { MSP, MspParser, encodeMsp } from '../src/drive/msp.js';
 import { driveReportHtml } from '../src/drive/report.js';
-import { Dispatcher } from '../src/worker/dispatcher.js';
 import type { FcStatus } from '../src/worker/fc.js';
-import type { ToWorker } from '../src/worker/protocol.js';
 import { FakeFc } from './fake-fc.js';
-import { StandInPort, fakeHost } from './worker-fakes.js';
+import { StandInPort, fakeHost, portRig } from './worker-fakes.js';
 
 const le16 = (values: number[]) => new Uint8Array(values.flatMap((v) => [v & 0xff, v >> 8]));
 
@@ -51,19 +49,7 @@ function setup(resolution: 1024 | 2048, map = 'TAER1234') {
     }
   });
   const ports = [adapter, usb];
-  const worker = new Dispatcher(fake.host, {
-    findPort: async (id) => ports.find((p) => p.vid === id.usbVendorId) as unknown as SerialPort,
-  });
-  const send = async (...messages: ToWorker[]): Promise<void> => {
-    for (const m of messages) worker.receive(m);
-    await worker.queue.idle();
-  };
-  const run = async (ms: number): Promise<void> => {
-    for (let i = 0; i < ms; i++) {
-      fake.clock.advance(1);
-      await new Promise((r) => setImmediate(r));
-    }
-  };
+  const { worker, send, run } = portRig(fake, async (id) => ports.find((p) => p.vid === id.usbVendorId) as unknown as SerialPort);
   const fcNow = (): FcStatus | undefined => fake.of('fc').at(-1)?.fc;
   return { ...fake, worker, send, run, fcNow };
 }
@@ -104,13 +90,9 @@ describe("the flight controller's own view while driving it", () => {
   it('says the flight controller is silent when nothing answers, and shows no value it did not send', async () => {
     const fake = fakeHost();
     const mute = new StandInPort(0x0483, () => undefined);
-    const worker = new Dispatcher(fake.host, { findPort: async () => mute as unknown as SerialPort });
-    worker.receive({ type: 'fc-open', port: FC_USB });
-    await worker.queue.idle();
-    for (let i = 0; i < 1500; i++) {
-      fake.clock.advance(1);
-      await new Promise((r) => setImmediate(r));
-    }
+    const { send, run } = portRig(fake, async () => mute as unknown as SerialPort);
+    await send({ type: 'fc-open', port: FC_USB });
+    await run(1500);
     expect(fake.of('fc').at(-1)?.fc).toMatchObject({
       state: 'silent',
       variant: null,

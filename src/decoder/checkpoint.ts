@@ -90,7 +90,6 @@ export function copyEpisodes(g: Readonly<EpisodeGraph>): EpisodeGraph {
 export interface LinkCheckpoint {
   readonly state: LinkState;
   readonly lastUs: number;
-  readonly systemPeriod: number;
   readonly periodTimes: Float64Array;
   readonly periodCount: number;
   readonly periodOldest: number;

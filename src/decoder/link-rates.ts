@@ -16,7 +16,7 @@
 import type { LinkCheckpoint } from './checkpoint.js';
 import { nominalPeriodOf, PERIOD_SNAP_US } from './link-rules.js';
 import type { LinkStats } from './link-types.js';
-import { FRAME_PERIOD_11MS_US } from './spec.js';
+import { FRAME_PERIOD_11MS_US, FRAME_PERIOD_22MS_US } from './spec.js';
 
 const PERIOD_WINDOW = 33;
 /** A mean frame interval below this (0.8 × 11 ms) is no system's period: frames a delivery burst brought together. */
@@ -64,6 +64,11 @@ export class LinkRates {
   #against = 0;
   /** Frames in a row whose byte 0 was a fade count. */
   #counted = 0;
+
+  /** The period the system byte states, µs (NaN: none). */
+  get stated(): number {
+    return this.#stated;
+  }
 
   /** A system byte states the period `periodUs` (NaN: none does now): it is the nominal period until refuted. */
   state(periodUs: number, s: LinkStats): void {
@@ -130,7 +135,7 @@ export class LinkRates {
    */
   #refute(newest: number, s: LinkStats): void {
     const stated = this.#stated;
-    const other = stated > FRAME_PERIOD_11MS_US ? FRAME_PERIOD_11MS_US : 2 * FRAME_PERIOD_11MS_US;
+    const other = stated > FRAME_PERIOD_11MS_US ? FRAME_PERIOD_11MS_US : FRAME_PERIOD_22MS_US;
     const { mean, longest, periods } = this.#window(newest);
     let against = mean >= BURST_MEAN_US && Math.abs(mean - other) <= Math.max(MEAN_FIT_US, longest / periods);
     if (against && other > stated) {

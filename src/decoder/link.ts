@@ -63,7 +63,6 @@ export class LinkMonitor {
   readonly #onMissed: LinkOptions['onMissed'];
   #state: LinkState = 'waiting';
   #lastUs = NaN;
-  #systemPeriod = NaN;
   /** The period and fade-rate windows. */
   readonly #rates = new LinkRates();
   /** The last system byte seen, and whether `systemInfo` knew it (one lookup per change, not per frame). */
@@ -124,7 +123,7 @@ export class LinkMonitor {
     this.#stalls = new StallJudge(this.#episodes, this.#stats, {
       holdAfterUs: () => this.holdAfterUs,
       counterHoldUs: () => this.#holdOption ?? holdThresholdUs(this.#stats.nominalPeriodUs, this.#jitterPrior),
-      periodKnown: () => Number.isFinite(this.#systemPeriod) && this.#stats.nominalPeriodUs === this.#systemPeriod,
+      periodKnown: () => Number.isFinite(this.#rates.stated) && this.#stats.nominalPeriodUs === this.#rates.stated,
       failsafeAfterUs: this.#failsafeAfterUs,
       add: (kind, startUs, lastFrameUs) => this.#add(kind, startUs, lastFrameUs),
     });
@@ -193,13 +192,11 @@ export class LinkMonitor {
       // The frames are an external remote's after all (re-read, or a rebind): the byte the period
       // was taken from was a fade count, and its period is no evidence; timing decides it again.
       this.#systemByte = -1;
-      this.#systemPeriod = NaN;
       this.#rates.state(NaN, s);
     } else if (frame.system !== null && frame.system !== this.#systemByte) {
       const info = systemInfo(frame.system);
       if (info) {
         this.#systemByte = frame.system;
-        this.#systemPeriod = info.periodUs;
         this.#rates.state(info.periodUs, s);
       }
     }
@@ -414,7 +411,6 @@ export class LinkMonitor {
     return {
       state: this.#state,
       lastUs: this.#lastUs,
-      systemPeriod: this.#systemPeriod,
       systemByte: this.#systemByte,
       ...this.#rates.checkpoint(),
       settled: logged?.blocks ?? [],
@@ -446,7 +442,6 @@ export class LinkMonitor {
   restore(cp: LinkCheckpoint): void {
     this.#state = cp.state;
     this.#lastUs = cp.lastUs;
-    this.#systemPeriod = cp.systemPeriod;
     this.#rates.restore(cp);
     this.#systemByte = cp.systemByte;
     const g = copyEpisodes(cp.graph);

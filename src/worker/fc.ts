@@ -53,9 +53,8 @@ export interface FcStatus {
   /** It says it has no valid receiver frames (Betaflight RXLOSS, iNav RC_LINK), null until it answers. */
   rxLoss: boolean | null;
   armingDisableFlags: number | null;
-  /** Replies read, and bytes that were no MSP reply (a bad checksum, or another protocol). */
+  /** Replies read. */
   replies: number;
-  badBytes: number;
   /** When it last answered, ms on the worker's clock (NaN: never). */
   lastReplyMs: number;
 }
@@ -116,7 +115,6 @@ export class FcReader {
       rxLoss: null,
       armingDisableFlags: null,
       replies: 0,
-      badBytes: 0,
       lastReplyMs: Number.NaN,
     };
     this.#openedMs = this.host.clock.now();
@@ -232,7 +230,6 @@ export class FcReader {
         }
       }
     }
-    s.badBytes = this.#parser.stats.discardedBytes + this.#parser.stats.badChecks;
   }
 
   #post(): void {

@@ -34,6 +34,11 @@ const clock = (us: number) => {
   return `${Math.floor(s / 60)}:${(s % 60).toFixed(1).padStart(4, '0')}`;
 };
 
+/** What to change where a check failed (nothing where it did not). */
+function Fix({ text }: { text: string | null }) {
+  return text === null ? null : <div class="drive-fix">{text}</div>;
+}
+
 /** Saves the conformance report of a drive that stopped, with what the flight controller said of itself. */
 function save(status: NonNullable<typeof drive.value>, format: 'html' | 'json'): void {
   const f = fc.peek();
@@ -335,7 +340,7 @@ export function DrivePanel({ granted, onClose }: { granted: SerialPort[]; onClos
                         <td>{c.expects}</td>
                         <td>
                           {c.found}
-                          {fixFor(c, status) !== null ? <div class="drive-fix">{fixFor(c, status)}</div> : null}
+                          <Fix text={fixFor(c, status)} />
                         </td>
                         <td class="verdict">{c.verdict}</td>
                       </tr>
