@@ -347,8 +347,11 @@ describe('every surface tells the same story about the same bytes', () => {
         }
         if (summarizeCapture(capture).link.missedBasis === 'frame-count') {
           // Without a fade counter the count rests on the schedule the first frames set: a frame
-          // missed among them, through 16 ms of batching, can hide in the first frames' lateness.
-          expect(Math.abs(live.missedFrames! - reference.missedFrames!)).toBeLessThanOrEqual(1);
+          // missed among them, through 16 ms of batching, can hide in the first frames' lateness;
+          // and one missed near the end in the last frames', where no window has measured the
+          // jitter (a damaged line's windows all miss frames): the live count is then what the
+          // frames prove beyond the longest hold a delivery burst showed.
+          expect(Math.abs(live.missedFrames! - reference.missedFrames!)).toBeLessThanOrEqual(2);
           live.missedFrames = reference.missedFrames;
         }
         // Bytes with a silence inside them are no frame where each byte has its own time; a

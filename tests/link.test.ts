@@ -268,6 +268,22 @@ describe('LinkMonitor: missed means missed', () => {
     expect(wrong).toEqual([]);
   });
 
+  it('without a counter, a stream shorter than a window, in USB batches of up to 100 ms, counts no frame it did not miss', () => {
+    // No window closes, so no delivery jitter is measured: the last batch's lateness proves nothing
+    // beyond the longest hold a batch showed (its frames came together, sent a period apart).
+    const wrong: string[] = [];
+    for (const system of [0xb2, 0x12] as const)
+      for (let durationUs = 130_000; durationUs <= 1_200_000; durationUs += 70_000)
+        for (const windowUs of [16_000, 32_000, 64_000, 100_000])
+          for (const seed of [1, 2]) {
+            const sim = simulate({ system, header: 'zero', seed, fades: { lossRate: 0, randomRate: 0 } }, durationUs, { truth: true });
+            const { link } = summarizeCapture(recording([sim], true, windowUs));
+            if (link.missedFrames !== 0)
+              wrong.push(`${system === 0xb2 ? 11 : 22} ms, ${durationUs / 1000} ms, ${windowUs / 1000} ms batches: ${link.missedFrames}`);
+          }
+    expect(wrong).toEqual([]);
+  });
+
   it('places missing frames where they were due, for the binned series', () => {
     const series = new LinkSeries(100_000, 0);
     const link = monitorWithSeries({}, series);

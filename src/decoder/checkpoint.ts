@@ -50,6 +50,9 @@ export interface LedgerCheckpoint {
   readonly pendingDelay: number;
   readonly delayUs: number;
   readonly jitterUs: number;
+  readonly burstFrames: number;
+  readonly burstStartUs: number;
+  readonly heldUs: number;
   readonly closes: number;
   readonly closedMissing: number;
   readonly closedPunctualUs: number;

@@ -62,6 +62,15 @@ export class FrameLedger {
   #winGapFromUs = NaN;
   #winGapToUs = NaN;
   readonly #spreads: number[] = [];
+  /** Frames after the first of the delivery burst the last frame came in, and that first frame's time. */
+  #burstFrames = 0;
+  #burstStartUs = NaN;
+  /**
+   * The longest a delivery burst proves the adapter held a frame: a burst of frames closer than
+   * half a period were sent a period apart each (or more, with frames missing among them), so
+   * its first frame was late by at least the periods between them less their arrival span.
+   */
+  #heldUs = 0;
   #pendingSpread = NaN;
   #pendingDelay = NaN;
   delayUs = NaN;
@@ -76,6 +85,7 @@ export class FrameLedger {
 
   reset(): void {
     this.#period = NaN;
+    this.#burstFrames = 0;
     this.#refUs = NaN;
     this.#lastUs = NaN;
     this.#openWindow(NaN);
@@ -117,6 +127,8 @@ export class FrameLedger {
       this.#refLateUs = NaN;
       this.#lastUs = t;
       this.#tailCount = 0;
+      this.#burstFrames = 0;
+      this.#burstStartUs = t;
       this.#openWindow(t);
       this.#take(t, 0, 0);
       return 0;
@@ -138,6 +150,13 @@ export class FrameLedger {
       this.#winGapUs = gap;
       this.#winGapFromUs = this.#lastUs;
       this.#winGapToUs = t;
+    }
+    if (gap < period / 2) {
+      const held = ++this.#burstFrames * period - (t - this.#burstStartUs);
+      if (held > this.#heldUs) this.#heldUs = held;
+    } else {
+      this.#burstFrames = 0;
+      this.#burstStartUs = t;
     }
     this.#lastUs = t;
     this.#take(t, late, this.#slot);
@@ -226,6 +245,9 @@ export class FrameLedger {
       pendingDelay: this.#pendingDelay,
       delayUs: this.delayUs,
       jitterUs: this.jitterUs,
+      burstFrames: this.#burstFrames,
+      burstStartUs: this.#burstStartUs,
+      heldUs: this.#heldUs,
       closes: this.closes,
       closedMissing: this.closedMissing,
       closedPunctualUs: this.closedPunctualUs,
@@ -258,6 +280,9 @@ export class FrameLedger {
     this.#pendingDelay = cp.pendingDelay;
     this.delayUs = cp.delayUs;
     this.jitterUs = cp.jitterUs;
+    this.#burstFrames = cp.burstFrames;
+    this.#burstStartUs = cp.burstStartUs;
+    this.#heldUs = cp.heldUs;
     this.closes = cp.closes;
     this.closedMissing = cp.closedMissing;
     this.closedPunctualUs = cp.closedPunctualUs;
@@ -287,7 +312,9 @@ export class FrameLedger {
       if (back <= TAIL_FRAMES && late < tailMin) tailMin = late;
       if (back > 1 && (this.#tailUs[(i + 1) % TAIL_KEPT] ?? NaN) - t > p / 2) vouched = late;
     }
-    const jitter = Number.isFinite(this.jitterUs) ? this.jitterUs : 0;
+    // Until windows have measured the delivery jitter, the adapter may have held the last frames
+    // as long as a delivery burst proved it holds one.
+    const jitter = Number.isFinite(this.jitterUs) ? this.jitterUs : this.#heldUs;
     const beyondJitter = Number.isFinite(tailMin) ? Math.round((tailMin - jitter) / p) : 0;
     // Against the later of the reference and the schedule before it (a window's rounding may have
     // counted a frame for the reference's lateness), and only on a schedule a window has
