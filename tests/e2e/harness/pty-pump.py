@@ -14,6 +14,12 @@ Started by pty-serial.ts; talks over stdio with length-prefixed frames:
     E  event, UTF-8 JSON
 The device path is restored on Q, on stdin EOF (parent died), on SIGTERM/SIGINT/SIGHUP and
 on any error: the parent crashing never leaves the pty in place of the real device.
+
+A device sysfs does not list (e.g. /dev/ttyS1 on a machine with one UART) is listed for the
+time the pump runs: Chromium enumerates serial ports from sysfs (a tty whose MAJOR/MINOR
+/proc/tty/drivers calls "serial") and opens the DEVNAME its uevent names, so an unused virtual
+console's uevent is covered (a bind mount) with ttyS0's numbers and this device's name. The mount
+is undone by the same restore; a stale one from a killed pump is undone at the next start.
 """
 import errno
 import json
@@ -23,6 +29,7 @@ import signal
 import socket
 import stat
 import struct
+import subprocess
 import sys
 import time
 import tty
@@ -32,6 +39,11 @@ BACKUP = DEV + '.satscope-orig'
 COALESCE_S = float(sys.argv[2]) / 1e6 if len(sys.argv) > 2 else 0.0005
 SIGNAL_SOCKET = b'\0satscope-pty-signals'
 SIGNAL_IN_FILE = '/dev/shm/satscope-pty-signals-in'
+NAME = os.path.basename(DEV)
+LISTED_IN_SYSFS = os.path.exists(f'/sys/class/tty/{NAME}')
+# The virtual consoles lent to unlisted devices, the last ones first (nothing uses them here).
+DONORS = [f'/sys/devices/virtual/tty/tty{n}/uevent' for n in range(63, 47, -1)]
+UEVENT_FILE = f'/dev/shm/satscope-uevent-{NAME}'
 
 out = sys.stdout.buffer
 
@@ -57,8 +69,46 @@ def is_our_link(path):
         return False
 
 
+def mounted_over(path):
+    with open('/proc/self/mountinfo') as f:
+        return any(line.split()[4] == path for line in f)
+
+
+def donor_of_ours():
+    """The virtual console's uevent this device is listed under (a mount of ours), or None."""
+    for donor in DONORS:
+        if mounted_over(donor):
+            with open(donor) as f:
+                if f'DEVNAME={NAME}\n' in f.read():
+                    return donor
+    return None
+
+
+def list_device():
+    """Make sysfs list DEV (see the module's note), unless it does already."""
+    if LISTED_IN_SYSFS or donor_of_ours():
+        return
+    with open('/sys/class/tty/ttyS0/uevent') as f:
+        numbers = [line for line in f.read().splitlines() if line.startswith(('MAJOR=', 'MINOR='))]
+    with open(UEVENT_FILE, 'w') as f:
+        f.write('\n'.join(numbers + [f'DEVNAME={NAME}']) + '\n')
+    donor = next(d for d in DONORS if os.path.exists(d) and not mounted_over(d))
+    subprocess.run(['mount', '--bind', UEVENT_FILE, donor], check=True)
+
+
+def unlist_device():
+    donor = donor_of_ours()
+    if donor:
+        subprocess.run(['umount', donor], check=False)
+    try:
+        os.unlink(UEVENT_FILE)
+    except FileNotFoundError:
+        pass
+
+
 def restore():
-    """Idempotent: remove our symlink, move the original device back."""
+    """Idempotent: remove our symlink, move the original device back, unlist a listed one."""
+    unlist_device()
     if is_our_link(DEV):
         os.unlink(DEV)
     if is_our_link(DEV + '.satscope-new'):
@@ -221,6 +271,7 @@ def main():
         sig.close()
         sig = None
     restore()  # a stale swap from a crashed run
+    list_device()
     new_pty()
     os.set_blocking(0, False)
     while True:

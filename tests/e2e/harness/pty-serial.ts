@@ -29,8 +29,11 @@ export function fakeSerialUnsupportedReason(device = SERIAL_DEVICE): string | nu
   if (process.platform !== 'linux') return 'not Linux';
   if (process.getuid?.() !== 0) return 'not root (needed to replace /dev/ttyS0 and write Chromium policy)';
   const name = device.split('/').pop()!;
-  if (!existsSync(device) && !existsSync(device + BACKUP_SUFFIX)) return `${device} is absent`;
-  if (!existsSync(`/sys/class/tty/${name}`)) return `/sys/class/tty/${name} is absent`;
+  const listed = existsSync(`/sys/class/tty/${name}`);
+  if (listed && !existsSync(device) && !existsSync(device + BACKUP_SUFFIX)) return `${device} is absent`;
+  // pty-pump.py lists a device sysfs lacks under a virtual console's uevent (a bind mount).
+  if (!listed && !(existsSync('/sys/class/tty/ttyS0') && existsSync('/sys/devices/virtual/tty/tty63/uevent')))
+    return `/sys/class/tty/${name} is absent and cannot be listed`;
   if (spawnSync('python3', ['-c', 'import os; os.openpty()']).status !== 0) return 'python3 with os.openpty() is missing';
   return null;
 }
