@@ -13,7 +13,7 @@
 import type { Browser } from 'playwright-core';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { SpektrumDecoder } from '../../src/decoder/decoder.js';
-import { BYTE_TIME_US } from '../../src/decoder/spec.js';
+import { BYTE_TIME_US, servoToPercent } from '../../src/decoder/spec.js';
 import { MIN_SILENCE_US } from '../../src/drive/schedule.js';
 import { browserUnavailable, shot, startSerialApp, type SerialAppSession } from './app-fixture.js';
 import { fakeSerialUnsupportedReason, type FakeSerialPort } from './harness/pty-serial.js';
@@ -157,4 +157,119 @@ describe.skipIf(skip !== null)('driving a flight controller through the adapter'
     },
     (SECONDS + 60) * 1000,
   );
+
+  it('takes the sticks from a gamepad, bounds its throttle by the ceiling, and the frames carry them', async () => {
+    const context = await browser.newContext({ viewport: { width: 1280, height: 1000 } });
+    // A gamepad the browser lists: the test moves its axes (the standard layout; mode 2).
+    await context.addInitScript(() => {
+      const pad = {
+        id: 'Test pad (STANDARD GAMEPAD)',
+        index: 0,
+        connected: true,
+        mapping: 'standard',
+        timestamp: 0,
+        axes: [0, 0, 0, 0],
+        buttons: Array.from({ length: 17 }, () => ({ pressed: false, touched: false, value: 0 })),
+      };
+      (window as unknown as { testPad: typeof pad }).testPad = pad;
+      Object.defineProperty(navigator, 'getGamepads', { value: () => [pad, null, null, null], configurable: true });
+    });
+    const page = await context.newPage();
+    const errors: string[] = [];
+    page.on('pageerror', (e) => errors.push(e.message));
+    await page.goto(rig!.server.url('/'));
+    await page.evaluate(() => localStorage.removeItem('satscope.drive.gamepad'));
+    await page.getByRole('button', { name: 'More ways to connect' }).click();
+    await page.getByRole('button', { name: 'Drive a flight controller…' }).click();
+    const panel = page.getByRole('region', { name: 'Drive a flight controller' });
+    await panel.waitFor();
+    await panel.getByLabel('Gamepad or transmitter (joystick mode)').check();
+    await panel.getByTestId('drive-pad-state').filter({ hasText: 'Test pad (STANDARD GAMEPAD): 4 axes, 17 buttons' }).waitFor();
+    // Gear from button 0, kept by the page across a reload.
+    await panel.getByLabel('Gear from').selectOption('button:0');
+    await page.reload();
+    await page.getByRole('button', { name: 'More ways to connect' }).click();
+    await page.getByRole('button', { name: 'Drive a flight controller…' }).click();
+    await panel.getByLabel('Gamepad or transmitter (joystick mode)').check();
+    expect(await panel.getByLabel('Gear from').inputValue()).toBe('button:0');
+
+    const decoder = new SpektrumDecoder();
+    const last = new Map<number, number>();
+    const stop = fake.onData((bytes, tUs) => {
+      decoder.push(bytes, tUs);
+      for (let f = decoder.next(); f !== undefined; f = decoder.next())
+        for (let i = 0; i < f.count; i++) last.set(f.ids[i] as number, servoToPercent(f.positions[i] as number, f.resolution));
+      void fake.write(bytes);
+    });
+    await panel.getByLabel('The propellers are off').check();
+    await panel.getByRole('button', { name: '▶ Start driving' }).click();
+    await panel.getByTestId('drive-state').filter({ hasText: 'Sending “manual”' }).waitFor();
+    // Left stick full up (throttle: past the −60 % ceiling), right stick half right (aileron +50 %), button 0 held.
+    await page.evaluate(() => {
+      const pad = (window as unknown as { testPad: { axes: number[]; buttons: { pressed: boolean; value: number }[] } }).testPad;
+      pad.axes = [0, -1, 0.5, 0];
+      pad.buttons[0] = { pressed: true, value: 1 };
+    });
+    const near = (id: number, want: number) => Math.abs((last.get(id) ?? Number.NaN) - want) <= 0.5;
+    for (let i = 0; i < 50 && !(near(0, -60) && near(1, 50) && near(4, 100)); i++) await new Promise((r) => setTimeout(r, 100));
+    const seen = Object.fromEntries([0, 1, 2, 3, 4].map((id) => [id, +(last.get(id) ?? Number.NaN).toFixed(1)]));
+    console.log(`gamepad sticks in the frames (%): ${JSON.stringify(seen)}`);
+    // The deadband (5 %) scales the aileron's half travel to 47 %.
+    expect(seen[1]).toBeCloseTo(47.4, 0);
+    expect(seen[0]).toBeCloseTo(-60, 0);
+    expect(seen[4]).toBeCloseTo(100, 0);
+    expect(seen[2]).toBeCloseTo(0, 0);
+    // Escape still stops.
+    await page.keyboard.press('Escape');
+    await panel.getByTestId('drive-state').filter({ hasText: 'Stopped: stopped by the user' }).waitFor();
+    stop();
+    expect(errors).toEqual([]);
+    await context.close();
+  }, 60_000);
+
+  it('takes the sticks from the keyboard, shows its map, and Space still stops', async () => {
+    const context = await browser.newContext({ viewport: { width: 1280, height: 1000 } });
+    const page = await context.newPage();
+    const errors: string[] = [];
+    page.on('pageerror', (e) => errors.push(e.message));
+    await page.goto(rig!.server.url('/'));
+    await page.getByRole('button', { name: 'More ways to connect' }).click();
+    await page.getByRole('button', { name: 'Drive a flight controller…' }).click();
+    const panel = page.getByRole('region', { name: 'Drive a flight controller' });
+    await panel.waitFor();
+    expect(await panel.getByRole('table', { name: 'Keyboard sticks' }).textContent()).toMatch(/W \/ SThrottle.*↑ \/ ↓Elevator/);
+    await panel.getByRole('checkbox', { name: 'Keyboard sticks' }).check();
+    const decoder = new SpektrumDecoder();
+    const last = new Map<number, number>();
+    const stop = fake.onData((bytes, tUs) => {
+      decoder.push(bytes, tUs);
+      for (let f = decoder.next(); f !== undefined; f = decoder.next())
+        for (let i = 0; i < f.count; i++) last.set(f.ids[i] as number, servoToPercent(f.positions[i] as number, f.resolution));
+      void fake.write(bytes);
+    });
+    await panel.getByLabel('The propellers are off').check();
+    await panel.getByRole('button', { name: '▶ Start driving' }).click();
+    await panel.getByTestId('drive-state').filter({ hasText: 'Sending “manual”' }).waitFor();
+    await page.locator('body').click({ position: { x: 5, y: 5 } });
+    // W held: the throttle climbs to the ceiling (−60 %) and no further; ↑ held: the elevator climbs.
+    await page.keyboard.down('w');
+    await page.keyboard.down('ArrowUp');
+    await new Promise((r) => setTimeout(r, 1500));
+    const held = { throttle: last.get(0), elevator: last.get(2) };
+    await page.keyboard.up('w');
+    await page.keyboard.up('ArrowUp');
+    // Let go: the elevator springs back to centre, the throttle stays.
+    await new Promise((r) => setTimeout(r, 1500));
+    const after = { throttle: last.get(0), elevator: last.get(2) };
+    console.log(`keyboard sticks in the frames (%): held ${JSON.stringify(held)}, let go ${JSON.stringify(after)}`);
+    expect(held.throttle).toBeCloseTo(-60, 0);
+    expect(held.elevator).toBeGreaterThan(90);
+    expect(after.throttle).toBeCloseTo(-60, 0);
+    expect(after.elevator).toBeCloseTo(0, 0);
+    await page.keyboard.press(' ');
+    await panel.getByTestId('drive-state').filter({ hasText: 'Stopped: stopped by the user' }).waitFor();
+    stop();
+    expect(errors).toEqual([]);
+    await context.close();
+  }, 60_000);
 });

@@ -23,6 +23,7 @@ import { chosenPort, identify, portLabel } from '../../serial.js';
 import { type DriveReport, driveReportHtml, fixFor } from '../../../drive/report.js';
 import { download, drive, fc, liveOf, send } from '../../store.js';
 import { FcView } from './fc.js';
+import { StickSources } from './inputs.js';
 import './style.css';
 
 const SYSTEMS = [SYSTEM_DSMX_11MS_2048, SYSTEM_DSMX_22MS_2048, SYSTEM_DSM2_11MS_2048, SYSTEM_DSM2_22MS_1024];
@@ -113,10 +114,14 @@ export function DrivePanel({ granted, onClose }: { granted: SerialPort[]; onClos
     });
   };
 
+  // The sticks held now, for the keyboard and gamepad loop (several may change in one frame).
+  const heldNow = useRef(held);
+  heldNow.current = held;
   const hold = (id: number, percent: number | null) => {
-    const next = { ...held };
+    const next = { ...heldNow.current };
     if (percent === null) delete next[id];
     else next[id] = percent;
+    heldNow.current = next;
     setHeld(next);
     send({ type: 'drive-channel', id, percent });
   };
@@ -383,6 +388,7 @@ export function DrivePanel({ granted, onClose }: { granted: SerialPort[]; onClos
           </label>
         ))}
       </fieldset>
+      <StickSources channels={receiver.channels} driving={driving} held={heldNow} ceiling={ceiling} onHold={hold} />
     </section>
   );
 }
