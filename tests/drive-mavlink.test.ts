@@ -16,8 +16,11 @@ import {
   readHeartbeat,
   readRcChannels,
   readRcReceiverHealth,
+  requestDataStream,
   requestMessageInterval,
   SENSOR_RC_RECEIVER,
+  autopilotName,
+  DATA_STREAM,
 } from '../src/drive/mavlink.js';
 import { concatBytes } from './bytes.js';
 
@@ -52,6 +55,9 @@ describe('MAVLink framing', () => {
     expect(hex(requestMessageInterval(65, 50_000))).toBe(
       `fd 20 00 00 00 ff be 4c 00 00 00 00 82 42 00 50 43 47 ${'00 '.repeat(20)}ff 01 01 01 d2 13`,
     );
+    // REQUEST_DATA_STREAM (66, CRC_EXTRA 148) for RC_CHANNELS at 20 Hz, start: the CRC worked out apart from this code.
+    expect(hex(requestDataStream(DATA_STREAM.RC_CHANNELS, 20))).toBe('fd 06 00 00 00 ff be 42 00 00 14 00 01 01 03 01 d4 8b');
+    expect([autopilotName(3), autopilotName(12), autopilotName(0)]).toEqual(['ArduPilot', 'PX4', 'MAV_AUTOPILOT 0']);
   });
 
   it('reads the messages it knows whatever the chunking, among others, signed frames and noise', () => {

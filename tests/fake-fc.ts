@@ -15,6 +15,15 @@ export interface FakeFcOptions {
   /** `map` as the CLI sets it (default "TAER1234", what a Spektrum user sets). */
   map?: string;
   recoveryMs?: number;
+  /**
+   * Whose DSM decoder: Betaflight's (above), or the one ArduPilot and PX4 share (their dsm.cpp:
+   * 1500 + (v − 1024) × 1000 / 1700 µs in integers, 10-bit values doubled first, throttle moved to
+   * channel 3: RC1 aileron, RC2 elevator, RC3 throttle, RC4 rudder, then the rest in order; as
+   * many channels as the highest id seen).
+   */
+  decoder?: 'betaflight' | 'dsm';
+  /** No frame for this long: the receiver is lost (Betaflight's rx.c: 100 ms). */
+  signalTimeoutMs?: number;
 }
 
 /** What the flight controller reads at a moment: its channels (µs, its own order), and RXLOSS. */
@@ -42,8 +51,13 @@ export class FakeFc {
   #lastFrameUs = Number.NEGATIVE_INFINITY;
   #goodSinceUs = Number.NaN;
   #rxLoss = true;
+  readonly #dsm: boolean;
+  readonly #timeoutUs: number;
+  #highest = -1;
 
   constructor(options: FakeFcOptions) {
+    this.#dsm = options.decoder === 'dsm';
+    this.#timeoutUs = (options.signalTimeoutMs ?? SIGNAL_TIMEOUT_US / 1000) * 1000;
     const bits11 = options.resolution === 2048;
     this.#shift = bits11 ? 3 : 2;
     this.#mask = bits11 ? 0x07 : 0x03;
@@ -73,10 +87,18 @@ export class FakeFc {
 
   /** What MSP_RC and the arming-disable flags say at `atUs`. */
   state(atUs: number): FcState {
-    if (atUs - this.#lastFrameUs > SIGNAL_TIMEOUT_US) {
+    if (atUs - this.#lastFrameUs > this.#timeoutUs) {
       this.#rxLoss = true;
       this.#goodSinceUs = Number.NaN;
     } else if (this.#rxLoss && atUs - this.#goodSinceUs >= this.#recoveryUs) this.#rxLoss = false;
+    if (this.#dsm) {
+      const eleven = (v: number) => (this.#shift === 3 ? v : v * 2);
+      const us = (v: number) => 1500 + Math.trunc(((eleven(v) - 1024) * 1000) / 1700);
+      // Its channel i takes receiver channel: RC1 ← 1, RC2 ← 2, RC3 ← 0, the rest their own.
+      const from = (i: number) => (i === 0 ? 1 : i === 1 ? 2 : i === 2 ? 0 : i);
+      const channels = Array.from({ length: this.#highest + 1 }, (_, i) => us(this.#raw[from(i)] ?? 0));
+      return { atUs, channels, rxLoss: this.#rxLoss };
+    }
     const us = (v: number) => (this.#shift === 3 ? 988 + v / 2 : 988 + v);
     const channels: number[] = [];
     for (let i = 0; i < this.#count; i++) {
@@ -90,7 +112,10 @@ export class FakeFc {
     const f = this.#frame;
     for (let b = 3; b < 16; b += 2) {
       const id = 0x0f & ((f[b - 1] as number) >> this.#shift);
-      if (id < this.#count && id < 12) this.#raw[id] = (((f[b - 1] as number) & this.#mask) << 8) | (f[b] as number);
+      if (id < this.#count && id < 12) {
+        this.#raw[id] = (((f[b - 1] as number) & this.#mask) << 8) | (f[b] as number);
+        if (id > this.#highest) this.#highest = id;
+      }
     }
     if (Number.isNaN(this.#goodSinceUs)) this.#goodSinceUs = atUs;
     this.#lastFrameUs = atUs;

@@ -2,7 +2,8 @@
  * MAVLink, as ArduPilot and PX4 speak it on their USB port: frames found and checked, the few
  * messages SatScope reads to grade a flight controller (HEARTBEAT: armed and in failsafe;
  * SYS_STATUS: the RC receiver's health; RC_CHANNELS: the channels it decoded), and the
- * requests it sends (its own HEARTBEAT, SET_MESSAGE_INTERVAL for RC_CHANNELS).
+ * requests it sends (its own HEARTBEAT, SET_MESSAGE_INTERVAL, and REQUEST_DATA_STREAM for an
+ * ArduPilot older than SET_MESSAGE_INTERVAL).
  *
  * Framing (mavlink.io, c_library_v2):
  * - v2: `FD len incompat compat seq sys comp msgid(3) payload crc(2) [signature(13)]`; a sender
@@ -19,6 +20,7 @@ export const MAVLINK = {
   SYS_STATUS: { id: 1, crcExtra: 124, length: 43 },
   RC_CHANNELS_RAW: { id: 35, crcExtra: 244, length: 22 },
   RC_CHANNELS: { id: 65, crcExtra: 118, length: 42 },
+  REQUEST_DATA_STREAM: { id: 66, crcExtra: 148, length: 6 },
   COMMAND_LONG: { id: 76, crcExtra: 152, length: 33 },
   COMMAND_ACK: { id: 77, crcExtra: 143, length: 10 },
   STATUSTEXT: { id: 253, crcExtra: 83, length: 54 },
@@ -242,4 +244,29 @@ export function requestMessageInterval(msgid: number, intervalUs: number, target
   v.setUint8(30, target.sysid);
   v.setUint8(31, target.compid);
   return encodeMavlink(MAVLINK.COMMAND_LONG.id, p, { seq });
+}
+
+/** MAV_DATA_STREAM ids REQUEST_DATA_STREAM takes (common.xml; deprecated there, still what ArduPilot's SRx_ rates answer). */
+export const DATA_STREAM = { EXTENDED_STATUS: 2, RC_CHANNELS: 3 } as const;
+
+/** REQUEST_DATA_STREAM: ask system `target` to start (or stop) stream `streamId` at `rateHz`. */
+export function requestDataStream(streamId: number, rateHz: number, target = { sysid: 1, compid: 1 }, seq = 0, start = true): Uint8Array {
+  const p = new Uint8Array(MAVLINK.REQUEST_DATA_STREAM.length);
+  const v = new DataView(p.buffer);
+  v.setUint16(0, rateHz, true);
+  v.setUint8(2, target.sysid);
+  v.setUint8(3, target.compid);
+  v.setUint8(4, streamId);
+  v.setUint8(5, start ? 1 : 0);
+  return encodeMavlink(MAVLINK.REQUEST_DATA_STREAM.id, p, { seq });
+}
+
+/** MAV_AUTOPILOT values SatScope names (common.xml); 8 (INVALID) is a ground station or a component that is no autopilot. */
+export const MAV_AUTOPILOT_ARDUPILOTMEGA = 3;
+export const MAV_AUTOPILOT_PX4 = 12;
+export const MAV_AUTOPILOT_INVALID = 8;
+
+/** The flight stack a HEARTBEAT's autopilot field names ('ArduPilot', 'PX4', or the number). */
+export function autopilotName(autopilot: number): string {
+  return autopilot === MAV_AUTOPILOT_ARDUPILOTMEGA ? 'ArduPilot' : autopilot === MAV_AUTOPILOT_PX4 ? 'PX4' : `MAV_AUTOPILOT ${autopilot}`;
 }

@@ -21,9 +21,38 @@ export interface DriveReport {
   notes: string[];
 }
 
-/** What to change on a Betaflight or iNav flight controller when a check fails, in its CLI's words. */
-export function fixFor(check: DriveCheck, report: Pick<DriveReport, 'receiver'>): string | null {
+/**
+ * What to change on the flight controller when a check fails, in its stack's own words: its CLI
+ * (Betaflight, iNav) or its parameters (ArduPilot, PX4), by the stack `report.fc` names
+ * (Betaflight's where it names none).
+ */
+export function fixFor(check: DriveCheck, report: Pick<DriveReport, 'receiver'> & { fc?: DriveReport['fc'] }): string | null {
   if (check.verdict !== 'fail') return null;
+  const stack = report.fc?.variant ?? null;
+  if (stack === 'ArduPilot') {
+    switch (check.id) {
+      case 'channel-map':
+        return "ArduPilot's DSM decoder puts the satellite's throttle on RC3: set RCMAP_ROLL 1, RCMAP_PITCH 2, RCMAP_THROTTLE 3, RCMAP_YAW 4 and check the radio calibration.";
+      case 'values':
+        return "Check RC_PROTOCOLS includes DSM; ArduPilot's own scale (1500 + (v − 1024) / 1.7 µs) differs from §9 by design, so calibrate the radio (RCn_MIN, RCn_MAX, RCn_TRIM).";
+      case 'latency':
+        return 'Check RC_PROTOCOLS, the SERIALn_PROTOCOL 23 (RCIN) port the satellite is on, and that no other RC source (RC_OVERRIDE from a GCS) feeds the channels.';
+      case 'failsafe':
+        return 'Check FS_THR_ENABLE and RC_FS_TIMEOUT (Copter; THR_FAILSAFE on Plane), and that the satellite is the only RC input.';
+    }
+  }
+  if (stack === 'PX4') {
+    switch (check.id) {
+      case 'channel-map':
+        return "PX4's DSM decoder puts the satellite's throttle on channel 3: set RC_MAP_ROLL 1, RC_MAP_PITCH 2, RC_MAP_THROTTLE 3, RC_MAP_YAW 4 (or redo the radio setup).";
+      case 'values':
+        return "PX4's own scale (1500 + (v − 1024) / 1.7 µs) differs from §9 by design: redo the radio calibration (RCn_MIN, RCn_MAX, RCn_TRIM).";
+      case 'latency':
+        return 'Check RC_INPUT_PROTO (or the DSM port set up for RC input) and that no other RC source feeds the channels.';
+      case 'failsafe':
+        return 'Check COM_RC_LOSS_T and NAV_RCL_ACT, and that the satellite is the only RC input.';
+    }
+  }
   const provider = report.receiver.system === 0x01 ? 'SPEKTRUM1024' : 'SPEKTRUM2048';
   switch (check.id) {
     case 'channel-map':

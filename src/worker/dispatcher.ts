@@ -84,7 +84,13 @@ export class Dispatcher {
       findPort: options.findPort,
     });
     this.fc = new FcReader(host, (identity) => this.serial.find(identity));
-    this.drive = new DriveSession(host, this.registry, this.serial, (sinceMs) => this.fc.readingsSince(sinceMs));
+    this.drive = new DriveSession(
+      host,
+      this.registry,
+      this.serial,
+      (sinceMs) => this.fc.readingsSince(sinceMs),
+      () => this.fc.expectedOrder,
+    );
     this.#makeReport = options.makeReport ?? WORKER_REPORT_MAKER;
     this.#readSlices = options.readSlices ?? READ_HERE;
   }

@@ -105,6 +105,8 @@ export class DriveSession {
     readonly serial: SerialPorts,
     /** The flight controller's readings since a time on the worker's clock (ms), if its port is read. */
     readonly fcReadings: (sinceMs: number) => FcTimedReading[] = () => [],
+    /** The order its channels should follow the receiver's in, by the stack it speaks (undefined: Betaflight's). */
+    readonly fcOrder: () => readonly number[] | undefined = () => undefined,
   ) {}
 
   /** The source whose port the drive writes (null: none). */
@@ -260,7 +262,7 @@ export class DriveSession {
       this.#gradeNote = "Not graded: the flight controller's USB port was not read during the drive.";
       return;
     }
-    this.#checks = gradeDrive(written, readings).checks;
+    this.#checks = gradeDrive(written, readings, this.fcOrder()).checks;
     this.#gradeNote = `Graded on ${readings.length} readings of the flight controller's channels.`;
   }
 

@@ -1,12 +1,35 @@
 /**
  * The flight controller's own view, while Drive sends it a satellite: its USB port, opened in
- * the worker beside the adapter, asked over MSP (Betaflight and iNav) what it decoded. It is
- * asked its flight stack and receiver setting once, its status (armed, and the arming-disable
- * flags that say RX loss) and channels 20 times a second; the page is told what it answered,
- * 4 times a second, and nothing it did not. MAVLink (ArduPilot, PX4) is read by the
- * library (src/drive/mavlink.ts) but not asked here yet.
+ * the worker beside the adapter at 115200, and what it decoded read in the protocol it speaks.
+ *
+ * - MSP (Betaflight, iNav): asked its flight stack and receiver setting once, its status (armed,
+ *   and the arming-disable flags that say RX loss) and channels 20 times a second.
+ * - MAVLink v2 (ArduPilot, PX4): found by its HEARTBEAT. ArduPilot sends one unasked; PX4's USB
+ *   port starts MAVLink once it hears some, so a GCS HEARTBEAT is sent once a second after the
+ *   port answered no MSP for `PROBE_AFTER_MS` (never to a port that answered MSP: Betaflight
+ *   reboots to its bootloader on a stray byte). Once found, RC_CHANNELS and SYS_STATUS are asked
+ *   for 20 times a second (SET_MESSAGE_INTERVAL, and REQUEST_DATA_STREAM for older ArduPilot),
+ *   again every few seconds while they do not come. Armed is HEARTBEAT's; the receiver lost is
+ *   SYS_STATUS's RC receiver health where the autopilot reports the receiver present (ArduPilot
+ *   clears it in radio failsafe), else RC_CHANNELS with no channel (chancount 0), else not said.
+ *
+ * The page is told what it answered, 4 times a second, and nothing it did not.
  */
 import { BAUD_RATE } from '../decoder/spec.js';
+import {
+  autopilotName,
+  DATA_STREAM,
+  gcsHeartbeat,
+  MAV_AUTOPILOT_INVALID,
+  MAV_STATE_CRITICAL,
+  MAVLINK,
+  MavlinkParser,
+  readHeartbeat,
+  readRcChannels,
+  readRcReceiverHealth,
+  requestDataStream,
+  requestMessageInterval,
+} from '../drive/mavlink.js';
 import {
   MSP,
   MspParser,
@@ -30,6 +53,20 @@ const POST_EVERY_MS = 250;
 const SILENT_MS = 1000;
 /** Channel readings kept for grading a drive: 20 minutes of them. */
 const MAX_READINGS = 24_000;
+/** No MSP reply for this long: a GCS HEARTBEAT goes out once a second, for a PX4 that waits to hear MAVLink, ms. */
+const PROBE_AFTER_MS = 1000;
+/** MAVLink: RC_CHANNELS and SYS_STATUS asked for at this interval, µs, and asked again this often while they do not come, ms. */
+const MAVLINK_INTERVAL_US = 50_000;
+const MAVLINK_ASK_AGAIN_MS = 3000;
+
+/**
+ * Each stack's channel order as receiver channel ids (its channel index → the Spektrum channel id
+ * it should follow): Betaflight and iNav with `map TAER1234` read roll, pitch, yaw, throttle;
+ * ArduPilot and PX4's DSM decoder moves throttle to channel 3 (RC1 roll, RC2 pitch, RC3
+ * throttle, RC4 yaw).
+ */
+export const MSP_ORDER: readonly number[] = [1, 2, 3, 0];
+export const MAVLINK_ORDER: readonly number[] = [1, 2, 0, 3];
 
 /** One MSP_RC answer, with the receiver state it had last said, on the worker's clock (ms). */
 export interface FcTimedReading {
@@ -40,18 +77,27 @@ export interface FcTimedReading {
 
 /** What the flight controller said about itself and its receiver, as the page shows it. */
 export interface FcStatus {
-  /** 'reading': replies come; 'silent': none for a second (not MSP, or another program has the port); 'closed'. */
+  /** 'reading': replies come; 'silent': none for a second (neither MSP nor MAVLink, or another program has the port); 'closed'. */
   state: 'opening' | 'reading' | 'silent' | 'closed';
   port: string;
-  /** The flight stack's four-letter name (MSP_FC_VARIANT: BTFL, INAV…), null until it answers. */
+  /** What it speaks: MSP (Betaflight, iNav) or MAVLink (ArduPilot, PX4); null until it answers either. */
+  protocol: 'msp' | 'mavlink' | null;
+  /** The flight stack: MSP_FC_VARIANT's four letters (BTFL, INAV…), or HEARTBEAT's autopilot ('ArduPilot', 'PX4'); null until said. */
   variant: string | null;
   /** Its serial receiver setting: 'SPEKTRUM1024', 'SPEKTRUM2048', another (by number), or null until it answers. */
   provider: string | null;
-  /** The channels it decoded (MSP_RC), µs, in its own order (roll, pitch, yaw, throttle, aux…); null until it answers. */
+  /**
+   * The channels it decoded, µs, in its own order (MSP_RC: roll, pitch, yaw, throttle, aux…;
+   * RC_CHANNELS: RC1 roll, RC2 pitch, RC3 throttle, RC4 yaw, RC5…, up to its channel count); null until it answers.
+   */
   channels: number[] | null;
   armed: boolean | null;
-  /** It says it has no valid receiver frames (Betaflight RXLOSS, iNav RC_LINK), null until it answers. */
+  /** It says it has no valid receiver frames (Betaflight RXLOSS, iNav RC_LINK, MAVLink RC receiver unhealthy or no channels), null until it says. */
   rxLoss: boolean | null;
+  /** MAVLink: HEARTBEAT's MAV_STATE is CRITICAL (a failsafe of any kind is on), null where not said. */
+  failsafe: boolean | null;
+  /** MAVLink: RC_CHANNELS' RSSI (0–254), null where not said. */
+  rssi: number | null;
   armingDisableFlags: number | null;
   /** Replies read. */
   replies: number;
@@ -70,6 +116,14 @@ export class FcReader {
   #done: Promise<void> = Promise.resolve();
   #openedMs = Number.NaN;
   #readings: FcTimedReading[] = [];
+  #mavlink = new MavlinkParser();
+  /** The autopilot MAVLink came from (sysid, compid), and the sequence of what is sent to it. */
+  #target: { sysid: number; compid: number } | null = null;
+  #seq = 0;
+  #lastRcMs = Number.NaN;
+  #askedMs = Number.NaN;
+  /** SYS_STATUS says the RC receiver is there: its health is the receiver state. */
+  #rcPresent = false;
 
   constructor(
     readonly host: Host,
@@ -104,16 +158,25 @@ export class FcReader {
     this.#port = port;
     this.#writer = port.writable.getWriter();
     this.#parser = new MspParser();
+    this.#mavlink = new MavlinkParser();
+    this.#target = null;
+    this.#seq = 0;
+    this.#lastRcMs = Number.NaN;
+    this.#askedMs = Number.NaN;
+    this.#rcPresent = false;
     this.#readings = [];
     this.#status = {
       state: 'opening',
       port: describePort(port),
+      protocol: null,
       variant: null,
       provider: null,
       channels: null,
       armed: null,
       rxLoss: null,
       armingDisableFlags: null,
+      failsafe: null,
+      rssi: null,
       replies: 0,
       lastReplyMs: Number.NaN,
     };
@@ -124,14 +187,18 @@ export class FcReader {
     const clock = this.host.clock;
     this.#timers.push(
       clock.every(ASK_EVERY_MS, () => {
+        // MAVLink streams unasked once asked; MSP answers each question.
+        if (this.#status?.protocol === 'mavlink') return;
         // Its status as often as its channels: when it says the receiver lost is timed to that.
         this.#ask(this.#status?.variant === 'INAV' ? MSP.INAV_STATUS : MSP.STATUS_EX);
         this.#ask(MSP.RC);
       }),
       clock.every(POST_EVERY_MS, () => {
-        if (this.#status?.variant === null) this.#ask(MSP.FC_VARIANT);
+        const s = this.#status;
+        if (s?.protocol === null && s.variant === null) this.#ask(MSP.FC_VARIANT);
         this.#post();
       }),
+      clock.every(1000, () => this.#mavlinkTick()),
     );
     this.#post();
   }
@@ -165,6 +232,41 @@ export class FcReader {
     this.#writer?.write(encodeMsp(cmd)).catch(() => undefined);
   }
 
+  #sendMavlink(bytes: Uint8Array): void {
+    this.#writer?.write(bytes).catch(() => undefined);
+  }
+
+  /**
+   * Once a second: no MSP answer for `PROBE_AFTER_MS`, a GCS HEARTBEAT (PX4's USB port starts
+   * MAVLink when it hears some; an autopilot streams to a GCS it hears); with an autopilot found,
+   * RC_CHANNELS and SYS_STATUS asked for again while they do not come.
+   */
+  #mavlinkTick(): void {
+    const s = this.#status;
+    if (s === null || s.protocol === 'msp') return;
+    const now = this.host.clock.now();
+    if (s.protocol === null && now - this.#openedMs < PROBE_AFTER_MS) return;
+    this.#sendMavlink(gcsHeartbeat(this.#seq++ & 0xff));
+    if (this.#target !== null && !(now - this.#lastRcMs < 1000) && !(now - this.#askedMs < MAVLINK_ASK_AGAIN_MS)) this.#askStreams();
+  }
+
+  /** Asks the autopilot for RC_CHANNELS and SYS_STATUS 20 times a second, both ways it may take it. */
+  #askStreams(): void {
+    const t = this.#target;
+    if (t === null) return;
+    this.#askedMs = this.host.clock.now();
+    for (const m of [MAVLINK.RC_CHANNELS.id, MAVLINK.SYS_STATUS.id])
+      this.#sendMavlink(requestMessageInterval(m, MAVLINK_INTERVAL_US, t, this.#seq++ & 0xff));
+    const hz = Math.round(1e6 / MAVLINK_INTERVAL_US);
+    for (const stream of [DATA_STREAM.RC_CHANNELS, DATA_STREAM.EXTENDED_STATUS])
+      this.#sendMavlink(requestDataStream(stream, hz, t, this.#seq++ & 0xff));
+  }
+
+  /** The order the flight controller's channels should follow the receiver's in (its channel index → receiver channel id), by the stack it speaks. */
+  get expectedOrder(): readonly number[] {
+    return this.#status?.protocol === 'mavlink' ? MAVLINK_ORDER : MSP_ORDER;
+  }
+
   async #read(reader: ReadableStreamDefaultReader<Uint8Array>): Promise<void> {
     this.#reader = reader;
     try {
@@ -184,9 +286,12 @@ export class FcReader {
   #take(bytes: Uint8Array): void {
     const s = this.#status;
     if (s === null) return;
+    if (s.protocol !== 'msp') this.#takeMavlink(s, bytes);
+    if (s.protocol === 'mavlink') return;
     this.#parser.push(bytes);
     for (let m = this.#parser.next(); m !== undefined; m = this.#parser.next()) {
       if (m.direction !== 'reply') continue;
+      s.protocol = 'msp';
       s.replies++;
       s.lastReplyMs = this.host.clock.now();
       switch (m.cmd) {
@@ -228,6 +333,41 @@ export class FcReader {
           }
           break;
         }
+      }
+    }
+  }
+
+  #takeMavlink(s: FcStatus, bytes: Uint8Array): void {
+    this.#mavlink.push(bytes);
+    for (let m = this.#mavlink.next(); m !== undefined; m = this.#mavlink.next()) {
+      if (m.msgid === MAVLINK.HEARTBEAT.id) {
+        const hb = readHeartbeat(m);
+        // Another ground station's heartbeat, or a component's (a camera, a gimbal): not the autopilot.
+        if (hb.autopilot === MAV_AUTOPILOT_INVALID) continue;
+        if (this.#target === null || this.#target.sysid !== m.sysid) {
+          this.#target = { sysid: m.sysid, compid: m.compid };
+          s.protocol = 'mavlink';
+          this.#askStreams();
+        }
+        s.variant = autopilotName(hb.autopilot);
+        s.armed = hb.armed;
+        s.failsafe = hb.systemStatus === MAV_STATE_CRITICAL;
+      } else if (this.#target === null || m.sysid !== this.#target.sysid) continue;
+      s.replies++;
+      s.lastReplyMs = this.host.clock.now();
+      if (m.msgid === MAVLINK.SYS_STATUS.id) {
+        const rc = readRcReceiverHealth(m);
+        this.#rcPresent = rc.present;
+        if (rc.present) s.rxLoss = !rc.healthy;
+      } else if (m.msgid === MAVLINK.RC_CHANNELS.id) {
+        const rc = readRcChannels(m);
+        this.#lastRcMs = s.lastReplyMs;
+        s.rssi = rc.rssi;
+        if (!this.#rcPresent) s.rxLoss = rc.count === 0 ? true : null;
+        const channels = rc.channels.slice(0, rc.count).map((us) => us ?? Number.NaN);
+        if (rc.count > 0) s.channels = channels;
+        if (this.#readings.length === MAX_READINGS) this.#readings.splice(0, MAX_READINGS / 2);
+        this.#readings.push({ atMs: s.lastReplyMs, channels, rxLoss: s.rxLoss });
       }
     }
   }

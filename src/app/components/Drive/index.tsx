@@ -345,7 +345,7 @@ export function DrivePanel({ granted, onClose }: { granted: SerialPort[]; onClos
                         <td>{c.expects}</td>
                         <td>
                           {c.found}
-                          <Fix text={fixFor(c, status)} />
+                          <Fix text={fixFor(c, { receiver: status.receiver, fc: fc.value })} />
                         </td>
                         <td class="verdict">{c.verdict}</td>
                       </tr>
