@@ -14,6 +14,7 @@ const ENTRIES = {
   satscope: 'src/decoder/index.ts',
   'satscope/capture': 'src/capture/index.ts',
   'satscope/report': 'src/report/index.ts',
+  'satscope/drive': 'src/drive/index.ts',
 };
 
 export async function entrySizes() {

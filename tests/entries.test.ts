@@ -1,6 +1,6 @@
 /**
  * The package's entries stay apart in a bundle: importing the core (`satscope`) pulls in neither
- * the capture importers nor the report's HTML nor the doctor.
+ * the capture importers nor the report's HTML nor the doctor nor Drive.
  */
 import { describe, expect, it } from 'vitest';
 import { entrySizes } from '../scripts/core-size.mjs';
@@ -12,6 +12,10 @@ describe('package entries in a bundle', () => {
     expect(core).toContain('push() after end()');
     expect(core).not.toMatch(/Saleae|Link health report|serialrx_provider|\.sscap/);
     expect(sizes['satscope/report'].text).toContain('Link health report');
+    // Drive stays out of the core and carries neither the health report nor the doctor.
+    expect(core).not.toMatch(/Drive report|MAVLink/);
+    expect(sizes['satscope/drive'].text).toContain('Drive report');
+    expect(sizes['satscope/drive'].text).not.toMatch(/Link health report|Saleae/);
     // The figure the README quotes, with room for small changes (14.1 kB since the decoder's
     // slots are read written out, not looped: 1.4x the decoding speed for 0.3 kB; 14.9 kB since
     // the link monitor's checkpoints share settled episodes, episode-log.ts: 0.5 kB for

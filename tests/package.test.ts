@@ -44,24 +44,25 @@ describe('the npm package', () => {
     expect(pkg.sideEffects).toBe(false);
     expect(pkg.dependencies ?? {}).toEqual({});
     const exports = pkg.exports as Record<string, Record<string, string> | string>;
-    expect(Object.keys(exports)).toEqual(['.', './capture', './report', './simulator', './package.json']);
+    expect(Object.keys(exports)).toEqual(['.', './capture', './report', './simulator', './drive', './package.json']);
     for (const [name, entry] of Object.entries(exports))
       if (name !== './package.json') expect(Object.keys(entry)).toEqual(['types', 'default']);
     expect((exports['./report'] as Record<string, string>).default).toBe('./dist/report/index.js');
     expect(pkg.bin).toEqual({ satscope: './dist/cli/main.js' });
   });
 
-  it('packs only the built library, capture files, simulator, doctor, CLI, README, LICENSE and package.json', () => {
+  it('packs only the built library, capture files, simulator, doctor, drive, CLI, README, LICENSE and package.json', () => {
     expect(files).toContain('dist/decoder/index.js');
     expect(files).toContain('dist/capture/index.js');
     expect(files).toContain('dist/decoder/index.d.ts');
     expect(files).toContain('dist/simulator/index.js');
     expect(files).toContain('dist/report/index.js');
+    expect(files).toContain('dist/drive/index.js');
     expect(files).toContain('dist/cli/main.js');
     expect(files).toContain('README.md');
     expect(files).toContain('LICENSE');
     const stray = files.filter(
-      (f) => !/^(dist\/(decoder|capture|report|simulator|cli)\/.+\.(js|d\.ts)|README\.md|LICENSE|package\.json)$/.test(f),
+      (f) => !/^(dist\/(decoder|capture|report|simulator|drive|cli)\/.+\.(js|d\.ts)|README\.md|LICENSE|package\.json)$/.test(f),
     );
     expect(stray).toEqual([]);
   });
@@ -117,5 +118,15 @@ describe('the npm package', () => {
     const lines = run('node', ['readme.mjs'], app).trim().split('\n');
     expect(lines[0]).toMatch(/^18\d frames, 2048 resolution, internal remote$/);
     expect(lines[1]).toBe('Throttle is channel 0; period 11000 µs; state failsafe');
+  });
+
+  it('runs the README drive example as written against the installed package', () => {
+    const readme = readFileSync(join(root, 'README.md'), 'utf8');
+    const block = /<!-- README drive example[^>]*-->\s*```js\n([\s\S]*?)```/.exec(readme);
+    expect(block, 'README drive example block').not.toBeNull();
+    const app = join(scratch, 'app');
+    writeFileSync(join(app, 'drive.mjs'), block![1]!);
+    const lines = run('node', ['drive.mjs'], app).trim().split('\n');
+    expect(lines).toEqual(['1637 frames written, 0 skipped', 'channel-map pass, values pass, latency pass, failsafe unknown']);
   });
 });

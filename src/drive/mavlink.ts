@@ -192,6 +192,7 @@ export interface Heartbeat {
   customMode: number;
 }
 
+/** Reads a HEARTBEAT (message 0): its MAV_TYPE, MAV_AUTOPILOT, armed (MAV_MODE_FLAG_SAFETY_ARMED) and MAV_STATE. */
 export function readHeartbeat(m: MavlinkMessage): Heartbeat {
   const v = new DataView(m.payload.buffer, m.payload.byteOffset, m.payload.byteLength);
   return {
@@ -211,6 +212,7 @@ export interface RcChannels {
   rssi: number | null;
 }
 
+/** Reads an RC_CHANNELS (message 65): channels 1–18 in µs (UINT16_MAX: unused, null here), chancount and RSSI (255: unknown, null here). */
 export function readRcChannels(m: MavlinkMessage): RcChannels {
   const v = new DataView(m.payload.buffer, m.payload.byteOffset, m.payload.byteLength);
   const channels: (number | null)[] = [];

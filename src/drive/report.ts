@@ -8,6 +8,7 @@ import type { DriveReceiver } from './builtins.js';
 import type { DriveCheck } from './grade.js';
 import type { DriveTimingStats } from './schedule.js';
 
+/** What a drive's report says: when, what was sent and how it was timed, what the flight controller said of itself, and the graded checks. */
 export interface DriveReport {
   /** When the drive ran (ISO 8601). */
   date: string;
