@@ -268,6 +268,13 @@ describe.skipIf(skip !== null)('driving a flight controller through the adapter'
     expect(after.elevator).toBeCloseTo(0, 0);
     await page.keyboard.press(' ');
     await panel.getByTestId('drive-state').filter({ hasText: 'Stopped: stopped by the user' }).waitFor();
+    // The loopback goes silent: the doctor's failsafe there is the drive's stop, and the page says so.
+    await page
+      .locator('[data-code="weak-link"] .title', { hasText: 'the drive stopped sending, not a weak link' })
+      .waitFor({ state: 'attached', timeout: 10_000 });
+    const findings = await page.locator('[data-code="weak-link"] .title').allTextContents();
+    console.log(`findings on the loopback after the stop: ${JSON.stringify(findings)}`);
+    expect(findings.join(' ')).not.toMatch(/the link is weak/);
     stop();
     expect(errors).toEqual([]);
     await context.close();

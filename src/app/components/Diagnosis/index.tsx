@@ -11,9 +11,9 @@ import { computed, signal } from '@preact/signals';
 import { useState } from 'preact/hooks';
 import type { DoctorFinding } from '../../../report/doctor-types.js';
 import type { FlightStack } from '../../../report/doctor-stacks.js';
-import { diagnosis, replayReading, send, sources } from '../../store.js';
+import { diagnosis, drive, replayReading, send, sources } from '../../store.js';
 import { plural } from '../../../report/report-text.js';
-import { splitFindings } from './current.js';
+import { splitFindings, withDriveLoop } from './current.js';
 import './style.css';
 
 const STACKS: readonly FlightStack[] = ['Betaflight', 'iNav', 'ArduPilot', 'PX4'];
@@ -39,7 +39,12 @@ const keyOf = (f: DoctorFinding): string => `${f.code}:${f.ports.join(',')}`;
 /** Ports whose adapter is gone: what the doctor last said of them is not the link now. */
 const lostPorts = computed(() => sources.value.filter((s) => s.kind === 'serial' && s.state === 'lost').map((s) => s.id));
 /** The findings about the link now, and those about ports lost since. */
-const split = computed(() => splitFindings(diagnosis.value?.findings ?? [], lostPorts.value));
+const split = computed(() => {
+  // The drive's loopback reads what the adapter sent: its gaps are frames not sent, not a weak link.
+  const d = drive.value;
+  const loop = d === null || d.source === null ? null : { source: d.source, skipped: d.timing.skipped, driving: d.state === 'driving' };
+  return splitFindings(withDriveLoop(diagnosis.value?.findings ?? [], loop), lostPorts.value);
+});
 /** "remote A", "remotes A and B": the lost ports' labels. */
 const lostNames = computed(() => {
   const labels = sources.value.filter((s) => lostPorts.value.includes(s.id)).map((s) => s.label);
