@@ -18,6 +18,7 @@ const finding = (
   todo: ['Move the satellite away from carbon and metal.'],
   settings: [],
   confirm: null,
+  sinceUs: 0,
 });
 
 describe("the drive's loopback in the findings", () => {

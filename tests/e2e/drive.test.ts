@@ -15,7 +15,8 @@ import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { SpektrumDecoder } from '../../src/decoder/decoder.js';
 import { BYTE_TIME_US, servoToPercent } from '../../src/decoder/spec.js';
 import { MIN_SILENCE_US } from '../../src/drive/schedule.js';
-import { browserUnavailable, shot, startSerialApp, type SerialAppSession } from './app-fixture.js';
+import { join } from 'node:path';
+import { browserUnavailable, SHOTS, shot, startSerialApp, type SerialAppSession } from './app-fixture.js';
 import { fakeSerialUnsupportedReason, type FakeSerialPort } from './harness/pty-serial.js';
 
 const skip = browserUnavailable() ?? fakeSerialUnsupportedReason();
@@ -219,6 +220,17 @@ describe.skipIf(skip !== null)('driving a flight controller through the adapter'
     expect(seen[0]).toBeCloseTo(-60, 0);
     expect(seen[4]).toBeCloseTo(100, 0);
     expect(seen[2]).toBeCloseTo(0, 0);
+    // The panel with the gamepad's mapping, to look at.
+    for (const [width, scheme] of [
+      [1280, 'light'],
+      [1280, 'dark'],
+      [390, 'light'],
+      [390, 'dark'],
+    ] as const) {
+      await page.setViewportSize({ width, height: 900 });
+      await page.emulateMedia({ colorScheme: scheme });
+      await panel.screenshot({ path: join(SHOTS, `drive-pad-${width < 600 ? 'phone' : 'desktop'}-${scheme}.png`) });
+    }
     // Escape still stops.
     await page.keyboard.press('Escape');
     await panel.getByTestId('drive-state').filter({ hasText: 'Stopped: stopped by the user' }).waitFor();

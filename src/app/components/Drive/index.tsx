@@ -375,7 +375,7 @@ export function DrivePanel({ granted, onClose }: { granted: SerialPort[]; onClos
               type="range"
               min={-100}
               max={100}
-              value={held[id] ?? (id === 0 ? -100 : 0)}
+              value={id === 0 ? Math.min(held[id] ?? -100, ceiling) : (held[id] ?? 0)}
               aria-label={`${CHANNEL_NAMES[id]} stick, %`}
               onInput={(e) => hold(id, Number((e.currentTarget as HTMLInputElement).value))}
             />
