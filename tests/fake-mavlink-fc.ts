@@ -8,8 +8,11 @@
  * - RC_CHANNELS and SYS_STATUS only once asked (SET_MESSAGE_INTERVAL, or REQUEST_DATA_STREAM
  *   RC_CHANNELS / EXTENDED_STATUS where `acceptsInterval` is false, an older ArduPilot).
  * - ArduPilot: RC_CHANNELS keeps coming in failsafe with the last values and its channel count;
- *   SYS_STATUS has the RC receiver present, healthy unless in radio failsafe. PX4 (as faked here):
- *   RC_CHANNELS only while frames come, SYS_STATUS without the RC receiver bits.
+ *   SYS_STATUS has the RC receiver present, healthy unless in radio failsafe (Copter's
+ *   `rc_receiver_present && !failsafe.radio`). PX4: RC_CHANNELS only while frames come (its
+ *   stream sends on an RC input update); SYS_STATUS has the RC receiver present, enabled and
+ *   healthy only while RC is valid (its commander's `setIsPresent(remote_control)`), or never
+ *   where `reportsRc` is false.
  *
  * Its receiver is a FakeFc with the DSM decoder ArduPilot and PX4 share. Bytes that are not
  * MAVLink (MSP asked of it first) are ignored.
@@ -26,6 +29,8 @@ export interface FakeMavlinkFcOptions {
   /** Takes SET_MESSAGE_INTERVAL (default); false: only REQUEST_DATA_STREAM, as an ArduPilot before 4.0. */
   acceptsInterval?: boolean;
   vid?: number;
+  /** PX4: SYS_STATUS says the RC receiver while it is valid (default); false: never. */
+  reportsRc?: boolean;
 }
 
 const SET_MESSAGE_INTERVAL = 511;
@@ -112,9 +117,10 @@ export class FakeMavlinkFc {
         v.setUint32(4, SENSOR_RC_RECEIVER | 0x3, true);
         v.setUint32(8, (state.rxLoss ? 0 : SENSOR_RC_RECEIVER) | 0x3, true);
       } else {
-        v.setUint32(0, 0x3, true);
-        v.setUint32(4, 0x3, true);
-        v.setUint32(8, 0x3, true);
+        const rc = this.options.reportsRc !== false && !state.rxLoss ? SENSOR_RC_RECEIVER : 0;
+        v.setUint32(0, rc | 0x3, true);
+        v.setUint32(4, rc | 0x3, true);
+        v.setUint32(8, rc | 0x3, true);
       }
       this.#send(MAVLINK.SYS_STATUS.id, p);
     }

@@ -16,7 +16,7 @@ import { fakeHost, portRig, StandInPort } from './worker-fakes.js';
 const ADAPTER = { index: 0, usbVendorId: 0x0403, usbProductId: 1 };
 const FC_USB = { index: 1, usbVendorId: 0x1209, usbProductId: 1 };
 
-function setup(stack: 'ArduPilot' | 'PX4', options: { armed?: boolean; acceptsInterval?: boolean } = {}) {
+function setup(stack: 'ArduPilot' | 'PX4', options: { armed?: boolean; acceptsInterval?: boolean; reportsRc?: boolean } = {}) {
   const fake = fakeHost();
   const fc = new FakeMavlinkFc({ stack, clock: fake.clock, ...options });
   const adapter = new StandInPort(0x0403, (bytes) => fc.rx(bytes));
@@ -64,8 +64,8 @@ describe("the flight controller's own view over MAVLink", () => {
     expect(fcNow()?.state).toBe('closed');
   });
 
-  it('wakes a PX4 that waits to hear MAVLink, and says nothing of its receiver state it does not report', async () => {
-    const { send, run, fcNow, fc, drive } = setup('PX4');
+  it('wakes a PX4 that waits to hear MAVLink, and reads the receiver lost when its RC drops out of SYS_STATUS', async () => {
+    const { send, run, fcNow, fc, drive, worker } = setup('PX4');
     await send({ type: 'fc-open', port: FC_USB });
     await run(800);
     // MSP first: a Betaflight would have answered. PX4 ignores it and says nothing yet.
@@ -76,10 +76,24 @@ describe("the flight controller's own view over MAVLink", () => {
     // Then a GCS heartbeat: PX4 starts MAVLink, is found, and asked for its streams.
     expect(fc.asked.get(MAVLINK.HEARTBEAT.id)).toBeGreaterThanOrEqual(1);
     expect(fcNow()).toMatchObject({ protocol: 'mavlink', variant: 'PX4', armed: false });
+    // It has never said it has a receiver: not said, never guessed.
+    expect(fcNow()?.rxLoss).toBeNull();
     await drive('manual');
     await run(1000);
     expect(fcNow()?.channels?.[2]).toBe(1099);
-    // PX4 (as faked) reports no RC receiver health: not said, never guessed.
+    expect(fcNow()?.rxLoss).toBe(false);
+    worker.receive({ type: 'drive-stop' });
+    await run(1000);
+    expect(fcNow()?.rxLoss).toBe(true);
+  });
+
+  it('says nothing of the receiver state of a PX4 that does not report it', async () => {
+    const { send, run, fcNow, drive } = setup('PX4', { reportsRc: false });
+    await send({ type: 'fc-open', port: FC_USB });
+    await run(2500);
+    await drive('manual');
+    await run(1000);
+    expect(fcNow()?.channels?.[2]).toBe(1099);
     expect(fcNow()?.rxLoss).toBeNull();
   });
 

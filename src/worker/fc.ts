@@ -10,8 +10,9 @@
  *   reboots to its bootloader on a stray byte). Once found, RC_CHANNELS and SYS_STATUS are asked
  *   for 20 times a second (SET_MESSAGE_INTERVAL, and REQUEST_DATA_STREAM for older ArduPilot),
  *   again every few seconds while they do not come. Armed is HEARTBEAT's; the receiver lost is
- *   SYS_STATUS's RC receiver health where the autopilot reports the receiver present (ArduPilot
- *   clears it in radio failsafe), else RC_CHANNELS with no channel (chancount 0), else not said.
+ *   SYS_STATUS's RC receiver bits once the autopilot has said the receiver present (ArduPilot
+ *   clears its health in radio failsafe; PX4's commander drops it as present while RC is lost),
+ *   else RC_CHANNELS with no channel (chancount 0), else not said.
  *
  * The page is told what it answered, 4 times a second, and nothing it did not.
  */
@@ -122,7 +123,7 @@ export class FcReader {
   #seq = 0;
   #lastRcMs = Number.NaN;
   #askedMs = Number.NaN;
-  /** SYS_STATUS says the RC receiver is there: its health is the receiver state. */
+  /** SYS_STATUS has said the RC receiver is there: from then on, present and healthy is the receiver state. */
   #rcPresent = false;
 
   constructor(
@@ -356,9 +357,12 @@ export class FcReader {
       s.replies++;
       s.lastReplyMs = this.host.clock.now();
       if (m.msgid === MAVLINK.SYS_STATUS.id) {
+        // ArduPilot keeps the receiver present once seen and clears its health in radio failsafe;
+        // PX4's commander says it present only while RC is valid. Either way: once said present,
+        // a SYS_STATUS without it present and healthy says the receiver lost.
         const rc = readRcReceiverHealth(m);
-        this.#rcPresent = rc.present;
-        if (rc.present) s.rxLoss = !rc.healthy;
+        if (rc.present) this.#rcPresent = true;
+        if (this.#rcPresent) s.rxLoss = !rc.healthy;
       } else if (m.msgid === MAVLINK.RC_CHANNELS.id) {
         const rc = readRcChannels(m);
         this.#lastRcMs = s.lastReplyMs;
