@@ -15,6 +15,7 @@ import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { SpektrumDecoder } from '../../src/decoder/decoder.js';
 import { BYTE_TIME_US, servoToPercent } from '../../src/decoder/spec.js';
 import { MIN_SILENCE_US } from '../../src/drive/schedule.js';
+import { encodeMavlink, MAVLINK, MavlinkParser, SENSOR_RC_RECEIVER } from '../../src/drive/mavlink.js';
 import { join } from 'node:path';
 import { browserUnavailable, SHOTS, shot, startSerialApp, type SerialAppSession } from './app-fixture.js';
 import { fakeSerialUnsupportedReason, type FakeSerialPort } from './harness/pty-serial.js';
@@ -288,6 +289,84 @@ describe.skipIf(skip !== null)('driving a flight controller through the adapter'
     console.log(`findings on the loopback after the stop: ${JSON.stringify(findings)}`);
     expect(findings.join(' ')).not.toMatch(/the link is weak/);
     stop();
+    expect(errors).toEqual([]);
+    await context.close();
+  }, 60_000);
+
+  it("reads an ArduPilot over MAVLink on the flight controller's port and shows what it said", async () => {
+    // The pty is the flight controller's USB port here: an ArduPilot that sends its HEARTBEAT
+    // unasked and RC_CHANNELS and SYS_STATUS once asked (SET_MESSAGE_INTERVAL or REQUEST_DATA_STREAM).
+    const context = await browser.newContext({ viewport: { width: 1280, height: 1000 } });
+    const page = await context.newPage();
+    const errors: string[] = [];
+    page.on('pageerror', (e) => errors.push(e.message));
+    let seq = 0;
+    const out = (id: number, payload: Uint8Array) =>
+      void fake.write(encodeMavlink(id, payload, { seq: seq++ & 0xff, sysid: 1, compid: 1 }));
+    const asked = new Set<number>();
+    const parser = new MavlinkParser();
+    const stopData = fake.onData((bytes) => {
+      parser.push(bytes);
+      for (let m = parser.next(); m !== undefined; m = parser.next()) asked.add(m.msgid);
+    });
+    const heartbeat = setInterval(() => out(MAVLINK.HEARTBEAT.id, Uint8Array.of(0, 0, 0, 0, 2, 3, 0x81, 4, 3)), 1000);
+    // Its channels as its DSM decoder gives them (RC1 roll, RC2 pitch, RC3 throttle, RC4 yaw…).
+    const us = [1701, 1500, 1099, 1500, 1900, 1500, 1500, 1500];
+    const streams = setInterval(() => {
+      if (!asked.has(MAVLINK.COMMAND_LONG.id) && !asked.has(MAVLINK.REQUEST_DATA_STREAM.id)) return;
+      const rc = new Uint8Array(MAVLINK.RC_CHANNELS.length);
+      const v = new DataView(rc.buffer);
+      us.forEach((x, i) => v.setUint16(4 + 2 * i, x, true));
+      v.setUint8(40, us.length);
+      v.setUint8(41, 200);
+      out(MAVLINK.RC_CHANNELS.id, rc);
+      const sys = new Uint8Array(MAVLINK.SYS_STATUS.length);
+      const w = new DataView(sys.buffer);
+      for (const at of [0, 4, 8]) w.setUint32(at, SENSOR_RC_RECEIVER, true);
+      out(MAVLINK.SYS_STATUS.id, sys);
+    }, 50);
+    try {
+      await page.goto(rig!.server.url('/'));
+      await page.getByRole('button', { name: 'More ways to connect' }).click();
+      await page.getByRole('button', { name: 'Drive a flight controller…' }).click();
+      const panel = page.getByRole('region', { name: 'Drive a flight controller' });
+      await panel.waitFor();
+      const view = panel.getByRole('region', { name: "The flight controller's view" });
+      // The port the page was granted, as the user picks it in the list.
+      await view.getByLabel('Its USB port').selectOption({ index: 0 });
+      await view.getByRole('button', { name: 'Read the flight controller' }).click();
+      await view
+        .getByTestId('fc-state')
+        .filter({ hasText: /ArduPilot on .* \(MAVLink\)/ })
+        .waitFor({ timeout: 10_000 });
+      await view.getByRole('cell', { name: '1099 µs' }).waitFor({ timeout: 5000 });
+      const table = await view.getByRole('region', { name: 'Channels the flight controller decoded' }).textContent();
+      const flags = await view.locator('.drive-fc-flags').textContent();
+      console.log(`ArduPilot on the page: ${JSON.stringify({ table, flags })}`);
+      expect(table).toContain('RC1 roll1701 µs');
+      expect(table).toContain('RC3 throttle1099 µs');
+      expect(flags).toMatch(
+        /Armed: yes · Receiver lost \(SYS_STATUS RC receiver, or no channels\): no · In failsafe \(MAV_STATE_CRITICAL\): no · RSSI: 200/,
+      );
+      expect(await view.getByRole('alert').textContent()).toMatch(/ARMED/);
+      expect(asked.has(MAVLINK.HEARTBEAT.id)).toBe(false);
+      for (const [width, scheme] of [
+        [1280, 'light'],
+        [1280, 'dark'],
+        [390, 'light'],
+        [390, 'dark'],
+      ] as const) {
+        await page.setViewportSize({ width, height: 900 });
+        await page.emulateMedia({ colorScheme: scheme });
+        await view.screenshot({ path: join(SHOTS, `drive-fc-mavlink-${width < 600 ? 'phone' : 'desktop'}-${scheme}.png`) });
+      }
+      await view.getByRole('button', { name: 'Stop reading' }).click();
+      await view.getByTestId('fc-state').filter({ hasText: 'Not reading' }).waitFor();
+    } finally {
+      clearInterval(heartbeat);
+      clearInterval(streams);
+      stopData();
+    }
     expect(errors).toEqual([]);
     await context.close();
   }, 60_000);
