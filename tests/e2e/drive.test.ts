@@ -221,6 +221,19 @@ describe.skipIf(skip !== null)('driving a flight controller through the adapter'
     expect(seen[0]).toBeCloseTo(-60, 0);
     expect(seen[4]).toBeCloseTo(100, 0);
     expect(seen[2]).toBeCloseTo(0, 0);
+    // Unplugged: its channels go back to the scenario (the manual one rests the throttle low, the sticks centred).
+    await page.evaluate(() => {
+      Object.defineProperty(navigator, 'getGamepads', { value: () => [null, null, null, null], configurable: true });
+    });
+    for (let i = 0; i < 50 && !(near(0, -100) && near(1, 0) && near(4, 0)); i++) await new Promise((r) => setTimeout(r, 100));
+    const gone = Object.fromEntries([0, 1, 4].map((id) => [id, +(last.get(id) ?? Number.NaN).toFixed(1)]));
+    console.log(`gamepad unplugged, the frames (%): ${JSON.stringify(gone)}`);
+    expect(gone).toEqual({ 0: -100, 1: 0, 4: 0 });
+    await page.evaluate(() => {
+      const pad = (window as unknown as { testPad: unknown }).testPad;
+      Object.defineProperty(navigator, 'getGamepads', { value: () => [pad, null, null, null], configurable: true });
+    });
+    await panel.getByTestId('drive-pad-state').filter({ hasText: 'Test pad' }).waitFor();
     // The panel with the gamepad's mapping, to look at.
     for (const [width, scheme] of [
       [1280, 'light'],
@@ -316,7 +329,7 @@ describe.skipIf(skip !== null)('driving a flight controller through the adapter'
       if (!asked.has(MAVLINK.COMMAND_LONG.id) && !asked.has(MAVLINK.REQUEST_DATA_STREAM.id)) return;
       const rc = new Uint8Array(MAVLINK.RC_CHANNELS.length);
       const v = new DataView(rc.buffer);
-      us.forEach((x, i) => v.setUint16(4 + 2 * i, x, true));
+      for (const [i, x] of us.entries()) v.setUint16(4 + 2 * i, x, true);
       v.setUint8(40, us.length);
       v.setUint8(41, 200);
       out(MAVLINK.RC_CHANNELS.id, rc);

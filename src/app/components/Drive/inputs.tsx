@@ -52,7 +52,8 @@ export function StickSources({
   /** The sticks held now (% by channel id), read each frame. */
   held: { current: Record<number, number> };
   ceiling: number;
-  onHold(id: number, percent: number): void;
+  /** A channel held at `percent` from the next frame on; null gives it back to the scenario. */
+  onHold(id: number, percent: number | null): void;
 }) {
   const [keyboard, setKeyboard] = useState(false);
   const [gamepad, setGamepad] = useState(false);
@@ -101,6 +102,8 @@ export function StickSources({
     /** The keyboard's sticks, and which of them the keys have moved (the others stay the scenario's). */
     let keys: Record<number, number> = {};
     const touched = new Set<number>();
+    /** The channels the gamepad holds: given back to the scenario (sticks at rest, throttle low) if the pad goes. */
+    let padHeld: number[] = [];
     const tick = (t: number) => {
       const dt = t - last;
       last = t;
@@ -121,13 +124,19 @@ export function StickSources({
           const state: PadState = { axes: p.axes, buttons: p.buttons };
           const values = gamepadChannels(state, m);
           Object.assign(want, values);
+          padHeld = Object.keys(values).map(Number);
           if (t - shown >= SHOW_EVERY_MS) {
             shown = t;
             setPad({ id: p.id, axes: p.axes.length, buttons: p.buttons.length, values });
           }
-        } else if (t - shown >= SHOW_EVERY_MS) {
-          shown = t;
-          setPad(null);
+        } else {
+          // Unplugged (or its transmitter off) mid-drive: its channels are not left where it last had them.
+          for (const id of padHeld) hold(id, null);
+          padHeld = [];
+          if (t - shown >= SHOW_EVERY_MS) {
+            shown = t;
+            setPad(null);
+          }
         }
       }
       for (const [id, v] of changed(held.current, want)) hold(id, Math.round(v));
