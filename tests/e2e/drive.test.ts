@@ -18,6 +18,7 @@ import { MIN_SILENCE_US } from '../../src/drive/schedule.js';
 import { encodeMavlink, MAVLINK, MavlinkParser, SENSOR_RC_RECEIVER } from '../../src/drive/mavlink.js';
 import { join } from 'node:path';
 import { browserUnavailable, SHOTS, shot, startSerialApp, type SerialAppSession } from './app-fixture.js';
+import { axe } from './axe.js';
 import { fakeSerialUnsupportedReason, type FakeSerialPort } from './harness/pty-serial.js';
 
 const skip = browserUnavailable() ?? fakeSerialUnsupportedReason();
@@ -244,6 +245,7 @@ describe.skipIf(skip !== null)('driving a flight controller through the adapter'
       await page.setViewportSize({ width, height: 900 });
       await page.emulateMedia({ colorScheme: scheme });
       await panel.screenshot({ path: join(SHOTS, `drive-pad-${width < 600 ? 'phone' : 'desktop'}-${scheme}.png`) });
+      expect(await axe(page, `drive sticks ${width} ${scheme}`, ['.drive'])).toEqual([]);
     }
     // Escape still stops.
     await page.keyboard.press('Escape');
@@ -372,6 +374,7 @@ describe.skipIf(skip !== null)('driving a flight controller through the adapter'
         await page.setViewportSize({ width, height: 900 });
         await page.emulateMedia({ colorScheme: scheme });
         await view.screenshot({ path: join(SHOTS, `drive-fc-mavlink-${width < 600 ? 'phone' : 'desktop'}-${scheme}.png`) });
+        expect(await axe(page, `drive MAVLink view ${width} ${scheme}`, ['.drive-fc'])).toEqual([]);
       }
       await view.getByRole('button', { name: 'Stop reading' }).click();
       await view.getByTestId('fc-state').filter({ hasText: 'Not reading' }).waitFor();
