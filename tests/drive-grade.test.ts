@@ -109,6 +109,37 @@ describe('grading a flight controller', () => {
       ),
     ).toMatchObject({ verdict: 'fail', found: expect.stringMatching(/never reported the receiver live/) });
     expect(check(exact('dropouts', 0), 'failsafe')?.verdict).toBe('pass');
+    // Exact by §9 whatever the frames look like: it holds still through every built-in.
+    for (const s of builtinScenarios({ system: 0xb2, remote: 'internal', channels: 12 }))
+      expect(check(exact(s.name, 20_000), 'steady')?.verdict, s.name).not.toBe('fail');
+  });
+
+  it('fails a flight controller whose value jumps while nothing sent moves, and one that drops the receiver while frames come', () => {
+    const scenario = builtinScenarios({ system: 0xb2, remote: 'internal', channels: 4 }).find((x) => x.name === 'fades') as DriveScenario;
+    const player = new DrivePlayer(scenario);
+    const sent = player.writesUntil(Number.POSITIVE_INFINITY);
+    const end = sent.at(-1)?.atUs ?? 0;
+    const readings = (glitchAtUs: number, lostAtUs: number): FcReading[] => {
+      const out: FcReading[] = [];
+      for (let t = 0; t < end; t += 20_000) {
+        const roll = Math.abs(t - glitchAtUs) < 10_000 ? 1800 : 1500;
+        out.push({ atUs: t, channels: [roll, 1500, 1500, 1101], rxLoss: t < 600_000 || Math.abs(t - lostAtUs) < 10_000 });
+      }
+      return out;
+    };
+    expect(check(gradeDrive(sent, readings(-1e9, -1e9), undefined, player.steps), 'steady')?.verdict).toBe('pass');
+    const jump = check(gradeDrive(sent, readings(4e6, -1e9), undefined, player.steps), 'steady');
+    expect(jump).toMatchObject({
+      verdict: 'fail',
+      found: expect.stringMatching(
+        /^1 reading of a value never sent: its channel 1 read 1800 µs and 1500 µs for one value sent \(1×, first at 4\.0 s \(/,
+      ),
+    });
+    const lost = check(gradeDrive(sent, readings(-1e9, 4e6), undefined, player.steps), 'steady');
+    expect(lost).toMatchObject({
+      verdict: 'fail',
+      found: expect.stringMatching(/receiver reported lost 1 time while frames came, first at 4\.0 s/),
+    });
   });
 
   it('says unknown where the flight controller tells nothing', () => {
@@ -118,6 +149,6 @@ describe('grading a flight controller', () => {
       readings.map((r) => ({ ...r, rxLoss: null })),
     );
     expect(check(g, 'failsafe')?.verdict).toBe('unknown');
-    expect(gradeDrive(sent, []).checks.map((c) => c.verdict)).toEqual(['unknown', 'unknown', 'unknown', 'unknown']);
+    expect(gradeDrive(sent, []).checks.map((c) => c.verdict)).toEqual(['unknown', 'unknown', 'unknown', 'unknown', 'unknown']);
   });
 });

@@ -8,6 +8,7 @@
  * Drive's grading, and the browser test's fake flight controller.
  */
 import { BYTE_TIME_US } from '../src/decoder/spec.js';
+import { encodeMsp, MSP, MspParser } from '../src/drive/msp.js';
 
 export interface FakeFcOptions {
   /** The serialrx_provider setting. */
@@ -119,5 +120,52 @@ export class FakeFc {
     }
     if (Number.isNaN(this.#goodSinceUs)) this.#goodSinceUs = atUs;
     this.#lastFrameUs = atUs;
+  }
+}
+
+const le16 = (values: number[]) => new Uint8Array(values.flatMap((v) => [v & 0xff, v >> 8]));
+
+/** Betaflight's MSP_STATUS_EX reply: armed in the flight-mode flags (offset 6), no extra mode bytes, then the arming-disable flags (RXLOSS is bit 2). */
+export function statusEx(armed: boolean, rxLoss: boolean): Uint8Array {
+  const p = new Uint8Array(22);
+  const v = new DataView(p.buffer);
+  v.setUint32(6, armed ? 1 : 0, true);
+  p[15] = 0;
+  p[16] = 26;
+  v.setUint32(17, rxLoss ? 1 << 2 : 0, true);
+  return p;
+}
+
+/**
+ * The same Betaflight's USB port: MSP requests in, replies out (its variant, its receiver setting,
+ * MSP_RC and MSP_STATUS_EX from what its UART read by then). Requests it does not know go unanswered.
+ */
+export class FakeBetaflightUsb {
+  readonly #requests = new MspParser();
+
+  constructor(
+    readonly fc: FakeFc,
+    readonly resolution: 1024 | 2048,
+  ) {}
+
+  /** Bytes from the page at `nowUs`; the replies to send back. */
+  push(bytes: Uint8Array, nowUs: number): Uint8Array[] {
+    const replies: Uint8Array[] = [];
+    this.#requests.push(bytes);
+    for (let m = this.#requests.next(); m !== undefined; m = this.#requests.next()) {
+      const state = this.fc.state(nowUs);
+      const payload =
+        m.cmd === MSP.FC_VARIANT
+          ? new TextEncoder().encode('BTFL')
+          : m.cmd === MSP.RX_CONFIG
+            ? new Uint8Array([this.resolution === 2048 ? 1 : 0])
+            : m.cmd === MSP.RC
+              ? le16(state.channels)
+              : m.cmd === MSP.STATUS_EX
+                ? statusEx(false, state.rxLoss)
+                : null;
+      if (payload !== null) replies.push(encodeMsp(m.cmd, payload, { direction: 'reply' }));
+    }
+    return replies;
   }
 }

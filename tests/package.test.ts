@@ -127,6 +127,6 @@ describe('the npm package', () => {
     const app = join(scratch, 'app');
     writeFileSync(join(app, 'drive.mjs'), block![1]!);
     const lines = run('node', ['drive.mjs'], app).trim().split('\n');
-    expect(lines).toEqual(['1637 frames written, 0 skipped', 'channel-map pass, values pass, latency pass, failsafe unknown']);
+    expect(lines).toEqual(['1637 frames written, 0 skipped', 'channel-map pass, values pass, latency pass, failsafe unknown, steady pass']);
   });
 });

@@ -2,12 +2,14 @@
  * Grading a flight controller's reading of what Drive sent: which of its channels follows which
  * receiver channel, how far its values are from the spec's (§9: 903 + 0.583 × position µs in
  * 2048 mode, 1.166 in 1024), how long a step takes to reach it, and when it reports the receiver
- * lost and back. The readings are the flight controller's own (MSP_RC and its arming-disable
+ * lost and back, and whether it holds still while nothing sent moves (a frame it misreads, an
+ * empty slot, X-Plus, a VTX frame, damage, a lying system byte or a format switch, shows as a
+ * jump the transmitter never sent). The readings are the flight controller's own (MSP_RC and its arming-disable
  * flags, or MAVLink RC_CHANNELS and its failsafe state) on the player's clock; what cannot be
  * told from them is said so, never guessed.
  */
 import { CHANNEL_NAMES, servoToMicros } from '../decoder/spec.js';
-import type { DriveWrite } from './player.js';
+import type { DriveStepTime, DriveWrite } from './player.js';
 
 /** What the flight controller said at a moment (µs on the player's clock). */
 export interface FcReading {
@@ -20,7 +22,7 @@ export interface FcReading {
 
 /** One graded check. */
 export interface DriveCheck {
-  id: 'channel-map' | 'values' | 'latency' | 'failsafe';
+  id: 'channel-map' | 'values' | 'latency' | 'failsafe' | 'steady';
   /** What the spec or the link needs, with its section. */
   expects: string;
   /** What the flight controller did, measured. */
@@ -108,6 +110,7 @@ export function gradeDrive(
   sent: readonly DriveWrite[],
   readings: readonly FcReading[],
   expectedMap: readonly number[] = [1, 2, 3, 0],
+  steps: readonly Pick<DriveStepTime, 'note' | 'endUs'>[] = [],
 ): DriveGrade {
   const byId = tracks(sent);
   const live = readings.filter((r) => r.rxLoss !== true);
@@ -172,6 +175,7 @@ export function gradeDrive(
   }
   checks.push(latency(byId, map, live));
   checks.push(failsafe(sent, readings));
+  checks.push(steadiness(byId, sent, readings, steps));
   return { checks, map };
 }
 
@@ -253,4 +257,143 @@ function failsafe(sent: readonly DriveWrite[], readings: readonly FcReading[]): 
   }
   if (parts.length === 0) return { id: 'failsafe', expects, found: 'No silence was sent.', verdict: 'unknown' };
   return { id: 'failsafe', expects, found: `${parts.join('; ')}.`, verdict: missed > 0 ? 'fail' : 'pass' };
+}
+
+/** A silence between frames this long is a dropout (the flight controller may rightly move). */
+const DROPOUT_US = 100_000;
+/** Frames that flowed this long without a dropout: a flight controller reporting the receiver lost then rejected them. */
+const FLOWING_US = 1_000_000;
+
+/**
+ * Readings taken when nothing sent had moved (no channel's value by §9 changed, no dropout) for
+ * `STEADY_US` are grouped by the values sent then: each of the flight controller's channels must
+ * read one value for one set of values sent, whenever it was sent (before and after a rebind,
+ * under either system byte). A reading off its group's usual value by over 2 µs is a value the
+ * transmitter never sent (a frame misread). And with frames flowing for `FLOWING_US`, it must
+ * not say the receiver is lost.
+ */
+function steadiness(
+  byId: Map<number, Track>,
+  sent: readonly DriveWrite[],
+  readings: readonly FcReading[],
+  steps: readonly Pick<DriveStepTime, 'note' | 'endUs'>[],
+): DriveCheck {
+  const expects =
+    'While nothing sent changes, every channel holds its value and the receiver stays live: §8 frames with empty slots (0xFFFF), X-Plus, VTX or a changing system byte carry no new stick values.';
+  // When anything sent moved: a channel came or moved (by more than 1 µs from where it last
+  // stood, so a slow sweep counts too), or the frames paused (where they came back).
+  const moves: number[] = [];
+  for (const track of byId.values()) {
+    let stood = Number.NaN;
+    for (const [t, v] of track)
+      if (!(Math.abs(v - stood) <= 1)) {
+        moves.push(t);
+        stood = v;
+      }
+  }
+  const frames = sent.filter((w) => w.frame !== null).map((w) => w.atUs);
+  const resumed: number[] = [];
+  for (let i = 1; i < frames.length; i++)
+    if ((frames[i] as number) - (frames[i - 1] as number) > DROPOUT_US) resumed.push(frames[i] as number);
+  moves.push(...resumed);
+  moves.sort((a, b) => a - b);
+  const firstFrame = frames[0] ?? Number.POSITIVE_INFINITY;
+  // Frames had been coming for this long at `t` (none missing for DROPOUT_US), or 0.
+  const flowingFor = (t: number): number => {
+    const last = lastAtOrBefore(frames, t);
+    return t - last > DROPOUT_US ? 0 : t - Math.max(firstFrame, lastAtOrBefore(resumed, t));
+  };
+  const where = (t: number) => {
+    const note = steps.find((st) => t < st.endUs)?.note;
+    return `at ${(t / 1e6).toFixed(1)} s${note === undefined ? '' : ` (${note})`}`;
+  };
+  // Readings that had nothing move in the STEADY_US before them, frames flowing, by the values sent.
+  const groups = new Map<string, FcReading[]>();
+  const tracks = [...byId.values()];
+  let lostWhileFlowing: FcReading | null = null;
+  let lostCount = 0;
+  for (const r of readings) {
+    const since = lastAtOrBefore(moves, r.atUs);
+    const flowing = flowingFor(r.atUs);
+    if (r.rxLoss === true && flowing >= FLOWING_US) {
+      lostCount++;
+      lostWhileFlowing ??= r;
+    }
+    if (!(flowing >= STEADY_US && r.atUs - since >= STEADY_US) || r.rxLoss === true) continue;
+    const key = tracks.map((track) => Math.round(valueAt(track, r.atUs) * 10)).join(' ');
+    const group = groups.get(key);
+    if (group === undefined) groups.set(key, [r]);
+    else group.push(r);
+  }
+  // Each channel's misreadings, by the value read and the value it held: how many, and when first.
+  const jumps = new Map<string, { first: number; count: number }>();
+  let jumpCount = 0;
+  let steadyReadings = 0;
+  for (const group of groups.values()) {
+    steadyReadings += group.length;
+    const width = Math.max(...group.map((r) => r.channels.length));
+    for (let j = 0; j < width; j++) {
+      const values = group.map((r) => r.channels[j] ?? Number.NaN);
+      const usual = mode(values);
+      for (const [k, v] of values.entries()) {
+        if (!(Math.abs(v - usual) > 2)) continue;
+        jumpCount++;
+        const key = `its channel ${j + 1} read ${v} µs and ${usual} µs for one value sent`;
+        const at = (group[k] as FcReading).atUs;
+        const seen = jumps.get(key);
+        if (seen === undefined) jumps.set(key, { first: at, count: 1 });
+        else {
+          seen.count++;
+          if (at < seen.first) seen.first = at;
+        }
+      }
+    }
+  }
+  const findings: string[] = [];
+  if (jumpCount > 0) {
+    const worst = [...jumps].sort((a, b) => b[1].count - a[1].count).slice(0, 3);
+    const told = worst.map(([what, { first, count }]) => `${what} (${count}×, first ${where(first)})`);
+    const more = jumps.size > worst.length ? `; and ${jumps.size - worst.length} more` : '';
+    findings.push(`${jumpCount} reading${jumpCount === 1 ? '' : 's'} of a value never sent: ${told.join('; ')}${more}`);
+  }
+  if (lostWhileFlowing !== null)
+    findings.push(
+      `receiver reported lost ${lostCount} time${lostCount === 1 ? '' : 's'} while frames came, first ${where(lostWhileFlowing.atUs)}`,
+    );
+  if (findings.length > 0) return { id: 'steady', expects, found: `${findings.join('; ')}.`, verdict: 'fail' };
+  if (steadyReadings === 0) return { id: 'steady', expects, found: 'Nothing sent stood still long enough to tell.', verdict: 'unknown' };
+  return {
+    id: 'steady',
+    expects,
+    found: `Held every channel over ${steadyReadings} readings while nothing sent moved, and never lost the receiver while frames came.`,
+    verdict: 'pass',
+  };
+}
+
+/** The last of the sorted `times` at or before `t`, or -Infinity. */
+function lastAtOrBefore(times: readonly number[], t: number): number {
+  let lo = 0;
+  let hi = times.length;
+  while (lo < hi) {
+    const mid = (lo + hi) >> 1;
+    if ((times[mid] as number) <= t) lo = mid + 1;
+    else hi = mid;
+  }
+  return lo === 0 ? Number.NEGATIVE_INFINITY : (times[lo - 1] as number);
+}
+
+/** The most common value (the first of equals). */
+function mode(values: readonly number[]): number {
+  const counts = new Map<number, number>();
+  let best = Number.NaN;
+  let bestCount = 0;
+  for (const v of values) {
+    const n = (counts.get(v) ?? 0) + 1;
+    counts.set(v, n);
+    if (n > bestCount) {
+      best = v;
+      bestCount = n;
+    }
+  }
+  return best;
 }

@@ -40,6 +40,8 @@ export function fixFor(check: DriveCheck, report: Pick<DriveReport, 'receiver'> 
         return 'Check RC_PROTOCOLS, the SERIALn_PROTOCOL 23 (RCIN) port the satellite is on, and that no other RC source (RC_OVERRIDE from a GCS) feeds the channels.';
       case 'failsafe':
         return 'Check FS_THR_ENABLE and RC_FS_TIMEOUT (Copter; THR_FAILSAFE on Plane), and that the satellite is the only RC input.';
+      case 'steady':
+        return 'ArduPilot guesses 10 or 11 bits from the channel IDs it sees: a jump after a rebind, a period switch or frames it misread is that guess; check RC_PROTOCOLS (DSM only) and update the firmware if the jumps stay.';
     }
   }
   if (stack === 'PX4') {
@@ -52,6 +54,8 @@ export function fixFor(check: DriveCheck, report: Pick<DriveReport, 'receiver'> 
         return 'Check RC_INPUT_PROTO (or the DSM port set up for RC input) and that no other RC source feeds the channels.';
       case 'failsafe':
         return 'Check COM_RC_LOSS_T and NAV_RCL_ACT, and that the satellite is the only RC input.';
+      case 'steady':
+        return 'PX4 guesses 10 or 11 bits from the channel IDs it sees: a jump after a rebind or frames it misread is that guess; check RC_INPUT_PROTO and update the firmware if the jumps stay.';
     }
   }
   const provider = report.receiver.system === 0x01 ? 'SPEKTRUM1024' : 'SPEKTRUM2048';
@@ -64,6 +68,8 @@ export function fixFor(check: DriveCheck, report: Pick<DriveReport, 'receiver'> 
       return 'Check `serialrx_provider`, the UART the satellite is on, and that nothing else (a second receiver, RX_MSP) feeds the channels.';
     case 'failsafe':
       return 'Check the failsafe settings (`failsafe_delay`, `failsafe_procedure` in Betaflight; `failsafe_*` in iNav) and that the receiver is the only RC source.';
+    case 'steady':
+      return `The resolution is a setting here, not read from the frames: set \`serialrx_provider = ${provider}\` to match the receiver (a rebind to the other format needs it changed too); if the jumps stay, the firmware misreads frames §8 allows (update it).`;
   }
 }
 

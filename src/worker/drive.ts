@@ -262,7 +262,7 @@ export class DriveSession {
       this.#gradeNote = "Not graded: the flight controller's USB port was not read during the drive.";
       return;
     }
-    this.#checks = gradeDrive(written, readings, this.fcOrder()).checks;
+    this.#checks = gradeDrive(written, readings, this.fcOrder(), this.#player?.steps ?? []).checks;
     this.#gradeNote = `Graded on ${readings.length} readings of the flight controller's channels.`;
   }
 
