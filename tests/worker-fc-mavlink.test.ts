@@ -60,6 +60,8 @@ describe("the flight controller's own view over MAVLink", () => {
     // Its failsafe after RC_FS_TIMEOUT (1 s): SYS_STATUS says the receiver unhealthy, HEARTBEAT critical.
     await run(2500);
     expect(fcNow()).toMatchObject({ rxLoss: true, failsafe: true });
+    // Over 6.5 s it was never sent a ground station's heartbeat (whose stop is its GCS failsafe).
+    expect(fc.asked.get(MAVLINK.HEARTBEAT.id) ?? 0).toBe(0);
     await send({ type: 'fc-close' });
     expect(fcNow()?.state).toBe('closed');
   });
@@ -72,8 +74,8 @@ describe("the flight controller's own view over MAVLink", () => {
     expect(fcNow()?.protocol).toBeNull();
     expect(fc.ignored).toBeGreaterThan(0);
     expect(fc.asked.size).toBe(0);
-    await run(2500);
-    // Then a GCS heartbeat: PX4 starts MAVLink, is found, and asked for its streams.
+    await run(3500);
+    // Then a GCS heartbeat (after 2.5 s without MSP or a HEARTBEAT): PX4 starts MAVLink, is found, and asked for its streams.
     expect(fc.asked.get(MAVLINK.HEARTBEAT.id)).toBeGreaterThanOrEqual(1);
     expect(fcNow()).toMatchObject({ protocol: 'mavlink', variant: 'PX4', armed: false });
     // It has never said it has a receiver: not said, never guessed.
@@ -90,7 +92,7 @@ describe("the flight controller's own view over MAVLink", () => {
   it('says nothing of the receiver state of a PX4 that does not report it', async () => {
     const { send, run, fcNow, drive } = setup('PX4', { reportsRc: false });
     await send({ type: 'fc-open', port: FC_USB });
-    await run(2500);
+    await run(4500);
     await drive('manual');
     await run(1000);
     expect(fcNow()?.channels?.[2]).toBe(1099);

@@ -6,8 +6,10 @@
  *   and the arming-disable flags that say RX loss) and channels 20 times a second.
  * - MAVLink v2 (ArduPilot, PX4): found by its HEARTBEAT. ArduPilot sends one unasked; PX4's USB
  *   port starts MAVLink once it hears some, so a GCS HEARTBEAT is sent once a second after the
- *   port answered no MSP for `PROBE_AFTER_MS` (never to a port that answered MSP: Betaflight
- *   reboots to its bootloader on a stray byte). Once found, RC_CHANNELS and SYS_STATUS are asked
+ *   port answered no MSP and said no HEARTBEAT for `PROBE_AFTER_MS` (never to a port that
+ *   answered MSP: Betaflight reboots to its bootloader on a stray byte), and on to a PX4; not to
+ *   an ArduPilot, which streams what it is asked for without one (a ground station's heartbeats
+ *   that stop are its GCS failsafe). Once found, RC_CHANNELS and SYS_STATUS are asked
  *   for 20 times a second (SET_MESSAGE_INTERVAL, and REQUEST_DATA_STREAM for older ArduPilot),
  *   again every few seconds while they do not come. Armed is HEARTBEAT's; the receiver lost is
  *   SYS_STATUS's RC receiver bits once the autopilot has said the receiver present (ArduPilot
@@ -54,8 +56,12 @@ const POST_EVERY_MS = 250;
 const SILENT_MS = 1000;
 /** Channel readings kept for grading a drive: 20 minutes of them. */
 const MAX_READINGS = 24_000;
-/** No MSP reply for this long: a GCS HEARTBEAT goes out once a second, for a PX4 that waits to hear MAVLink, ms. */
-const PROBE_AFTER_MS = 1000;
+/**
+ * No MSP reply and no HEARTBEAT for this long: a GCS HEARTBEAT goes out once a second, for a PX4
+ * that waits to hear MAVLink, ms. Over ArduPilot's heartbeat period (1 s), so an ArduPilot is
+ * heard before it is sent anything.
+ */
+const PROBE_AFTER_MS = 2500;
 /** MAVLink: RC_CHANNELS and SYS_STATUS asked for at this interval, µs, and asked again this often while they do not come, ms. */
 const MAVLINK_INTERVAL_US = 50_000;
 const MAVLINK_ASK_AGAIN_MS = 3000;
@@ -247,7 +253,7 @@ export class FcReader {
     if (s === null || s.protocol === 'msp') return;
     const now = this.host.clock.now();
     if (s.protocol === null && now - this.#openedMs < PROBE_AFTER_MS) return;
-    this.#sendMavlink(gcsHeartbeat(this.#seq++ & 0xff));
+    if (s.variant !== 'ArduPilot') this.#sendMavlink(gcsHeartbeat(this.#seq++ & 0xff));
     if (this.#target !== null && !(now - this.#lastRcMs < 1000) && !(now - this.#askedMs < MAVLINK_ASK_AGAIN_MS)) this.#askStreams();
   }
 
