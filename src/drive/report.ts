@@ -73,7 +73,19 @@ export function fixFor(check: DriveCheck, report: Pick<DriveReport, 'receiver'> 
   }
 }
 
+/** A fix's text in pieces: what it names to type (between backticks) apart from its words. */
+export function codeSpans(text: string): { code: boolean; text: string }[] {
+  return text
+    .split('`')
+    .map((piece, i) => ({ code: i % 2 === 1, text: piece }))
+    .filter((p) => p.text !== '');
+}
+
 const esc = (s: string) => s.replace(/[&<>"']/g, (c) => `&#${c.charCodeAt(0)};`);
+const fixHtml = (fix: string) =>
+  codeSpans(fix)
+    .map((p) => (p.code ? `<code>${esc(p.text)}</code>` : esc(p.text)))
+    .join('');
 const ms = (us: number) => `${(us / 1000).toFixed(1)} ms`;
 
 /** The report as one self-contained HTML page. */
@@ -82,7 +94,7 @@ export function driveReportHtml(r: DriveReport): string {
   const rows = r.checks
     .map((c) => {
       const fix = fixFor(c, r);
-      return `<tr class="${c.verdict}"><th>${esc(c.id)}</th><td>${esc(c.expects)}</td><td>${esc(c.found)}</td><td class="v">${c.verdict}</td><td>${fix === null ? '' : esc(fix)}</td></tr>`;
+      return `<tr class="${c.verdict}"><th>${esc(c.id)}</th><td>${esc(c.expects)}</td><td>${esc(c.found)}</td><td class="v">${c.verdict}</td><td>${fix === null ? '' : fixHtml(fix)}</td></tr>`;
     })
     .join('\n');
   const interval = t.interval === null ? 'none' : `${ms(t.interval.p1)} / ${ms(t.interval.p50)} / ${ms(t.interval.p99)}`;

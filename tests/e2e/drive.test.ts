@@ -1,11 +1,9 @@
 /**
  * Drive through Chromium's real WebSerial: the page writes a DSMX 11 ms satellite to the pty
- * standing in for the adapter, another tab in front, and the test reads it as a flight
- * controller's UART would: bytes grouped by the silence between them (the pty has no wire: a
- * group is what one read of the pty returned, so the reader's own lateness merges frames too).
- * The page keeps 8 ms of silence before every frame by its clock; at the pty every group must be
- * whole frames, in 11 ms slots (frames read together are printed, not judged). What the test
- * reads it writes back (the
+ * standing in for the adapter, and the test reads it as a flight controller's UART would
+ * (drive-timing.ts; with the tab hidden: drive-background.test.ts). The page keeps 8 ms of
+ * silence before every frame by its clock; at the pty every group must be whole frames, in 11 ms
+ * slots (frames read together are printed, not judged). What the test reads it writes back (the
  * loopback self-test): the page decodes it as a receiver. Escape stops the stream at once.
  * SATSCOPE_DRIVE_SECONDS sets how long it drives (default 30; docs/drive.md quotes a 600 s run);
  * the distribution is printed.
@@ -13,10 +11,11 @@
 import type { Browser } from 'playwright-core';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { SpektrumDecoder } from '../../src/decoder/decoder.js';
-import { BYTE_TIME_US, servoToPercent } from '../../src/decoder/spec.js';
+import { servoToPercent } from '../../src/decoder/spec.js';
 import { MIN_SILENCE_US } from '../../src/drive/schedule.js';
 import { encodeMavlink, MAVLINK, MavlinkParser, SENSOR_RC_RECEIVER } from '../../src/drive/mavlink.js';
 import { join } from 'node:path';
+import { burstFigures, bursts } from './drive-timing.js';
 import { browserUnavailable, SHOTS, shot, startSerialApp, type SerialAppSession } from './app-fixture.js';
 import { axe } from './axe.js';
 import { fakeSerialUnsupportedReason, type FakeSerialPort } from './harness/pty-serial.js';
@@ -39,26 +38,9 @@ afterAll(async () => {
   await rig?.close();
 });
 
-/** Bytes as they came, grouped into bursts by a silence of 3 ms or more: one burst is what a flight controller reads as one frame. */
-function bursts(chunks: { bytes: Uint8Array; tUs: number }[]): { startUs: number; endUs: number; length: number }[] {
-  const out: { startUs: number; endUs: number; length: number }[] = [];
-  for (const c of chunks) {
-    // A chunk's arrival is its last byte's: its first left the wire (length - 1) bytes earlier.
-    const startUs = c.tUs - (c.bytes.length - 1) * BYTE_TIME_US;
-    const last = out[out.length - 1];
-    if (last !== undefined && startUs - last.endUs < 3000) {
-      last.endUs = c.tUs;
-      last.length += c.bytes.length;
-    } else out.push({ startUs, endUs: c.tUs, length: c.bytes.length });
-  }
-  return out;
-}
-
-const quantile = (sorted: number[], q: number) => sorted[Math.min(sorted.length - 1, Math.floor(q * sorted.length))] ?? Number.NaN;
-
 describe.skipIf(skip !== null)('driving a flight controller through the adapter', () => {
   it(
-    `writes ${SECONDS} s of DSMX 11 ms frame by frame, another tab in front, and reads it back through the loopback`,
+    `writes ${SECONDS} s of DSMX 11 ms frame by frame and reads it back through the loopback`,
     async () => {
       const context = await browser.newContext({ viewport: { width: 1280, height: 1000 } });
       const page = await context.newPage();
@@ -86,13 +68,7 @@ describe.skipIf(skip !== null)('driving a flight controller through the adapter'
       });
       await startButton.click();
       await panel.getByTestId('drive-state').filter({ hasText: 'Sending “manual”' }).waitFor();
-      // The tab goes to the background: another one in front.
-      const other = await context.newPage();
-      await other.goto('about:blank');
-      await other.bringToFront();
-      const hidden = await page.evaluate(() => document.visibilityState);
       await new Promise((r) => setTimeout(r, SECONDS * 1000));
-      await page.bringToFront();
       // The panel at both widths and in both themes, to look at.
       for (const [width, scheme] of [
         [1280, 'light'],
@@ -115,37 +91,16 @@ describe.skipIf(skip !== null)('driving a flight controller through the adapter'
       // Escape stopped it: at most the two writes the worker lets be on their way (drive.ts) after it.
       expect(chunks.length - atStop).toBeLessThanOrEqual(2);
 
-      const b = bursts(chunks);
-      const lengths = new Map<number, number>();
-      for (const x of b) lengths.set(x.length, (lengths.get(x.length) ?? 0) + 1);
-      const intervals = b
-        .slice(1)
-        .map((x, i) => x.startUs - (b[i]?.startUs ?? 0))
-        .sort((p, q) => p - q);
-      const silences = b
-        .slice(1)
-        .map((x, i) => x.startUs - (b[i]?.endUs ?? 0))
-        .sort((p, q) => p - q);
-      const report = {
-        hidden,
-        groups: b.length,
-        lengths: Object.fromEntries(lengths),
-        intervalMs: [0, 0.01, 0.5, 0.99, 1].map((q) => +(quantile(intervals, q) / 1000).toFixed(2)),
-        shortestSilenceMs: +((silences[0] ?? 0) / 1000).toFixed(2),
-        decoded,
-        loop,
-        timing,
-      };
-      console.log(`drive through the pty: ${JSON.stringify(report)}`);
-      const frames = b.reduce((n, x) => n + x.length / 16, 0);
+      const { spanUs: span, ...figures } = burstFigures(bursts(chunks));
+      console.log(`drive through the pty: ${JSON.stringify({ ...figures, decoded, loop, timing })}`);
+      const { frames } = figures;
       // Frames the worker skipped (its timer late) are no frames: at most a tenth (below).
       expect(frames).toBeGreaterThan(((SECONDS * 1e6) / 11_000) * 0.9);
       // Whole frames only: nothing split or cut short.
-      expect([...lengths.keys()].every((n) => n % 16 === 0)).toBe(true);
+      expect(Object.keys(figures.lengths).every((n) => Number(n) % 16 === 0)).toBe(true);
       // Frames read in one piece with the next are reported, not judged: the pty's reader cannot
       // tell its own lateness (hundreds of ms under load) from the page's.
       // The slots kept: over the drive, frames written plus frames skipped come 11 ms apart.
-      const span = (b.at(-1)?.startUs ?? 0) - (b[0]?.startUs ?? 0);
       const skippedNow = Number(/; (\d+) skipped/.exec(timing ?? '')?.[1] ?? Number.NaN);
       expect(Math.abs(span / (frames + skippedNow - 1) - 11_000)).toBeLessThanOrEqual(330);
       // The page's own account: the silence it kept by its clock, and few frames skipped.

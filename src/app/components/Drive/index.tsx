@@ -20,7 +20,7 @@ import {
   systemInfo,
 } from '../../../decoder/spec.js';
 import { chosenPort, identify, portLabel } from '../../serial.js';
-import { type DriveReport, driveReportHtml, fixFor } from '../../../drive/report.js';
+import { codeSpans, type DriveReport, driveReportHtml, fixFor } from '../../../drive/report.js';
 import { download, drive, fc, liveOf, send } from '../../store.js';
 import { FcView } from './fc.js';
 import { StickSources } from './inputs.js';
@@ -37,7 +37,9 @@ const clock = (us: number) => {
 
 /** What to change where a check failed (nothing where it did not). */
 function Fix({ text }: { text: string | null }) {
-  return text === null ? null : <div class="drive-fix">{text}</div>;
+  return text === null ? null : (
+    <div class="drive-fix">{codeSpans(text).map((p, i) => (p.code ? <code key={i}>{p.text}</code> : p.text))}</div>
+  );
 }
 
 /** Saves the conformance report of a drive that stopped, with what the flight controller said of itself. */
@@ -342,8 +344,8 @@ export function DrivePanel({ granted, onClose }: { granted: SerialPort[]; onClos
                     {status.checks.map((c) => (
                       <tr key={c.id} class={c.verdict}>
                         <th>{c.id}</th>
-                        <td>{c.expects}</td>
-                        <td>
+                        <td data-label="Should">{c.expects}</td>
+                        <td data-label="Did">
                           {c.found}
                           <Fix text={fixFor(c, { receiver: status.receiver, fc: fc.value })} />
                         </td>
