@@ -13,7 +13,7 @@ import { concatBytes } from '../bytes.js';
 import { usbChunks, withSpikes } from '../feeds.js';
 import { chromiumAvailable, launchChromium, startStaticServer, type LaunchChromiumOptions, type StaticServer } from './harness/browser.js';
 import { installSerialPolicy } from './harness/policy.js';
-import { openFakeSerialPort, type FakeSerialPort } from './harness/pty-serial.js';
+import { openFakeSerialPort, type FakeSerialPort, type FakeSerialPortOptions } from './harness/pty-serial.js';
 
 export const ROOT = resolve(import.meta.dirname, '../..');
 export const APP_DIR = join(ROOT, 'dist-app');
@@ -106,7 +106,7 @@ export interface SerialAppSession extends AppSession {
  * of /dev/ttyS0, and Chromium: what every real-WebSerial test needs. `close()` undoes it all,
  * and so does a failure half-way.
  */
-export async function startSerialApp(launch: LaunchChromiumOptions = {}): Promise<SerialAppSession> {
+export async function startSerialApp(launch: LaunchChromiumOptions = {}, port: FakeSerialPortOptions = {}): Promise<SerialAppSession> {
   mkdirSync(SHOTS, { recursive: true });
   const undo: (() => Promise<void>)[] = [];
   const close = async () => {
@@ -117,7 +117,7 @@ export async function startSerialApp(launch: LaunchChromiumOptions = {}): Promis
     undo.push(() => server.close());
     const policy = await installSerialPolicy(server.origin);
     undo.push(() => policy.remove());
-    const fake = await openFakeSerialPort();
+    const fake = await openFakeSerialPort(port);
     undo.push(() => fake.close());
     const browser = await launchChromium(launch);
     undo.push(() => browser.close());

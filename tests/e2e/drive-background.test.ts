@@ -34,7 +34,7 @@ beforeAll(async () => {
   if (skip !== null) return;
   server = await startStaticServer(APP_DIR);
   policy = await installSerialPolicy(server.origin);
-  fake = await openFakeSerialPort();
+  fake = await openFakeSerialPort({ realtime: true });
   win = await WindowedChromium.launch();
 }, 60_000);
 

@@ -30,7 +30,8 @@ let browser: Browser;
 
 beforeAll(async () => {
   if (skip !== null) return;
-  rig = await startSerialApp();
+  // The pump at a real-time priority: what it reads in one piece, the page wrote together.
+  rig = await startSerialApp({}, { realtime: true });
   ({ fake, browser } = rig);
 });
 

@@ -175,6 +175,12 @@ export interface FakeSerialPortOptions {
   coalesceUs?: number;
   /** Waiting for another test (process) using the same device. Default 120 s. */
   lockTimeoutMs?: number;
+  /**
+   * Run the pump at a real-time priority (SCHED_FIFO, where `chrt` may), so that on a loaded
+   * machine it reads the page's writes as they come and stamps them on time: what it reads in one
+   * piece was then written together, not held up by the reader. Default false.
+   */
+  realtime?: boolean;
 }
 
 function frame(kind: string, payload: Uint8Array): Buffer {
@@ -210,7 +216,10 @@ export async function openFakeSerialPort(options: FakeSerialPortOptions = {}): P
   const lock: Lock = await acquireLock(`serial-${device.replaceAll('/', '_')}`, options.lockTimeoutMs);
   restoreSerialDevice(device); // stale swap from a crashed run (its owner is gone: we hold the lock)
 
-  const child: ChildProcess = spawn('python3', ['-u', PUMP, device, String(options.coalesceUs ?? 500)], {
+  const pump = ['python3', '-u', PUMP, device, String(options.coalesceUs ?? 500)];
+  const realtime = options.realtime === true && spawnSync('chrt', ['-f', '20', 'true']).status === 0;
+  const [command, ...args] = realtime ? ['chrt', '-f', '20', ...pump] : pump;
+  const child: ChildProcess = spawn(command as string, args, {
     stdio: ['pipe', 'pipe', 'pipe'],
   });
   let stderr = '';
