@@ -107,6 +107,37 @@ describe("the flight controller's own view while driving it", () => {
     expect(html).not.toMatch(/<script|https?:\/\//);
   });
 
+  it('grades a drive by hand (the sticks alone run an hour) over its last 2 minutes, on the sticks that moved', async () => {
+    const { send, run, of, worker } = setup(2048);
+    await send({ type: 'fc-open', port: FC_USB });
+    await run(300);
+    await send({
+      type: 'drive-start',
+      port: ADAPTER,
+      receiver: { system: 0xb2, remote: 'internal', channels: 6 },
+      scenario: 'manual',
+      throttleCeilingPercent: 100,
+    });
+    // Three minutes of the aileron stepped by hand every 2 s, the other sticks left alone.
+    for (let s = 0; s < 90; s++) {
+      worker.receive({ type: 'drive-channel', id: 1, percent: s % 2 === 0 ? 60 : -40 });
+      await run(2000);
+    }
+    await send({ type: 'drive-stop' });
+    const done = of('drive').at(-1)?.drive;
+    expect(done?.gradeNote).toMatch(
+      /^Graded on \d+ readings of the flight controller's channels, over the drive's last 2 minutes \(from 6\d s\)\.$/,
+    );
+    const checks = Object.fromEntries((done?.checks ?? []).map((c) => [c.id, c]));
+    expect(checks['channel-map']).toMatchObject({
+      verdict: 'pass',
+      found: 'As expected (Elevator, Rudder, Throttle: no channel followed them).',
+    });
+    expect(checks.latency?.verdict).toBe('pass');
+    expect(checks.latency?.found).toMatch(/^60 steps/);
+    expect(checks.steady?.verdict).toBe('pass');
+  }, 60_000);
+
   it('does not grade a drive the flight controller was not read during, and says so', async () => {
     const { send, run, of } = setup(2048);
     await send({

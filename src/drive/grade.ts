@@ -141,15 +141,20 @@ export function gradeDrive(
     if (bestId >= 0) map.set(j, bestId);
   }
   const name = (id: number | undefined) => (id === undefined ? 'nothing that moved' : (CHANNEL_NAMES[id] ?? `channel ${id}`));
+  // Judged on the channels that followed a stick; one that followed none is said, not failed
+  // (a stick the scenario or the user never moved says nothing of the order).
   const wrong = expectedMap
-    .map((id, j) => (map.get(j) === id ? null : `its channel ${j + 1} follows ${name(map.get(j))}, not ${name(id)}`))
+    .map((id, j) => (!map.has(j) || map.get(j) === id ? null : `its channel ${j + 1} follows ${name(map.get(j))}, not ${name(id)}`))
     .filter((x) => x !== null);
-  const unseen = expectedMap.filter((_, j) => !map.has(j)).length;
+  const unseen = expectedMap.filter((_, j) => !map.has(j));
+  const still =
+    unseen.length > 0 ? ` (${unseen.map((id) => name(id)).join(', ')}: no channel followed ${unseen.length === 1 ? 'it' : 'them'})` : '';
   checks.push({
     id: 'channel-map',
     expects: `Channels 1-4 read as ${expectedMap.map((id) => name(id)).join(', ')} (§8.5: the receiver's channel IDs name them).`,
-    found: map.size === 0 ? 'No channel followed any stick that moved.' : `${wrong.length === 0 ? 'As expected' : wrong.join('; ')}.`,
-    verdict: unseen === expectedMap.length ? 'unknown' : wrong.length === 0 ? 'pass' : 'fail',
+    found:
+      map.size === 0 ? 'No channel followed any stick that moved.' : `${wrong.length === 0 ? 'As expected' : wrong.join('; ')}${still}.`,
+    verdict: unseen.length === expectedMap.length ? 'unknown' : wrong.length === 0 ? 'pass' : 'fail',
   });
   // How far its values are from the spec's, over the mapped channels, where the value sent had
   // stood still for `STEADY_US` (a reading of a moving stick measures the latency too).

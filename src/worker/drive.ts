@@ -25,7 +25,10 @@ import type { SourceRegistry } from './registry.js';
 const STATUS_MS = 250;
 /** A timer that wakes within this of a write's time (the ms clock's rounding) finds it due, µs. */
 const WAKE_TOLERANCE_US = 1;
-/** A scenario up to this long keeps what it wrote, to grade the flight controller's reading against, µs. */
+/**
+ * What it wrote in the last this long a drive keeps, to grade the flight controller's reading
+ * against: a whole built-in scenario, the last of a long one (the sticks alone run an hour), µs.
+ */
 const MAX_GRADED_US = 2 * 60e6;
 /** Writes a drive lets be on their way to the port at once (see `#tick`). */
 const MAX_WRITING = 2;
@@ -94,7 +97,9 @@ export class DriveSession {
   #requested = 0;
   #cancelled = 0;
   /** What was written, while the scenario is short enough to grade (null: not kept). */
-  #written: DriveWrite[] | null = null;
+  #written: DriveWrite[] = [];
+  /** The first of `#written` still in the last `MAX_GRADED_US` (the rest is dropped now and then, not each write). */
+  #writtenFrom = 0;
   #receiver: DriveReceiver | null = null;
   #checks: DriveCheck[] | null = null;
   #gradeNote: string | null = null;
@@ -150,7 +155,8 @@ export class DriveSession {
     this.#schedule = new WriteSchedule(this.#player);
     this.#sent = null;
     this.#receiver = r.receiver;
-    this.#written = this.#player.durationUs <= MAX_GRADED_US ? [] : null;
+    this.#written = [];
+    this.#writtenFrom = 0;
     this.#checks = null;
     this.#gradeNote = null;
     this.#state = 'driving';
@@ -192,6 +198,18 @@ export class DriveSession {
     this.#schedule = null;
   }
 
+  /** Keeps a write for grading; what fell out of the last `MAX_GRADED_US` goes once it is as many writes as those kept. */
+  #keep(w: DriveWrite): void {
+    const written = this.#written;
+    written.push(w);
+    while (this.#writtenFrom < written.length && (written[this.#writtenFrom] as DriveWrite).atUs < w.atUs - MAX_GRADED_US)
+      this.#writtenFrom++;
+    if (this.#writtenFrom > written.length / 2) {
+      written.splice(0, this.#writtenFrom);
+      this.#writtenFrom = 0;
+    }
+  }
+
   #nowUs(): number {
     return (this.host.clock.now() - this.#startMs) * 1000;
   }
@@ -211,7 +229,7 @@ export class DriveSession {
     const w = schedule.take(now + WAKE_TOLERANCE_US);
     if (w !== null) {
       writing.count++;
-      this.#written?.push(w);
+      this.#keep(w);
       writer.write(w.bytes).then(
         () => {
           // A tick that found the port's hands full left no timer: this write's end wakes it.
@@ -247,23 +265,21 @@ export class DriveSession {
    * includes the time an answer takes, half a reading interval at the most.
    */
   #grade(): void {
-    const written = this.#written;
-    this.#written = null;
-    if (written === null) {
-      this.#gradeNote = 'Not graded: a scenario over 2 minutes (the sticks alone run an hour) keeps no record of what it sent.';
-      return;
-    }
-    const readings = this.fcReadings(this.#startMs).map((r) => ({
-      atUs: (r.atMs - this.#startMs) * 1000,
-      channels: r.channels,
-      rxLoss: r.rxLoss,
-    }));
+    const written = this.#written.slice(this.#writtenFrom);
+    this.#written = [];
+    this.#writtenFrom = 0;
+    const fromUs = written[0]?.atUs ?? 0;
+    const readings = this.fcReadings(this.#startMs)
+      .map((r) => ({ atUs: (r.atMs - this.#startMs) * 1000, channels: r.channels, rxLoss: r.rxLoss }))
+      .filter((r) => r.atUs >= fromUs);
     if (readings.length === 0) {
       this.#gradeNote = "Not graded: the flight controller's USB port was not read during the drive.";
       return;
     }
     this.#checks = gradeDrive(written, readings, this.fcOrder(), this.#player?.steps ?? []).checks;
-    this.#gradeNote = `Graded on ${readings.length} readings of the flight controller's channels.`;
+    const last =
+      fromUs > 0 ? `, over the drive's last ${Math.round(MAX_GRADED_US / 60e6)} minutes (from ${(fromUs / 1e6).toFixed(0)} s)` : '';
+    this.#gradeNote = `Graded on ${readings.length} readings of the flight controller's channels${last}.`;
   }
 
   #post(): void {
