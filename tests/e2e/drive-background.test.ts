@@ -17,6 +17,7 @@ import { fakeSerialUnsupportedReason, monotonicUs, openFakeSerialPort, type Fake
 import { WindowedChromium, windowedUnavailable } from './harness/windowed.js';
 import { existsSync } from 'node:fs';
 import { join } from 'node:path';
+import { openDrive } from './drive-page.js';
 
 const skip =
   (existsSync(join(APP_DIR, 'index.html')) ? null : `${APP_DIR} is not built (npm run build)`) ??
@@ -24,6 +25,9 @@ const skip =
   fakeSerialUnsupportedReason();
 if (skip !== null) console.warn(`skipping Drive in a background tab: ${skip}`);
 const SECONDS = Number(process.env.SATSCOPE_DRIVE_SECONDS ?? 15);
+
+/** How long to wait for the serial devices, ms. */
+const WAIT_MS = 300_000;
 
 let server: StaticServer;
 let policy: SerialPolicy;
@@ -34,9 +38,10 @@ beforeAll(async () => {
   if (skip !== null) return;
   server = await startStaticServer(APP_DIR);
   policy = await installSerialPolicy(server.origin);
-  fake = await openFakeSerialPort({ realtime: true });
+  // The other browser tests hold /dev/ttyS0 a file at a time: wait for it as long as one may take.
+  fake = await openFakeSerialPort({ realtime: true, lockTimeoutMs: WAIT_MS });
   win = await WindowedChromium.launch();
-}, 60_000);
+}, WAIT_MS + 60_000);
 
 afterAll(async () => {
   await win?.close();
@@ -54,9 +59,7 @@ describe.skipIf(skip !== null)('driving a flight controller with the tab in the 
       const errors: string[] = [];
       page.on('pageerror', (e) => errors.push(e.message));
       await page.goto(server.url('/'));
-      await page.getByRole('button', { name: 'More ways to connect' }).click();
-      await page.getByRole('button', { name: 'Drive a flight controller…' }).click();
-      let panel = page.getByRole('region', { name: 'Drive a flight controller' });
+      let panel = await openDrive(page);
       await panel.getByLabel('The propellers are off').check();
 
       const chunks: PtyChunk[] = [];

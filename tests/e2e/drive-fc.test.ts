@@ -16,10 +16,14 @@ import { APP_DIR, browserUnavailable, SHOTS } from './app-fixture.js';
 import { launchChromium, startStaticServer, type StaticServer } from './harness/browser.js';
 import { installSerialPolicy, type SerialPolicy } from './harness/policy.js';
 import { fakeSerialUnsupportedReason, monotonicUs, openFakeSerialPort, type FakeSerialPort } from './harness/pty-serial.js';
+import { openDrive } from './drive-page.js';
 
 const SECOND = '/dev/ttyS1';
 const skip = browserUnavailable() ?? fakeSerialUnsupportedReason() ?? fakeSerialUnsupportedReason(SECOND);
 if (skip !== null) console.warn(`skipping Drive with the flight controller read back: ${skip}`);
+
+/** How long to wait for the serial devices, ms. */
+const WAIT_MS = 300_000;
 
 let server: StaticServer;
 let policy: SerialPolicy;
@@ -31,9 +35,10 @@ beforeAll(async () => {
   mkdirSync(SHOTS, { recursive: true });
   server = await startStaticServer(APP_DIR);
   policy = await installSerialPolicy(server.origin);
-  ports = [await openFakeSerialPort(), await openFakeSerialPort({ device: SECOND })];
+  // The other browser tests hold /dev/ttyS0 a file at a time: wait for it as long as one may take.
+  ports = [await openFakeSerialPort({ lockTimeoutMs: WAIT_MS }), await openFakeSerialPort({ device: SECOND, lockTimeoutMs: WAIT_MS })];
   browser = await launchChromium();
-}, 60_000);
+}, WAIT_MS + 60_000);
 
 afterAll(async () => {
   await browser?.close();
@@ -67,9 +72,7 @@ describe.skipIf(skip !== null)('driving a flight controller and reading it back,
     page.on('pageerror', (e) => errors.push(e.message));
     try {
       await page.goto(server.url('/'));
-      await page.getByRole('button', { name: 'More ways to connect' }).click();
-      await page.getByRole('button', { name: 'Drive a flight controller…' }).click();
-      const panel = page.getByRole('region', { name: 'Drive a flight controller' });
+      const panel = await openDrive(page);
       const view = panel.getByRole('region', { name: "The flight controller's view" });
       await view.getByLabel('Its USB port').selectOption({ index: 1 });
       await view.getByRole('button', { name: 'Read the flight controller' }).click();

@@ -11,7 +11,6 @@
 import type { Browser } from 'playwright-core';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { SpektrumDecoder } from '../../src/decoder/decoder.js';
-import { servoToPercent } from '../../src/decoder/spec.js';
 import { MIN_SILENCE_US } from '../../src/drive/schedule.js';
 import { encodeMavlink, MAVLINK, MavlinkParser, SENSOR_RC_RECEIVER } from '../../src/drive/mavlink.js';
 import { join } from 'node:path';
@@ -19,6 +18,7 @@ import { burstFigures, bursts } from './drive-timing.js';
 import { browserUnavailable, SHOTS, shot, startSerialApp, type SerialAppSession } from './app-fixture.js';
 import { axe } from './axe.js';
 import { fakeSerialUnsupportedReason, type FakeSerialPort } from './harness/pty-serial.js';
+import { openDrive, sticksAtPty } from './drive-page.js';
 
 const skip = browserUnavailable() ?? fakeSerialUnsupportedReason();
 if (skip !== null) console.warn(`skipping the Drive tests: ${skip}`);
@@ -48,10 +48,7 @@ describe.skipIf(skip !== null)('driving a flight controller through the adapter'
       const errors: string[] = [];
       page.on('pageerror', (e) => errors.push(e.message));
       await page.goto(rig!.server.url('/'));
-      await page.getByRole('button', { name: 'More ways to connect' }).click();
-      await page.getByRole('button', { name: 'Drive a flight controller…' }).click();
-      const panel = page.getByRole('region', { name: 'Drive a flight controller' });
-      await panel.waitFor();
+      const panel = await openDrive(page);
       // Nothing is sent before the user says the propellers are off.
       const startButton = panel.getByRole('button', { name: '▶ Start driving' });
       expect(await startButton.isDisabled()).toBe(true);
@@ -138,28 +135,17 @@ describe.skipIf(skip !== null)('driving a flight controller through the adapter'
     page.on('pageerror', (e) => errors.push(e.message));
     await page.goto(rig!.server.url('/'));
     await page.evaluate(() => localStorage.removeItem('satscope.drive.gamepad'));
-    await page.getByRole('button', { name: 'More ways to connect' }).click();
-    await page.getByRole('button', { name: 'Drive a flight controller…' }).click();
-    const panel = page.getByRole('region', { name: 'Drive a flight controller' });
-    await panel.waitFor();
+    const panel = await openDrive(page);
     await panel.getByLabel('Gamepad or transmitter (joystick mode)').check();
     await panel.getByTestId('drive-pad-state').filter({ hasText: 'Test pad (STANDARD GAMEPAD): 4 axes, 17 buttons' }).waitFor();
     // Gear from button 0, kept by the page across a reload.
     await panel.getByLabel('Gear from').selectOption('button:0');
     await page.reload();
-    await page.getByRole('button', { name: 'More ways to connect' }).click();
-    await page.getByRole('button', { name: 'Drive a flight controller…' }).click();
+    await openDrive(page);
     await panel.getByLabel('Gamepad or transmitter (joystick mode)').check();
     expect(await panel.getByLabel('Gear from').inputValue()).toBe('button:0');
 
-    const decoder = new SpektrumDecoder();
-    const last = new Map<number, number>();
-    const stop = fake.onData((bytes, tUs) => {
-      decoder.push(bytes, tUs);
-      for (let f = decoder.next(); f !== undefined; f = decoder.next())
-        for (let i = 0; i < f.count; i++) last.set(f.ids[i] as number, servoToPercent(f.positions[i] as number, f.resolution));
-      void fake.write(bytes);
-    });
+    const { last, stop } = sticksAtPty(fake);
     await panel.getByLabel('The propellers are off').check();
     await panel.getByRole('button', { name: '▶ Start driving' }).click();
     await panel.getByTestId('drive-state').filter({ hasText: 'Sending “manual”' }).waitFor();
@@ -217,20 +203,10 @@ describe.skipIf(skip !== null)('driving a flight controller through the adapter'
     const errors: string[] = [];
     page.on('pageerror', (e) => errors.push(e.message));
     await page.goto(rig!.server.url('/'));
-    await page.getByRole('button', { name: 'More ways to connect' }).click();
-    await page.getByRole('button', { name: 'Drive a flight controller…' }).click();
-    const panel = page.getByRole('region', { name: 'Drive a flight controller' });
-    await panel.waitFor();
+    const panel = await openDrive(page);
     expect(await panel.getByRole('table', { name: 'Keyboard sticks' }).textContent()).toMatch(/W \/ SThrottle.*↑ \/ ↓Elevator/);
     await panel.getByRole('checkbox', { name: 'Keyboard sticks' }).check();
-    const decoder = new SpektrumDecoder();
-    const last = new Map<number, number>();
-    const stop = fake.onData((bytes, tUs) => {
-      decoder.push(bytes, tUs);
-      for (let f = decoder.next(); f !== undefined; f = decoder.next())
-        for (let i = 0; i < f.count; i++) last.set(f.ids[i] as number, servoToPercent(f.positions[i] as number, f.resolution));
-      void fake.write(bytes);
-    });
+    const { last, stop } = sticksAtPty(fake);
     await panel.getByLabel('The propellers are off').check();
     await panel.getByRole('button', { name: '▶ Start driving' }).click();
     await panel.getByTestId('drive-state').filter({ hasText: 'Sending “manual”' }).waitFor();
@@ -298,10 +274,7 @@ describe.skipIf(skip !== null)('driving a flight controller through the adapter'
     }, 50);
     try {
       await page.goto(rig!.server.url('/'));
-      await page.getByRole('button', { name: 'More ways to connect' }).click();
-      await page.getByRole('button', { name: 'Drive a flight controller…' }).click();
-      const panel = page.getByRole('region', { name: 'Drive a flight controller' });
-      await panel.waitFor();
+      const panel = await openDrive(page);
       const view = panel.getByRole('region', { name: "The flight controller's view" });
       // The port the page was granted, as the user picks it in the list.
       await view.getByLabel('Its USB port').selectOption({ index: 0 });
