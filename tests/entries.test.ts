@@ -26,7 +26,10 @@ describe('package entries in a bundle', () => {
     // ends it and judged by the counter over the burst after it: 0.5 kB; 17.0 kB since an
     // acquisition pass that finds no start is not scored again: 0.1 kB, 3.5x on noise; 17.7 kB
     // since a system byte's period is refuted by the frames' timing and a stream's end counts
-    // what its last deliveries vouch for: 0.3 kB).
-    expect(sizes.satscope.gzip).toBeLessThan(18 * 1024);
+    // what its last deliveries vouch for: 0.3 kB; 18.9 kB since an external remote's frames that
+    // read as well a few bytes off are said unproven, weighed frame by frame and re-read on the
+    // first header that moves as no count does: 1.0 kB, the least that tells a count from a
+    // held stick, where before a reading a word off was shown as certain).
+    expect(sizes.satscope.gzip).toBeLessThan(19 * 1024);
   }, 60_000);
 });

@@ -66,6 +66,7 @@ const IDLE: SourceStatus = {
     forcedMismatch: null,
     withheld: null,
     remoteAmbiguous: false,
+    alignmentUnproven: false,
   },
 };
 

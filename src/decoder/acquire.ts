@@ -12,7 +12,16 @@
  * (runs of 0xFF are frames of seven empty slots) never locks. The winning chain's frames are
  * emitted as they stand (`confirmedUntil`).
  */
-import { byteAt, channelEvidence, countZeroWords, INVALID, layoutChannels, phaseBitsAfterFirst, slotLayout } from './frame.js';
+import {
+  byteAt,
+  channelEvidence,
+  countZeroWords,
+  INVALID,
+  layoutChannels,
+  phaseBitsAfterFirst,
+  slotDisorder,
+  slotLayout,
+} from './frame.js';
 import { formatOf, setReason } from './format.js';
 import {
   B0_FADES,
@@ -124,6 +133,34 @@ export function acquire(d: Core): boolean {
     frames++;
     if (skipped >= 0) skipped++;
   }
+  // An external remote's frames may read as well a few words off (`shiftedReadings`): take the
+  // likelier alignment, and say it is not proven until a header moves as no fade count does.
+  let alts = 0;
+  if (!internal) {
+    // A proven alignment goes on where the new chain starts right where the last frame ended
+    // (frames lost in a dropout leave no bytes: the count jumps, the alignment does not) or
+    // its count goes on.
+    const proven = d.s.haveLast && d.s.remote === 'external' && d.s.alignAlts === 0 && d.s.resolution === resolution;
+    const goesOn =
+      d.w.base + o === d.s.lastEnd || countFollows((d.s.last0 << 8) | d.s.last1, (byteAt(d.w.buf, o) << 8) | byteAt(d.w.buf, o + 1));
+    if (!(proven && goesOn)) {
+      alts = shiftedReadings(d, o, resolution, frames);
+    }
+    const j = alts >>> 16;
+    alts &= 0xffff;
+    if (j > 0) {
+      alts = rotateShifts(alts | 1, j) & ~1;
+      o += j;
+      scoreChain(d, o, resolution, Math.min(ACQUIRE_FRAMES, Math.floor((d.w.tail - o) / FRAME_SIZE)));
+      frames = d.chain.frames;
+      skipped = d.chain.skipped;
+      while (o - FRAME_SIZE >= p && chainsInto(d, o - FRAME_SIZE, o, resolution, false, 0)) {
+        o -= FRAME_SIZE;
+        frames++;
+        if (skipped >= 0) skipped++;
+      }
+    }
+  }
   const sameRemote =
     d.s.haveLast &&
     d.s.remote === (internal ? 'internal' : 'external') &&
@@ -164,7 +201,10 @@ export function acquire(d: Core): boolean {
   if (!sameRemote) d.s.haveLast = false;
   const changed =
     d.s.everLocked &&
-    (d.s.remote !== (internal ? 'internal' : 'external') || d.s.system !== (internal ? system : null) || d.s.resolution !== resolution);
+    (d.s.remote !== (internal ? 'internal' : 'external') ||
+      d.s.system !== (internal ? system : null) ||
+      d.s.resolution !== resolution ||
+      (d.s.alignAlts !== 0) !== (alts !== 0));
   d.s.locked = true;
   d.s.noStartBelow = 0;
   d.s.stagedAt = -1;
@@ -180,6 +220,8 @@ export function acquire(d: Core): boolean {
   d.s.system = internal ? system : null;
   d.s.b0Mode = internal ? b0Mode : B0_FADES;
   d.s.ambiguous = ambiguous;
+  d.s.alignAlts = alts;
+  d.s.altLast.fill(-1);
   setReason(d.s, resolution);
   event(d, { type: 'locked', offset: d.w.base + o, format: formatOf(d.s) });
   if (changed) event(d, { type: 'format-changed', offset: d.w.base + o, format: formatOf(d.s) });
@@ -490,4 +532,56 @@ export function chainStartsAt(d: Core, a: number): 0 | 1 | typeof NEED_MORE {
   if (frames < MIN_CHAIN) return 0;
   const forced = d.s.opts.resolution;
   return (forced !== 1024 && scoreChain(d, a, 2048, frames) >= 0) || (forced !== 2048 && scoreChain(d, a, 1024, frames) >= 0) ? 1 : 0;
+}
+
+/**
+ * The byte shifts (bit j for j = 1…15) at which the external remote's frames at `o` read as
+ * well, with nothing the bytes show against them: as many frames (up to ACQUIRE_FRAMES)
+ * starting j bytes later, each valid (every slot a valid ID, no repeats), no phase bit past a
+ * frame's first slot, and a header that never falls (a fade count only rises; by how much
+ * between two frames nothing tells without byte times, where frames lost leave no trace). An
+ * external remote that sends one frame shape (22 ms, up to 7 channels: no pair, no phase bit)
+ * and a fade count that is also a servo word (at 1024 one below 12288, at 2048 one below
+ * 26624 or, with the phase bit, read first) reads so a word early or late: a held stick's
+ * word (or an empty slot) as the count, the count as a channel. Only a header that falls (a
+ * stick moving down), or a slot ID changing, tells them apart; the locked path weighs them
+ * frame by frame (`weighAlignment` in locked.ts).
+ *
+ * In bits 16 and up, the likelier shift: the one whose slots are in the order a single-shape
+ * transmitter sends (slotDisorder: IDs ascending, empty slots last), which the count read as a
+ * channel breaks in every shifted reading of such a frame; ties keep the reading at `o` (0),
+ * then the lower shift. A preference only: the spec leaves the slot order to the transmitter
+ * (§8.5), so the format says the alignment is not proven.
+ */
+function shiftedReadings(d: Core, o: number, resolution: Resolution, frames: number): number {
+  const buf = d.w.buf;
+  const need = Math.min(frames, ACQUIRE_FRAMES);
+  let alts = 0;
+  let best = 0;
+  let least = -1;
+  for (let j = 0; j < FRAME_SIZE && need >= MIN_CHAIN; j++) {
+    const a = o + j;
+    let disorder = 0;
+    let k = 0;
+    for (; k < need && a + (k + 1) * FRAME_SIZE <= d.w.tail; k++) {
+      const f = a + k * FRAME_SIZE;
+      const layout = slotLayout(buf, f, resolution);
+      if (layout === INVALID || silenceInside(d, f) || (resolution === 2048 && phaseBitsAfterFirst(buf, f, layout) > 0)) break;
+      const count = (byteAt(buf, f) << 8) | byteAt(buf, f + 1);
+      if (k > 0 && ((count - ((byteAt(buf, f - FRAME_SIZE) << 8) | byteAt(buf, f - FRAME_SIZE + 1))) & 0xffff) >= 0x8000) break;
+      disorder += slotDisorder(layout);
+    }
+    if (j > 0 && k < need) continue;
+    if (j > 0) alts |= 1 << j;
+    if (least < 0 || disorder < least) {
+      least = disorder;
+      best = j;
+    }
+  }
+  return alts | (best << 16);
+}
+
+/** Shifts (bit j: j bytes after an alignment) seen from the alignment `j` bytes later (bit 0 is the alignment itself). */
+export function rotateShifts(mask: number, j: number): number {
+  return ((mask >>> j) | (mask << (FRAME_SIZE - j))) & 0xffff;
 }

@@ -42,7 +42,7 @@ interface CheckpointData {
 }
 
 /** Bumped whenever what a checkpoint holds changes: a checkpoint of another version is refused. */
-const CHECKPOINT_VERSION = 3;
+const CHECKPOINT_VERSION = 4;
 
 function checkResolution(resolution: unknown): asserts resolution is 'auto' | Resolution {
   if (resolution !== 'auto' && resolution !== 1024 && resolution !== 2048) {

@@ -20,6 +20,7 @@ export function formatOf(s: Readonly<DecoderState>): FormatInfo {
     forcedMismatch: s.forcedMismatch,
     withheld: s.withheld,
     remoteAmbiguous: s.ambiguous,
+    alignmentUnproven: s.alignAlts !== 0,
   };
 }
 
@@ -77,6 +78,7 @@ function explain(s: DecoderState): string {
       ? `internal remote (system byte ${hex(s.system ?? 0)}, ${sys.name})${b0}${or}`
       : `internal remote (system byte ${hex(s.system ?? 0)} is none of the four in §8.3: ignored)${b0}`;
   }
+  if (s.alignAlts !== 0) remote += unproven(s.alignAlts);
   switch (s.reason) {
     case 'override':
       return `${res} resolution set by the user; ${remote}.`;
@@ -89,4 +91,11 @@ function explain(s: DecoderState): string {
     default:
       return `${res} resolution inferred from the channel IDs (no valid system byte); ${remote}.`;
   }
+}
+
+/** What an unproven frame alignment (`alignAlts`: bit j, frames j bytes later) means, and what decides it. */
+function unproven(alts: number): string {
+  let bytes = '';
+  for (let j = 1; j < 16; j++) if ((alts >> j) & 1) bytes += `${bytes ? ', ' : ''}${j}`;
+  return `; where frames start is not yet proven: they read as well ${bytes} bytes later (a held stick as the fade count, the count as a channel): move each stick in turn to decide it`;
 }

@@ -455,3 +455,22 @@ export function readVtxControl(b: Uint8Array, o: number, store: VtxControl): Vtx
   store.power = raw & 0x07;
   return store;
 }
+
+/**
+ * How far a valid layout's slot order is from the order a single-shape transmitter sends
+ * (22 ms, up to 7 channels: channel IDs ascending, empty slots after them): the normal-channel
+ * slots that come after an empty, X-Plus or VTX slot or after a higher channel ID. A reading
+ * shifted by words rotates the slots (the fade count read as a channel lands last, after the
+ * empties, or first): the real reading is 0 where the shifted one is not. A preference, not a
+ * rule of the spec (§8.5 leaves the order to the transmitter).
+ */
+export function slotDisorder(layout: number): number {
+  let n = 0;
+  let prev = (layout & CODE_MASK) as number;
+  for (let i = 1; i < SLOTS_PER_FRAME; i++) {
+    const code = (layout >> (CODE_BITS * i)) & CODE_MASK;
+    if (code <= MAX_NORMAL_CHANNEL && prev > code) n++;
+    prev = code;
+  }
+  return n;
+}

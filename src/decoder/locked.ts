@@ -19,9 +19,9 @@
  * an unlock into an acquisition, which itself consumes or locks with frames it has confirmed
  * (emitted unconditionally): so it always returns after bounded work.
  */
-import { acquire, chainStartsAt, silenceInside } from './acquire.js';
+import { acquire, chainStartsAt, rotateShifts, silenceInside } from './acquire.js';
 import { NEED_MORE } from './byte0.js';
-import { byteAt, type FrameSlots, INVALID, readFrame, showSlots, slotLayout } from './frame.js';
+import { byteAt, type FrameSlots, INVALID, phaseBitsAfterFirst, readFrame, showSlots, slotDisorder, slotLayout } from './frame.js';
 import { formatOf, setReason } from './format.js';
 import { B0_FADES, B0_RSSI, B0_UNKNOWN, byte0Follows, countFollows, FADE_STEP, plausibleRssi } from './header.js';
 import { FRAME_SIZE } from './spec.js';
@@ -57,7 +57,15 @@ function steadyStep(d: Core): DecodedFrame | null {
   const o = w.head;
   const n = o + FRAME_SIZE;
   const at = w.base + o;
-  if (at !== s.stagedAt || n + FRAME_SIZE > w.tail || at < s.confirmedUntil || !s.haveLast || s.ambiguous || s.b0Mode === B0_UNKNOWN) {
+  if (
+    at !== s.stagedAt ||
+    n + FRAME_SIZE > w.tail ||
+    at < s.confirmedUntil ||
+    !s.haveLast ||
+    s.ambiguous ||
+    s.alignAlts !== 0 ||
+    s.b0Mode === B0_UNKNOWN
+  ) {
     return null;
   }
   const layout = s.stagedLayout;
@@ -88,6 +96,11 @@ function lockedStep(d: Core): DecodedFrame | null | undefined {
   if (avail < FRAME_SIZE) {
     if (w.ended && avail > 0) discard(d, o, avail, 'end-of-stream');
     return undefined;
+  }
+  if (s.alignAlts !== 0) {
+    // The alignment is not proven: the readings a few bytes off are weighed first.
+    const weighed = weighAlignment(d, o);
+    if (weighed !== 0) return weighed === NEED_MORE ? undefined : null;
   }
   const at = w.base + o;
   // Bytes with a silence inside them (where each byte has its own time) are no frame.
@@ -341,10 +354,26 @@ function rereadExternal(d: Core, o: number): void {
   event(d, { type: 'format-changed', offset: d.w.base + o, format: formatOf(s) });
 }
 
+/**
+ * Whether the lock's header fell at the frame at `o` or the one after it, as no fade count does
+ * (a fall of less than half the range: more is a wrap): a held stick's word read as the count
+ * that moved down.
+ */
+function headerFell(d: Core, o: number): boolean {
+  const { s } = d;
+  const buf = d.w.buf;
+  const last = (s.last0 << 8) | s.last1;
+  const a = (byteAt(buf, o) << 8) | byteAt(buf, o + 1);
+  const b = (byteAt(buf, o + FRAME_SIZE) << 8) | byteAt(buf, o + FRAME_SIZE + 1);
+  return ((a - last) & 0xffff) >= 0x8000 || ((b - a) & 0xffff) >= 0x8000;
+}
+
 /** Discards the bytes from `o` up to `q`, where frames continue. */
 function resync(d: Core, o: number, q: number): void {
   d.s.stats.resyncs++;
   d.s.stats.badFrames++;
+  // Bytes went: a shifted reading's last header is no measure across them.
+  if (d.s.alignAlts !== 0) d.s.altLast.fill(-1);
   event(d, { type: 'resync', offset: d.w.base + q });
   discard(d, o, q - o, q - o < FRAME_SIZE ? 'truncated-frame' : 'noise');
 }
@@ -409,6 +438,7 @@ function show(d: Core, o: number, slots: FrameSlots): DecodedFrame {
   s.last0 = b0;
   s.last1 = b1;
   s.haveLast = true;
+  s.lastEnd = at + FRAME_SIZE;
   s.jumpTrusted = false;
   showSlots(frame, slots);
   const stats = s.stats;
@@ -451,4 +481,84 @@ function fadeDelta(d: Core, o: number, from: number, to: number, mask: number): 
   if (!counted) d.s.stats.fadeJumps++;
   event(d, { type: 'fade-jump', offset: d.w.base + o, from, to, counted });
   return counted ? delta : 0;
+}
+
+/**
+ * Weighs the readings of the stream a few bytes off the lock's (`alignAlts`, from acquisition's
+ * `shiftedReadings`) at the frame at `o`, with the frame after it in. Where the lock's frame
+ * and the next are valid and continue each other, the bytes are whole: a shifted reading whose
+ * frame there is no frame (the count it reads as a channel changed ID), or whose header fell
+ * as no fade count does (a held stick that moved down), is refuted (a rise, however large, is
+ * what a count does across lost frames, and without byte times nothing shows them); when none is left the alignment is proven (a
+ * `format-changed` event). Where instead the lock's own header stops continuing (its "count"
+ * was a stick) while a shifted reading's goes on, the stream is read again at that reading
+ * from here: the bytes before it are discarded, its header is the last count, the layouts
+ * learnt are forgotten, and a `format-changed` event says so (proven when no other reading held). Elsewhere (damage) nothing is
+ * judged. Returns 0 to go on with the frame at `o`, 1 after a re-read, NEED_MORE for bytes.
+ */
+function weighAlignment(d: Core, o: number): number {
+  const { s, w } = d;
+  const buf = w.buf;
+  const n = o + FRAME_SIZE;
+  if (n + FRAME_SIZE > w.tail) return w.ended ? 0 : NEED_MORE;
+  const resolution = s.resolution;
+  const whole =
+    !silenceInside(d, o) &&
+    !silenceInside(d, n) &&
+    slotLayout(buf, o, resolution) !== INVALID &&
+    slotLayout(buf, n, resolution) !== INVALID;
+  const holds = whole && fitsLast(d, o) && follows(d, o, n);
+  let held = 0;
+  let judged = 0;
+  let best = -1;
+  let least = 0;
+  for (let j = 1; j < FRAME_SIZE; j++) {
+    const bit = 1 << j;
+    if ((s.alignAlts & bit) === 0) continue;
+    const a = o + j;
+    const layout = silenceInside(d, a) ? INVALID : slotLayout(buf, a, resolution);
+    const count = (byteAt(buf, a) << 8) | byteAt(buf, a + 1);
+    const last = s.altLast[j] ?? -1;
+    if (layout === INVALID || (resolution === 2048 && phaseBitsAfterFirst(buf, a, layout) > 0)) continue;
+    // A fall is no count's; a jump up is a count's across lost frames as well as a stick's.
+    if (last >= 0 && ((count - last) & 0xffff) >= 0x8000) continue;
+    held |= bit;
+    if (last < 0) continue;
+    judged |= bit;
+    const v = slotDisorder(layout);
+    if (best < 0 || v < least) {
+      best = j;
+      least = v;
+    }
+  }
+  if (holds) {
+    for (let j = 1; j < FRAME_SIZE; j++) if ((held & (1 << j)) !== 0) s.altLast[j] = (byteAt(buf, o + j) << 8) | byteAt(buf, o + j + 1);
+    if (held !== s.alignAlts) {
+      s.alignAlts = held;
+      if (held === 0) event(d, { type: 'format-changed', offset: w.base + o, format: formatOf(s) });
+    }
+    return 0;
+  }
+  if (!whole || !s.haveLast || best < 0 || !headerFell(d, o)) {
+    // Damage, a count that jumped (frames lost: the lock's reading may be right), or nothing to
+    // weigh against yet: judge afresh after it.
+    s.altLast.fill(-1);
+    return 0;
+  }
+  // The lock's header broke where a shifted reading's goes on: that reading is the stream.
+  // The other readings that held, seen from there, are weighed afresh from the next frame.
+  const last = s.altLast[best] ?? 0;
+  const rest = rotateShifts(judged, best) & ~1;
+  s.altLast.fill(-1);
+  const at = w.base + o + best;
+  discard(d, o, best, 'noise');
+  s.alignAlts = rest;
+  s.last0 = last >> 8;
+  s.last1 = last & 0xff;
+  s.layoutCount = 0;
+  s.stagedAt = -1;
+  s.confirmedUntil = 0;
+  s.jumpTrusted = false;
+  event(d, { type: 'format-changed', offset: at, format: formatOf(s) });
+  return 1;
 }

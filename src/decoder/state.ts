@@ -36,10 +36,20 @@ export interface DecoderState {
   withheld: Withheld | null;
   /** The internal reading may be an external count whose low byte is a §8.3 system byte (`format.remoteAmbiguous`). */
   ambiguous: boolean;
+  /**
+   * Byte shifts (bit j: the frames start j bytes later, 1–15) at which an external remote's
+   * stream reads as well as the lock's reading (`format.alignmentUnproven`, acquire.ts's
+   * `shiftedReadings`); 0 when the alignment is proven. `altLast[j]`: the header the reading
+   * at shift j read in the last frame weighed, -1 when none is to be judged against.
+   */
+  alignAlts: number;
+  altLast: Int32Array;
   /** Header bytes of the last emitted frame (for deltas and continuity), valid when `haveLast`. */
   last0: number;
   last1: number;
   haveLast: boolean;
+  /** Stream offset where the last emitted frame ends. */
+  lastEnd: number;
   /** Whether a fade jump at the first frame after a lock is the receiver's own count (same remote, known layouts). */
   jumpTrusted: boolean;
   /**
@@ -80,9 +90,12 @@ export function initialState(opts: DecoderState['opts'], fixedBy: DecoderState['
     forcedMismatch: null,
     withheld: null,
     ambiguous: false,
+    alignAlts: 0,
+    altLast: new Int32Array(16).fill(-1),
     last0: 0,
     last1: 0,
     haveLast: false,
+    lastEnd: -1,
     jumpTrusted: false,
     noStartBelow: 0,
     layouts: new Int32Array(LAYOUT_MEMORY),
@@ -113,6 +126,7 @@ export function copyState(s: Readonly<DecoderState>): DecoderState {
     ...s,
     opts: { ...s.opts },
     layouts: s.layouts.slice(),
+    altLast: s.altLast.slice(),
     shown: copySlots(s.shown),
     staged: copySlots(s.staged),
     stats: { ...s.stats },

@@ -123,6 +123,16 @@ export interface FormatInfo {
    * new remote).
    */
   remoteAmbiguous: boolean;
+  /**
+   * True while the frame alignment is not proven: an external remote sending one frame shape
+   * (22 ms, up to 7 channels: no phase bit, no pair), whose UINT16 fade count is also a valid
+   * servo word, reads as well with its frames starting some words earlier or later (a held
+   * stick's word read as the fade count, the fade count read as a channel). The decoder reads
+   * the likelier alignment (slots in the order transmitters send them) and says it is not sure;
+   * the header of either reading moving as no fade count moves (a stick moving) decides, and a
+   * re-read there is a `format-changed` event. Frames decoded while it is true are not proven.
+   */
+  alignmentUnproven: boolean;
 }
 
 /**
