@@ -51,6 +51,13 @@ export function formatSummary(s: CaptureSummary, name: string, ports: readonly n
     f.headerMode === 'rssi' ? 'RSSI in dBm, SPM4649T' : f.headerMode === 'unknown' ? 'fades or RSSI, not yet known' : 'UINT8 fades';
   add('Remote', f.remote === 'internal' ? `internal (byte 0 = ${byte0})` : 'external (bytes 0–1 = UINT16 fades)');
   add('Resolution', `${f.resolution ?? '?'} — ${f.explanation}`);
+  if (s.unprovenFrames > 0)
+    add(
+      'Alignment',
+      f.alignmentUnproven
+        ? `not yet proven in ${plural(s.unprovenFrames, 'frame')}: their channel values and fades may be each other's; move each stick in turn to decide it`
+        : `proven after ${plural(s.unprovenFrames, 'frame')} read unproven (their channel values and fades may be each other's)`,
+    );
   const d = s.decoder;
   add(
     'Frames',

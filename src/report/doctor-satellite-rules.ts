@@ -21,11 +21,31 @@ export const LINK_ADVICE = [
   'Do a range check with the transmitter in range-test mode before flying again.',
 ];
 
-export function satelliteFindings(p: PortState, now: number, ctx: RuleContext, add: AddFinding): void {
+export function satelliteFindings(p: PortState, now: number, ctx: RuleContext, addFinding: AddFinding): void {
   const source = p.source as DoctorPortSource;
   const format: FormatInfo = source.decoder.format;
   const link = source.link;
   if (!format.locked || format.resolution === null || format.remote === null) return;
+  // Where frames start is not proven: what they carry (channels, fades) may be misread, so no
+  // finding about this remote is certain until a stick moves.
+  const unaligned = format.alignmentUnproven;
+  const add: AddFinding = unaligned ? (f) => addFinding(f.confidence === 'certain' ? { ...f, confidence: 'likely' } : f) : addFinding;
+  if (unaligned) {
+    addFinding({
+      code: 'alignment-unproven',
+      ports: [p.port],
+      severity: 'info',
+      confidence: 'certain',
+      title: `${p.label}: where its frames start is not yet proven`,
+      evidence: [{ text: format.explanation, timeUs: null }],
+      todo: [
+        'Move each stick and switch through its range, one at a time: a stick read as the fade count moves as no count does, and the decoder then reads the frames from where they start (its findings become certain).',
+        'Until then the channel values and the fade count shown may be each other (an external remote at 22 ms with up to 7 channels, opened mid-stream, and a fade count of 256 or more: spec §8.4, §8.5).',
+      ],
+      settings: [],
+      confirm: null,
+    });
+  }
   const resolution = format.resolution;
   const remote = format.remote;
   const period = link.stats.nominalPeriodUs;

@@ -28,6 +28,7 @@ export type DoctorCode =
   | 'adapter-away'
   // A satellite the flight controller will read wrong
   | 'fc-settings'
+  | 'alignment-unproven'
   | 'bind-mode'
   | 'system-byte-contradicted'
   | 'xplus-channels'

@@ -34,6 +34,8 @@ export interface CaptureSummary {
   channels: ChannelSummary[];
   /** Format changes the decoder made along the way (e.g. an external remote whose fades looked like a system byte). */
   formatChanges: number;
+  /** Frames decoded while where frames start was not proven (`format.alignmentUnproven`): their channels and fades may be misread. */
+  unprovenFrames: number;
   issues: readonly CaptureIssue[];
 }
 
@@ -86,6 +88,8 @@ export class ChannelRanges {
 export function summarizeCapture(capture: Capture, options: DecodeCaptureOptions = {}): CaptureSummary {
   const ranges = new ChannelRanges();
   let formatChanges = 0;
+  let unproven = false;
+  let unprovenFrames = 0;
   const userEvent = options.onEvent;
   const { decoder, link } = decodeCapture(
     capture,
@@ -93,10 +97,14 @@ export function summarizeCapture(capture: Capture, options: DecodeCaptureOptions
       ...options,
       onEvent: (e) => {
         if (e.type === 'format-changed') formatChanges++;
+        if (e.type === 'format-changed' || e.type === 'locked') unproven = e.format.alignmentUnproven;
         userEvent?.(e);
       },
     },
-    (f) => ranges.frame(f),
+    (f) => {
+      if (unproven) unprovenFrames++;
+      ranges.frame(f);
+    },
   );
   const port = options.port ?? 0;
   return {
@@ -111,6 +119,7 @@ export function summarizeCapture(capture: Capture, options: DecodeCaptureOptions
     episodes: link.episodes.map((e) => ({ ...e })),
     channels: ranges.channels(),
     formatChanges,
+    unprovenFrames,
     issues: capture.issues,
   };
 }

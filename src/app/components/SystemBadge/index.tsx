@@ -48,6 +48,11 @@ export function SystemBadge() {
       </span>
       {hex !== null ? <span class="chip">system {hex}</span> : null}
       {format.headerMode === 'rssi' ? <span class="chip accent">RSSI (SPM4649T)</span> : null}
+      {format.alignmentUnproven ? (
+        <span class="chip accent" data-testid="alignment" title="Channel values and fades may be each other's until a stick moves">
+          Frame start unproven: move a stick
+        </span>
+      ) : null}
       <p class="why">{format.explanation}</p>
     </section>
   );
