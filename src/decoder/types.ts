@@ -129,8 +129,10 @@ export interface FormatInfo {
    * servo word, reads as well with its frames starting some words earlier or later (a held
    * stick's word read as the fade count, the fade count read as a channel). The decoder reads
    * the likelier alignment (slots in the order transmitters send them) and says it is not sure;
-   * the header of either reading moving as no fade count moves (a stick moving) decides, and a
-   * re-read there is a `format-changed` event. Frames decoded while it is true are not proven.
+   * the header of either reading falling as no fade count does (a stick moving down), or a
+   * shifted frame that stops being one, decides (a `format-changed` event, with a re-read from
+   * there when the lock's own reading fell). A rise decides nothing: a count jumps so across
+   * lost frames. Frames decoded while it is true are not proven.
    */
   alignmentUnproven: boolean;
 }

@@ -39,7 +39,7 @@ export function satelliteFindings(p: PortState, now: number, ctx: RuleContext, a
       title: `${p.label}: where its frames start is not yet proven`,
       evidence: [{ text: format.explanation, timeUs: null }],
       todo: [
-        'Move each stick and switch through its range, one at a time: a stick read as the fade count moves as no count does, and the decoder then reads the frames from where they start (its findings become certain).',
+        'Move each stick and switch through its range, one at a time: a stick read as the fade count falls as no count does, and the decoder then reads the frames from where they start (its findings become certain).',
         'Until then the channel values and the fade count shown may be each other (an external remote at 22 ms with up to 7 channels, opened mid-stream, and a fade count of 256 or more: spec §8.4, §8.5).',
       ],
       settings: [],
