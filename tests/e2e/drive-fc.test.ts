@@ -106,7 +106,11 @@ describe.skipIf(skip !== null)('driving a flight controller and reading it back,
       expect(role.filter((r) => r === 'usb')).toHaveLength(1);
       const verdicts = Object.fromEntries(rows.map((r) => [r.id, r.verdict]));
       // Betaflight's rules: TAER1234 order, its own scale (off §9 at the ends), read within 2 frames.
-      expect(verdicts).toEqual({ 'channel-map': 'pass', values: 'fail', latency: 'pass', failsafe: 'unknown', steady: 'pass' });
+      // The sweep sends no silence; a loaded machine's writer may (a late timer skips frames), and
+      // the failsafe check then grades those silences: never a fail.
+      const { failsafe, ...rest } = verdicts;
+      expect(rest).toEqual({ 'channel-map': 'pass', values: 'fail', latency: 'pass', steady: 'pass' });
+      expect(['unknown', 'pass']).toContain(failsafe);
       expect(rows.find((r) => r.id === 'values')?.found).toMatch(/serialrx_provider = SPEKTRUM2048/);
       // The report as saved: the same checks, and what the flight controller said of itself.
       const [download] = await Promise.all([
