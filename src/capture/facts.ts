@@ -9,6 +9,7 @@
  * worked out from (an object spread with new columns is another capture anyway).
  */
 import type { Capture } from './model.js';
+import { type AnyCapture, isStreamed, type StreamedCapture } from './capture-windows.js';
 
 interface Kept {
   chunkEnds: Uint32Array;
@@ -22,13 +23,21 @@ interface Kept {
 
 const kept = new WeakMap<Capture, Kept>();
 
+/** A streamed capture's facts: it has no columns to change. */
+const keptStreamed = new WeakMap<StreamedCapture, Map<string, unknown>>();
+
 /** The facts' names (`captureFact`). */
 const PORT_CHUNKS = 'port chunks';
 const TIMES_IN_ORDER = 'times in order';
 const PORT_INDEX = 'port index';
 
 /** The facts kept for `capture`, made afresh when its columns or events are not the ones they came from. */
-function factsOf(capture: Capture): Map<string, unknown> {
+function factsOf(capture: AnyCapture): Map<string, unknown> {
+  if (isStreamed(capture)) {
+    let facts = keptStreamed.get(capture);
+    if (facts === undefined) keptStreamed.set(capture, (facts = new Map()));
+    return facts;
+  }
   const { chunkEnds, chunkTimesUs, chunkPorts, byteTimesUs, events } = capture;
   let k = kept.get(capture);
   if (
@@ -47,7 +56,7 @@ function factsOf(capture: Capture): Map<string, unknown> {
 }
 
 /** `work(capture)`, worked out once per capture and `name` (see above); the caller copies what it hands out. */
-export function captureFact<T>(capture: Capture, name: string, work: (capture: Capture) => T): T {
+export function captureFact<C extends AnyCapture, T>(capture: C, name: string, work: (capture: C) => T): T {
   const facts = factsOf(capture);
   if (facts.has(name)) return facts.get(name) as T;
   const fact = work(capture);
@@ -56,7 +65,8 @@ export function captureFact<T>(capture: Capture, name: string, work: (capture: C
 }
 
 /** The port indices that have at least one data chunk, in increasing order (one pass per capture: `captureFact`). */
-export function capturePorts(capture: Capture): number[] {
+export function capturePorts(capture: AnyCapture): number[] {
+  if (isStreamed(capture)) return [...capture.ports];
   const counts = captureFact(capture, PORT_CHUNKS, chunksByPort);
   const ports: number[] = [];
   for (let p = 0; p < 256; p++) if ((counts[p] ?? 0) > 0) ports.push(p);

@@ -8,6 +8,9 @@
 import { closeSync, readFileSync, writeFileSync } from 'node:fs';
 import { basename } from 'node:path';
 import { captureChunks, type Capture } from '../capture/model.js';
+import type { AnyCapture } from '../capture/capture-windows.js';
+import { diagnosedHealthReport } from '../report/doctor-report.js';
+import { openStreamed } from './streamed-file.js';
 import { capturePorts } from '../capture/facts.js';
 import { SpektrumDecoder } from '../decoder/decoder.js';
 import { captureSpan } from '../report/capture-span.js';
@@ -71,6 +74,17 @@ async function main(argv: string[]): Promise<number> {
       }
     }
   }
+  // info and report read the file a window at a time when it streams (openStreamed), else whole.
+  if (args.command !== 'decode') {
+    const streamed = openStreamed(args.file);
+    if (streamed !== null) {
+      try {
+        return await summed(streamed.capture, args, out);
+      } finally {
+        streamed.close();
+      }
+    }
+  }
   // The report decodes ports on two threads, which read the columns where they are.
   const loaded = loadCapture(args.file, { shared: args.command === 'report' });
   if ('error' in loaded) {
@@ -78,6 +92,19 @@ async function main(argv: string[]): Promise<number> {
     return loaded.exitCode;
   }
   const { capture } = loaded;
+  if (args.command !== 'decode') return summed(capture, args, out);
+  for (const issue of capture.issues) process.stderr.write(`satscope: ${args.file}: ${issue.message}\n`);
+  const port = args.port ?? 0;
+  const noData = portProblem(capture, args.port);
+  if (noData !== null) {
+    process.stderr.write(`satscope: ${args.file}: ${noData}\n`);
+    return 1;
+  }
+  return decode(capturePieces(capture, port), args, port, out);
+}
+
+/** `satscope info` or `report` of a capture, held or streamed. */
+async function summed(capture: AnyCapture, args: Args, out: TextOutput): Promise<number> {
   for (const issue of capture.issues) process.stderr.write(`satscope: ${args.file}: ${issue.message}\n`);
   if (args.command === 'report') return report(capture, args, out);
   if (args.command === 'info' && !args.json && args.port === null && capturePorts(capture).length > 1) return infoAll(capture, args, out);
@@ -93,11 +120,11 @@ async function main(argv: string[]): Promise<number> {
     out.text(args.json ? `${JSON.stringify(summary, null, 2)}\n` : `${text()}\n`);
     return finish(out, summary.decoder.frames > 0 ? 0 : 1);
   }
-  return decode(capturePieces(capture, port), args, port, out);
+  return finish(out, 0);
 }
 
 /** `satscope info` of a capture with several ports and none chosen: each port's summary in turn. */
-function infoAll(capture: Capture, args: Args, out: TextOutput): Promise<number> {
+function infoAll(capture: AnyCapture, args: Args, out: TextOutput): Promise<number> {
   const ports = capturePorts(capture);
   const blocks = ports.map((port) => summarizeCapture(capture, { resolution: args.resolution, port }));
   const origin = captureSpan(capture).startUs;
@@ -106,7 +133,7 @@ function infoAll(capture: Capture, args: Args, out: TextOutput): Promise<number>
 }
 
 /** Why the port asked for (or port 0) cannot be decoded, naming the ports that have data; null when it can. */
-function portProblem(capture: Capture, asked: number | null): string | null {
+function portProblem(capture: AnyCapture, asked: number | null): string | null {
   const ports = capturePorts(capture);
   const port = asked ?? 0;
   if (ports.includes(port)) return null;
@@ -203,9 +230,13 @@ async function finish(out: TextOutput, code: number): Promise<number> {
 }
 
 /** `satscope report`: the health report of every port with the doctor's findings, as HTML or JSON, to stdout or --out. */
-async function report(capture: Capture, args: Args, out: TextOutput): Promise<number> {
+async function report(capture: AnyCapture, args: Args, out: TextOutput): Promise<number> {
   const name = basename(args.file);
-  const r = threadedReport(capture, { resolution: args.resolution, name }).report;
+  // A streamed capture's ports are decoded one after the other, each in a walk of the file.
+  const r =
+    'windows' in capture
+      ? diagnosedHealthReport(capture, { resolution: args.resolution, name })
+      : threadedReport(capture, { resolution: args.resolution, name }).report;
   const text = args.json ? `${JSON.stringify(r, null, 2)}\n` : reportHtml(r);
   if (args.out !== null) {
     try {

@@ -11,6 +11,8 @@ import { doctorCapture, type DoctorReport } from '../report/doctor-capture.js';
 import { formatClock } from '../report/report-text.js';
 import type { DoctorFinding } from '../report/doctor-types.js';
 import { loadCapture } from './input.js';
+import { openStreamed } from './streamed-file.js';
+import type { AnyCapture } from '../capture/capture-windows.js';
 import { TIMING_WORDS } from './format.js';
 import { plural } from '../report/report-text.js';
 
@@ -64,15 +66,30 @@ export function doctorCommand(argv: string[], io: DoctorIo = defaultIo): number 
     return usage(`--resolution must be auto, 1024 or 2048, not '${resolution}'`);
   const file = positionals[0] as string;
 
-  const loaded = loadCapture(file);
-  if ('error' in loaded) {
-    io.err(`satscope doctor: ${loaded.error}\n`);
-    return loaded.exitCode;
+  // Read a window at a time when the file streams (openStreamed), else whole.
+  const streamed = openStreamed(file);
+  try {
+    let capture: AnyCapture;
+    if (streamed !== null) capture = streamed.capture;
+    else {
+      const loaded = loadCapture(file);
+      if ('error' in loaded) {
+        io.err(`satscope doctor: ${loaded.error}\n`);
+        return loaded.exitCode;
+      }
+      capture = loaded.capture;
+    }
+    return diagnose(capture, file, resolution, values.json === true, io);
+  } finally {
+    streamed?.close();
   }
-  const { capture } = loaded;
+}
+
+/** The doctor's report of `capture`, printed; the exit code. */
+function diagnose(capture: AnyCapture, file: string, resolution: string, json: boolean, io: DoctorIo): number {
   for (const issue of capture.issues) io.err(`satscope doctor: ${file}: ${issue.message}\n`);
   const report = doctorCapture(capture, { resolution: resolution === 'auto' ? 'auto' : (Number(resolution) as 1024 | 2048) });
-  io.out(values.json === true ? `${JSON.stringify(report, null, 2)}\n` : formatDoctorReport(report, basename(file)));
+  io.out(json ? `${JSON.stringify(report, null, 2)}\n` : formatDoctorReport(report, basename(file)));
   return report.findings.some((f) => f.severity === 'problem') ? 1 : 0;
 }
 

@@ -10,6 +10,7 @@
  * span (`captureSpan`) is one pass over its chunk times, taken once by the caller.
  */
 import type { Capture, CaptureEvent, CaptureTiming } from '../capture/model.js';
+import { type AnyCapture, captureWindows, isStreamed } from '../capture/capture-windows.js';
 import { SpektrumDecoder, type DecoderOptions } from '../decoder/decoder.js';
 import { USB_CHUNK_JITTER_US } from '../decoder/spec.js';
 import type { DecodedFrame } from '../decoder/types.js';
@@ -96,8 +97,43 @@ export function firstScanned(capture: Capture, port: number, fromUs: number): { 
   return { chunk: 0, offset: 0 };
 }
 
+/**
+ * `firstScanned` of a capture read a window at a time, walking forward to where the backward walk
+ * starts: the place it finds is the start of the last `SCAN_MEMORY` bytes of the port's last
+ * stretch of `SCAN_MEMORY` or more that start nothing, before the first chunk timed `fromUs` or
+ * later. The port's last `SCAN_MEMORY` bytes' places are kept in a ring to say where that is.
+ */
+export function firstScannedStreamed(capture: AnyCapture, port: number, fromUs: number): { chunk: number; offset: number } {
+  const ringChunk = new Float64Array(SCAN_MEMORY);
+  const ringOffset = new Float64Array(SCAN_MEMORY);
+  let found = { chunk: 0, offset: 0 };
+  let clean = 0;
+  let k = 0;
+  for (const w of captureWindows(capture, port)) {
+    const { bytes, chunkEnds, chunkTimesUs, chunkPorts } = w;
+    let from = 0;
+    for (let i = 0; i < chunkEnds.length; i++) {
+      const to = chunkEnds[i] ?? from;
+      if (chunkPorts[i] === port) {
+        if (!((chunkTimesUs[i] ?? NaN) < fromUs)) return found;
+        const chunk = w.firstChunk + i;
+        const head = i === 0 ? w.headBefore : 0;
+        for (let b = from; b < to; b++) {
+          ringChunk[k] = chunk;
+          ringOffset[k] = b - from + head;
+          k = (k + 1) % SCAN_MEMORY;
+          if (startsCandidate(bytes[b] ?? 0)) clean = 0;
+          else if (++clean >= SCAN_MEMORY) found = { chunk: ringChunk[k] ?? 0, offset: ringOffset[k] ?? 0 };
+        }
+      }
+      from = to;
+    }
+  }
+  return found;
+}
+
 /** The capture's events on `port`, in the order they were recorded among the chunks. */
-function portEvents(capture: Capture, port: number): CaptureEvent[] {
+function portEvents(capture: AnyCapture, port: number): CaptureEvent[] {
   return capture.events.filter((e) => e.port === port).sort((a, b) => a.chunkIndex - b.chunkIndex);
 }
 
@@ -109,7 +145,7 @@ function portEvents(capture: Capture, port: number): CaptureEvent[] {
  * link's binned series.
  */
 export function decodeCapture(
-  capture: Capture,
+  capture: AnyCapture,
   options: DecodeCaptureOptions,
   onFrame: (frame: DecodedFrame, link: LinkMonitor) => void,
 ): { decoder: SpektrumDecoder; link: LinkMonitor; series: LinkSeries } {
@@ -135,7 +171,6 @@ export function decodeCapture(
     doctor.detach(port);
     doctor.attach(port, { decoder, link, label: typeof label === 'string' && label !== '' ? label : `Port ${port}` });
   }
-  const { bytes, chunkEnds, chunkTimesUs, chunkPorts, byteTimesUs } = capture;
   const drain = (): void => {
     for (let f = decoder.next(); f !== undefined; f = decoder.next()) {
       link.frame(f);
@@ -143,12 +178,6 @@ export function decodeCapture(
       doctor?.frame(port, f);
       onFrame(f, link);
     }
-  };
-  /** Bytes [from, to) of the capture, as they arrived (no view made: `pushRange`). */
-  const push = (from: number, to: number, time: number | Float64Array | undefined, unscanned: number): void => {
-    doctor?.bytes(port, bytes, time, unscanned, from, to);
-    decoder.pushRange(bytes, from, to, time);
-    drain();
   };
   // The doctor's packet scan starts at chunk `scan.chunk`, byte `scan.offset` in it, when its
   // findings are taken only at the end and nothing else reads the scan: a port opened at another
@@ -159,23 +188,38 @@ export function decodeCapture(
     capture.timing === 'per-chunk' &&
     Number.isFinite(end) &&
     !events.some((e) => /baud/i.test(e.text));
-  const scan = judged ? firstScanned(capture, port, lineWindow(end).fromS * 1e6) : { chunk: 0, offset: 0 };
-  let from = 0;
-  for (let i = 0; i < chunkEnds.length; i++) {
-    const to = chunkEnds[i] ?? from;
-    if (chunkPorts[i] === port) {
-      eventsBefore(i);
-      if (byteTimesUs !== undefined) {
-        for (let s = from; s < to; s += SLICE_BYTES) push(s, Math.min(s + SLICE_BYTES, to), byteTimesUs, 0);
-      } else {
-        const t = chunkTimesUs[i] ?? NaN;
-        if (Number.isNaN(t)) {
-          // Untimed (a raw dump is one chunk): pushed in pieces, so the decoder never copies the whole of it.
-          for (let s = from; s < to; s += UNTIMED_PIECE_BYTES) push(s, Math.min(s + UNTIMED_PIECE_BYTES, to), undefined, 0);
-        } else push(from, to, t, i < scan.chunk ? to - from : i === scan.chunk ? scan.offset : 0);
+  const fromUs = lineWindow(end).fromS * 1e6;
+  const scan = !judged
+    ? { chunk: 0, offset: 0 }
+    : isStreamed(capture)
+      ? firstScannedStreamed(capture, port, fromUs)
+      : firstScanned(capture, port, fromUs);
+  for (const w of captureWindows(capture, port)) {
+    const { bytes, chunkEnds, chunkTimesUs, chunkPorts, byteTimesUs, firstChunk } = w;
+    /** Bytes [from, to) of the window, as they arrived (no view made: `pushRange`). */
+    const push = (from: number, to: number, time: number | Float64Array | undefined, unscanned: number): void => {
+      doctor?.bytes(port, bytes, time, unscanned, from, to);
+      decoder.pushRange(bytes, from, to, time);
+      drain();
+    };
+    let from = 0;
+    for (let k = 0; k < chunkEnds.length; k++) {
+      const to = chunkEnds[k] ?? from;
+      const i = firstChunk + k;
+      if (chunkPorts[k] === port) {
+        eventsBefore(i);
+        if (byteTimesUs !== undefined) {
+          for (let s = from; s < to; s += SLICE_BYTES) push(s, Math.min(s + SLICE_BYTES, to), byteTimesUs, 0);
+        } else {
+          const t = chunkTimesUs[k] ?? NaN;
+          if (Number.isNaN(t)) {
+            // Untimed (a raw dump is one chunk): pushed in pieces, so the decoder never copies the whole of it.
+            for (let s = from; s < to; s += UNTIMED_PIECE_BYTES) push(s, Math.min(s + UNTIMED_PIECE_BYTES, to), undefined, 0);
+          } else push(from, to, t, i < scan.chunk ? to - from : i === scan.chunk ? scan.offset : 0);
+        }
       }
+      from = to;
     }
-    from = to;
   }
   eventsBefore(Infinity);
   decoder.end();

@@ -6,8 +6,9 @@
  * time found as its records are walked (a capture replayed from its File), by the same rule
  * (`SpanTally`).
  */
-import { type Capture, chunkFirstByteUs } from '../capture/model.js';
+import { chunkFirstByteUs } from '../capture/model.js';
 import { captureFact } from '../capture/facts.js';
+import { type AnyCapture, type CaptureWindow, captureWindows, isStreamed } from '../capture/capture-windows.js';
 import { BYTE_TIME_US } from '../decoder/spec.js';
 
 export interface CaptureSpan {
@@ -57,14 +58,27 @@ function spanBetween(earliestUs: number, latestUs: number): CaptureSpan {
 }
 
 /** The capture's span, NaN for both without timing: one pass over its chunk columns, once per capture (`captureFact`). */
-export function captureSpan(capture: Capture): CaptureSpan {
-  const { startUs, endUs } = captureFact(capture, SPAN, spanOf);
+export function captureSpan(capture: AnyCapture): CaptureSpan {
+  const { startUs, endUs } = isStreamed(capture)
+    ? (capture.span ?? captureFact(capture, SPAN, spanOf))
+    : captureFact(capture, SPAN, spanOf);
   return { startUs, endUs };
 }
 
-function spanOf(capture: Capture): CaptureSpan {
-  const { chunkEnds, chunkTimesUs, byteTimesUs } = capture;
+function spanOf(capture: AnyCapture): CaptureSpan {
   const tally = new SpanTally();
+  // Untimed, only the events have times: no window needs reading.
+  if (capture.timing !== 'none') for (const w of captureWindows(capture)) spanOfWindow(w, tally);
+  for (const e of capture.events) tally.event(e.timeUs);
+  return tally.span;
+}
+
+/**
+ * The span's rule over one window of chunks. A chunk timed by its arrival is never cut between
+ * windows; one timed per byte is, and its parts' first and last bytes span what it does.
+ */
+export function spanOfWindow(w: CaptureWindow, tally: SpanTally): void {
+  const { chunkEnds, chunkTimesUs, byteTimesUs } = w;
   let from = 0;
   for (let i = 0; i < chunkEnds.length; i++) {
     const to = chunkEnds[i] ?? from;
@@ -74,6 +88,4 @@ function spanOf(capture: Capture): CaptureSpan {
     }
     from = to;
   }
-  for (const e of capture.events) tally.event(e.timeUs);
-  return tally.span;
 }

@@ -4,11 +4,12 @@
  * arrive, with the capture's events ("port opened", line errors) fed in where they happened.
  * Pure: same capture, same findings.
  */
+import { type AnyCapture, captureDataBytes, type CaptureWindow, captureWindows, isStreamed } from '../capture/capture-windows.js';
 import { BYTE_TIME_US, type Resolution } from '../decoder/spec.js';
 import { LinkMonitor } from '../decoder/link.js';
 import { SpektrumDecoder } from '../decoder/decoder.js';
 import { capturePorts } from '../capture/facts.js';
-import { chunkFirstByteUs, type Capture, type CaptureKind, type CaptureTiming } from '../capture/model.js';
+import { chunkFirstByteUs, type CaptureKind, type CaptureTiming } from '../capture/model.js';
 import { Doctor } from './doctor.js';
 import type { DoctorCode, DoctorFinding, Severity } from './doctor-types.js';
 import { doctorEvent, stopsPort } from './doctor-events.js';
@@ -73,42 +74,53 @@ interface Piece {
  * Everything a capture holds in arrival order, data and events, walked as often as asked. Chunk
  * timing (and none) is the file's order, read straight from the chunk columns: no object per
  * chunk, so a day-long capture costs nothing here. A per-byte capture holds one chunk per port,
- * cut into slices and put back in time order across ports (such captures are small).
+ * cut into slices and put back in time order across ports: held, they are sorted; streamed
+ * (whose reader makes sure each port's slices come in time order), each port is walked on its
+ * own and the ports' slices merged, earliest first and, at the same time, the lower port's.
  */
-function arrival(capture: Capture): { each: (visit: Visit) => void; bytes: number } {
+function arrival(capture: AnyCapture): { each: (visit: Visit) => void; bytes: number } {
   const timed = capture.timing !== 'none';
   const events = [...capture.events].sort((a, b) => a.chunkIndex - b.chunkIndex);
-  const { bytes, chunkEnds, chunkTimesUs, chunkPorts, byteTimesUs } = capture;
-  const walk = (visit: Visit): void => {
+  const walk = (visit: Visit, windows: Iterable<CaptureWindow> = captureWindows(capture)): void => {
     let e = 0;
     const eventsBefore = (upTo: number): void => {
       for (let ev = events[e]; ev !== undefined && ev.chunkIndex <= upTo; ev = events[++e])
         visit(ev.port, ev.timeUs, ev.timeUs, null, undefined, ev.text);
     };
-    let from = 0;
-    for (let i = 0; i < chunkEnds.length; i++) {
-      eventsBefore(i);
-      const to = chunkEnds[i] ?? from;
-      const port = chunkPorts[i] ?? 0;
-      if (byteTimesUs !== undefined) {
-        for (let s = from; s < to; s += SLICE_BYTES) {
-          const end = Math.min(s + SLICE_BYTES, to);
-          const times = byteTimesUs.subarray(s, end);
-          visit(port, times[times.length - 1] ?? NaN, times[0] ?? NaN, bytes.subarray(s, end), times, '');
+    for (const w of windows) {
+      const { bytes, chunkEnds, chunkTimesUs, chunkPorts, byteTimesUs, firstChunk, byteOffset } = w;
+      const last = chunkEnds.length - 1;
+      let from = 0;
+      for (let k = 0; k < chunkEnds.length; k++) {
+        eventsBefore(firstChunk + k);
+        const to = chunkEnds[k] ?? from;
+        const port = chunkPorts[k] ?? 0;
+        if (byteTimesUs !== undefined) {
+          for (let s = from; s < to; s += SLICE_BYTES) {
+            const end = Math.min(s + SLICE_BYTES, to);
+            const times = byteTimesUs.subarray(s, end);
+            visit(port, times[times.length - 1] ?? NaN, times[0] ?? NaN, bytes.subarray(s, end), times, '');
+          }
+        } else {
+          const chunkTime = chunkTimesUs[k] ?? NaN;
+          // A chunk cut between windows (untimed only) is placed as a whole: where it ends, how long it is.
+          const after = k === last ? w.tailAfter : 0;
+          const length = to - from + (k === 0 ? w.headBefore : 0) + after;
+          // Untimed: as if the bytes came back to back at 115200.
+          const t = timed ? chunkTime : (byteOffset + to + after) * BYTE_TIME_US;
+          // A decoder dates a chunk's frames back from its arrival at 115200: none is earlier than this.
+          const first = chunkFirstByteUs(t, length, BYTE_TIME_US);
+          visit(port, t, first, bytes.subarray(from, to), timed && !Number.isNaN(chunkTime) ? chunkTime : undefined, '');
         }
-      } else {
-        const chunkTime = chunkTimesUs[i] ?? NaN;
-        // Untimed: as if the bytes came back to back at 115200.
-        const t = timed ? chunkTime : to * BYTE_TIME_US;
-        // A decoder dates a chunk's frames back from its arrival at 115200: none is earlier than this.
-        const first = chunkFirstByteUs(t, to - from, BYTE_TIME_US);
-        visit(port, t, first, bytes.subarray(from, to), timed && !Number.isNaN(chunkTime) ? chunkTime : undefined, '');
+        from = to;
       }
-      from = to;
     }
     eventsBefore(Infinity);
   };
-  if (capture.timing !== 'per-byte') return { each: walk, bytes: bytes.length };
+  const bytes = captureDataBytes(capture);
+  if (capture.timing !== 'per-byte') return { each: (visit) => walk(visit), bytes };
+  // A streamed per-byte capture (a CSV) has no events: its reader says so.
+  if (isStreamed(capture)) return { each: (visit) => mergedPorts(capture.ports, (port) => capture.windows(port), visit), bytes };
   const pieces: Piece[] = [];
   walk((port, timeUs, firstUs, data, time, text) => {
     pieces.push({ port, order: pieces.length, timeUs, firstUs, bytes: data, time, text });
@@ -118,15 +130,68 @@ function arrival(capture: Capture): { each: (visit: Visit) => void; bytes: numbe
     each: (visit) => {
       for (const p of pieces) visit(p.port, p.timeUs, p.firstUs, p.bytes, p.time, p.text);
     },
-    bytes: bytes.length,
+    bytes,
   };
+}
+
+/**
+ * Each port's data pieces merged into one time order: the earliest next piece of any port first,
+ * the lower port's at the same time, as the held capture's sort puts them when each port's
+ * pieces come in time order (the streamed reader makes sure they do). Every port is walked at
+ * once, a walk of its own windows each, holding one window of each.
+ */
+function mergedPorts(ports: readonly number[], windowsOf: (port: number) => Iterable<CaptureWindow>, visit: Visit): void {
+  const streams = ports.map((port) => slicesOf(windowsOf(port)));
+  const heads = streams.map((s) => s.next());
+  for (;;) {
+    let best: Piece | undefined;
+    let at = -1;
+    for (let i = 0; i < heads.length; i++) {
+      const h = heads[i];
+      if (h === undefined || h.done === true) continue;
+      if (best === undefined || h.value.timeUs < best.timeUs) {
+        best = h.value;
+        at = i;
+      }
+    }
+    if (best === undefined) return;
+    visit(best.port, best.timeUs, best.firstUs, best.bytes, best.time, best.text);
+    heads[at] = streams[at]?.next() ?? { done: true, value: undefined };
+  }
+}
+
+/** The slices of per-byte chunks in windows, as `arrival` cuts them. */
+function* slicesOf(windows: Iterable<CaptureWindow>): Generator<Piece, void, undefined> {
+  let order = 0;
+  for (const { bytes, chunkEnds, chunkPorts, byteTimesUs } of windows) {
+    if (byteTimesUs === undefined) continue;
+    let from = 0;
+    for (let k = 0; k < chunkEnds.length; k++) {
+      const to = chunkEnds[k] ?? from;
+      const port = chunkPorts[k] ?? 0;
+      for (let s = from; s < to; s += SLICE_BYTES) {
+        const end = Math.min(s + SLICE_BYTES, to);
+        const times = byteTimesUs.subarray(s, end);
+        yield {
+          port,
+          order: order++,
+          timeUs: times[times.length - 1] ?? NaN,
+          firstUs: times[0] ?? NaN,
+          bytes: bytes.subarray(s, end),
+          time: times,
+          text: '',
+        };
+      }
+      from = to;
+    }
+  }
 }
 
 /**
  * Runs the doctor over every port of a capture and returns the findings at its end and the
  * timeline of findings along the way. Never throws on the capture's content.
  */
-export function doctorCapture(capture: Capture, options: DoctorCaptureOptions = {}): DoctorReport {
+export function doctorCapture(capture: AnyCapture, options: DoctorCaptureOptions = {}): DoctorReport {
   const step = options.stepUs ?? 250_000;
   if (!(step > 0)) throw new TypeError(`stepUs must be positive, not ${step}`);
   const timed = capture.timing !== 'none';

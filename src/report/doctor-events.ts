@@ -4,7 +4,7 @@
  * makes. The live worker, `doctorCapture` and the report's one pass all go through here, so a
  * recording says what was seen.
  */
-import type { Capture } from '../capture/model.js';
+import { type AnyCapture, captureWindows } from '../capture/capture-windows.js';
 import type { Doctor } from './doctor.js';
 import { type Absences, absenceEnds, absenceStarts, absencesUntil, noAbsences } from './absences.js';
 
@@ -31,7 +31,7 @@ export interface RecordedStop {
 }
 
 /** The capture's recorded stops in the order they were recorded among its chunks. */
-export function recordedStops(capture: Capture): RecordedStop[] {
+export function recordedStops(capture: AnyCapture): RecordedStop[] {
   return capture.events
     .filter((e) => stopsPort(e.text))
     .map((e) => ({ port: e.port, chunkIndex: e.chunkIndex, timeUs: e.timeUs }))
@@ -66,8 +66,7 @@ export class StopCursor {
 }
 
 /** A recording's absences (`Absences`) by port, up to `endUs` (the capture's end); ports without any are left out. */
-export function recordedAbsences(capture: Capture, endUs: number): Map<number, Omit<Absences, 'fromUs'>> {
-  const { chunkPorts, chunkTimesUs } = capture;
+export function recordedAbsences(capture: AnyCapture, endUs: number): Map<number, Omit<Absences, 'fromUs'>> {
   const stops = recordedStops(capture);
   const out = new Map<number, Omit<Absences, 'fromUs'>>();
   if (stops.length === 0) return out;
@@ -78,10 +77,13 @@ export function recordedAbsences(capture: Capture, endUs: number): Map<number, O
     return a;
   };
   let s = 0;
-  for (let i = 0; i < chunkPorts.length; i++) {
-    for (let stop = stops[s]; stop !== undefined && stop.chunkIndex <= i; stop = stops[++s]) absenceStarts(of(stop.port), stop.timeUs);
-    const a = byPort.get(chunkPorts[i] ?? -1);
-    if (a !== undefined) absenceEnds(a, chunkTimesUs[i] ?? Number.NaN);
+  for (const { chunkPorts, chunkTimesUs, firstChunk } of captureWindows(capture)) {
+    for (let k = 0; k < chunkPorts.length; k++) {
+      const i = firstChunk + k;
+      for (let stop = stops[s]; stop !== undefined && stop.chunkIndex <= i; stop = stops[++s]) absenceStarts(of(stop.port), stop.timeUs);
+      const a = byPort.get(chunkPorts[k] ?? -1);
+      if (a !== undefined) absenceEnds(a, chunkTimesUs[k] ?? Number.NaN);
+    }
   }
   for (; s < stops.length; s++) absenceStarts(of(stops[s]!.port), stops[s]!.timeUs);
   for (const [port, a] of byPort) {

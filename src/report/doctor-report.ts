@@ -8,6 +8,7 @@
  * rest on one reading. A capture without timing is the exception: the doctor reads it on a clock
  * of its own (bytes back to back at 115200, `doctorCapture`), which the report does not use.
  */
+import type { AnyCapture } from '../capture/capture-windows.js';
 import type { Capture } from '../capture/model.js';
 import { capturePorts } from '../capture/facts.js';
 import { healthReportFeeding, type ReadingsElsewhere } from './report.js';
@@ -21,7 +22,7 @@ import { Doctor } from './doctor.js';
 import type { DoctorFinding, DoctorOptions } from './doctor-types.js';
 
 /** The report's doctor for a timed capture: the whole capture remembered, times from its start. */
-function reportDoctorOptions(capture: Capture, span: { startUs: number }): DoctorOptions {
+function reportDoctorOptions(capture: AnyCapture, span: { startUs: number }): DoctorOptions {
   return {
     timing: capture.timing === 'per-byte' ? 'per-byte' : 'per-chunk',
     memoryUs: Infinity,
@@ -46,7 +47,7 @@ export function diagnosedReportJobs(capture: Capture, options: HealthReportOptio
 }
 
 /** `healthReport(capture, options)` with `diagnosis` filled in. Pure, like both. */
-export function diagnosedHealthReport(capture: Capture, options: HealthReportOptions = {}, elsewhere?: ReadingsElsewhere): HealthReport {
+export function diagnosedHealthReport(capture: AnyCapture, options: HealthReportOptions = {}, elsewhere?: ReadingsElsewhere): HealthReport {
   let report: HealthReport;
   let findings: DoctorFinding[];
   if (capture.timing === 'none') {

@@ -10,6 +10,7 @@
  * Which readings to make elsewhere is `likelyReadings`: a guess that costs nothing when wrong,
  * since the report decodes on its own thread whatever it asks for and nobody made.
  */
+import type { AnyCapture } from '../capture/capture-windows.js';
 import type { Capture } from '../capture/model.js';
 import { SpektrumDecoder } from '../decoder/decoder.js';
 import type { DecoderCheckpoint, LinkCheckpoint } from '../decoder/checkpoint.js';
@@ -71,7 +72,7 @@ export function readPortMessage(capture: Capture, job: PortReadingJob): PortRead
  * The port's `PortData` from `message`, as `decodePort` would have returned it on this thread;
  * the port's doctor state goes into `doctor` (when the report has one), replacing what it held.
  */
-export function adoptPortMessage(capture: Capture, message: PortReadingMessage, doctor: Doctor | undefined): PortData {
+export function adoptPortMessage(capture: AnyCapture, message: PortReadingMessage, doctor: Doctor | undefined): PortData {
   const { job } = message;
   const decoder = new SpektrumDecoder({ resolution: job.resolution, resolutionFrom: job.from });
   decoder.restore(message.decoder);

@@ -5,7 +5,7 @@
  * `SPIKE_MIN_JUMP_PERCENT`). Sums, not a record per frame, so a day-long capture costs the same
  * memory as a minute.
  */
-import type { Capture } from '../capture/model.js';
+import type { AnyCapture } from '../capture/capture-windows.js';
 import { CHANNEL_COUNT, channelName, channelResolution, servoToMicros, servoToPercent, type Resolution } from '../decoder/spec.js';
 import type { DecodedFrame, DecoderStats, FormatInfo } from '../decoder/types.js';
 import type { LinkMonitor } from '../decoder/link.js';
@@ -414,7 +414,7 @@ class PortTally {
 
 /** Decodes one port, summing what the report needs per frame, and finds spikes as it goes. */
 export function decodePort(
-  capture: Capture,
+  capture: AnyCapture,
   port: number,
   resolution: 'auto' | Resolution,
   resolutionFrom: 'user' | 'internal-remote',

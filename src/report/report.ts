@@ -8,7 +8,7 @@
  * report's time zero (`timeline.originUs`, the earliest time recorded in the capture on any
  * port), so that the ports of a multi-port capture share one time axis.
  */
-import type { Capture } from '../capture/model.js';
+import { type AnyCapture, captureDataBytes } from '../capture/capture-windows.js';
 import { capturePorts } from '../capture/facts.js';
 import { CHANNEL_COUNT, channelName, systemInfo, type Resolution } from '../decoder/spec.js';
 import { becameFailsafe, episodeEndAt, type LinkEpisode } from '../decoder/episode.js';
@@ -46,7 +46,7 @@ function episodeOf(e: LinkEpisode, origin: number, end: number): ReportEpisode {
  * The health report of every port of a capture (one remote receiver per port). Decodes each
  * port once where it can (`readPorts`); never throws on the capture's content.
  */
-export function healthReport(capture: Capture, options: HealthReportOptions = {}): HealthReport {
+export function healthReport(capture: AnyCapture, options: HealthReportOptions = {}): HealthReport {
   return healthReportFeeding(capture, options, undefined);
 }
 
@@ -67,7 +67,7 @@ export type ReadingsElsewhere = (
  * readings made on other threads.
  */
 export function healthReportFeeding(
-  capture: Capture,
+  capture: AnyCapture,
   options: HealthReportOptions,
   doctor: Doctor | undefined,
   span: { startUs: number; endUs: number } = captureSpan(capture),
@@ -305,7 +305,7 @@ export function healthReportFeeding(
       name: options.name ?? null,
       kind: capture.kind,
       timing: capture.timing,
-      bytes: capture.bytes.length,
+      bytes: captureDataBytes(capture),
       ports,
       createdAt: typeof meta.createdAt === 'string' ? meta.createdAt : null,
       recordedFrom: typeof meta.source === 'string' ? meta.source : null,

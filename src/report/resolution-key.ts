@@ -3,8 +3,8 @@
  * remote takes from the internal one, and the order a whole capture's ports are decoded in so
  * that each is decoded once: the internal remote's port first, then the others with its key.
  */
+import { type AnyCapture, captureWindows } from '../capture/capture-windows.js';
 import { capturePorts } from '../capture/facts.js';
-import type { Capture } from '../capture/model.js';
 import { decodeCapture } from './capture-pass.js';
 import { SpektrumDecoder } from '../decoder/decoder.js';
 import { systemInfo, type Resolution } from '../decoder/spec.js';
@@ -31,27 +31,29 @@ const LOOK_AHEAD_BYTES = 1 << 16;
  * a decoder of their own. Only an order to decode in and a guess of the key: the key itself
  * comes from the whole decode.
  */
-function lookAhead(capture: Capture, port: number): FormatInfo {
+function lookAhead(capture: AnyCapture, port: number): FormatInfo {
   const decoder = new SpektrumDecoder();
-  const { bytes, chunkEnds, chunkPorts } = capture;
-  let from = 0;
   let fed = 0;
-  for (let i = 0; i < chunkEnds.length && fed < LOOK_AHEAD_BYTES; i++) {
-    const to = chunkEnds[i] ?? from;
-    if (chunkPorts[i] === port) {
-      const end = Math.min(to, from + LOOK_AHEAD_BYTES - fed);
-      decoder.push(bytes.subarray(from, end));
-      fed += end - from;
-      while (decoder.next() !== undefined) {}
-      if (decoder.format.locked && decoder.format.remote !== null) break;
+  for (const { bytes, chunkEnds, chunkPorts } of captureWindows(capture, port)) {
+    let from = 0;
+    for (let i = 0; i < chunkEnds.length; i++) {
+      if (fed >= LOOK_AHEAD_BYTES) return decoder.format;
+      const to = chunkEnds[i] ?? from;
+      if (chunkPorts[i] === port) {
+        const end = Math.min(to, from + LOOK_AHEAD_BYTES - fed);
+        decoder.push(bytes.subarray(from, end));
+        fed += end - from;
+        while (decoder.next() !== undefined) {}
+        if (decoder.format.locked && decoder.format.remote !== null) return decoder.format;
+      }
+      from = to;
     }
-    from = to;
   }
   return decoder.format;
 }
 
 /** Whether a port's stream starts as an internal remote (`lookAhead`). */
-export function looksInternal(capture: Capture, port: number): boolean {
+export function looksInternal(capture: AnyCapture, port: number): boolean {
   return lookAhead(capture, port).remote === 'internal';
 }
 
@@ -68,7 +70,7 @@ export interface PortReadingAsked {
  * the first. A guess from each port's first bytes (`lookAhead`): the key the internal remote's
  * start shows is the one its whole decode gives unless the remote changed its resolution.
  */
-export function likelyReadings(capture: Capture, ports: readonly number[], resolution: 'auto' | Resolution): PortReadingAsked[] {
+export function likelyReadings(capture: AnyCapture, ports: readonly number[], resolution: 'auto' | Resolution): PortReadingAsked[] {
   if (resolution !== 'auto' || ports.length < 2) return ports.slice(1).map((port) => ({ port, resolution, from: 'user' }));
   const starts = new Map(ports.map((p) => [p, lookAhead(capture, p)]));
   const lead = ports.filter((p) => starts.get(p)?.remote === 'internal');
@@ -188,7 +190,7 @@ function asWritten<T extends PortReading>(ports: readonly number[], decode: Port
  * the ports as the report does, without what listens to the frames; a setting given by the user
  * (or a single port) needs no decode.
  */
-export function portResolutions(capture: Capture, resolution: 'auto' | Resolution): Map<number, PortReadingAsked> {
+export function portResolutions(capture: AnyCapture, resolution: 'auto' | Resolution): Map<number, PortReadingAsked> {
   const ports = capturePorts(capture);
   if (resolution !== 'auto' || ports.length < 2) return new Map(ports.map((port) => [port, { port, resolution, from: 'user' }]));
   const read = readPorts(

@@ -2,6 +2,7 @@
  * The summary `satscope info` prints: one port of a capture decoded (`decodeCapture`) and summed
  * up. Pure: the capture is already in memory, and the caller chooses how to show the result.
  */
+import type { AnyCapture } from '../capture/capture-windows.js';
 import type { Capture, CaptureIssue } from '../capture/model.js';
 import type { LinkEpisode } from '../decoder/episode.js';
 import type { LinkStats } from '../decoder/link-types.js';
@@ -85,7 +86,7 @@ export class ChannelRanges {
 }
 
 /** Decodes a capture (one port) and sums it up. */
-export function summarizeCapture(capture: Capture, options: DecodeCaptureOptions = {}): CaptureSummary {
+export function summarizeCapture(capture: AnyCapture, options: DecodeCaptureOptions = {}): CaptureSummary {
   const ranges = new ChannelRanges();
   let formatChanges = 0;
   let unproven = false;
