@@ -63,7 +63,8 @@ class CsvFields {
   count = 0;
 
   constructor(
-    private readonly bytes: Uint8Array,
+    /** The bytes the line is in: a reader that reads a file a piece at a time sets each piece here. */
+    public bytes: Uint8Array,
     capacity: number,
   ) {
     this.starts = new Int32Array(capacity);
@@ -262,6 +263,125 @@ export function isBlank(bytes: Uint8Array, ls: number, le: number): boolean {
 }
 
 /**
+ * The rows of a Saleae async-serial export, a line at a time: the header's columns from the first
+ * line that is not blank, then each row's byte, time (µs) and port, or the issue that leaves it
+ * out. What `importSaleaeCsv` reads a file with, and the streaming reader (csv-stream.ts) a
+ * piece of a file at a time: the same rules, the same issues, the same ports.
+ */
+export class SaleaeRows {
+  cols: CsvColumns | undefined;
+  readonly issues: CaptureIssue[] = [];
+  /** Each analyser name's port, first seen = port 0. */
+  readonly portNames = new Map<string, number>();
+  /** The last row's byte, time (µs) and port, when `line` said it gave one. */
+  value = 0;
+  timeUs = 0;
+  port = 0;
+  #fields: CsvFields | undefined;
+  #need = 0;
+  #bytes: Uint8Array = new Uint8Array(0);
+  /** File offset of the piece's byte 0. */
+  #base = 0;
+  // The previous row's analyser name, so that a string is only made when it changes.
+  #prevNameStart = 0;
+  #prevNameEnd = -1;
+  #prevPort = 0;
+
+  /** The piece of the file the next lines are in, and its file offset. */
+  piece(bytes: Uint8Array, base: number): void {
+    this.#bytes = bytes;
+    this.#base = base;
+    if (this.#fields !== undefined) this.#fields.bytes = bytes;
+    // The previous name is in the last piece: looked up again by its text.
+    this.#prevNameEnd = -1;
+  }
+
+  /**
+   * Line `lineNo` of the piece, `[ls, le)` without its LF: true when it gave a byte.
+   * @throws {CaptureFormatError} when the first line that is not blank is no async-serial header
+   */
+  line(ls: number, end: number, lineNo: number): boolean {
+    const bytes = this.#bytes;
+    let le = end;
+    if (le > ls && bytes[le - 1] === CR) le--;
+    if (isBlank(bytes, ls, le)) return false;
+    const lineText = (): string => quote(utf8Decode(bytes, ls, le));
+    const issue = (kind: CaptureIssue['kind'], why: string): false => {
+      this.issues.push({ kind, offset: this.#base + ls, length: le - ls, line: lineNo, message: `line ${lineNo}: ${why}` });
+      return false;
+    };
+    const cols = this.cols;
+    const fields = this.#fields;
+    if (!cols || !fields) {
+      this.cols = csvColumns(bytes, ls, le);
+      if (!this.cols) {
+        throw new CaptureFormatError(
+          `not a Saleae async-serial CSV: line ${lineNo} should be a header with a time column ("Time [s]" or "start_time") ` +
+            `and a value column ("Value" or "data"), but it is ${lineText()}`,
+        );
+      }
+      this.#fields = new CsvFields(bytes, this.cols.count);
+      this.#need = Math.max(this.cols.time, this.cols.value, this.cols.name, this.cols.type) + 1;
+      return false;
+    }
+    const need = this.#need;
+    if (!fields.split(ls, le)) return issue('malformed-row', `unterminated quote in ${lineText()}`);
+    if (fields.count < need) return issue('malformed-row', `expected at least ${need} columns, found ${fields.count} in ${lineText()}`);
+    if (cols.type >= 0 && !fields.equalsIgnoreCase(cols.type, 'data'))
+      return issue('skipped-row', `row of type ${quote(fields.text(cols.type))} is not serial data; skipped`);
+    const ts = fields.starts[cols.time] ?? 0;
+    const te = fields.ends[cols.time] ?? 0;
+    let ns = secondsToNs(bytes, ts, te);
+    if (Number.isNaN(ns)) {
+      // A time that is no number of seconds (-Infinity, NaN, text) still dates a good byte:
+      // kept, NaN, for the time rule to step over and report (`bad-time`) as any jump.
+      const text = fields.text(cols.time);
+      const seconds = DECIMAL_NUMBER.test(text) || /^[+-]?Infinity$/.test(text) ? Number(text) : NaN;
+      ns = Number.isFinite(seconds) ? Math.round(seconds * 1e9) : seconds;
+    }
+    const value = byteValue(bytes, fields.starts[cols.value] ?? 0, fields.ends[cols.value] ?? 0);
+    if (value < 0) return issue('malformed-row', `value ${quote(fields.text(cols.value))} is not a byte in hex (0x3E) or decimal (62)`);
+    let flagged: string | undefined;
+    for (const e of cols.errors) {
+      if (e.index >= fields.count || fields.isEmpty(e.index)) continue;
+      const flag = fields.text(e.index);
+      if (!NO_ERROR.has(flag.toLowerCase())) {
+        flagged = e.title + (flag.toLowerCase() === e.title.toLowerCase() ? '' : ` = ${flag}`);
+        break;
+      }
+    }
+    if (flagged !== undefined)
+      return issue(
+        'flagged-byte',
+        `byte ${fields.text(cols.value)} flagged by the analyser (${flagged}); left out because its bits are unreliable`,
+      );
+    let port = 0;
+    if (cols.name >= 0) {
+      if (fields.sameBytes(cols.name, this.#prevNameStart, this.#prevNameEnd)) {
+        port = this.#prevPort;
+      } else {
+        const name = fields.text(cols.name);
+        let known = this.portNames.get(name);
+        if (known === undefined) {
+          if (this.portNames.size === 256) return issue('malformed-row', `analyser ${quote(name)} would be a 257th port; skipped`);
+          known = this.portNames.size;
+          this.portNames.set(name, known);
+        }
+        port = known;
+        this.#prevNameStart = fields.starts[cols.name] ?? 0;
+        this.#prevNameEnd = fields.ends[cols.name] ?? 0;
+        this.#prevPort = port;
+      }
+    }
+    this.value = value;
+    // Whole ns to µs: one correctly rounded division, so 9260826000 ns is exactly 9260826 µs.
+    this.timeUs = ns / 1e3;
+    this.port = port;
+    return true;
+  }
+}
+
+/**
  * A Saleae Logic "Async Serial" CSV export, Logic 1 (`Time [s],Value,Parity Error,Framing
  * Error`) or Logic 2 (`name,type,start_time,duration,"data"`); columns are found by name. Each
  * row is one byte with its time, so the result has `timing: 'per-byte'`; times are in µs,
@@ -289,124 +409,29 @@ export function importSaleaeCsv(input: string | Uint8Array): Capture {
   else throw new TypeError('importSaleaeCsv expects a string or a Uint8Array');
   const n = bytes.length;
 
-  const issues: CaptureIssue[] = [];
-  const issue = (kind: CaptureIssue['kind'], line: number, ls: number, le: number, why: string): void => {
-    issues.push({ kind, offset: ls, length: le - ls, line, message: `line ${line}: ${why}` });
-  };
-  const lineText = (ls: number, le: number): string => quote(utf8Decode(bytes, ls, le));
-
   // Rows arrive in time order across every analyser; they are grouped by port at the end.
   // A Logic 1 row is about 25 bytes, so this rarely grows.
   const estimate = Math.max(16, Math.ceil(n / 24));
   const values = new Column(new Uint8Array(estimate), (s) => new Uint8Array(s));
   const times = new Column(new Float64Array(estimate), (s) => new Float64Array(s));
   const ports = new Column(new Uint8Array(estimate), (s) => new Uint8Array(s));
-  const portNames = new Map<string, number>();
-  // The previous row's analyser name, so that a string is only made when it changes.
-  let prevNameStart = 0;
-  let prevNameEnd = -1;
-  let prevPort = 0;
-
-  let cols: CsvColumns | undefined;
-  let fields: CsvFields | undefined;
-  let need = 0;
+  const rows = new SaleaeRows();
+  rows.piece(bytes, 0);
   let lineNo = 0;
   let pos = bomLength(bytes);
   while (pos < n) {
     const nl = bytes.indexOf(LF, pos);
     const ls = pos;
-    let le = nl < 0 ? n : nl;
+    const le = nl < 0 ? n : nl;
     pos = le + 1;
     lineNo++;
-    if (le > ls && bytes[le - 1] === CR) le--;
-    if (isBlank(bytes, ls, le)) continue;
-
-    if (!cols || !fields) {
-      cols = csvColumns(bytes, ls, le);
-      if (!cols) {
-        throw new CaptureFormatError(
-          `not a Saleae async-serial CSV: line ${lineNo} should be a header with a time column ("Time [s]" or "start_time") ` +
-            `and a value column ("Value" or "data"), but it is ${lineText(ls, le)}`,
-        );
-      }
-      fields = new CsvFields(bytes, cols.count);
-      need = Math.max(cols.time, cols.value, cols.name, cols.type) + 1;
-      continue;
+    if (rows.line(ls, le, lineNo)) {
+      values.push(rows.value);
+      times.push(rows.timeUs);
+      ports.push(rows.port);
     }
-
-    if (!fields.split(ls, le)) {
-      issue('malformed-row', lineNo, ls, le, `unterminated quote in ${lineText(ls, le)}`);
-      continue;
-    }
-    if (fields.count < need) {
-      issue('malformed-row', lineNo, ls, le, `expected at least ${need} columns, found ${fields.count} in ${lineText(ls, le)}`);
-      continue;
-    }
-    if (cols.type >= 0 && !fields.equalsIgnoreCase(cols.type, 'data')) {
-      issue('skipped-row', lineNo, ls, le, `row of type ${quote(fields.text(cols.type))} is not serial data; skipped`);
-      continue;
-    }
-    const ts = fields.starts[cols.time] ?? 0;
-    const te = fields.ends[cols.time] ?? 0;
-    let ns = secondsToNs(bytes, ts, te);
-    if (Number.isNaN(ns)) {
-      // A time that is no number of seconds (-Infinity, NaN, text) still dates a good byte:
-      // kept, NaN, for the time rule to step over and report (`bad-time`) as any jump.
-      const text = fields.text(cols.time);
-      const seconds = DECIMAL_NUMBER.test(text) || /^[+-]?Infinity$/.test(text) ? Number(text) : NaN;
-      ns = Number.isFinite(seconds) ? Math.round(seconds * 1e9) : seconds;
-    }
-    const value = byteValue(bytes, fields.starts[cols.value] ?? 0, fields.ends[cols.value] ?? 0);
-    if (value < 0) {
-      issue('malformed-row', lineNo, ls, le, `value ${quote(fields.text(cols.value))} is not a byte in hex (0x3E) or decimal (62)`);
-      continue;
-    }
-    let flagged: string | undefined;
-    for (const e of cols.errors) {
-      if (e.index >= fields.count || fields.isEmpty(e.index)) continue;
-      const flag = fields.text(e.index);
-      if (!NO_ERROR.has(flag.toLowerCase())) {
-        flagged = e.title + (flag.toLowerCase() === e.title.toLowerCase() ? '' : ` = ${flag}`);
-        break;
-      }
-    }
-    if (flagged !== undefined) {
-      issue(
-        'flagged-byte',
-        lineNo,
-        ls,
-        le,
-        `byte ${fields.text(cols.value)} flagged by the analyser (${flagged}); left out because its bits are unreliable`,
-      );
-      continue;
-    }
-    let port = 0;
-    if (cols.name >= 0) {
-      if (fields.sameBytes(cols.name, prevNameStart, prevNameEnd)) {
-        port = prevPort;
-      } else {
-        const name = fields.text(cols.name);
-        let known = portNames.get(name);
-        if (known === undefined) {
-          if (portNames.size === 256) {
-            issue('malformed-row', lineNo, ls, le, `analyser ${quote(name)} would be a 257th port; skipped`);
-            continue;
-          }
-          known = portNames.size;
-          portNames.set(name, known);
-        }
-        port = known;
-        prevNameStart = fields.starts[cols.name] ?? 0;
-        prevNameEnd = fields.ends[cols.name] ?? 0;
-        prevPort = port;
-      }
-    }
-    values.push(value);
-    // Whole ns to µs: one correctly rounded division, so 9260826000 ns is exactly 9260826 µs.
-    times.push(ns / 1e3);
-    ports.push(port);
   }
-
+  const { cols, issues, portNames } = rows;
   if (!cols) throw new CaptureFormatError('not a Saleae async-serial CSV: the file has no header line (it is empty or blank)');
   const count = values.length;
   if (count === 0) {
