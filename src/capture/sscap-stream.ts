@@ -42,7 +42,7 @@ type RecordVisit = (type: number, port: number, timeUs: number, bytes: Uint8Arra
  * the file's end, or one fails its CRC: a file to salvage. It yields after each piece, so that a
  * reader hands on what it made of the piece before the next is read.
  */
-function* walkRecords(file: ByteFile, from: number, visit: RecordVisit): Generator<void, boolean, undefined> {
+function* walkRecords(file: ByteFile, from: number, visit: RecordVisit, checked: boolean): Generator<void, boolean, undefined> {
   const size = file.size;
   let buf = new Uint8Array(PIECE_BYTES);
   let view = new DataView(buf.buffer);
@@ -63,7 +63,7 @@ function* walkRecords(file: ByteFile, from: number, visit: RecordVisit): Generat
       if (total < 0) return false;
       if (p + total > have) break;
       const end = p + total - CRC_SIZE;
-      if (!crcFollows(buf, p + REC_OFF_TYPE, end, view)) return false;
+      if (checked && !crcFollows(buf, p + REC_OFF_TYPE, end, view)) return false;
       visit(
         buf[p + REC_OFF_TYPE] ?? 0,
         buf[p + REC_OFF_PORT] ?? 0,
@@ -95,11 +95,20 @@ const WINDOW_BYTES = 1 << 20;
 /** Chunks a window holds at most. */
 const WINDOW_CHUNKS = 1 << 15;
 
+/** What the first pass tells the capture's span as it walks (`SpanTally`, in the report's layer, which has the rule). */
+export interface SpanSink {
+  /** A data chunk of `count` bytes (at least one) that arrived at `arrivalUs`. */
+  chunk(arrivalUs: number, count: number): void;
+  event(timeUs: number): void;
+  readonly span: { startUs: number; endUs: number };
+}
+
 /**
  * `file`, an .sscap, as `parseCapture` reads it, a window at a time; null when the salvaging
- * reader or the time rule would change anything (see above): then the file is read whole.
+ * reader or the time rule would change anything (see above): then the file is read whole. With
+ * `span`, the first pass finds the capture's span too, and no walk is needed for it.
  */
-export function streamSscap(file: ByteFile): StreamedCapture | null {
+export function streamSscap(file: ByteFile, span?: SpanSink): StreamedCapture | null {
   const head = new Uint8Array(Math.min(file.size, HEADER_FIXED_SIZE));
   if (file.read(head, 0) < HEADER_FIXED_SIZE) return null;
   const metaLength = new DataView(head.buffer).getUint32(OFF_META_LENGTH, true);
@@ -138,6 +147,7 @@ export function streamSscap(file: ByteFile): StreamedCapture | null {
         waiting = [];
         last = timeUs;
       }
+      if (end > start) span?.chunk(timeUs, end - start);
       chunksByPort[port] = (chunksByPort[port] ?? 0) + 1;
       chunks++;
       dataBytes += end - start;
@@ -154,6 +164,7 @@ export function streamSscap(file: ByteFile): StreamedCapture | null {
   if (!intact) return null;
   // Times and no times mixed, or times out of line: the rule steps over them (with every time in view).
   if (timed > 0 && (untimed > 0 || !inLine)) return null;
+  for (const e of events) span?.event(e.timeUs);
   const ports: number[] = [];
   for (let p = 0; p < 256; p++) if ((chunksByPort[p] ?? 0) > 0) ports.push(p);
   return {
@@ -164,6 +175,7 @@ export function streamSscap(file: ByteFile): StreamedCapture | null {
     issues: [],
     dataBytes,
     ports,
+    ...(span !== undefined ? { span: span.span } : {}),
     windows: (port?: number) => sscapWindows(file, headerLength, port),
   };
 }
@@ -203,21 +215,29 @@ function* sscapWindows(file: ByteFile, headerLength: number, port: number | unde
     length = 0;
     count = 0;
   };
-  const walk = walkRecords(file, headerLength, (type, p, timeUs, bytes, start, end) => {
-    if (type !== RECORD_TYPE_DATA) return;
-    const n = port === undefined || p === port ? end - start : 0;
-    if (count === WINDOW_CHUNKS || length + n > data.length) {
-      close();
-      if (n > data.length) data = new Uint8Array(n);
-    }
-    covered += end - start;
-    data.set(bytes.subarray(start, start + n), length);
-    length += n;
-    ends[count] = length;
-    times[count] = timeUs;
-    ports[count] = p;
-    count++;
-  });
+  // Every CRC was checked by the first pass: the walks after it read the records as they found them.
+  const walk = walkRecords(
+    file,
+    headerLength,
+    (type, p, timeUs, bytes, start, end) => {
+      if (type !== RECORD_TYPE_DATA) return;
+      const n = port === undefined || p === port ? end - start : 0;
+      if (count === WINDOW_CHUNKS || length + n > data.length) {
+        close();
+        if (n > data.length) data = new Uint8Array(n);
+      }
+      covered += end - start;
+      // A record's payload is a few dozen bytes: copied a byte at a time, with no view made for it.
+      if (n > 256) data.set(bytes.subarray(start, start + n), length);
+      else for (let k = 0; k < n; k++) data[length + k] = bytes[start + k] ?? 0;
+      length += n;
+      ends[count] = length;
+      times[count] = timeUs;
+      ports[count] = p;
+      count++;
+    },
+    false,
+  );
   // The first pass found the file intact; a file changed since is read as far as it still is.
   for (let r = walk.next(); r.done !== true; r = walk.next()) {
     if (length >= WINDOW_BYTES / 2 || count >= WINDOW_CHUNKS / 2) close();
@@ -229,7 +249,7 @@ function* sscapWindows(file: ByteFile, headerLength: number, port: number | unde
 
 /** `walkRecords` to its end: whether the file is intact. */
 function walkAll(file: ByteFile, from: number, visit: RecordVisit): boolean {
-  const walk = walkRecords(file, from, visit);
+  const walk = walkRecords(file, from, visit, true);
   for (;;) {
     const r = walk.next();
     if (r.done === true) return r.value;
