@@ -45,11 +45,14 @@ function* eachRow(file: ByteFile, rows: SaleaeRows, row: () => void): Generator<
     }
     yield;
     if (ended && pos >= have) return;
-    // The line not yet whole goes to the front of a fresh buffer (a longer one for a long line).
+    // The line not yet whole goes to the front of the buffer (a longer one for a long line): the
+    // one buffer serves the whole walk (a row's byte and time are copied out of it).
     const rest = have - Math.min(pos, have);
-    const next = new Uint8Array(Math.max(PIECE_BYTES, rest * 2));
-    next.set(buf.subarray(have - rest, have));
-    buf = next;
+    if (rest * 2 > buf.length) {
+      const next = new Uint8Array(rest * 2);
+      next.set(buf.subarray(have - rest, have));
+      buf = next;
+    } else buf.copyWithin(0, have - rest, have);
     at += have - rest;
     have = rest;
   }

@@ -76,13 +76,16 @@ function* walkRecords(file: ByteFile, from: number, visit: RecordVisit, checked:
     }
     yield;
     if (at + have >= size && p < have) return false;
-    // What is left (the start of a record) goes to the front of a fresh buffer, grown for a long record.
+    // What is left (the start of a record) goes to the front of the buffer, grown for a long
+    // record: the one buffer serves the whole walk (what a visit keeps, it copies).
     const rest = have - p;
     const need = rest >= RECORD_HEADER_SIZE ? Math.max(PIECE_BYTES, recordSize(buf, view, p)) : PIECE_BYTES;
-    const next = new Uint8Array(need);
-    next.set(buf.subarray(p, have));
-    buf = next;
-    view = new DataView(buf.buffer);
+    if (need > buf.length) {
+      const next = new Uint8Array(need);
+      next.set(buf.subarray(p, have));
+      buf = next;
+      view = new DataView(buf.buffer);
+    } else buf.copyWithin(0, p, have);
     at += p;
     have = rest;
     if (rest === 0 && at >= size) break;
