@@ -1,14 +1,14 @@
 /**
  * The `satscope` command: decode, summarise and report on captures from scripts. A thin shell
- * over the library: read the file, hand it to `readCapture`, then to the decoder,
- * `summarizeCapture` or `healthReport`, print. Output streams with backpressure (output.ts).
+ * over the library: open the file a window at a time (`openStreamed`) or read it whole
+ * (`loadCapture`), hand it to the decoder, `summarizeCapture` or `healthReport`, print. Output streams with backpressure (output.ts).
  * Exit codes: 0 ok (also when the reader stops early), 1 the file could not be decoded or the
  * output not written, 2 bad usage or unreadable file.
  */
 import { closeSync, readFileSync, writeFileSync } from 'node:fs';
 import { basename } from 'node:path';
 import { captureChunks, type Capture } from '../capture/model.js';
-import type { AnyCapture } from '../capture/capture-windows.js';
+import type { AnyCapture, StreamedCapture } from '../capture/capture-windows.js';
 import { diagnosedHealthReport } from '../report/doctor-report.js';
 import { openStreamed } from './streamed-file.js';
 import { capturePorts } from '../capture/facts.js';
@@ -74,15 +74,13 @@ async function main(argv: string[]): Promise<number> {
       }
     }
   }
-  // info and report read the file a window at a time when it streams (openStreamed), else whole.
-  if (args.command !== 'decode') {
-    const streamed = openStreamed(args.file);
-    if (streamed !== null) {
-      try {
-        return await summed(streamed.capture, args, out);
-      } finally {
-        streamed.close();
-      }
+  // Any other file is read a window at a time when it streams (openStreamed), else whole.
+  const streamed = openStreamed(args.file);
+  if (streamed !== null) {
+    try {
+      return await (args.command === 'decode' ? decodeStreamed(streamed.capture, args, out) : summed(streamed.capture, args, out));
+    } finally {
+      streamed.close();
     }
   }
   // The report decodes ports on two threads, which read the columns where they are.
@@ -101,6 +99,18 @@ async function main(argv: string[]): Promise<number> {
     return 1;
   }
   return decode(capturePieces(capture, port), args, port, out);
+}
+
+/** `satscope decode` of a streamed capture: its issues, then the port's frames as its windows are read. */
+function decodeStreamed(capture: StreamedCapture, args: Args, out: TextOutput): Promise<number> {
+  for (const issue of capture.issues) process.stderr.write(`satscope: ${args.file}: ${issue.message}\n`);
+  const port = args.port ?? 0;
+  const noData = portProblem(capture, args.port);
+  if (noData !== null) {
+    process.stderr.write(`satscope: ${args.file}: ${noData}\n`);
+    return Promise.resolve(1);
+  }
+  return decode(windowPieces(capture, port), args, port, out);
 }
 
 /** `satscope info` or `report` of a capture, held or streamed. */
@@ -169,6 +179,25 @@ type Time = number | Float64Array | undefined;
 /** The pieces of one port of a capture to push, in order. */
 function* capturePieces(capture: Capture, port: number): Generator<{ bytes: Uint8Array; time: Time }> {
   for (const chunk of captureChunks(capture, port)) yield* pieces(chunk);
+}
+
+/**
+ * The pieces of one port of a streamed capture to push, in order: those `capturePieces` gives of
+ * the capture held (a chunk cut between windows is cut where `pieces` cuts it anyway).
+ */
+function* windowPieces(capture: StreamedCapture, port: number): Generator<{ bytes: Uint8Array; time: Time }> {
+  for (const { bytes, chunkEnds, chunkTimesUs, chunkPorts, byteTimesUs } of capture.windows(port)) {
+    let from = 0;
+    for (let k = 0; k < chunkEnds.length; k++) {
+      const to = chunkEnds[k] ?? from;
+      if (chunkPorts[k] === port) {
+        const t = chunkTimesUs[k] ?? NaN;
+        const times = byteTimesUs?.subarray(from, to);
+        yield* pieces({ bytes: bytes.subarray(from, to), time: times ?? (Number.isNaN(t) ? undefined : t) });
+      }
+      from = to;
+    }
+  }
 }
 
 /** The pieces of a raw dump read from its file, untimed. */

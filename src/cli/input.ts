@@ -1,6 +1,8 @@
 /**
- * Reading the capture a command names: the file's bytes through `readCapture`, or why not, in
- * the words and exit codes every command uses (2: the file cannot be read, 1: not a capture).
+ * Reading the capture a command names whole: the file's bytes through `readCapture`, or why not,
+ * in the words and exit codes every command uses (2: the file cannot be read, 1: not a capture).
+ * `decode` reads an .sscap or a CSV so; `info`, `report` and `doctor` only a file that cannot be
+ * streamed (streamed-file.ts), one the reader must repair.
  *
  * A big file (`PARTS_MIN_BYTES` and up) is read on two threads, each half of it by one, into
  * shared memory. When it is an intact .sscap, its records are then cut into parts (`planParts`)

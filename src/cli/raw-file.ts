@@ -1,7 +1,8 @@
 /**
  * A raw byte dump read a piece at a time: `satscope decode` streams one so, holding a piece, not
- * the file (a 1 GB dump held whole cost 1.1 GB). Only a raw dump streams: it has no times, so
- * nothing in it needs the rest of the file to be read; an .sscap or a CSV goes to `loadCapture`.
+ * the file (a 1 GB dump held whole cost 1.1 GB). It has no times, so nothing in it needs the rest
+ * of the file to be read; `decode` of an .sscap or a CSV goes to `loadCapture`. (`info`, `report`
+ * and `doctor` stream every kind: streamed-file.ts.)
  */
 import { closeSync, fstatSync, openSync, readSync } from 'node:fs';
 import { basename } from 'node:path';
