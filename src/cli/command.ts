@@ -9,7 +9,6 @@ import { closeSync, readFileSync, writeFileSync } from 'node:fs';
 import { basename } from 'node:path';
 import { captureChunks, type Capture } from '../capture/model.js';
 import type { AnyCapture, StreamedCapture } from '../capture/capture-windows.js';
-import { diagnosedHealthReport } from '../report/doctor-report.js';
 import { openStreamed } from './streamed-file.js';
 import { capturePorts } from '../capture/facts.js';
 import { SpektrumDecoder } from '../decoder/decoder.js';
@@ -261,11 +260,8 @@ async function finish(out: TextOutput, code: number): Promise<number> {
 /** `satscope report`: the health report of every port with the doctor's findings, as HTML or JSON, to stdout or --out. */
 async function report(capture: AnyCapture, args: Args, out: TextOutput): Promise<number> {
   const name = basename(args.file);
-  // A streamed capture's ports are decoded one after the other, each in a walk of the file.
-  const r =
-    'windows' in capture
-      ? diagnosedHealthReport(capture, { resolution: args.resolution, name })
-      : threadedReport(capture, { resolution: args.resolution, name }).report;
+  // A streamed capture's second thread streams the file on its own.
+  const r = threadedReport(capture, { resolution: args.resolution, name }, undefined, args.file).report;
   const text = args.json ? `${JSON.stringify(r, null, 2)}\n` : reportHtml(r);
   if (args.out !== null) {
     try {

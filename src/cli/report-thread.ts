@@ -7,9 +7,9 @@ import type { PortReadingJob, PortReadingMessage } from '../report/report-port-m
 import type { Capture } from '../capture/model.js';
 import { workerSide } from './waited-worker.js';
 
-/** What `threadedReport` hands this thread. */
+/** What `threadedReport` hands this thread: the capture's columns, or the file to stream it from (this thread walks it on its own). */
 export interface ReportThreadData {
-  capture: Capture;
+  capture: Capture | { file: string };
   jobs: PortReadingJob[];
 }
 
@@ -22,12 +22,21 @@ const send = (result: ReportThreadResult): void => post(result);
 try {
   // Loaded here rather than imported above: a module that fails to load is posted too.
   const { readPortMessage } = await import('../report/report-port-message.js');
-  for (const job of data.jobs) {
-    try {
-      send({ ok: readPortMessage(data.capture, job) });
-    } catch (error) {
-      send({ error: String(error) });
+  const { openStreamed } = await import('./streamed-file.js');
+  const given = data.capture;
+  const streamed = 'file' in given ? openStreamed(given.file) : null;
+  const capture = 'file' in given ? streamed?.capture : given;
+  try {
+    for (const job of data.jobs) {
+      try {
+        if (capture === undefined) throw new Error(`${'file' in given ? given.file : ''} does not stream`);
+        send({ ok: readPortMessage(capture, job) });
+      } catch (error) {
+        send({ error: String(error) });
+      }
     }
+  } finally {
+    streamed?.close();
   }
 } catch (error) {
   for (let i = 0; i < data.jobs.length; i++) send({ error: String(error) });

@@ -11,7 +11,7 @@
 import { diagnosedHealthReport, diagnosedReportJobs } from '../report/doctor-report.js';
 import { sameReading, type PortReadingMessage } from '../report/report-port-message.js';
 import type { HealthReport, HealthReportOptions } from '../report/report-types.js';
-import type { Capture } from '../capture/model.js';
+import { type AnyCapture, captureDataBytes, isStreamed } from '../capture/capture-windows.js';
 import type { ReportThreadData, ReportThreadResult } from './report-thread.js';
 import { secondCore, WaitedWorker } from './waited-worker.js';
 
@@ -24,17 +24,24 @@ export const THREADED_MIN_BYTES = 2 << 20;
  * worker thread.
  */
 export function threadedReport(
-  capture: Capture,
+  capture: AnyCapture,
   options: HealthReportOptions,
   minBytes = THREADED_MIN_BYTES,
+  file?: string,
 ): { report: HealthReport; fromWorker: number } {
-  const jobs = capture.bytes.length >= minBytes && secondCore() ? diagnosedReportJobs(capture, options) : [];
+  // A streamed capture's worker streams the file itself (`file`): it is not held to be shared.
+  const jobs =
+    captureDataBytes(capture) >= minBytes && secondCore() && (!isStreamed(capture) || file !== undefined)
+      ? diagnosedReportJobs(capture, options)
+      : [];
   if (jobs.length === 0) return { report: diagnosedHealthReport(capture, options), fromWorker: 0 };
-  const { kind, meta, timing, bytes, chunkEnds, chunkTimesUs, chunkPorts, byteTimesUs, events } = capture;
-  const data: ReportThreadData = {
-    capture: { kind, meta, timing, bytes, chunkEnds, chunkTimesUs, chunkPorts, byteTimesUs, events, issues: [] },
-    jobs,
-  };
+  let shared: ReportThreadData['capture'];
+  if (isStreamed(capture)) shared = { file: file ?? '' };
+  else {
+    const { kind, meta, timing, bytes, chunkEnds, chunkTimesUs, chunkPorts, byteTimesUs, events } = capture;
+    shared = { kind, meta, timing, bytes, chunkEnds, chunkTimesUs, chunkPorts, byteTimesUs, events, issues: [] };
+  }
+  const data: ReportThreadData = { capture: shared, jobs };
   const worker = new WaitedWorker<ReportThreadResult>(new URL('./report-thread.js', import.meta.url), data);
   let fromWorker = 0;
   try {

@@ -9,7 +9,6 @@
  * of its own (bytes back to back at 115200, `doctorCapture`), which the report does not use.
  */
 import type { AnyCapture } from '../capture/capture-windows.js';
-import type { Capture } from '../capture/model.js';
 import { capturePorts } from '../capture/facts.js';
 import { healthReportFeeding, type ReadingsElsewhere } from './report.js';
 import type { PortReadingJob } from './report-port-message.js';
@@ -35,7 +34,7 @@ function reportDoctorOptions(capture: AnyCapture, span: { startUs: number }): Do
  * its first (`likelyReadings`), with its clock and its doctor's options: jobs for other threads
  * (`readPortMessage`), handed back through its `elsewhere`.
  */
-export function diagnosedReportJobs(capture: Capture, options: HealthReportOptions = {}): PortReadingJob[] {
+export function diagnosedReportJobs(capture: AnyCapture, options: HealthReportOptions = {}): PortReadingJob[] {
   const span = captureSpan(capture);
   const doctor = capture.timing === 'none' ? null : reportDoctorOptions(capture, span);
   return likelyReadings(capture, capturePorts(capture), options.resolution ?? 'auto').map((r) => ({

@@ -11,7 +11,6 @@
  * since the report decodes on its own thread whatever it asks for and nobody made.
  */
 import type { AnyCapture } from '../capture/capture-windows.js';
-import type { Capture } from '../capture/model.js';
 import { SpektrumDecoder } from '../decoder/decoder.js';
 import type { DecoderCheckpoint, LinkCheckpoint } from '../decoder/checkpoint.js';
 import type { Resolution } from '../decoder/spec.js';
@@ -51,7 +50,7 @@ export function sameReading(job: PortReadingJob, port: number, resolution: 'auto
 }
 
 /** Makes `job`'s reading of `capture` (on any thread: pure, like the report). */
-export function readPortMessage(capture: Capture, job: PortReadingJob): PortReadingMessage {
+export function readPortMessage(capture: AnyCapture, job: PortReadingJob): PortReadingMessage {
   const doctor = job.doctor === null ? undefined : new Doctor(job.doctor);
   const { remote, ...data } = decodePort(capture, job.port, job.resolution, job.from, {
     originUs: job.originUs,
