@@ -5,7 +5,8 @@
  * thread's timers throttled, while the worker writes DSMX 11 ms to the pty on its own timers.
  * The test reads the pty as a flight controller's UART would (drive-timing.ts) and writes it back
  * (the loopback). It drives as long visible first, so the two distributions, printed, are of one
- * run on one machine's load. SATSCOPE_DRIVE_SECONDS sets how long each (default 15).
+ * run on one machine's load. SATSCOPE_DRIVE_SECONDS sets how long hidden (default 15),
+ * SATSCOPE_DRIVE_VISIBLE_SECONDS how long visible (default the same).
  */
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { MIN_SILENCE_US } from '../../src/drive/schedule.js';
@@ -25,6 +26,7 @@ const skip =
   fakeSerialUnsupportedReason();
 if (skip !== null) console.warn(`skipping Drive in a background tab: ${skip}`);
 const SECONDS = Number(process.env.SATSCOPE_DRIVE_SECONDS ?? 15);
+const VISIBLE_SECONDS = Number(process.env.SATSCOPE_DRIVE_VISIBLE_SECONDS ?? SECONDS);
 
 /** How long to wait for the serial devices, ms. */
 const WAIT_MS = 300_000;
@@ -52,7 +54,7 @@ afterAll(async () => {
 
 describe.skipIf(skip !== null)('driving a flight controller with the tab in the background', () => {
   it(
-    `writes DSMX 11 ms for ${SECONDS} s visible, then ${SECONDS} s from a hidden tab, frame by frame, and reads it back through the loopback`,
+    `writes DSMX 11 ms for ${VISIBLE_SECONDS} s visible, then ${SECONDS} s from a hidden tab, frame by frame, and reads it back through the loopback`,
     async () => {
       let browser = await win.attach();
       let page = browser.contexts()[0]!.pages()[0]!;
@@ -77,9 +79,9 @@ describe.skipIf(skip !== null)('driving a flight controller with the tab in the 
         document.addEventListener('visibilitychange', () => w.visibility.push([document.visibilityState, performance.now(), w.ticks]));
         setInterval(() => w.ticks++, 10);
       });
-      const wait = () => new Promise((r) => setTimeout(r, SECONDS * 1000));
+      const wait = (seconds = SECONDS) => new Promise((r) => setTimeout(r, seconds * 1000));
       const visibleFrom = monotonicUs();
-      await wait();
+      await wait(VISIBLE_SECONDS);
       const visibleTo = monotonicUs();
       await win.background();
       const hiddenFrom = monotonicUs();
@@ -132,6 +134,6 @@ describe.skipIf(skip !== null)('driving a flight controller with the tab in the 
       expect(loop).toMatch(/read back \d+ frames.*; 0 broken, 0 resyncs/);
       expect(errors).toEqual([]);
     },
-    (SECONDS + 90) * 1000,
+    (VISIBLE_SECONDS + SECONDS + 90) * 1000,
   );
 });
