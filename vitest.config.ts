@@ -11,6 +11,9 @@ export default defineConfig({
     // than the cores); the browser tests mostly wait on the page, so two at once take 6 min
     // where one takes 8 (bench/README.md has no row for it: the figure is the suite's wall time).
     maxWorkers: 2,
+    // The Drive browser tests (tests/e2e/drive*) time a writer against a clock: `npm test` runs
+    // them after the rest, with nothing beside them (package.json), so they measure the page, not
+    // the neighbouring test file's load.
     hookTimeout: 120_000,
   },
 });
