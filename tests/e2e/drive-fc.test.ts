@@ -16,7 +16,7 @@ import { APP_DIR, browserUnavailable, SHOTS } from './app-fixture.js';
 import { launchChromium, startStaticServer, type StaticServer } from './harness/browser.js';
 import { installSerialPolicy, type SerialPolicy } from './harness/policy.js';
 import { fakeSerialUnsupportedReason, monotonicUs, openFakeSerialPort, type FakeSerialPort } from './harness/pty-serial.js';
-import { openDrive } from './drive-page.js';
+import { eachLook, openDrive } from './drive-page.js';
 
 const SECOND = '/dev/ttyS1';
 const skip = browserUnavailable() ?? fakeSerialUnsupportedReason() ?? fakeSerialUnsupportedReason(SECOND);
@@ -120,16 +120,9 @@ describe.skipIf(skip !== null)('driving a flight controller and reading it back,
       const report = JSON.parse(readFileSync((await download.path()) as string, 'utf8')) as DriveReport;
       expect(report.fc).toMatchObject({ variant: 'BTFL', provider: 'SPEKTRUM2048' });
       expect(Object.fromEntries(report.checks.map((c) => [c.id, c.verdict]))).toEqual(verdicts);
-      for (const [width, scheme] of [
-        [1280, 'light'],
-        [1280, 'dark'],
-        [390, 'light'],
-        [390, 'dark'],
-      ] as const) {
-        await page.setViewportSize({ width, height: 900 });
-        await page.emulateMedia({ colorScheme: scheme });
-        await grade.screenshot({ path: join(SHOTS, `drive-grade-${width < 600 ? 'phone' : 'desktop'}-${scheme}.png`) });
-      }
+      await eachLook(page, async ({ name }) => {
+        await grade.screenshot({ path: join(SHOTS, `drive-grade-${name}.png`) });
+      });
       expect(existsSync(join(SHOTS, 'drive-grade-phone-dark.png'))).toBe(true);
     } finally {
       for (const stop of stops) stop();

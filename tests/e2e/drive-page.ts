@@ -28,3 +28,20 @@ export function sticksAtPty(fake: FakeSerialPort): { last: Map<number, number>; 
   });
   return { last, stop };
 }
+
+/** The four looks the Drive tests take: desktop and phone widths, light and dark; `look` is called at each, the page set to it. */
+export async function eachLook(
+  page: Page,
+  look: (at: { width: number; scheme: 'light' | 'dark'; name: string }) => Promise<void>,
+): Promise<void> {
+  for (const [width, scheme] of [
+    [1280, 'light'],
+    [1280, 'dark'],
+    [390, 'light'],
+    [390, 'dark'],
+  ] as const) {
+    await page.setViewportSize({ width, height: 900 });
+    await page.emulateMedia({ colorScheme: scheme });
+    await look({ width, scheme, name: `${width < 600 ? 'phone' : 'desktop'}-${scheme}` });
+  }
+}

@@ -18,7 +18,7 @@ import { burstFigures, bursts } from './drive-timing.js';
 import { browserUnavailable, SHOTS, shot, startSerialApp, type SerialAppSession } from './app-fixture.js';
 import { axe } from './axe.js';
 import { fakeSerialUnsupportedReason, type FakeSerialPort } from './harness/pty-serial.js';
-import { openDrive, sticksAtPty } from './drive-page.js';
+import { eachLook, openDrive, sticksAtPty } from './drive-page.js';
 
 const skip = browserUnavailable() ?? fakeSerialUnsupportedReason();
 if (skip !== null) console.warn(`skipping the Drive tests: ${skip}`);
@@ -68,16 +68,9 @@ describe.skipIf(skip !== null)('driving a flight controller through the adapter'
       await panel.getByTestId('drive-state').filter({ hasText: 'Sending “manual”' }).waitFor();
       await new Promise((r) => setTimeout(r, SECONDS * 1000));
       // The panel at both widths and in both themes, to look at.
-      for (const [width, scheme] of [
-        [1280, 'light'],
-        [1280, 'dark'],
-        [390, 'light'],
-        [390, 'dark'],
-      ] as const) {
-        await page.setViewportSize({ width, height: 900 });
-        await page.emulateMedia({ colorScheme: scheme });
-        await shot(page, `drive-${width < 600 ? 'phone' : 'desktop'}-${scheme}`);
-      }
+      await eachLook(page, async ({ name }) => {
+        await shot(page, `drive-${name}`);
+      });
       const echo = process.env.SATSCOPE_DRIVE_ECHO !== '0';
       const loop = echo ? await panel.getByTestId('drive-loopback').textContent() : null;
       const timing = await panel.getByTestId('drive-timing').textContent();
@@ -183,17 +176,10 @@ describe.skipIf(skip !== null)('driving a flight controller through the adapter'
     });
     await panel.getByTestId('drive-pad-state').filter({ hasText: 'Test pad' }).waitFor();
     // The panel with the gamepad's mapping, to look at.
-    for (const [width, scheme] of [
-      [1280, 'light'],
-      [1280, 'dark'],
-      [390, 'light'],
-      [390, 'dark'],
-    ] as const) {
-      await page.setViewportSize({ width, height: 900 });
-      await page.emulateMedia({ colorScheme: scheme });
-      await panel.screenshot({ path: join(SHOTS, `drive-pad-${width < 600 ? 'phone' : 'desktop'}-${scheme}.png`) });
+    await eachLook(page, async ({ width, scheme, name }) => {
+      await panel.screenshot({ path: join(SHOTS, `drive-pad-${name}.png`) });
       expect(await axe(page, `drive sticks ${width} ${scheme}`, ['.drive'])).toEqual([]);
-    }
+    });
     // Escape still stops.
     await page.keyboard.press('Escape');
     await panel.getByTestId('drive-state').filter({ hasText: 'Stopped: stopped by the user' }).waitFor();
@@ -299,17 +285,10 @@ describe.skipIf(skip !== null)('driving a flight controller through the adapter'
       );
       expect(await view.getByRole('alert').textContent()).toMatch(/ARMED/);
       expect(asked.has(MAVLINK.HEARTBEAT.id)).toBe(false);
-      for (const [width, scheme] of [
-        [1280, 'light'],
-        [1280, 'dark'],
-        [390, 'light'],
-        [390, 'dark'],
-      ] as const) {
-        await page.setViewportSize({ width, height: 900 });
-        await page.emulateMedia({ colorScheme: scheme });
-        await view.screenshot({ path: join(SHOTS, `drive-fc-mavlink-${width < 600 ? 'phone' : 'desktop'}-${scheme}.png`) });
+      await eachLook(page, async ({ width, scheme, name }) => {
+        await view.screenshot({ path: join(SHOTS, `drive-fc-mavlink-${name}.png`) });
         expect(await axe(page, `drive MAVLink view ${width} ${scheme}`, ['.drive-fc'])).toEqual([]);
-      }
+      });
       await view.getByRole('button', { name: 'Stop reading' }).click();
       await view.getByTestId('fc-state').filter({ hasText: 'Not reading' }).waitFor();
     } finally {
